@@ -1,0 +1,24 @@
+//! Pure shadow-mapping math, with no GPU: bounding boxes, camera and light
+//! projections, and the mapping from normalized device coordinates to shadow-map
+//! texture coordinates.
+//!
+//! Conventions, used everywhere in Gnomon:
+//! - World space is right-handed and y-up.
+//! - View spaces look down −z (right-handed, as `glam::camera::rh`).
+//! - Clip space follows WebGPU/D3D: NDC x and y in [−1, 1] with y up, depth z in [0, 1].
+//! - Texture space has u to the right and v **down**, both in [0, 1]; texel (0, 0) is the
+//!   top-left of the image. The y flip lives in [`texture_from_ndc`] and nowhere else.
+//! - Matrices are named `to_from_from`: `clip_from_world` maps world points to clip space.
+
+mod aabb;
+mod projection;
+mod light;
+
+pub use aabb::Aabb;
+pub use light::{LightProjection, ProjectionKind, directional_light_projection, spot_light_projection};
+pub use projection::{
+    camera_clip_from_view, linearize_perspective_depth, ndc_to_texture, texture_from_ndc,
+    texture_to_ndc, view_from_world_look_at,
+};
+
+pub use glam;

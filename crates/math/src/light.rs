@@ -1,0 +1,181 @@
+//! Light-space projections: an orthographic box fitted to the scene for directional
+//! lights, and a perspective frustum built from a spot light's cone.
+
+use glam::{Mat4, Vec3};
+
+use crate::{Aabb, projection::view_from_world_look_at};
+
+/// The shape of a light's shadow projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProjectionKind {
+    /// Parallel rays; `width` × `height` world units are covered by the map.
+    Orthographic { width: f32, height: f32 },
+    /// Rays from a point; `fov` is the full (square) field of view in radians.
+    Perspective { fov: f32 },
+}
+
+/// Everything a renderer needs to draw and sample one shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightProjection {
+    pub light_from_world: Mat4,
+    pub clip_from_light: Mat4,
+    pub kind: ProjectionKind,
+    /// Distance along the light's view axis of the depth-0 plane.
+    pub near: f32,
+    /// Distance along the light's view axis of the depth-1 plane.
+    pub far: f32,
+}
+
+impl LightProjection {
+    pub fn clip_from_world(&self) -> Mat4 {
+        self.clip_from_light * self.light_from_world
+    }
+
+    /// World size of one texel of a `resolution`² map, at `distance` along the light's
+    /// view axis (the distance is ignored for orthographic maps).
+    pub fn texel_world_size(&self, resolution: u32, distance: f32) -> f32 {
+        match self.kind {
+            ProjectionKind::Orthographic { width, height } => width.max(height) / resolution as f32,
+            ProjectionKind::Perspective { fov } => {
+                2.0 * distance * (0.5 * fov).tan() / resolution as f32
+            }
+        }
+    }
+
+    /// For a perspective map, the factor k such that a texel at view distance d spans
+    /// k·d world units; for an orthographic map, the constant texel size. The shader
+    /// uses `texel = k_ortho + k_persp · d`.
+    pub fn texel_size_coefficients(&self, resolution: u32) -> (f32, f32) {
+        match self.kind {
+            ProjectionKind::Orthographic { .. } => (self.texel_world_size(resolution, 0.0), 0.0),
+            ProjectionKind::Perspective { .. } => (0.0, self.texel_world_size(resolution, 1.0)),
+        }
+    }
+}
+
+/// An orthographic projection for a directional light travelling along `direction`,
+/// fitted tightly to `bounds`: the box's corners, seen from the light, fill the map
+/// in x and y, and span the depth range in z.
+///
+/// The fit is in light view space, so the map's texels are square in world units
+/// only when the fitted width and height are equal; the shader uses the larger one
+/// for the texel size, so biases stay conservative.
+pub fn directional_light_projection(direction: Vec3, bounds: &Aabb) -> LightProjection {
+    let direction = direction.normalize();
+    let center = bounds.center();
+    let radius = bounds.bounding_radius().max(1e-3);
+    // The eye only fixes the orientation and the origin of depth; any point behind the
+    // bounds along −direction works. Putting it one radius out keeps numbers small.
+    let eye = center - direction * (2.0 * radius);
+    let light_from_world = view_from_world_look_at(eye, center, Vec3::Y);
+    let in_light = bounds.transformed(light_from_world);
+    // A small margin so that geometry exactly on the fitted boundary is not clipped.
+    let margin = 1e-3 * radius;
+    let (left, right) = (in_light.min.x - margin, in_light.max.x + margin);
+    let (bottom, top) = (in_light.min.y - margin, in_light.max.y + margin);
+    // View space looks down −z: the nearest point has the largest z.
+    let near = -in_light.max.z - margin;
+    let far = -in_light.min.z + margin;
+    let clip_from_light =
+        glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far);
+    LightProjection {
+        light_from_world,
+        clip_from_light,
+        kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
+        near,
+        far,
+    }
+}
+
+/// A perspective projection for a spot light at `position` pointing along
+/// `direction`, whose full field of view covers the outer cone (half-angle
+/// `outer_angle` radians), from `near` to `far` (usually the light's range).
+pub fn spot_light_projection(
+    position: Vec3,
+    direction: Vec3,
+    outer_angle: f32,
+    near: f32,
+    far: f32,
+) -> LightProjection {
+    let light_from_world = view_from_world_look_at(position, position + direction, Vec3::Y);
+    let fov = 2.0 * outer_angle;
+    LightProjection {
+        light_from_world,
+        clip_from_light: glam::camera::rh::proj::directx::perspective(fov, 1.0, near, far),
+        kind: ProjectionKind::Perspective { fov },
+        near,
+        far,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ndc_to_texture;
+    use glam::Vec4;
+
+    fn project(m: Mat4, p: Vec3) -> Vec3 {
+        let c = m * p.extend(1.0);
+        c.truncate() / c.w
+    }
+
+    #[test]
+    fn directional_light_straight_down_matches_hand_computed_box() {
+        // Sun straight down onto the box [−2, 2] × [0, 1] × [−3, 3].
+        let bounds = Aabb::new(Vec3::new(-2.0, 0.0, -3.0), Vec3::new(2.0, 1.0, 3.0));
+        let p = directional_light_projection(Vec3::NEG_Y, &bounds);
+        let m = p.clip_from_world();
+        // The top of the box is nearest to the light, the bottom farthest. The fit adds
+        // a margin of 1e-3 × the bounding radius (√53 / 2) on every side, so over the
+        // depth range 1 + 2·margin the top sits at margin / (1 + 2·margin).
+        let margin = 1e-3 * 53f32.sqrt() / 2.0;
+        let top = project(m, Vec3::new(0.0, 1.0, 0.0));
+        let bottom = project(m, Vec3::new(0.0, 0.0, 0.0));
+        assert!((top.z - margin / (1.0 + 2.0 * margin)).abs() < 1e-6, "{top}");
+        assert!((bottom.z - (1.0 + margin) / (1.0 + 2.0 * margin)).abs() < 1e-6, "{bottom}");
+        // Looking down with the z-axis fallback up vector, the fitted extents are the
+        // box's 4 × 6 footprint (plus the small margin).
+        let ProjectionKind::Orthographic { width, height } = p.kind else { panic!() };
+        let (w, h) = (width.min(height), width.max(height));
+        assert!((w - 4.0).abs() < 0.02 && (h - 6.0).abs() < 0.02, "{w} × {h}");
+        // Every corner lands inside the map.
+        for c in bounds.corners() {
+            let t = ndc_to_texture(project(m, c));
+            assert!(t.cmpge(Vec3::splat(-1e-6)).all() && t.cmple(Vec3::splat(1.0 + 1e-6)).all());
+        }
+        // Texel size: the larger extent over the resolution.
+        assert!((p.texel_world_size(1024, 0.0) - h / 1024.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn directional_light_maps_parallel_rays_to_one_texel() {
+        let bounds = Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0));
+        let dir = Vec3::new(1.0, -2.0, 0.5).normalize();
+        let m = directional_light_projection(dir, &bounds).clip_from_world();
+        let a = project(m, Vec3::new(0.3, 1.0, -0.2));
+        let b = project(m, Vec3::new(0.3, 1.0, -0.2) + 3.0 * dir);
+        assert!((a.truncate() - b.truncate()).length() < 1e-5, "same ray, same xy");
+        assert!(b.z > a.z, "farther along the light is deeper");
+    }
+
+    #[test]
+    fn spot_light_matches_hand_computed_frustum() {
+        // Spot at (0, 10, 0) pointing down, outer half-angle 45°: fov 90°, so the cone's
+        // edge at the ground (distance 10) is 10 units from the axis and lands on the
+        // map's edge.
+        let p = spot_light_projection(Vec3::new(0.0, 10.0, 0.0), Vec3::NEG_Y, 45f32.to_radians(), 0.5, 20.0);
+        let m = p.clip_from_world();
+        let centre = project(m, Vec3::ZERO);
+        assert!(centre.truncate().length() < 1e-5);
+        // Hand-computed depth at distance 10: f(z − n)/(z(f − n)) = 20·9.5/(10·19.5).
+        assert!((centre.z - 20.0 * 9.5 / (10.0 * 19.5)).abs() < 1e-5);
+        let edge = project(m, Vec3::new(10.0, 0.0, 0.0));
+        assert!((edge.x.abs().max(edge.y.abs()) - 1.0).abs() < 1e-5, "{edge}");
+        // Texel size grows linearly with distance: 2·d·tan(45°)/res.
+        assert!((p.texel_world_size(1000, 10.0) - 0.02).abs() < 1e-6);
+        let (k0, k1) = p.texel_size_coefficients(1000);
+        assert!(k0 == 0.0 && (k1 - 0.002).abs() < 1e-8);
+        // Behind the light: w < 0.
+        assert!((m * Vec4::new(0.0, 11.0, 0.0, 1.0)).w < 0.0);
+    }
+}

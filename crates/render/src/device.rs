@@ -1,0 +1,84 @@
+//! Headless adapter and device selection, honouring `WGPU_BACKEND`,
+//! `WGPU_ADAPTER_NAME` and `WGPU_POWER_PREF`.
+
+use crate::RenderError;
+
+/// What was picked, for `--verbose` and for reports.
+#[derive(Clone, Debug)]
+pub struct GpuInfo {
+    pub adapter: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+}
+
+impl std::fmt::Display for GpuInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "adapter: {} ({}), backend: {}, driver: {} {}",
+            self.adapter, self.device_type, self.backend, self.driver, self.driver_info
+        )
+    }
+}
+
+/// An open device and its queue, with no window.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: GpuInfo,
+    pub limits: wgpu::Limits,
+}
+
+impl Gpu {
+    /// Picks an adapter without a surface and opens a device on it, asking for the
+    /// adapter's own limits so that large shadow maps are available where supported.
+    pub fn new_headless() -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let backends = match std::env::var("WGPU_BACKEND") {
+            Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
+            Err(_) => String::new(),
+        };
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
+            .map_err(|_| RenderError::NoAdapter { backends })?;
+        let adapter_info = adapter.get_info();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("gnomon"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::DeviceRequest { adapter: adapter_info.name.clone(), reason: e.to_string() })?;
+        let info = GpuInfo {
+            adapter: adapter_info.name,
+            backend: format!("{:?}", adapter_info.backend),
+            device_type: format!("{:?}", adapter_info.device_type),
+            driver: adapter_info.driver,
+            driver_info: adapter_info.driver_info,
+        };
+        Ok(Self { device, queue, info, limits })
+    }
+
+    /// Runs `f`, turning any validation, out-of-memory or internal error it raises
+    /// into a [`RenderError::Gpu`] instead of wgpu's default panic.
+    pub(crate) fn checked<T>(&self, during: &'static str, f: impl FnOnce() -> T) -> Result<T, RenderError> {
+        let scopes = [
+            self.device.push_error_scope(wgpu::ErrorFilter::Internal),
+            self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
+            self.device.push_error_scope(wgpu::ErrorFilter::Validation),
+        ];
+        let value = f();
+        let mut first = None;
+        for scope in scopes.into_iter().rev() {
+            if let Some(e) = pollster::block_on(scope.pop()) {
+                first.get_or_insert(e.to_string());
+            }
+        }
+        match first {
+            Some(message) => Err(RenderError::Gpu { during, message }),
+            None => Ok(value),
+        }
+    }
+}

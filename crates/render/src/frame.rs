@@ -1,0 +1,395 @@
+//! One frame: resolve the camera and light, draw the shadow map, shade the image,
+//! and read every output back.
+
+use glam::{Vec3, Vec4};
+use gnomon_math::{LightProjection, directional_light_projection, spot_light_projection};
+use gnomon_scene::{Camera, Light, Scene, Settings};
+use wgpu::util::DeviceExt;
+
+use crate::{
+    Gpu, GpuScene, RenderError,
+    gpu_types::{CameraGpu, LightGpu},
+    passes::{
+        Layouts, SHADOW_FORMAT,
+        lighting::{self, LightingPass},
+        shadow::ShadowPass,
+    },
+    readback, techniques,
+};
+
+/// Optional outputs of a frame.
+#[derive(Clone, Debug, Default)]
+pub struct OutputRequest {
+    /// Read the shadow map back (resolution² floats).
+    pub shadow_map: bool,
+}
+
+/// The light's depth map as rendered, with what is needed to interpret it.
+#[derive(Clone, Debug)]
+pub struct ShadowMapImage {
+    pub resolution: u32,
+    /// Raw depth in [0, 1], row-major, top row first (texture space, v down).
+    pub depth: Vec<f32>,
+}
+
+/// Everything a frame produced. Images are row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// RGBA8, sRGB-encoded.
+    pub color: Vec<u8>,
+    /// Shadow factor in [0, 1] (1 lit); 0 outside a spot light's cone or range;
+    /// NaN where no surface is seen (background).
+    pub visibility: Vec<f32>,
+    /// World-space position of the visible surface; NaN for background.
+    pub position: Vec<Vec3>,
+    /// World-space unit normal of the visible surface, facing the camera; NaN for background.
+    pub normal: Vec<Vec3>,
+    /// View-space depth (distance along the camera's axis); NaN for background.
+    pub depth: Vec<f32>,
+    /// Instance index + 1 of the visible surface; 0 for background.
+    pub object_id: Vec<u32>,
+    pub camera: Camera,
+    pub light: Light,
+    /// The shadow map's projection.
+    pub light_projection: LightProjection,
+    pub shadow_resolution: u32,
+    pub shadow_map: Option<ShadowMapImage>,
+}
+
+impl Frame {
+    pub fn pixel_count(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+
+    /// World size of one shadow texel at `world` (which must be in front of the light).
+    pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
+        let distance = -self.light_projection.light_from_world.transform_point3(world).z;
+        self.light_projection.texel_world_size(self.shadow_resolution, distance)
+    }
+}
+
+/// The renderer: pass pipelines and layouts, reused across frames.
+pub struct Renderer<'g> {
+    gpu: &'g Gpu,
+    layouts: Layouts,
+    shadow_pass: ShadowPass,
+    lighting_pass: LightingPass,
+    compare_sampler: wgpu::Sampler,
+}
+
+impl<'g> Renderer<'g> {
+    pub fn new(gpu: &'g Gpu) -> Self {
+        let device = &gpu.device;
+        let layouts = Layouts::new(device);
+        let compare_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow compare"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            // Lit when the receiver's depth ≤ the stored occluder depth.
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        Self {
+            gpu,
+            shadow_pass: ShadowPass::new(device, &layouts),
+            lighting_pass: LightingPass::new(device, &layouts),
+            layouts,
+            compare_sampler,
+        }
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        self.gpu
+    }
+
+    /// Uploads `scene` and renders it. To render one scene many times, upload it once
+    /// with [`GpuScene::upload`] and call [`Renderer::render_uploaded`].
+    pub fn render(&mut self, scene: &Scene, settings: &Settings, request: &OutputRequest) -> Result<Frame, RenderError> {
+        settings.validate()?;
+        let uploaded = GpuScene::upload(self.gpu, scene)?;
+        self.render_uploaded(&uploaded, scene, settings, request)
+    }
+
+    /// Checks `settings` against the device's limits.
+    pub fn check_limits(&self, settings: &Settings) -> Result<(), RenderError> {
+        let limits = &self.gpu.limits;
+        let adapter = self.gpu.info.adapter.clone();
+        let max = limits.max_texture_dimension_2d;
+        let requested = settings.shadow.map.resolution;
+        if requested > max {
+            return Err(RenderError::ShadowMapTooLarge { requested, max, adapter });
+        }
+        let (width, height) = (settings.image.width, settings.image.height);
+        if width > max || height > max {
+            return Err(RenderError::ImageTooLarge { width, height, max, adapter });
+        }
+        let needed = lighting::target_bytes_per_pixel();
+        if limits.max_color_attachment_bytes_per_sample < needed {
+            return Err(RenderError::AttachmentsTooLarge {
+                available: limits.max_color_attachment_bytes_per_sample,
+                needed,
+                adapter,
+            });
+        }
+        Ok(())
+    }
+
+    /// Renders an uploaded scene. `scene` must be the one `uploaded` was made from.
+    pub fn render_uploaded(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
+        settings.validate()?;
+        self.check_limits(settings)?;
+        let camera = settings.resolve_camera(scene)?;
+        let light = settings.resolve_light(scene)?;
+        let shadow = &settings.shadow;
+        let resolution = shadow.map.resolution;
+        let projection = light_projection(scene, &light);
+        let technique = techniques::lookup(shadow.filter.technique);
+        let light_gpu = light_uniform(scene, &light, &projection, settings, technique.filter_params(&shadow.filter));
+        let (width, height) = (settings.image.width, settings.image.height);
+        let aspect = width as f32 / height as f32;
+        let camera_gpu = CameraGpu {
+            clip_from_world: camera.clip_from_world(aspect),
+            view_from_world: camera.view_from_world(),
+            eye: camera.eye.extend(1.0),
+        };
+
+        let gpu = self.gpu;
+        let device = &gpu.device;
+        let (pending, shadow_pending) = gpu.checked("rendering the frame", || {
+            let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("light"),
+                contents: bytemuck::bytes_of(&light_gpu),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let camera_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("camera"),
+                contents: bytemuck::bytes_of(&camera_gpu),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("scene"),
+                layout: &self.layouts.scene,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uploaded.instances.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: light_buffer.as_entire_binding() },
+                ],
+            });
+            let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("camera"),
+                layout: &self.layouts.camera,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: camera_buffer.as_entire_binding() }],
+            });
+            let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shadow map"),
+                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: SHADOW_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let shadow_view = shadow_map.create_view(&Default::default());
+            let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow map"),
+                layout: &self.layouts.shadow,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&shadow_view) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.compare_sampler) },
+                ],
+            });
+            let targets: Vec<wgpu::Texture> = lighting::TARGETS
+                .iter()
+                .map(|&format| render_target(device, width, height, format))
+                .collect();
+            let target_views: Vec<wgpu::TextureView> = targets.iter().map(|t| t.create_view(&Default::default())).collect();
+            let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
+            let depth_view = depth.create_view(&Default::default());
+
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("shadow"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &shadow_view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(self.shadow_pass.pipeline(device, &shadow.bias));
+                pass.set_bind_group(0, &scene_group, &[]);
+                uploaded.draw(&mut pass, true);
+            }
+            {
+                let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
+                    .iter()
+                    .map(|view| {
+                        Some(wgpu::RenderPassColorAttachment {
+                            view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                        })
+                    })
+                    .collect();
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("lighting"),
+                    color_attachments: &attachments,
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth_view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(self.lighting_pass.pipeline(device, shadow.filter.technique));
+                pass.set_bind_group(0, &scene_group, &[]);
+                pass.set_bind_group(1, &camera_group, &[]);
+                pass.set_bind_group(2, &shadow_group, &[]);
+                uploaded.draw(&mut pass, false);
+            }
+            let pending: Vec<_> = targets
+                .iter()
+                .map(|t| readback::record(device, &mut encoder, t, wgpu::TextureAspect::All))
+                .collect();
+            let shadow_pending = request
+                .shadow_map
+                .then(|| readback::record(device, &mut encoder, &shadow_map, wgpu::TextureAspect::DepthOnly));
+            gpu.queue.submit([encoder.finish()]);
+            (pending, shadow_pending)
+        })?;
+
+        let mut pending = pending.into_iter();
+        let mut next = || pending.next().expect("one readback per target");
+        let color: Vec<u8> = next().read(gpu)?;
+        let mut visibility: Vec<f32> = next().read(gpu)?;
+        let position_w: Vec<Vec4> = next().read(gpu)?;
+        let normal_w: Vec<Vec4> = next().read(gpu)?;
+        let object_id: Vec<u32> = next().read(gpu)?;
+        let shadow_map = match shadow_pending {
+            Some(p) => Some(ShadowMapImage { resolution, depth: p.read(gpu)? }),
+            None => None,
+        };
+
+        // Background pixels get NaN, as documented, decided by the object id (0).
+        let nan3 = Vec3::splat(f32::NAN);
+        let mut position = Vec::with_capacity(position_w.len());
+        let mut depth = Vec::with_capacity(position_w.len());
+        for (i, p) in position_w.iter().enumerate() {
+            if object_id[i] == 0 {
+                visibility[i] = f32::NAN;
+                position.push(nan3);
+                depth.push(f32::NAN);
+            } else {
+                position.push(p.truncate());
+                depth.push(p.w);
+            }
+        }
+        let normal = normal_w
+            .iter()
+            .zip(&object_id)
+            .map(|(n, &id)| if id == 0 { nan3 } else { n.truncate() })
+            .collect();
+        Ok(Frame {
+            width,
+            height,
+            color,
+            visibility,
+            position,
+            normal,
+            depth,
+            object_id,
+            camera,
+            light,
+            light_projection: projection,
+            shadow_resolution: resolution,
+            shadow_map,
+        })
+    }
+}
+
+fn render_target(device: &wgpu::Device, width: u32, height: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("render target"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// The shadow projection of `light`: for a sun, an orthographic box fitted to the
+/// scene's bounds; for a spot, the perspective frustum of its cone out to its range.
+pub fn light_projection(scene: &Scene, light: &Light) -> LightProjection {
+    match light {
+        Light::Directional(sun) => directional_light_projection(sun.direction, &scene.bounds()),
+        Light::Spot(spot) => spot_light_projection(
+            spot.position,
+            spot.direction,
+            spot.outer_angle_degrees.to_radians(),
+            spot.shadow_near(),
+            spot.range,
+        ),
+    }
+}
+
+fn light_uniform(
+    scene: &Scene,
+    light: &Light,
+    projection: &LightProjection,
+    settings: &Settings,
+    filter: [f32; 4],
+) -> LightGpu {
+    let resolution = settings.shadow.map.resolution;
+    let (texel_ortho, texel_per_distance) = projection.texel_size_coefficients(resolution);
+    let common = LightGpu {
+        clip_from_world: projection.clip_from_world(),
+        light_from_world: projection.light_from_world,
+        texel: Vec4::new(texel_ortho, texel_per_distance, settings.shadow.bias.normal_offset, resolution as f32),
+        filter: Vec4::from_array(filter),
+        ambient: scene.ambient.extend(0.0),
+        cone: Vec4::new(1.0, -1.0, projection.near, projection.far),
+        ..Default::default()
+    };
+    match light {
+        Light::Directional(sun) => LightGpu {
+            radiance: (sun.color * sun.intensity).extend(0.0),
+            direction: sun.direction.normalize().extend(0.0),
+            ..common
+        },
+        Light::Spot(spot) => LightGpu {
+            radiance: (spot.color * spot.intensity).extend(0.0),
+            direction: spot.direction.normalize().extend(1.0),
+            position: spot.position.extend(spot.range),
+            cone: Vec4::new(
+                spot.inner_angle_degrees.to_radians().cos(),
+                spot.outer_angle_degrees.to_radians().cos(),
+                projection.near,
+                projection.far,
+            ),
+            ..common
+        },
+    }
+}
+

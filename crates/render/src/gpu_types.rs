@@ -1,0 +1,69 @@
+//! Plain-old-data mirrors of the WGSL structs in `passes/*.wgsl`.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+
+/// One entry of the instance storage buffer (`Instance` in `scene_common.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct InstanceGpu {
+    pub world_from_object: Mat4,
+    pub normal_from_object: Mat4,
+    pub base_color: Vec4,
+    /// x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1).
+    pub material: Vec4,
+}
+
+/// The light uniform (`Light` in `scene_common.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Default)]
+pub struct LightGpu {
+    pub clip_from_world: Mat4,
+    pub light_from_world: Mat4,
+    /// rgb: colour × intensity.
+    pub radiance: Vec4,
+    /// xyz: the sun's travel direction or the spot's axis; w: 0 for a sun, 1 for a spot.
+    pub direction: Vec4,
+    /// xyz: spot position; w: spot range.
+    pub position: Vec4,
+    /// x: cos(inner angle), y: cos(outer angle), z: map near plane, w: map far plane.
+    pub cone: Vec4,
+    /// x: texel world size of an orthographic map; y: texel world size per unit of
+    /// distance for a perspective map; z: normal offset in texels; w: map resolution.
+    pub texel: Vec4,
+    /// Technique parameters, defined by each technique module.
+    pub filter: Vec4,
+    /// rgb: ambient light.
+    pub ambient: Vec4,
+}
+
+/// The camera uniform (`Camera` in `lighting.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct CameraGpu {
+    pub clip_from_world: Mat4,
+    pub view_from_world: Mat4,
+    pub eye: Vec4,
+}
+
+/// One vertex: position, normal, texture coordinate (locations 0, 1, 2).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct VertexGpu {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+}
+
+impl VertexGpu {
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+
+    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<VertexGpu>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &Self::ATTRIBUTES,
+        }
+    }
+}

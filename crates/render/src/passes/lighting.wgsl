@@ -1,0 +1,119 @@
+// Lighting pass: Lambert diffuse + Blinn-Phong specular + ambient, with the shadow
+// factor of the selected technique multiplying only the direct term. Also writes the
+// per-pixel visibility, world position, normal, view depth and object id.
+//
+// A technique provides `fn sample_shadow(coords: vec3<f32>) -> f32`, where coords is
+// (u, v, depth) in the shadow map's texture space (v down, depth in [0, 1]).
+
+struct Camera {
+    clip_from_world: mat4x4<f32>,
+    view_from_world: mat4x4<f32>,
+    eye: vec4<f32>,
+};
+
+@group(1) @binding(0) var<uniform> camera: Camera;
+@group(2) @binding(0) var shadow_map: texture_depth_2d;
+@group(2) @binding(1) var shadow_compare: sampler_comparison;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) instance: u32,
+};
+
+@vertex
+fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
+    let inst = instances[instance_index];
+    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+    var out: VertexOut;
+    out.clip = camera.clip_from_world * world;
+    out.world = world.xyz;
+    out.normal = (inst.normal_from_object * vec4<f32>(v.normal, 0.0)).xyz;
+    out.instance = instance_index;
+    return out;
+}
+
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    @location(1) visibility: f32,
+    @location(2) position: vec4<f32>,
+    @location(3) normal: vec4<f32>,
+    @location(4) object_id: u32,
+};
+
+// Shadow-map coordinates of a receiver at `world` with unit normal `n`: the point is
+// first pushed along its normal by the normal-offset bias (in texels of the map at
+// the receiver), then projected: clip → NDC → texture space with v flipped.
+// Returns (u, v, depth, inside) where inside is 1 when the point projects into the
+// map's frustum.
+fn shadow_coords(world: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
+    let texel_world = light.texel.x + light.texel.y * max(distance, 0.0);
+    let p = world + n * (light.texel.z * texel_world);
+    let clip = light.clip_from_world * vec4<f32>(p, 1.0);
+    if clip.w <= 0.0 {
+        return vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+    let ndc = clip.xyz / clip.w;
+    let uv = ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5, 0.5);
+    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && ndc.z >= 0.0 && ndc.z <= 1.0;
+    return vec4<f32>(uv, ndc.z, select(0.0, 1.0, inside));
+}
+
+// Fraction of the light arriving at `world` before shadowing: 1 for the sun, the
+// cone and range test for a spot (0 outside the outer cone or beyond the range).
+// Returns (unit direction to the light, cone factor in [0, 1]).
+fn light_geometry(world: vec3<f32>) -> vec4<f32> {
+    if light.direction.w < 0.5 {
+        return vec4<f32>(-light.direction.xyz, 1.0);
+    }
+    let to_light = light.position.xyz - world;
+    let dist = length(to_light);
+    let l = to_light / dist;
+    let cos_angle = dot(-l, light.direction.xyz);
+    let inside = cos_angle >= light.cone.y && dist <= light.position.w;
+    let falloff = smoothstep(light.cone.y, light.cone.x, cos_angle);
+    return vec4<f32>(l, select(0.0, falloff, inside));
+}
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
+    let inst = instances[in.instance];
+    // Two-sided shading: a back face seen by the camera is lit as its flipped side, as
+    // a ray tracer would see it.
+    var n = normalize(in.normal);
+    if !front {
+        n = -n;
+    }
+    let geometry = light_geometry(in.world);
+    let l = geometry.xyz;
+    let cone = geometry.w;
+
+    let coords = shadow_coords(in.world, n);
+    var visibility = 1.0;
+    if coords.w > 0.5 {
+        visibility = sample_shadow(coords.xyz);
+    }
+    if light.direction.w > 0.5 && cone <= 0.0 {
+        // Outside a spot's cone or range no light arrives: visibility 0 by definition.
+        visibility = 0.0;
+    }
+
+    let albedo = inst.base_color.rgb;
+    let n_dot_l = max(dot(n, l), 0.0);
+    let v = normalize(camera.eye.xyz - in.world);
+    let h = normalize(l + v);
+    let specular = inst.material.x * pow(max(dot(n, h), 0.0), inst.material.y) * select(0.0, 1.0, n_dot_l > 0.0);
+    let direct = light.radiance.rgb * cone * (albedo * n_dot_l + vec3<f32>(specular));
+    let color = light.ambient.rgb * albedo + visibility * direct;
+
+    var out: FragmentOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.visibility = visibility;
+    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
+    out.position = vec4<f32>(in.world, view_depth);
+    out.normal = vec4<f32>(n, 0.0);
+    out.object_id = u32(inst.material.z);
+    return out;
+}

@@ -1,0 +1,88 @@
+//! The render passes and the resources they share: bind group layouts, the WGSL
+//! composition, and the pipeline caches.
+
+pub(crate) mod lighting;
+pub(crate) mod shadow;
+
+/// The shadow map's texel format.
+pub(crate) const SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Concatenates WGSL sources into one module. WGSL allows module-scope declarations
+/// in any order, so the shared declarations, the technique and the pass compose freely.
+pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
+    parts.join("\n")
+}
+
+/// The WGSL every geometry pass starts with.
+pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
+
+/// Bind group layouts shared by the passes.
+pub(crate) struct Layouts {
+    /// Group 0: instances (storage) and the light (uniform).
+    pub scene: wgpu::BindGroupLayout,
+    /// Group 1 of the lighting pass: the camera.
+    pub camera: wgpu::BindGroupLayout,
+    /// Group 2 of the lighting pass: the shadow map and its comparison sampler.
+    pub shadow: wgpu::BindGroupLayout,
+}
+
+impl Layouts {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let scene = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: vf,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                uniform_entry(1, vf),
+            ],
+        });
+        let camera = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("camera"),
+            entries: &[uniform_entry(0, vf)],
+        });
+        let shadow = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow map"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+            ],
+        });
+        Self { scene, camera, shadow }
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}

@@ -1,0 +1,80 @@
+//! Copying textures back to the CPU: row padding to wgpu's 256-byte alignment on
+//! the way out, and removed again on the way in.
+
+use crate::{Gpu, RenderError};
+
+/// A texture copy recorded into an encoder, waiting to be mapped.
+pub(crate) struct PendingReadback {
+    buffer: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    bytes_per_texel: u32,
+    padded_bytes_per_row: u32,
+}
+
+/// Records a copy of mip 0 of `texture` (of `aspect`) into a mappable buffer.
+pub(crate) fn record(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+) -> PendingReadback {
+    let (width, height) = (texture.width(), texture.height());
+    let bytes_per_texel = texture.format().block_copy_size(Some(aspect)).unwrap_or(4);
+    let unpadded = width * bytes_per_texel;
+    let padded_bytes_per_row = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: padded_bytes_per_row as u64 * height as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_bytes_per_row),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    PendingReadback { buffer, width, height, bytes_per_texel, padded_bytes_per_row }
+}
+
+impl PendingReadback {
+    /// Maps the buffer (after the copy's submission) and returns the tightly packed
+    /// texels, top row first.
+    pub fn read<T: bytemuck::Pod>(self, gpu: &Gpu) -> Result<Vec<T>, RenderError> {
+        let slice = self.buffer.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = sender.send(r);
+        });
+        gpu.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu { during: "waiting for the frame", message: e.to_string() })?;
+        receiver
+            .recv()
+            .map_err(|e| RenderError::Gpu { during: "reading back", message: e.to_string() })?
+            .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })?;
+        let row = (self.width * self.bytes_per_texel) as usize;
+        let mut bytes = Vec::with_capacity(row * self.height as usize);
+        {
+            let mapped = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })?;
+            for y in 0..self.height as usize {
+                let start = y * self.padded_bytes_per_row as usize;
+                bytes.extend_from_slice(&mapped[start..start + row]);
+            }
+        }
+        self.buffer.unmap();
+        // Copy into a properly aligned vector of T.
+        let mut out = vec![T::zeroed(); bytes.len() / std::mem::size_of::<T>()];
+        bytemuck::cast_slice_mut::<T, u8>(&mut out).copy_from_slice(&bytes);
+        Ok(out)
+    }
+}

@@ -1,0 +1,250 @@
+//! Built-in procedural scenes. Each is selectable by name on the command line and is
+//! also a test fixture, so their geometry is exact and documented.
+
+use glam::{Mat4, Vec3};
+
+use crate::{
+    Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, geometry, sun_direction,
+};
+
+/// A built-in scene: its name, what it shows, and how to build it.
+pub struct Builtin {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub build: fn() -> Scene,
+}
+
+/// Every built-in scene. The first is the default.
+pub const BUILTINS: &[Builtin] = &[
+    Builtin { name: "spheres", description: "a box and nine spheres on a ground plane: the classic test scene", build: spheres },
+    Builtin { name: "contact", description: "objects resting on the ground, thin walls and a narrow gap: peter-panning and leaks", build: contact },
+    Builtin { name: "grazing", description: "a large plane lit at a grazing angle with a few casters: shadow acne", build: grazing },
+    Builtin { name: "columns", description: "a long ground with rows of columns far from the camera: a large depth range", build: columns },
+];
+
+/// Builds the built-in scene called `name`, or `None` when there is none.
+pub fn build(name: &str) -> Option<Scene> {
+    BUILTINS.iter().find(|b| b.name == name).map(|b| (b.build)())
+}
+
+/// The names of all built-in scenes, for error messages and help.
+pub fn names() -> Vec<&'static str> {
+    BUILTINS.iter().map(|b| b.name).collect()
+}
+
+/// Incremental construction of a procedural scene.
+struct SceneBuilder {
+    meshes: Vec<Mesh>,
+    materials: Vec<Material>,
+    instances: Vec<Instance>,
+}
+
+impl SceneBuilder {
+    fn new() -> Self {
+        Self { meshes: Vec::new(), materials: Vec::new(), instances: Vec::new() }
+    }
+
+    fn mesh(&mut self, mesh: Mesh) -> usize {
+        self.meshes.push(mesh);
+        self.meshes.len() - 1
+    }
+
+    fn material(&mut self, name: &str, base_color: Vec3) -> usize {
+        self.materials.push(Material::new(name, base_color));
+        self.materials.len() - 1
+    }
+
+    fn place(&mut self, name: &str, mesh: usize, material: usize, world_from_object: Mat4) {
+        self.instances.push(Instance {
+            name: name.into(),
+            mesh,
+            material,
+            world_from_object,
+            casts_shadow: true,
+        });
+    }
+
+    fn finish(self, name: &str, camera: Camera, sun: DirectionalLight, spot: SpotLight) -> Scene {
+        Scene {
+            name: name.into(),
+            meshes: self.meshes,
+            materials: self.materials,
+            instances: self.instances,
+            camera,
+            sun,
+            spot,
+            ambient: Vec3::splat(0.12),
+        }
+    }
+}
+
+fn sun(elevation_degrees: f32, azimuth_degrees: f32) -> DirectionalLight {
+    DirectionalLight {
+        direction: -sun_direction(elevation_degrees, azimuth_degrees),
+        color: Vec3::new(1.0, 0.97, 0.92),
+        intensity: 1.0,
+    }
+}
+
+fn spot(position: Vec3, target: Vec3, outer_degrees: f32, range: f32) -> SpotLight {
+    SpotLight {
+        position,
+        direction: (target - position).normalize(),
+        inner_angle_degrees: 0.8 * outer_degrees,
+        outer_angle_degrees: outer_degrees,
+        range,
+        color: Vec3::new(1.0, 0.95, 0.85),
+        intensity: 1.6,
+    }
+}
+
+fn at(p: Vec3) -> Mat4 {
+    Mat4::from_translation(p)
+}
+
+const GROUND: Vec3 = Vec3::new(0.72, 0.72, 0.70);
+
+/// A 24 × 24 ground, a 2 × 2 × 2 box and nine spheres of radius 0.55 to 0.95 in a
+/// 3 × 3 grid: the left column rests on the ground, the others float 0.5 and 1.5 above it.
+pub fn spheres() -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(24.0, 24.0));
+    let cube = b.mesh(geometry::cuboid(Vec3::ONE));
+    let grey = b.material("ground", GROUND);
+    let box_mat = b.material("box", Vec3::new(0.75, 0.45, 0.25));
+    b.place("ground", ground, grey, Mat4::IDENTITY);
+    b.place("box", cube, box_mat, at(Vec3::new(-6.0, 1.0, -4.0)) * Mat4::from_rotation_y(0.5));
+    let palette = [Vec3::new(0.8, 0.2, 0.2), Vec3::new(0.2, 0.65, 0.3), Vec3::new(0.2, 0.4, 0.85)];
+    for (row, z) in [-3.0f32, 0.0, 3.0].into_iter().enumerate() {
+        for (col, x) in [-3.0f32, 0.0, 3.0].into_iter().enumerate() {
+            let radius = 0.55 + 0.2 * row as f32;
+            let lift = [0.0, 0.5, 1.5][col];
+            let mesh = b.mesh(geometry::uv_sphere(radius, 48, 24));
+            let mat = b.material(&format!("sphere {row}{col}"), palette[(row + col) % 3]);
+            b.place(&format!("sphere {row},{col}"), mesh, mat, at(Vec3::new(x, radius + lift, z)));
+        }
+    }
+    let camera = Camera {
+        eye: Vec3::new(2.0, 9.0, 14.0),
+        target: Vec3::new(-0.5, 0.6, 0.0),
+        up: Vec3::Y,
+        fov_y_degrees: 45.0,
+        near: 0.1,
+        far: 100.0,
+    };
+    b.finish("spheres", camera, sun(48.0, 35.0), spot(Vec3::new(4.0, 9.0, 5.0), Vec3::ZERO, 40.0, 30.0))
+}
+
+/// Objects resting exactly on the ground (y = 0): a 2 × 1 × 2 box, a unit sphere, a
+/// cylinder, a 0.04-thick wall, and two 1.5 m cubes with a 0.1 m gap between them.
+pub fn contact() -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(16.0, 16.0));
+    let grey = b.material("ground", GROUND);
+    let warm = b.material("warm", Vec3::new(0.8, 0.5, 0.3));
+    let cool = b.material("cool", Vec3::new(0.3, 0.5, 0.8));
+    let green = b.material("green", Vec3::new(0.35, 0.7, 0.35));
+    b.place("ground", ground, grey, Mat4::IDENTITY);
+    let slab = b.mesh(geometry::cuboid(Vec3::new(1.0, 0.5, 1.0)));
+    b.place("box", slab, warm, at(Vec3::new(-3.5, 0.5, 0.0)));
+    let ball = b.mesh(geometry::uv_sphere(1.0, 48, 24));
+    b.place("sphere", ball, cool, at(Vec3::new(0.0, 1.0, -2.5)));
+    let post = b.mesh(geometry::cylinder(0.5, 2.0, 32));
+    b.place("cylinder", post, green, at(Vec3::new(3.0, 0.0, -3.0)));
+    let wall = b.mesh(geometry::cuboid(Vec3::new(1.5, 0.75, 0.02)));
+    b.place("thin wall", wall, warm, at(Vec3::new(0.5, 0.75, 2.0)));
+    let cube = b.mesh(geometry::cuboid(Vec3::splat(0.75)));
+    b.place("gap cube left", cube, cool, at(Vec3::new(3.0, 0.75, 1.5)));
+    b.place("gap cube right", cube, cool, at(Vec3::new(3.0 + 1.6, 0.75, 1.5)));
+    let camera = Camera {
+        eye: Vec3::new(0.0, 6.0, 10.0),
+        target: Vec3::new(0.0, 0.3, 0.0),
+        up: Vec3::Y,
+        fov_y_degrees: 50.0,
+        near: 0.1,
+        far: 60.0,
+    };
+    b.finish("contact", camera, sun(35.0, 200.0), spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0))
+}
+
+/// An 80 × 80 plane under a sun 6° above the horizon, with three 3 m posts and a box.
+pub fn grazing() -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(80.0, 80.0));
+    let grey = b.material("ground", GROUND);
+    let warm = b.material("warm", Vec3::new(0.8, 0.55, 0.3));
+    b.place("ground", ground, grey, Mat4::IDENTITY);
+    let post = b.mesh(geometry::cuboid(Vec3::new(0.2, 1.5, 0.2)));
+    for (i, x) in [-6.0f32, 0.0, 6.0].into_iter().enumerate() {
+        b.place(&format!("post {i}"), post, warm, at(Vec3::new(x, 1.5, -2.0 - 2.0 * i as f32)));
+    }
+    let block = b.mesh(geometry::cuboid(Vec3::new(1.5, 1.0, 1.5)));
+    b.place("block", block, warm, at(Vec3::new(-10.0, 1.0, 4.0)));
+    let camera = Camera {
+        eye: Vec3::new(0.0, 7.0, 22.0),
+        target: Vec3::new(0.0, 0.0, -2.0),
+        up: Vec3::Y,
+        fov_y_degrees: 50.0,
+        near: 0.1,
+        far: 200.0,
+    };
+    b.finish("grazing", camera, sun(6.0, 250.0), spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0))
+}
+
+/// A 20 × 400 ground running along −z with two rows of 6 m columns every 8 m, seen
+/// from one end: a depth range of several hundred metres.
+pub fn columns() -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(20.0, 400.0));
+    let grey = b.material("ground", GROUND);
+    let stone = b.material("stone", Vec3::new(0.78, 0.74, 0.66));
+    b.place("ground", ground, grey, at(Vec3::new(0.0, 0.0, -195.0)));
+    let column = b.mesh(geometry::cylinder(0.5, 6.0, 24));
+    for i in 0..48 {
+        let z = -8.0 * i as f32;
+        b.place(&format!("column L{i}"), column, stone, at(Vec3::new(-5.0, 0.0, z)));
+        b.place(&format!("column R{i}"), column, stone, at(Vec3::new(5.0, 0.0, z)));
+    }
+    let camera = Camera {
+        eye: Vec3::new(0.0, 2.0, 6.0),
+        target: Vec3::new(0.0, 1.5, -40.0),
+        up: Vec3::Y,
+        fov_y_degrees: 60.0,
+        near: 0.1,
+        far: 500.0,
+    };
+    b.finish("columns", camera, sun(40.0, 60.0), spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_builds_and_validates() {
+        for b in BUILTINS {
+            let scene = (b.build)();
+            assert_eq!(scene.name, b.name);
+            scene.validate().unwrap();
+            assert!(scene.triangle_count() > 0);
+            assert!((scene.sun.direction.length() - 1.0).abs() < 1e-5);
+            assert!(scene.sun.direction.y < 0.0, "{}: the sun shines downward", b.name);
+        }
+        assert!(build("no-such-scene").is_none());
+    }
+
+    #[test]
+    fn contact_objects_rest_on_the_ground() {
+        let scene = contact();
+        for i in scene.instances.iter().skip(1) {
+            let lowest = scene.meshes[i.mesh].bounds().transformed(i.world_from_object).min.y;
+            assert!(lowest.abs() < 1e-5, "{} floats at {lowest}", i.name);
+        }
+    }
+
+    #[test]
+    fn grazing_sun_is_six_degrees_up() {
+        let d = grazing().sun.direction;
+        assert!(((-d.y).asin().to_degrees() - 6.0).abs() < 1e-3);
+    }
+}

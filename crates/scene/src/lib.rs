@@ -1,0 +1,13 @@
+//! Gnomon's scene model (meshes, materials, instances, camera, lights), the typed
+//! render settings, and the built-in procedural scenes. No GPU.
+
+pub mod builtin;
+pub mod geometry;
+mod model;
+pub mod settings;
+
+pub use model::{
+    Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight,
+    sun_direction,
+};
+pub use settings::Settings;

@@ -1,0 +1,207 @@
+//! The scene model: what the renderer draws and what the reference ray tracer traces.
+
+use gnomon_math::Aabb;
+use glam::{Mat4, Vec2, Vec3};
+
+/// A triangle mesh in object space. Triangles are counter-clockwise when seen from
+/// the side their normals point to.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+}
+
+/// A surface's appearance for the lighting pass (Lambert + Blinn-Phong).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGB base colour (albedo), each channel in [0, 1].
+    pub base_color: Vec3,
+    /// Weight of the Blinn-Phong highlight.
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    pub shininess: f32,
+}
+
+impl Material {
+    pub fn new(name: &str, base_color: Vec3) -> Self {
+        Self { name: name.into(), base_color, specular: 0.25, shininess: 48.0 }
+    }
+}
+
+/// One placed copy of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instance {
+    pub name: String,
+    pub mesh: usize,
+    pub material: usize,
+    pub world_from_object: Mat4,
+    /// Whether the instance is drawn into shadow maps. Every instance receives shadows.
+    pub casts_shadow: bool,
+}
+
+/// A perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, in degrees.
+    pub fov_y_degrees: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    pub fn view_from_world(&self) -> Mat4 {
+        gnomon_math::view_from_world_look_at(self.eye, self.target, self.up)
+    }
+
+    pub fn clip_from_view(&self, aspect: f32) -> Mat4 {
+        gnomon_math::camera_clip_from_view(self.fov_y_degrees.to_radians(), aspect, self.near, self.far)
+    }
+
+    pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
+        self.clip_from_view(aspect) * self.view_from_world()
+    }
+}
+
+/// A light infinitely far away: parallel rays travelling along `direction`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// The direction the light travels (from the sun toward the scene), unit length.
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Irradiance scale on a surface facing the light.
+    pub intensity: f32,
+}
+
+/// A point light restricted to a cone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLight {
+    pub position: Vec3,
+    /// The cone's axis, unit length, pointing away from the light.
+    pub direction: Vec3,
+    /// Half-angle in degrees inside which the light is at full strength.
+    pub inner_angle_degrees: f32,
+    /// Half-angle in degrees outside which no light arrives.
+    pub outer_angle_degrees: f32,
+    /// Distance in world units beyond which no light arrives; also the shadow map's far plane.
+    pub range: f32,
+    pub color: Vec3,
+    pub intensity: f32,
+}
+
+impl SpotLight {
+    /// The shadow map's near plane: close enough for casters near the light, far
+    /// enough to keep depth precision (a fixed fraction of the range).
+    pub fn shadow_near(&self) -> f32 {
+        (self.range * 2e-3).max(1e-3)
+    }
+}
+
+/// The light a render uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    Directional(DirectionalLight),
+    Spot(SpotLight),
+}
+
+/// Direction *toward* the sun for an elevation above the horizon and an azimuth
+/// measured from +z toward +x, both in degrees.
+pub fn sun_direction(elevation_degrees: f32, azimuth_degrees: f32) -> Vec3 {
+    let (el, az) = (elevation_degrees.to_radians(), azimuth_degrees.to_radians());
+    Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
+}
+
+/// A complete scene with its default view and lights.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub instances: Vec<Instance>,
+    pub camera: Camera,
+    /// The scene's default sun, used with `--light sun`.
+    pub sun: DirectionalLight,
+    /// The scene's default spot light, used with `--light spot`.
+    pub spot: SpotLight,
+    /// Linear RGB ambient light, added unshadowed.
+    pub ambient: Vec3,
+}
+
+/// A scene that is not well formed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SceneError {
+    #[error("scene `{scene}`: instance `{instance}` refers to mesh {mesh}, but there are {count} meshes")]
+    MeshOutOfRange { scene: String, instance: String, mesh: usize, count: usize },
+    #[error("scene `{scene}`: instance `{instance}` refers to material {material}, but there are {count} materials")]
+    MaterialOutOfRange { scene: String, instance: String, material: usize, count: usize },
+    #[error("scene `{scene}`: mesh `{mesh}` has {positions} positions, {normals} normals and {uvs} UVs; all three must match")]
+    AttributeCountMismatch { scene: String, mesh: String, positions: usize, normals: usize, uvs: usize },
+    #[error("scene `{scene}`: mesh `{mesh}` has an index {index} beyond its {vertices} vertices, or an index count not a multiple of 3")]
+    BadIndices { scene: String, mesh: String, index: u32, vertices: usize },
+    #[error("scene `{scene}`: mesh `{mesh}` has a non-finite position or normal")]
+    NonFinite { scene: String, mesh: String },
+}
+
+impl Scene {
+    /// World-space bounds of all instances.
+    pub fn bounds(&self) -> Aabb {
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh].bounds().transformed(i.world_from_object))
+            .fold(Aabb::EMPTY, Aabb::union)
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.instances.iter().map(|i| self.meshes[i.mesh].triangle_count()).sum()
+    }
+
+    /// Checks every cross-reference and attribute so that later stages can index freely.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let scene = self.name.clone();
+        for m in &self.meshes {
+            let (p, n, t) = (m.positions.len(), m.normals.len(), m.uvs.len());
+            if p != n || p != t {
+                return Err(SceneError::AttributeCountMismatch {
+                    scene, mesh: m.name.clone(), positions: p, normals: n, uvs: t,
+                });
+            }
+            if m.indices.len() % 3 != 0 || m.indices.iter().any(|&i| i as usize >= p) {
+                let index = m.indices.iter().copied().find(|&i| i as usize >= p).unwrap_or(0);
+                return Err(SceneError::BadIndices { scene, mesh: m.name.clone(), index, vertices: p });
+            }
+            if !m.positions.iter().chain(&m.normals).all(|v| v.is_finite()) {
+                return Err(SceneError::NonFinite { scene, mesh: m.name.clone() });
+            }
+        }
+        for i in &self.instances {
+            if i.mesh >= self.meshes.len() {
+                return Err(SceneError::MeshOutOfRange {
+                    scene, instance: i.name.clone(), mesh: i.mesh, count: self.meshes.len(),
+                });
+            }
+            if i.material >= self.materials.len() {
+                return Err(SceneError::MaterialOutOfRange {
+                    scene, instance: i.name.clone(), material: i.material, count: self.materials.len(),
+                });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,492 @@
+//! The one typed settings structure for a render: image size, camera, light and
+//! shadows. The command-line flags (clap) and the file format (serde/TOML) are both
+//! derived from these definitions, so their names, defaults and help text agree.
+//!
+//! Camera and light fields are optional overrides of the scene's own defaults. The
+//! shadow settings are orthogonal axes: the filter (technique), the bias, the map,
+//! and the partition of the light's view.
+
+use clap::{Args, ValueEnum};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::{Camera, Light, Scene, sun_direction};
+
+/// Everything that configures one render besides the scene itself.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Settings {
+    #[command(flatten)]
+    pub image: ImageSettings,
+    #[command(flatten)]
+    pub camera: CameraSettings,
+    #[command(flatten)]
+    pub light: LightSettings,
+    #[command(flatten)]
+    pub shadow: ShadowSettings,
+}
+
+/// The output image.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ImageSettings {
+    /// Image width in pixels (1 to 16384).
+    #[arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image")]
+    pub width: u32,
+    /// Image height in pixels (1 to 16384).
+    #[arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image")]
+    pub height: u32,
+}
+
+impl Default for ImageSettings {
+    fn default() -> Self {
+        Self { width: 1280, height: 720 }
+    }
+}
+
+/// Overrides of the scene's camera. An absent field keeps the scene's value.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraSettings {
+    /// Camera position in world units, as X,Y,Z [default: the scene's].
+    #[arg(long = "camera-eye", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at, as X,Y,Z [default: the scene's].
+    #[arg(long = "camera-target", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    pub target: Option<Vec3>,
+    /// Full vertical field of view in degrees, in (0, 180) [default: the scene's].
+    #[arg(long = "fov", value_name = "DEGREES", help_heading = "Camera")]
+    pub fov_y_degrees: Option<f32>,
+    /// Near clip distance in world units, > 0 [default: the scene's].
+    #[arg(long = "camera-near", value_name = "DISTANCE", help_heading = "Camera")]
+    pub near: Option<f32>,
+    /// Far clip distance in world units, > near [default: the scene's].
+    #[arg(long = "camera-far", value_name = "DISTANCE", help_heading = "Camera")]
+    pub far: Option<f32>,
+}
+
+/// Which of the scene's lights is rendered.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightKind {
+    /// The scene's directional light (sun), with an orthographic shadow map fitted to the scene.
+    #[default]
+    Sun,
+    /// The scene's spot light, with a perspective shadow map covering its cone.
+    Spot,
+}
+
+/// The light, and overrides of the scene's light parameters.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct LightSettings {
+    /// Which light casts the shadows.
+    #[arg(long = "light", value_enum, default_value_t, help_heading = "Light")]
+    pub kind: LightKind,
+    /// Sun elevation above the horizon in degrees, in (0, 90] [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_elevation: Option<f32>,
+    /// Sun azimuth in degrees, measured from +z toward +x [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_azimuth: Option<f32>,
+    /// Spot light position, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub spot_position: Option<Vec3>,
+    /// Point the spot light aims at, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub spot_target: Option<Vec3>,
+    /// Spot cone outer half-angle in degrees, in (0, 89]: no light outside it [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub spot_outer_angle: Option<f32>,
+    /// Spot cone inner half-angle in degrees, in [0, outer]: full light inside it [default: 80% of outer].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub spot_inner_angle: Option<f32>,
+    /// Spot light range in world units, > 0; also the shadow map's far plane [default: the scene's].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub spot_range: Option<f32>,
+}
+
+/// How the shadow map is sampled and filtered.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum Technique {
+    /// One point-sampled depth comparison: Williams (1978), the textbook algorithm.
+    #[value(name = "hard")]
+    #[serde(rename = "hard")]
+    Hard,
+    /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
+    #[default]
+    #[value(name = "pcf2x2")]
+    #[serde(rename = "pcf2x2")]
+    Pcf2x2,
+    /// N×N box PCF (N = --pcf-kernel) built from bilinear comparison taps one texel apart.
+    #[value(name = "pcf")]
+    #[serde(rename = "pcf")]
+    Pcf,
+}
+
+impl Technique {
+    /// The name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Hard => "hard",
+            Technique::Pcf2x2 => "pcf2x2",
+            Technique::Pcf => "pcf",
+        }
+    }
+
+    pub fn all() -> &'static [Technique] {
+        Technique::value_variants()
+    }
+}
+
+/// The filter axis: which technique, and its parameters.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FilterSettings {
+    /// Shadow filtering technique.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    pub technique: Technique,
+    /// Kernel width N of `pcf`, in shadow texels: 3, 5, 7 or 9.
+    #[arg(long, value_name = "N", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter")]
+    pub pcf_kernel: u32,
+}
+
+impl Default for FilterSettings {
+    fn default() -> Self {
+        Self { technique: Technique::default(), pcf_kernel: 3 }
+    }
+}
+
+/// Which faces the shadow pass culls.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CullMode {
+    /// Cull faces turned away from the light: the usual choice.
+    #[default]
+    Back,
+    /// Cull faces turned toward the light, so closed meshes store their back faces:
+    /// the classic anti-acne trick, which can leak where meshes are open or thin.
+    Front,
+    /// Draw both sides.
+    None,
+}
+
+/// The bias axis: offsets that keep a surface from shadowing itself (acne) without
+/// detaching shadows from their casters (peter-panning).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BiasSettings {
+    /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
+    /// For Depth32Float one unit is 2^(e−23) for a primitive whose largest depth has
+    /// exponent e: about 6e-8 at depth 0.5.
+    #[arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias")]
+    pub depth_bias: i32,
+    /// Rasterizer slope-scaled depth bias (D3D `SlopeScaledDepthBias`): multiplies the
+    /// caster's depth slope per shadow texel, so 1 pushes a surface back by the depth
+    /// it spans across one texel. Must be finite and ≥ 0.
+    #[arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias")]
+    pub slope_bias: f32,
+    /// Normal-offset bias: the receiver is pushed along its surface normal by this many
+    /// shadow texels (world size of a texel at the receiver) before the lookup. ≥ 0.
+    #[arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias")]
+    pub normal_offset: f32,
+    /// Faces culled when drawing casters into the shadow map.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow bias")]
+    pub cull: CullMode,
+}
+
+impl BiasSettings {
+    /// No bias at all, for demonstrating acne.
+    pub fn none() -> Self {
+        Self { depth_bias: 0, slope_bias: 0.0, normal_offset: 0.0, cull: CullMode::Back }
+    }
+}
+
+impl Default for BiasSettings {
+    fn default() -> Self {
+        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.6, cull: CullMode::Back }
+    }
+}
+
+/// The storage format of the shadow map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MapFormat {
+    /// 32-bit float depth: exact enough for every technique here, and filterable by comparison.
+    #[default]
+    Depth32float,
+}
+
+/// The map axis: the shadow map's size and format.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MapSettings {
+    /// Shadow map width and height in texels: 256 to 8192, and at most the device's
+    /// maximum 2D texture size.
+    #[arg(long = "shadow-res", value_name = "TEXELS", default_value_t = MapSettings::default().resolution, help_heading = "Shadow map")]
+    pub resolution: u32,
+    /// Shadow map texel format.
+    #[arg(long = "shadow-format", value_enum, default_value_t, help_heading = "Shadow map")]
+    pub format: MapFormat,
+}
+
+impl Default for MapSettings {
+    fn default() -> Self {
+        Self { resolution: 2048, format: MapFormat::default() }
+    }
+}
+
+/// How the light's view is split into shadow maps.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Partition {
+    /// One map covering everything the light sees (fitted to the scene bounds for a sun).
+    #[default]
+    Single,
+}
+
+/// Shadow settings, one field per orthogonal axis.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct ShadowSettings {
+    #[command(flatten)]
+    pub filter: FilterSettings,
+    #[command(flatten)]
+    pub bias: BiasSettings,
+    #[command(flatten)]
+    pub map: MapSettings,
+    /// Partition of the light's view into maps.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub partition: Partition,
+}
+
+/// A setting outside its valid range. The message names the flag and what is valid.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("{flag} = {value} is invalid: {valid}")]
+pub struct SettingsError {
+    pub flag: &'static str,
+    pub value: String,
+    pub valid: String,
+}
+
+fn check(ok: bool, flag: &'static str, value: impl ToString, valid: impl Into<String>) -> Result<(), SettingsError> {
+    if ok { Ok(()) } else { Err(SettingsError { flag, value: value.to_string(), valid: valid.into() }) }
+}
+
+fn check_opt(v: Option<f32>, flag: &'static str, ok: impl Fn(f32) -> bool, valid: &str) -> Result<(), SettingsError> {
+    match v {
+        Some(x) => check(x.is_finite() && ok(x), flag, x, valid),
+        None => Ok(()),
+    }
+}
+
+fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
+    match v {
+        Some(p) => check(p.is_finite(), flag, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
+        None => Ok(()),
+    }
+}
+
+/// The largest shadow map Gnomon allows, whatever the device.
+pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
+/// The smallest shadow map Gnomon allows.
+pub const MIN_SHADOW_RESOLUTION: u32 = 256;
+
+impl Settings {
+    /// Checks every value against its documented range. Device-dependent limits (the
+    /// largest texture) are checked by the renderer, which knows the device.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let i = &self.image;
+        check((1..=16384).contains(&i.width), "--width", i.width, "1 to 16384 pixels")?;
+        check((1..=16384).contains(&i.height), "--height", i.height, "1 to 16384 pixels")?;
+        let c = &self.camera;
+        check_vec(c.eye, "--camera-eye")?;
+        check_vec(c.target, "--camera-target")?;
+        check_opt(c.fov_y_degrees, "--fov", |x| x > 0.0 && x < 180.0, "between 0 and 180 degrees, exclusive")?;
+        check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
+        check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
+        let l = &self.light;
+        check_opt(l.sun_elevation, "--sun-elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
+        check_opt(l.sun_azimuth, "--sun-azimuth", |_| true, "a finite angle in degrees")?;
+        check_vec(l.spot_position, "--spot-position")?;
+        check_vec(l.spot_target, "--spot-target")?;
+        check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
+        check_opt(l.spot_inner_angle, "--spot-inner-angle", |x| x >= 0.0 && x <= 89.0, "in [0, outer angle] degrees")?;
+        check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
+        let s = &self.shadow;
+        check(
+            matches!(s.filter.pcf_kernel, 3 | 5 | 7 | 9),
+            "--pcf-kernel",
+            s.filter.pcf_kernel,
+            "3, 5, 7 or 9",
+        )?;
+        let b = &s.bias;
+        check(b.slope_bias.is_finite() && b.slope_bias >= 0.0, "--slope-bias", b.slope_bias, "a finite factor ≥ 0")?;
+        check(b.normal_offset.is_finite() && b.normal_offset >= 0.0, "--normal-offset", b.normal_offset, "a finite number of texels ≥ 0")?;
+        let r = s.map.resolution;
+        check(
+            (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
+            "--shadow-res",
+            r,
+            format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
+        )?;
+        Ok(())
+    }
+
+    /// The camera: the scene's, with these settings' overrides applied.
+    pub fn resolve_camera(&self, scene: &Scene) -> Result<Camera, SettingsError> {
+        let c = &self.camera;
+        let mut cam = scene.camera;
+        cam.eye = c.eye.unwrap_or(cam.eye);
+        cam.target = c.target.unwrap_or(cam.target);
+        cam.fov_y_degrees = c.fov_y_degrees.unwrap_or(cam.fov_y_degrees);
+        cam.near = c.near.unwrap_or(cam.near);
+        cam.far = c.far.unwrap_or(cam.far);
+        check(cam.far > cam.near, "--camera-far", cam.far, format!("greater than the near distance {}", cam.near))?;
+        check((cam.target - cam.eye).length() > 1e-6, "--camera-target", "the eye position", "a point different from the camera position")?;
+        Ok(cam)
+    }
+
+    /// The light: the scene's light of the chosen kind, with these settings' overrides.
+    pub fn resolve_light(&self, scene: &Scene) -> Result<Light, SettingsError> {
+        let l = &self.light;
+        Ok(match l.kind {
+            LightKind::Sun => {
+                let mut sun = scene.sun;
+                if l.sun_elevation.is_some() || l.sun_azimuth.is_some() {
+                    let to_sun = -sun.direction;
+                    let elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
+                    let azimuth = to_sun.x.atan2(to_sun.z).to_degrees();
+                    sun.direction = -sun_direction(
+                        l.sun_elevation.unwrap_or(elevation),
+                        l.sun_azimuth.unwrap_or(azimuth),
+                    );
+                }
+                Light::Directional(sun)
+            }
+            LightKind::Spot => {
+                let mut spot = scene.spot;
+                let target = spot.position + spot.direction;
+                spot.position = l.spot_position.unwrap_or(spot.position);
+                if l.spot_position.is_some() || l.spot_target.is_some() {
+                    let aim = l.spot_target.unwrap_or(target) - spot.position;
+                    check(aim.length() > 1e-6, "--spot-target", "the spot position", "a point different from the spot light's position")?;
+                    spot.direction = aim.normalize();
+                }
+                if let Some(outer) = l.spot_outer_angle {
+                    spot.outer_angle_degrees = outer;
+                    spot.inner_angle_degrees = 0.8 * outer;
+                }
+                if let Some(inner) = l.spot_inner_angle {
+                    spot.inner_angle_degrees = inner;
+                }
+                check(
+                    spot.inner_angle_degrees <= spot.outer_angle_degrees,
+                    "--spot-inner-angle",
+                    spot.inner_angle_degrees,
+                    format!("at most the outer angle {}", spot.outer_angle_degrees),
+                )?;
+                spot.range = l.spot_range.unwrap_or(spot.range);
+                Light::Spot(spot)
+            }
+        })
+    }
+}
+
+/// Parses `X,Y,Z` into a vector.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three comma-separated numbers X,Y,Z, got `{s}`"));
+    }
+    let mut v = [0.0f32; 3];
+    for (slot, part) in v.iter_mut().zip(&parts) {
+        *slot = part.parse().map_err(|_| format!("`{part}` in `{s}` is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("`{part}` in `{s}` is not finite"));
+        }
+    }
+    Ok(Vec3::from_array(v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        settings: Settings,
+    }
+
+    #[test]
+    fn flag_defaults_equal_struct_defaults() {
+        let parsed = Cli::try_parse_from(["gnomon"]).unwrap().settings;
+        assert_eq!(parsed, Settings::default());
+        parsed.validate().unwrap();
+    }
+
+    #[test]
+    fn flags_and_toml_agree() {
+        let parsed = Cli::try_parse_from([
+            "gnomon", "--technique", "pcf", "--pcf-kernel", "5", "--shadow-res", "1024",
+            "--slope-bias", "2.5", "--cull", "front", "--light", "spot", "--camera-eye", "1,2,3",
+        ])
+        .unwrap()
+        .settings;
+        let text = r#"
+            [camera]
+            eye = [1.0, 2.0, 3.0]
+            [light]
+            kind = "spot"
+            [shadow.filter]
+            technique = "pcf"
+            pcf_kernel = 5
+            [shadow.bias]
+            slope_bias = 2.5
+            cull = "front"
+            [shadow.map]
+            resolution = 1024
+        "#;
+        let from_file: Settings = toml::from_str(text).unwrap();
+        assert_eq!(parsed, from_file);
+        // And a round trip through TOML keeps everything.
+        let again: Settings = toml::from_str(&toml::to_string(&parsed).unwrap()).unwrap();
+        assert_eq!(again, parsed);
+    }
+
+    #[test]
+    fn invalid_values_name_the_flag_and_the_range() {
+        let mut s = Settings::default();
+        s.shadow.map.resolution = 100;
+        let e = s.validate().unwrap_err();
+        assert_eq!(e.flag, "--shadow-res");
+        assert!(e.to_string().contains("256 to 8192"), "{e}");
+        let mut s = Settings::default();
+        s.shadow.filter.pcf_kernel = 4;
+        assert_eq!(s.validate().unwrap_err().flag, "--pcf-kernel");
+        let mut s = Settings::default();
+        s.camera.fov_y_degrees = Some(180.0);
+        assert_eq!(s.validate().unwrap_err().flag, "--fov");
+        assert!(parse_vec3("1,2").is_err() && parse_vec3("1,x,3").is_err() && parse_vec3("1,inf,2").is_err());
+        assert_eq!(parse_vec3(" 1, 2.5,-3").unwrap(), Vec3::new(1.0, 2.5, -3.0));
+    }
+
+    #[test]
+    fn technique_names_are_the_flag_values() {
+        let names: Vec<_> = Technique::all().iter().map(|t| t.name()).collect();
+        assert_eq!(names, ["hard", "pcf2x2", "pcf"]);
+    }
+
+    #[test]
+    fn sun_overrides_keep_the_other_angle() {
+        let scene = crate::builtin::spheres();
+        let mut s = Settings::default();
+        s.light.sun_elevation = Some(30.0);
+        let Light::Directional(sun) = s.resolve_light(&scene).unwrap() else { panic!() };
+        assert!(((-sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
+        let (a0, a1) = (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
+        assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
+    }
+}
