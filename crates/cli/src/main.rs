@@ -1,1 +1,79 @@
-fn main() {}
+//! `gnomon`: the command-line front end. Parses flags (generated from the typed
+//! settings in `gnomon-scene`), runs the renderer, and writes images and float outputs.
+
+mod output;
+mod render_cmd;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Gnomon: a real-time shadow-mapping engine and lab.
+#[derive(Parser)]
+#[command(name = "gnomon", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene with a shadow technique to a PNG (the default command).
+    Render(Box<render_cmd::RenderArgs>),
+    /// List the built-in scenes.
+    Scenes,
+    /// List the shadow techniques.
+    Techniques,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => render_cmd::run(&render_cmd::RenderArgs::default_from_cli()),
+        Some(Command::Render(args)) => render_cmd::run(&args),
+        Some(Command::Scenes) => {
+            for b in gnomon_scene::builtin::BUILTINS {
+                println!("{:<10} {}", b.name, b.description);
+            }
+            Ok(())
+        }
+        Some(Command::Techniques) => {
+            use clap::ValueEnum;
+            for t in gnomon_scene::settings::Technique::all() {
+                let help = t
+                    .to_possible_value()
+                    .and_then(|v| v.get_help().map(|h| h.to_string()))
+                    .unwrap_or_default();
+                println!("{:<8} {help}", t.name());
+            }
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("gnomon: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    use super::Cli;
+
+    /// Every option of every subcommand explains itself in `--help`.
+    #[test]
+    fn every_option_has_help_text() {
+        let mut command = Cli::command();
+        command.build();
+        for sub in command.get_subcommands() {
+            for arg in sub.get_arguments() {
+                let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+                assert!(!help.trim().is_empty(), "`{} --{}` has no help", sub.get_name(), arg.get_id());
+            }
+        }
+    }
+}

@@ -11,14 +11,14 @@
 //! - Matrices are named `to_from_from`: `clip_from_world` maps world points to clip space.
 
 mod aabb;
-mod projection;
 mod light;
+mod projection;
 
 pub use aabb::Aabb;
 pub use light::{LightProjection, ProjectionKind, directional_light_projection, spot_light_projection};
 pub use projection::{
-    camera_clip_from_view, linearize_perspective_depth, ndc_to_texture, texture_from_ndc,
-    texture_to_ndc, view_from_world_look_at,
+    camera_clip_from_view, linearize_perspective_depth, ndc_to_texture, texture_from_ndc, texture_to_ndc,
+    view_from_world_look_at,
 };
 
 pub use glam;

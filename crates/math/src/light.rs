@@ -36,9 +36,7 @@ impl LightProjection {
     pub fn texel_world_size(&self, resolution: u32, distance: f32) -> f32 {
         match self.kind {
             ProjectionKind::Orthographic { width, height } => width.max(height) / resolution as f32,
-            ProjectionKind::Perspective { fov } => {
-                2.0 * distance * (0.5 * fov).tan() / resolution as f32
-            }
+            ProjectionKind::Perspective { fov } => 2.0 * distance * (0.5 * fov).tan() / resolution as f32,
         }
     }
 
@@ -76,8 +74,7 @@ pub fn directional_light_projection(direction: Vec3, bounds: &Aabb) -> LightProj
     // View space looks down −z: the nearest point has the largest z.
     let near = -in_light.max.z - margin;
     let far = -in_light.min.z + margin;
-    let clip_from_light =
-        glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far);
+    let clip_from_light = glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far);
     LightProjection {
         light_from_world,
         clip_from_light,

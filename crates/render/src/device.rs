@@ -34,7 +34,20 @@ pub struct Gpu {
 impl Gpu {
     /// Picks an adapter without a surface and opens a device on it, asking for the
     /// adapter's own limits so that large shadow maps are available where supported.
+    ///
+    /// `GNOMON_MAX_TEXTURE_SIZE=N` caps the 2D texture size below the adapter's, to
+    /// check settings against a smaller GPU than the one at hand.
     pub fn new_headless() -> Result<Self, RenderError> {
+        let cap = std::env::var("GNOMON_MAX_TEXTURE_SIZE").ok().and_then(|v| v.trim().parse::<u32>().ok());
+        Self::new_headless_with(|limits| {
+            if let Some(cap) = cap {
+                limits.max_texture_dimension_2d = limits.max_texture_dimension_2d.min(cap.max(1));
+            }
+        })
+    }
+
+    /// Like [`Gpu::new_headless`], letting `adjust` lower the limits asked for.
+    pub fn new_headless_with(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let backends = match std::env::var("WGPU_BACKEND") {
             Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
@@ -43,14 +56,18 @@ impl Gpu {
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
             .map_err(|_| RenderError::NoAdapter { backends })?;
         let adapter_info = adapter.get_info();
-        let limits = adapter.limits();
+        let mut limits = adapter.limits();
+        adjust(&mut limits);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gnomon"),
             required_features: wgpu::Features::empty(),
             required_limits: limits.clone(),
             ..Default::default()
         }))
-        .map_err(|e| RenderError::DeviceRequest { adapter: adapter_info.name.clone(), reason: e.to_string() })?;
+        .map_err(|e| RenderError::DeviceRequest {
+            adapter: adapter_info.name.clone(),
+            reason: e.to_string(),
+        })?;
         let info = GpuInfo {
             adapter: adapter_info.name,
             backend: format!("{:?}", adapter_info.backend),

@@ -80,7 +80,11 @@ pub struct Renderer<'g> {
 }
 
 impl<'g> Renderer<'g> {
-    pub fn new(gpu: &'g Gpu) -> Self {
+    pub fn new(gpu: &'g Gpu) -> Result<Self, RenderError> {
+        gpu.checked("creating the renderer", || Self::new_unchecked(gpu))
+    }
+
+    fn new_unchecked(gpu: &'g Gpu) -> Self {
         let device = &gpu.device;
         let layouts = Layouts::new(device);
         let compare_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -108,7 +112,12 @@ impl<'g> Renderer<'g> {
 
     /// Uploads `scene` and renders it. To render one scene many times, upload it once
     /// with [`GpuScene::upload`] and call [`Renderer::render_uploaded`].
-    pub fn render(&mut self, scene: &Scene, settings: &Settings, request: &OutputRequest) -> Result<Frame, RenderError> {
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
         settings.validate()?;
         let uploaded = GpuScene::upload(self.gpu, scene)?;
         self.render_uploaded(&uploaded, scene, settings, request)
@@ -154,7 +163,8 @@ impl<'g> Renderer<'g> {
         let resolution = shadow.map.resolution;
         let projection = light_projection(scene, &light);
         let technique = techniques::lookup(shadow.filter.technique);
-        let light_gpu = light_uniform(scene, &light, &projection, settings, technique.filter_params(&shadow.filter));
+        let light_gpu =
+            light_uniform(scene, &light, &projection, settings, technique.filter_params(&shadow.filter));
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
         let camera_gpu = CameraGpu {
@@ -206,15 +216,22 @@ impl<'g> Renderer<'g> {
                 label: Some("shadow map"),
                 layout: &self.layouts.shadow,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&shadow_view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.compare_sampler) },
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&shadow_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
+                    },
                 ],
             });
             let targets: Vec<wgpu::Texture> = lighting::TARGETS
                 .iter()
                 .map(|&format| render_target(device, width, height, format))
                 .collect();
-            let target_views: Vec<wgpu::TextureView> = targets.iter().map(|t| t.create_view(&Default::default())).collect();
+            let target_views: Vec<wgpu::TextureView> =
+                targets.iter().map(|t| t.create_view(&Default::default())).collect();
             let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
             let depth_view = depth.create_view(&Default::default());
 
@@ -225,7 +242,10 @@ impl<'g> Renderer<'g> {
                     color_attachments: &[],
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: &shadow_view,
-                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
                         stencil_ops: None,
                     }),
                     timestamp_writes: None,
@@ -239,12 +259,19 @@ impl<'g> Renderer<'g> {
             {
                 let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
                     .iter()
-                    .map(|view| {
+                    .enumerate()
+                    .map(|(i, view)| {
+                        // The colour image gets an opaque sky; the data targets zero
+                        // (object id 0 marks background).
+                        let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
                         Some(wgpu::RenderPassColorAttachment {
                             view,
                             depth_slice: None,
                             resolve_target: None,
-                            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Clear(clear),
+                                store: wgpu::StoreOp::Store,
+                            },
                         })
                     })
                     .collect();
@@ -253,7 +280,10 @@ impl<'g> Renderer<'g> {
                     color_attachments: &attachments,
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: &depth_view,
-                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Discard,
+                        }),
                         stencil_ops: None,
                     }),
                     timestamp_writes: None,
@@ -326,7 +356,15 @@ impl<'g> Renderer<'g> {
     }
 }
 
-fn render_target(device: &wgpu::Device, width: u32, height: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+/// Background colour of the image, linear RGB.
+const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
+
+fn render_target(
+    device: &wgpu::Device,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some("render target"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -366,8 +404,13 @@ fn light_uniform(
     let common = LightGpu {
         clip_from_world: projection.clip_from_world(),
         light_from_world: projection.light_from_world,
-        texel: Vec4::new(texel_ortho, texel_per_distance, settings.shadow.bias.normal_offset, resolution as f32),
-        filter: Vec4::from_array(filter),
+        texel: Vec4::new(
+            texel_ortho,
+            texel_per_distance,
+            settings.shadow.bias.normal_offset,
+            resolution as f32,
+        ),
+        params: Vec4::from_array(filter),
         ambient: scene.ambient.extend(0.0),
         cone: Vec4::new(1.0, -1.0, projection.near, projection.far),
         ..Default::default()
@@ -392,4 +435,3 @@ fn light_uniform(
         },
     }
 }
-

@@ -115,7 +115,11 @@ impl GpuScene {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         for d in self.draws.iter().filter(|d| d.casts_shadow || !casters_only) {
-            pass.draw_indexed(d.first_index..d.first_index + d.index_count, d.base_vertex, d.instance..d.instance + 1);
+            pass.draw_indexed(
+                d.first_index..d.first_index + d.index_count,
+                d.base_vertex,
+                d.instance..d.instance + 1,
+            );
         }
     }
 }

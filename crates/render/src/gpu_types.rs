@@ -32,7 +32,7 @@ pub struct LightGpu {
     /// distance for a perspective map; z: normal offset in texels; w: map resolution.
     pub texel: Vec4,
     /// Technique parameters, defined by each technique module.
-    pub filter: Vec4,
+    pub params: Vec4,
     /// rgb: ambient light.
     pub ambient: Vec4,
 }

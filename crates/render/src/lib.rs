@@ -6,7 +6,7 @@
 //! # fn main() -> Result<(), gnomon_render::RenderError> {
 //! let gpu = gnomon_render::Gpu::new_headless()?;
 //! let scene = gnomon_scene::builtin::spheres();
-//! let mut renderer = gnomon_render::Renderer::new(&gpu);
+//! let mut renderer = gnomon_render::Renderer::new(&gpu)?;
 //! let frame = renderer.render(&scene, &gnomon_scene::Settings::default(), &Default::default())?;
 //! println!("{} of {} pixels lit", frame.visibility.iter().filter(|v| **v > 0.5).count(), frame.pixel_count());
 //! # Ok(()) }
@@ -44,7 +44,9 @@ pub enum RenderError {
         gnomon_scene::settings::MAX_SHADOW_RESOLUTION
     )]
     ShadowMapTooLarge { requested: u32, max: u32, adapter: String },
-    #[error("an image of {width}×{height} is larger than adapter `{adapter}` allows: at most {max} pixels a side")]
+    #[error(
+        "an image of {width}×{height} is larger than adapter `{adapter}` allows: at most {max} pixels a side"
+    )]
     ImageTooLarge { width: u32, height: u32, max: u32, adapter: String },
     #[error(
         "adapter `{adapter}` allows {available} bytes of colour attachments per pixel; the lighting \

@@ -22,7 +22,8 @@ pub(crate) fn record(
     let (width, height) = (texture.width(), texture.height());
     let bytes_per_texel = texture.format().block_copy_size(Some(aspect)).unwrap_or(4);
     let unpadded = width * bytes_per_texel;
-    let padded_bytes_per_row = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded_bytes_per_row =
+        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: padded_bytes_per_row as u64 * height as u64,
@@ -63,9 +64,10 @@ impl PendingReadback {
         let row = (self.width * self.bytes_per_texel) as usize;
         let mut bytes = Vec::with_capacity(row * self.height as usize);
         {
-            let mapped = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })?;
+            let mapped = slice.get_mapped_range().map_err(|e| RenderError::Gpu {
+                during: "mapping a readback buffer",
+                message: e.to_string(),
+            })?;
             for y in 0..self.height as usize {
                 let start = y * self.padded_bytes_per_row as usize;
                 bytes.extend_from_slice(&mapped[start..start + row]);

@@ -3,9 +3,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::{
-    Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, geometry, sun_direction,
-};
+use crate::{Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, geometry, sun_direction};
 
 /// A built-in scene: its name, what it shows, and how to build it.
 pub struct Builtin {
@@ -16,10 +14,26 @@ pub struct Builtin {
 
 /// Every built-in scene. The first is the default.
 pub const BUILTINS: &[Builtin] = &[
-    Builtin { name: "spheres", description: "a box and nine spheres on a ground plane: the classic test scene", build: spheres },
-    Builtin { name: "contact", description: "objects resting on the ground, thin walls and a narrow gap: peter-panning and leaks", build: contact },
-    Builtin { name: "grazing", description: "a large plane lit at a grazing angle with a few casters: shadow acne", build: grazing },
-    Builtin { name: "columns", description: "a long ground with rows of columns far from the camera: a large depth range", build: columns },
+    Builtin {
+        name: "spheres",
+        description: "a box and nine spheres on a ground plane: the classic test scene",
+        build: spheres,
+    },
+    Builtin {
+        name: "contact",
+        description: "objects resting on the ground, thin walls and a narrow gap: peter-panning and leaks",
+        build: contact,
+    },
+    Builtin {
+        name: "grazing",
+        description: "a large plane lit at a grazing angle with a few casters: shadow acne",
+        build: grazing,
+    },
+    Builtin {
+        name: "columns",
+        description: "a long ground with rows of columns far from the camera: a large depth range",
+        build: columns,
+    },
 ];
 
 /// Builds the built-in scene called `name`, or `None` when there is none.
@@ -164,7 +178,12 @@ pub fn contact() -> Scene {
         near: 0.1,
         far: 60.0,
     };
-    b.finish("contact", camera, sun(35.0, 200.0), spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0))
+    b.finish(
+        "contact",
+        camera,
+        sun(35.0, 200.0),
+        spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0),
+    )
 }
 
 /// An 80 × 80 plane under a sun 6° above the horizon, with three 3 m posts and a box.
@@ -188,7 +207,12 @@ pub fn grazing() -> Scene {
         near: 0.1,
         far: 200.0,
     };
-    b.finish("grazing", camera, sun(6.0, 250.0), spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0))
+    b.finish(
+        "grazing",
+        camera,
+        sun(6.0, 250.0),
+        spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0),
+    )
 }
 
 /// A 20 × 400 ground running along −z with two rows of 6 m columns every 8 m, seen
@@ -213,7 +237,12 @@ pub fn columns() -> Scene {
         near: 0.1,
         far: 500.0,
     };
-    b.finish("columns", camera, sun(40.0, 60.0), spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0))
+    b.finish(
+        "columns",
+        camera,
+        sun(40.0, 60.0),
+        spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0),
+    )
 }
 
 #[cfg(test)]

@@ -129,7 +129,9 @@ mod tests {
 
     #[test]
     fn builders_wind_counter_clockwise_outward() {
-        for m in [plane(2.0, 3.0), cuboid(Vec3::new(1.0, 2.0, 0.5)), uv_sphere(1.0, 16, 8), cylinder(0.5, 2.0, 12)] {
+        for m in
+            [plane(2.0, 3.0), cuboid(Vec3::new(1.0, 2.0, 0.5)), uv_sphere(1.0, 16, 8), cylinder(0.5, 2.0, 12)]
+        {
             assert_outward_winding(&m);
             assert_eq!(m.positions.len(), m.normals.len());
             assert_eq!(m.positions.len(), m.uvs.len());

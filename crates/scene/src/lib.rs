@@ -7,7 +7,6 @@ mod model;
 pub mod settings;
 
 pub use model::{
-    Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight,
-    sun_direction,
+    Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight, sun_direction,
 };
 pub use settings::Settings;

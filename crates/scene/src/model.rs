@@ -1,7 +1,7 @@
 //! The scene model: what the renderer draws and what the reference ray tracer traces.
 
-use gnomon_math::Aabb;
 use glam::{Mat4, Vec2, Vec3};
+use gnomon_math::Aabb;
 
 /// A triangle mesh in object space. Triangles are counter-clockwise when seen from
 /// the side their normals point to.
@@ -149,11 +149,17 @@ pub struct Scene {
 pub enum SceneError {
     #[error("scene `{scene}`: instance `{instance}` refers to mesh {mesh}, but there are {count} meshes")]
     MeshOutOfRange { scene: String, instance: String, mesh: usize, count: usize },
-    #[error("scene `{scene}`: instance `{instance}` refers to material {material}, but there are {count} materials")]
+    #[error(
+        "scene `{scene}`: instance `{instance}` refers to material {material}, but there are {count} materials"
+    )]
     MaterialOutOfRange { scene: String, instance: String, material: usize, count: usize },
-    #[error("scene `{scene}`: mesh `{mesh}` has {positions} positions, {normals} normals and {uvs} UVs; all three must match")]
+    #[error(
+        "scene `{scene}`: mesh `{mesh}` has {positions} positions, {normals} normals and {uvs} UVs; all three must match"
+    )]
     AttributeCountMismatch { scene: String, mesh: String, positions: usize, normals: usize, uvs: usize },
-    #[error("scene `{scene}`: mesh `{mesh}` has an index {index} beyond its {vertices} vertices, or an index count not a multiple of 3")]
+    #[error(
+        "scene `{scene}`: mesh `{mesh}` has an index {index} beyond its {vertices} vertices, or an index count not a multiple of 3"
+    )]
     BadIndices { scene: String, mesh: String, index: u32, vertices: usize },
     #[error("scene `{scene}`: mesh `{mesh}` has a non-finite position or normal")]
     NonFinite { scene: String, mesh: String },
@@ -179,7 +185,11 @@ impl Scene {
             let (p, n, t) = (m.positions.len(), m.normals.len(), m.uvs.len());
             if p != n || p != t {
                 return Err(SceneError::AttributeCountMismatch {
-                    scene, mesh: m.name.clone(), positions: p, normals: n, uvs: t,
+                    scene,
+                    mesh: m.name.clone(),
+                    positions: p,
+                    normals: n,
+                    uvs: t,
                 });
             }
             if m.indices.len() % 3 != 0 || m.indices.iter().any(|&i| i as usize >= p) {
@@ -193,12 +203,18 @@ impl Scene {
         for i in &self.instances {
             if i.mesh >= self.meshes.len() {
                 return Err(SceneError::MeshOutOfRange {
-                    scene, instance: i.name.clone(), mesh: i.mesh, count: self.meshes.len(),
+                    scene,
+                    instance: i.name.clone(),
+                    mesh: i.mesh,
+                    count: self.meshes.len(),
                 });
             }
             if i.material >= self.materials.len() {
                 return Err(SceneError::MaterialOutOfRange {
-                    scene, instance: i.name.clone(), material: i.material, count: self.materials.len(),
+                    scene,
+                    instance: i.name.clone(),
+                    material: i.material,
+                    count: self.materials.len(),
                 });
             }
         }

@@ -269,11 +269,21 @@ pub struct SettingsError {
     pub valid: String,
 }
 
-fn check(ok: bool, flag: &'static str, value: impl ToString, valid: impl Into<String>) -> Result<(), SettingsError> {
+fn check(
+    ok: bool,
+    flag: &'static str,
+    value: impl ToString,
+    valid: impl Into<String>,
+) -> Result<(), SettingsError> {
     if ok { Ok(()) } else { Err(SettingsError { flag, value: value.to_string(), valid: valid.into() }) }
 }
 
-fn check_opt(v: Option<f32>, flag: &'static str, ok: impl Fn(f32) -> bool, valid: &str) -> Result<(), SettingsError> {
+fn check_opt(
+    v: Option<f32>,
+    flag: &'static str,
+    ok: impl Fn(f32) -> bool,
+    valid: &str,
+) -> Result<(), SettingsError> {
     match v {
         Some(x) => check(x.is_finite() && ok(x), flag, x, valid),
         None => Ok(()),
@@ -302,7 +312,12 @@ impl Settings {
         let c = &self.camera;
         check_vec(c.eye, "--camera-eye")?;
         check_vec(c.target, "--camera-target")?;
-        check_opt(c.fov_y_degrees, "--fov", |x| x > 0.0 && x < 180.0, "between 0 and 180 degrees, exclusive")?;
+        check_opt(
+            c.fov_y_degrees,
+            "--fov",
+            |x| x > 0.0 && x < 180.0,
+            "between 0 and 180 degrees, exclusive",
+        )?;
         check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
         check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
         let l = &self.light;
@@ -311,7 +326,12 @@ impl Settings {
         check_vec(l.spot_position, "--spot-position")?;
         check_vec(l.spot_target, "--spot-target")?;
         check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
-        check_opt(l.spot_inner_angle, "--spot-inner-angle", |x| x >= 0.0 && x <= 89.0, "in [0, outer angle] degrees")?;
+        check_opt(
+            l.spot_inner_angle,
+            "--spot-inner-angle",
+            |x| (0.0..=89.0).contains(&x),
+            "in [0, outer angle] degrees",
+        )?;
         check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
         let s = &self.shadow;
         check(
@@ -321,8 +341,18 @@ impl Settings {
             "3, 5, 7 or 9",
         )?;
         let b = &s.bias;
-        check(b.slope_bias.is_finite() && b.slope_bias >= 0.0, "--slope-bias", b.slope_bias, "a finite factor ≥ 0")?;
-        check(b.normal_offset.is_finite() && b.normal_offset >= 0.0, "--normal-offset", b.normal_offset, "a finite number of texels ≥ 0")?;
+        check(
+            b.slope_bias.is_finite() && b.slope_bias >= 0.0,
+            "--slope-bias",
+            b.slope_bias,
+            "a finite factor ≥ 0",
+        )?;
+        check(
+            b.normal_offset.is_finite() && b.normal_offset >= 0.0,
+            "--normal-offset",
+            b.normal_offset,
+            "a finite number of texels ≥ 0",
+        )?;
         let r = s.map.resolution;
         check(
             (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
@@ -342,8 +372,18 @@ impl Settings {
         cam.fov_y_degrees = c.fov_y_degrees.unwrap_or(cam.fov_y_degrees);
         cam.near = c.near.unwrap_or(cam.near);
         cam.far = c.far.unwrap_or(cam.far);
-        check(cam.far > cam.near, "--camera-far", cam.far, format!("greater than the near distance {}", cam.near))?;
-        check((cam.target - cam.eye).length() > 1e-6, "--camera-target", "the eye position", "a point different from the camera position")?;
+        check(
+            cam.far > cam.near,
+            "--camera-far",
+            cam.far,
+            format!("greater than the near distance {}", cam.near),
+        )?;
+        check(
+            (cam.target - cam.eye).length() > 1e-6,
+            "--camera-target",
+            "the eye position",
+            "a point different from the camera position",
+        )?;
         Ok(cam)
     }
 
@@ -370,7 +410,12 @@ impl Settings {
                 spot.position = l.spot_position.unwrap_or(spot.position);
                 if l.spot_position.is_some() || l.spot_target.is_some() {
                     let aim = l.spot_target.unwrap_or(target) - spot.position;
-                    check(aim.length() > 1e-6, "--spot-target", "the spot position", "a point different from the spot light's position")?;
+                    check(
+                        aim.length() > 1e-6,
+                        "--spot-target",
+                        "the spot position",
+                        "a point different from the spot light's position",
+                    )?;
                     spot.direction = aim.normalize();
                 }
                 if let Some(outer) = l.spot_outer_angle {
@@ -430,8 +475,21 @@ mod tests {
     #[test]
     fn flags_and_toml_agree() {
         let parsed = Cli::try_parse_from([
-            "gnomon", "--technique", "pcf", "--pcf-kernel", "5", "--shadow-res", "1024",
-            "--slope-bias", "2.5", "--cull", "front", "--light", "spot", "--camera-eye", "1,2,3",
+            "gnomon",
+            "--technique",
+            "pcf",
+            "--pcf-kernel",
+            "5",
+            "--shadow-res",
+            "1024",
+            "--slope-bias",
+            "2.5",
+            "--cull",
+            "front",
+            "--light",
+            "spot",
+            "--camera-eye",
+            "1,2,3",
         ])
         .unwrap()
         .settings;
@@ -486,7 +544,8 @@ mod tests {
         s.light.sun_elevation = Some(30.0);
         let Light::Directional(sun) = s.resolve_light(&scene).unwrap() else { panic!() };
         assert!(((-sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
-        let (a0, a1) = (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
+        let (a0, a1) =
+            (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
         assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
     }
 }

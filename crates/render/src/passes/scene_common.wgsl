@@ -26,7 +26,7 @@ struct Light {
     position: vec4<f32>,     // xyz: spot position; w: range
     cone: vec4<f32>,         // x: cos inner, y: cos outer, z: near, w: far
     texel: vec4<f32>,        // x: ortho texel size, y: texel size per unit distance, z: normal offset (texels), w: map size
-    filter: vec4<f32>,       // technique parameters, see each technique
+    params: vec4<f32>,       // technique parameters, see each technique
     ambient: vec4<f32>,      // rgb: ambient light
 };
 

@@ -19,7 +19,7 @@ pub trait ShadowTechnique: Sync {
     fn technique(&self) -> Technique;
     /// WGSL source defining `sample_shadow`.
     fn wgsl(&self) -> &'static str;
-    /// The four floats passed to the shader as `light.filter`.
+    /// The four floats passed to the shader as `light.params`.
     fn filter_params(&self, settings: &FilterSettings) -> [f32; 4];
 }
 
@@ -28,11 +28,9 @@ pub static REGISTRY: &[&dyn ShadowTechnique] = &[&hard::Hard, &pcf::Pcf2x2, &pcf
 
 /// The registered implementation of `technique`.
 pub fn lookup(technique: Technique) -> &'static dyn ShadowTechnique {
-    REGISTRY
-        .iter()
-        .copied()
-        .find(|t| t.technique() == technique)
-        .unwrap_or_else(|| unreachable!("technique {technique:?} is not registered; see `every_technique_is_registered_once`"))
+    REGISTRY.iter().copied().find(|t| t.technique() == technique).unwrap_or_else(|| {
+        unreachable!("technique {technique:?} is not registered; see `every_technique_is_registered_once`")
+    })
 }
 
 #[cfg(test)]

@@ -1,9 +1,9 @@
 // The PCF family (Reeves, Salesin & Cook 1987), on the comparison sampler:
-// light.filter.x = 0: one bilinear comparison tap (hardware 2×2 PCF);
-// light.filter.x = N > 0: an N×N box of bilinear taps one texel apart.
+// light.params.x = 0: one bilinear comparison tap (hardware 2×2 PCF);
+// light.params.x = N > 0: an N×N box of bilinear taps one texel apart.
 
 fn sample_shadow(coords: vec3<f32>) -> f32 {
-    let n = i32(light.filter.x);
+    let n = i32(light.params.x);
     if n <= 0 {
         return textureSampleCompareLevel(shadow_map, shadow_compare, coords.xy, coords.z);
     }

@@ -1,0 +1,247 @@
+//! Output files: PNG, OpenEXR and `.npy` encoders, and staging so that a failed run
+//! leaves no partial file behind (everything is written to a temporary file beside
+//! its destination and renamed only once every output has been encoded).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use glam::Vec3;
+use gnomon_math::{LightProjection, ProjectionKind, linearize_perspective_depth};
+use gnomon_render::ShadowMapImage;
+
+/// Fails unless `path` has one of `extensions` and its directory exists.
+pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !ext.as_deref().is_some_and(|e| extensions.contains(&e)) {
+        bail!(
+            "{flag} {}: the file name must end in {}",
+            path.display(),
+            extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ")
+        );
+    }
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        bail!(
+            "{flag} {}: cannot write there, the directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    if path.is_dir() {
+        bail!("{flag} {}: is a directory, expected a file name", path.display());
+    }
+    Ok(())
+}
+
+/// Fails unless `dir` is a directory or could be created (its parent exists).
+pub fn check_dir(dir: &Path, flag: &str) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{flag} {}: exists and is not a directory", dir.display());
+    }
+    if !dir.exists() && !parent_dir(dir).is_dir() {
+        bail!("{flag} {}: cannot create it, its parent directory does not exist", dir.display());
+    }
+    Ok(())
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Encoded files waiting to be moved into place.
+#[derive(Default)]
+pub struct Staged {
+    files: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        for (temp, _) in &self.files {
+            let _ = std::fs::remove_file(temp);
+        }
+    }
+}
+
+impl Staged {
+    fn temp_for(&mut self, path: &Path) -> PathBuf {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let temp = parent_dir(path).join(format!(".{name}.gnomon-{}.tmp", std::process::id()));
+        self.files.push((temp.clone(), path.to_path_buf()));
+        temp
+    }
+
+    fn write_with(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&Path) -> anyhow::Result<()>,
+    ) -> anyhow::Result<()> {
+        let temp = self.temp_for(path);
+        write(&temp).with_context(|| format!("cannot write {}", path.display()))
+    }
+
+    pub fn png_rgba(&mut self, path: &Path, width: u32, height: u32, rgba: &[u8]) -> anyhow::Result<()> {
+        self.write_with(path, |temp| {
+            image::save_buffer_with_format(
+                temp,
+                rgba,
+                width,
+                height,
+                image::ExtendedColorType::Rgba8,
+                image::ImageFormat::Png,
+            )?;
+            Ok(())
+        })
+    }
+
+    pub fn png_gray16(&mut self, path: &Path, width: u32, height: u32, gray: &[u16]) -> anyhow::Result<()> {
+        self.write_with(path, |temp| {
+            // `image` takes 16-bit samples in native byte order and writes PNG's big-endian.
+            let bytes: &[u8] = bytemuck::cast_slice(gray);
+            image::save_buffer_with_format(
+                temp,
+                bytes,
+                width,
+                height,
+                image::ExtendedColorType::L16,
+                image::ImageFormat::Png,
+            )?;
+            Ok(())
+        })
+    }
+
+    /// One float channel, by the path's extension: `.exr` (channel `Y`) or `.npy`.
+    pub fn float_image(
+        &mut self,
+        path: &Path,
+        width: u32,
+        height: u32,
+        values: &[f32],
+    ) -> anyhow::Result<()> {
+        let npy = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+        self.write_with(path, |temp| {
+            if npy {
+                write_npy(temp, width, height, values)
+            } else {
+                write_exr_y(temp, width, height, values)
+            }
+        })
+    }
+
+    pub fn exr_rgb(&mut self, path: &Path, width: u32, height: u32, values: &[Vec3]) -> anyhow::Result<()> {
+        self.write_with(path, |temp| {
+            let w = width as usize;
+            exr::prelude::write_rgb_file(temp, w, height as usize, |x, y| {
+                let v = values[y * w + x];
+                (v.x, v.y, v.z)
+            })?;
+            Ok(())
+        })
+    }
+
+    /// Moves every staged file into place and returns the destinations.
+    pub fn commit(mut self) -> anyhow::Result<Vec<PathBuf>> {
+        let files = std::mem::take(&mut self.files);
+        let mut done = Vec::new();
+        for (i, (temp, dest)) in files.iter().enumerate() {
+            if let Err(e) = std::fs::rename(temp, dest) {
+                for (t, _) in &files[i..] {
+                    let _ = std::fs::remove_file(t);
+                }
+                return Err(e).with_context(|| format!("cannot write {}", dest.display()));
+            }
+            done.push(dest.clone());
+        }
+        Ok(done)
+    }
+}
+
+/// A single-channel float32 OpenEXR file with channel `Y`.
+fn write_exr_y(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::Result<()> {
+    use exr::prelude::*;
+    let w = width as usize;
+    let channels = SpecificChannels::build()
+        .with_channel("Y")
+        .with_pixel_fn(|p: Vec2<usize>| (values[p.y() * w + p.x()],));
+    Image::from_channels((w, height as usize), channels).write().to_file(path)?;
+    Ok(())
+}
+
+/// A NumPy `.npy` file (format version 1.0): little-endian float32, C order, shape
+/// (height, width).
+fn write_npy(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::Result<()> {
+    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({height}, {width}), }}");
+    // Magic (6) + version (2) + header length (2) + header + '\n' must be a multiple of 64.
+    let unpadded = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
+    header.push('\n');
+    let mut bytes = Vec::with_capacity(10 + header.len() + 4 * values.len());
+    bytes.extend_from_slice(b"\x93NUMPY\x01\x00");
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    for v in values {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, bytes)?;
+    Ok(())
+}
+
+/// The shadow map as 16-bit gray: depth linearized for perspective maps, then
+/// stretched over the range the casters cover. Empty texels (depth 1) are white.
+pub fn shadow_map_to_gray16(map: &ShadowMapImage, projection: &LightProjection) -> Vec<u16> {
+    let linear = |d: f32| match projection.kind {
+        ProjectionKind::Perspective { .. } => {
+            let z = linearize_perspective_depth(d, projection.near, projection.far);
+            (z - projection.near) / (projection.far - projection.near)
+        }
+        ProjectionKind::Orthographic { .. } => d,
+    };
+    let covered = map.depth.iter().copied().filter(|&d| d < 1.0).map(linear);
+    let (lo, hi) = covered.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    map.depth
+        .iter()
+        .map(|&d| {
+            if d >= 1.0 {
+                u16::MAX
+            } else {
+                (((linear(d) - lo) / span).clamp(0.0, 1.0) * 65535.0).round() as u16
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_header_is_aligned_and_data_follows() {
+        let dir = std::env::temp_dir().join(format!("gnomon-npy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("v.npy");
+        write_npy(&path, 3, 2, &[0.0, 0.5, 1.0, f32::NAN, 0.25, 0.75]).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        assert_eq!((10 + header_len) % 64, 0);
+        let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+        assert!(header.contains("'shape': (2, 3)") && header.contains("'<f4'"), "{header}");
+        let data = &bytes[10 + header_len..];
+        assert_eq!(data.len(), 24);
+        assert_eq!(f32::from_le_bytes(data[4..8].try_into().unwrap()), 0.5);
+        assert!(f32::from_le_bytes(data[12..16].try_into().unwrap()).is_nan());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn file_checks_name_the_flag_and_the_problem() {
+        let e = check_file(Path::new("out.jpg"), &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("--out") && e.contains(".png"), "{e}");
+        let e = check_file(Path::new("/no/such/dir/out.png"), &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("does not exist"), "{e}");
+        assert!(check_file(Path::new("out.png"), &["png"], "--out").is_ok());
+    }
+}

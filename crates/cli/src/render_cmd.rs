@@ -1,0 +1,129 @@
+//! `gnomon render`: one scene, one light, one technique, to an image and optional
+//! float outputs.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use gnomon_render::{Gpu, OutputRequest, Renderer};
+use gnomon_scene::{Settings, builtin};
+
+use crate::output::{self, Staged};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Built-in scene to render (see `gnomon scenes`).
+    #[arg(default_value = "spheres")]
+    pub scene: String,
+    /// Output image (PNG, sRGB).
+    #[arg(long, short, default_value = "gnomon.png", help_heading = "Outputs")]
+    pub out: PathBuf,
+    /// Also write the light's depth map as a 16-bit grayscale PNG: depth stretched to
+    /// the covered range (near = black), linearized first for perspective (spot) maps;
+    /// texels with no caster are white.
+    #[arg(long, value_name = "FILE.png", help_heading = "Outputs")]
+    pub shadow_map_out: Option<PathBuf>,
+    /// Also write the per-pixel shadow factor as 32-bit float: `.exr` (one channel `Y`)
+    /// or `.npy` (float32, shape (height, width), top row first). 1 is lit, 0 is
+    /// shadowed (and outside a spot light's cone); background pixels are NaN.
+    #[arg(long, value_name = "FILE.exr|FILE.npy", help_heading = "Outputs")]
+    pub visibility_out: Option<PathBuf>,
+    /// Also write per-pixel float images to this directory (created if missing):
+    /// position.exr (world XYZ), normal.exr (world XYZ), depth.exr (view depth, Y),
+    /// object_id.exr (instance index + 1, Y; 0 is background) and visibility.exr.
+    /// Background pixels are NaN in the first three.
+    #[arg(long, value_name = "DIR", help_heading = "Outputs")]
+    pub aov_out: Option<PathBuf>,
+    /// Print the adapter, driver and backend used, and timings.
+    #[arg(long, short)]
+    pub verbose: bool,
+    #[command(flatten)]
+    pub settings: Settings,
+}
+
+impl RenderArgs {
+    /// The arguments of a bare `gnomon` invocation: every default.
+    pub fn default_from_cli() -> Self {
+        use clap::FromArgMatches;
+        let command = <Self as Args>::augment_args(clap::Command::new("render"));
+        let matches = command.get_matches_from(["render"]);
+        Self::from_arg_matches(&matches).expect("defaults always parse")
+    }
+}
+
+pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+    let started = std::time::Instant::now();
+    let settings = &args.settings;
+    settings.validate()?;
+    let scene = builtin::build(&args.scene).with_context(|| {
+        format!("unknown scene `{}`: the built-in scenes are {}", args.scene, builtin::names().join(", "))
+    })?;
+
+    // Check every output location before any work, so that a typo costs nothing.
+    output::check_file(&args.out, &["png"], "--out")?;
+    if let Some(p) = &args.shadow_map_out {
+        output::check_file(p, &["png"], "--shadow-map-out")?;
+    }
+    if let Some(p) = &args.visibility_out {
+        output::check_file(p, &["exr", "npy"], "--visibility-out")?;
+    }
+    if let Some(dir) = &args.aov_out {
+        output::check_dir(dir, "--aov-out")?;
+    }
+
+    let gpu = Gpu::new_headless()?;
+    if args.verbose {
+        eprintln!("gnomon: {}", gpu.info);
+    }
+    let mut renderer = Renderer::new(&gpu)?;
+    renderer.check_limits(settings)?;
+    let request = OutputRequest { shadow_map: args.shadow_map_out.is_some() };
+    let render_started = std::time::Instant::now();
+    let frame = renderer.render(&scene, settings, &request)?;
+    if args.verbose {
+        eprintln!(
+            "gnomon: scene `{}` ({} triangles, {} instances), {}×{}, technique {}, shadow map {}², rendered in {:.1} ms",
+            scene.name,
+            scene.triangle_count(),
+            scene.instances.len(),
+            frame.width,
+            frame.height,
+            settings.shadow.filter.technique.name(),
+            frame.shadow_resolution,
+            render_started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+
+    // Encode everything to temporary files first; rename only when all succeeded.
+    let mut staged = Staged::default();
+    staged.png_rgba(&args.out, frame.width, frame.height, &frame.color)?;
+    if let (Some(path), Some(map)) = (&args.shadow_map_out, &frame.shadow_map) {
+        let linear = output::shadow_map_to_gray16(map, &frame.light_projection);
+        staged.png_gray16(path, map.resolution, map.resolution, &linear)?;
+    }
+    if let Some(path) = &args.visibility_out {
+        staged.float_image(path, frame.width, frame.height, &frame.visibility)?;
+    }
+    if let Some(dir) = &args.aov_out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--aov-out: cannot create directory {}", dir.display()))?;
+        let (w, h) = (frame.width, frame.height);
+        staged.exr_rgb(&dir.join("position.exr"), w, h, &frame.position)?;
+        staged.exr_rgb(&dir.join("normal.exr"), w, h, &frame.normal)?;
+        staged.float_image(&dir.join("depth.exr"), w, h, &frame.depth)?;
+        let ids: Vec<f32> = frame.object_id.iter().map(|&i| i as f32).collect();
+        staged.float_image(&dir.join("object_id.exr"), w, h, &ids)?;
+        staged.float_image(&dir.join("visibility.exr"), w, h, &frame.visibility)?;
+    }
+    let written = staged.commit()?;
+    for path in &written {
+        println!("{}", path.display());
+    }
+    if args.verbose {
+        eprintln!("gnomon: done in {:.1} ms", started.elapsed().as_secs_f64() * 1e3);
+    }
+    if written.is_empty() {
+        bail!("nothing was written");
+    }
+    Ok(())
+}

@@ -1,0 +1,144 @@
+//! End-to-end tests of the `gnomon` binary: the default render, the float outputs,
+//! and bad input (clear message, non-zero exit, no file left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn gnomon(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gnomon")).current_dir(dir).args(args).output().expect("run gnomon")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("gnomon-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn no_arguments_renders_spheres_to_gnomon_png() {
+    let dir = temp_dir("default");
+    let out = gnomon(&dir, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "gnomon.png");
+    let image = image::open(dir.join("gnomon.png")).unwrap().to_rgba8();
+    assert_eq!(image.dimensions(), (1280, 720));
+    // Not blank: the image has sky, lit ground and shadow, so many distinct colours.
+    let distinct: std::collections::HashSet<_> = image.pixels().map(|p| p.0).collect();
+    assert!(distinct.len() > 1000, "only {} distinct colours", distinct.len());
+    assert_eq!(files_in(&dir), ["gnomon.png"]);
+}
+
+#[test]
+fn float_outputs_are_written_with_their_documented_layout() {
+    let dir = temp_dir("floats");
+    let out = gnomon(
+        &dir,
+        &[
+            "render",
+            "contact",
+            "--width",
+            "160",
+            "--height",
+            "90",
+            "--shadow-res",
+            "512",
+            "--out",
+            "c.png",
+            "--visibility-out",
+            "v.npy",
+            "--shadow-map-out",
+            "map.png",
+            "--aov-out",
+            "aov",
+            "--verbose",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("adapter:") && stderr(&out).contains("backend:"),
+        "--verbose names the adapter: {}",
+        stderr(&out)
+    );
+    let bytes = std::fs::read(dir.join("v.npy")).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(header.contains("'shape': (90, 160)"), "{header}");
+    let values: Vec<f32> =
+        bytes[10 + header_len..].chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    assert_eq!(values.len(), 160 * 90);
+    assert!(values.iter().all(|v| v.is_nan() || (0.0..=1.0).contains(v)));
+    let lit = values.iter().filter(|v| **v > 0.5).count();
+    let shadowed = values.iter().filter(|v| **v < 0.5).count();
+    assert!(lit > 1000 && shadowed > 100, "lit {lit}, shadowed {shadowed}");
+    let map = image::open(dir.join("map.png")).unwrap();
+    assert_eq!((map.width(), map.height()), (512, 512));
+    assert!(matches!(map, image::DynamicImage::ImageLuma16(_)));
+    assert_eq!(
+        files_in(&dir.join("aov")),
+        ["depth.exr", "normal.exr", "object_id.exr", "position.exr", "visibility.exr"]
+    );
+}
+
+#[test]
+fn an_unknown_scene_names_the_valid_ones() {
+    let dir = temp_dir("unknown");
+    let out = gnomon(&dir, &["render", "nope"]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(e.contains("unknown scene `nope`") && e.contains("spheres, contact, grazing, columns"), "{e}");
+    assert!(files_in(&dir).is_empty());
+}
+
+#[test]
+fn a_shadow_map_beyond_the_device_limit_is_refused() {
+    let dir = temp_dir("limit");
+    let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(&dir)
+        .env("GNOMON_MAX_TEXTURE_SIZE", "2048")
+        .args(["render", "--shadow-res", "4096"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(e.contains("--shadow-res = 4096") && e.contains("up to 2048"), "{e}");
+    assert!(files_in(&dir).is_empty());
+    let out = gnomon(&dir, &["render", "--shadow-res", "100000"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("256 to 8192"), "{}", stderr(&out));
+    assert!(files_in(&dir).is_empty());
+}
+
+#[test]
+fn an_unwritable_output_fails_cleanly_and_writes_nothing() {
+    let dir = temp_dir("unwritable");
+    std::fs::write(dir.join("a-file"), b"x").unwrap();
+    // The directory of --out does not exist.
+    let out = gnomon(&dir, &["render", "--out", "missing/x.png"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("missing") && stderr(&out).contains("does not exist"), "{}", stderr(&out));
+    // One good output and one bad: neither is written.
+    let out = gnomon(
+        &dir,
+        &["render", "--width", "64", "--height", "64", "--out", "ok.png", "--visibility-out", "a-file/v.npy"],
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--visibility-out"), "{}", stderr(&out));
+    // A wrong extension names the valid ones.
+    let out = gnomon(&dir, &["render", "--visibility-out", "v.txt"]);
+    assert!(stderr(&out).contains(".exr or .npy"), "{}", stderr(&out));
+    assert_eq!(files_in(&dir), ["a-file"]);
+}

@@ -1,0 +1,173 @@
+//! GPU tests against analytic shadows: a square occluder over a plane under a sun
+//! and under a spot light. The shadow boundary must be within one shadow texel plus
+//! one pixel of the exact projection, for every technique of the foundation.
+
+mod support;
+
+use glam::{Mat4, Vec2, Vec3};
+use gnomon_scene::{Light, geometry, settings::Technique};
+use support::*;
+
+/// Signed distance from `p` to the axis-aligned square of half-size `half` at
+/// `center` (negative inside).
+fn square_distance(p: Vec2, center: Vec2, half: f32) -> f32 {
+    let d = (p - center).abs() - Vec2::splat(half);
+    d.max(Vec2::ZERO).length() + d.max_element().min(0.0)
+}
+
+struct BoundaryReport {
+    compared: usize,
+    shadowed: usize,
+    mismatched: usize,
+    worst_excess: f32,
+}
+
+/// Compares the ground pixels of `frame` with an analytic shadow given by
+/// `distance_to_shadow_edge` (negative inside the shadow). A mismatch is allowed
+/// only within one texel plus one pixel footprint of the exact edge.
+fn check_boundary(
+    frame: &gnomon_render::Frame,
+    distance_to_shadow_edge: impl Fn(Vec3) -> f32,
+    texel: impl Fn(Vec3) -> f32,
+) -> BoundaryReport {
+    let mut r = BoundaryReport { compared: 0, shadowed: 0, mismatched: 0, worst_excess: f32::NEG_INFINITY };
+    for i in 0..frame.pixel_count() {
+        // Ground only (object id 1), and only where the ground faces up toward the light.
+        if frame.object_id[i] != 1 || frame.visibility[i].is_nan() {
+            continue;
+        }
+        let p = frame.position[i];
+        let d = distance_to_shadow_edge(p);
+        let analytic_shadow = d < 0.0;
+        let shadowed = frame.visibility[i] < 0.5;
+        r.compared += 1;
+        r.shadowed += shadowed as usize;
+        if analytic_shadow != shadowed {
+            r.mismatched += 1;
+            let allowed = texel(p) + pixel_footprint(frame, i);
+            r.worst_excess = r.worst_excess.max(d.abs() - allowed);
+        }
+    }
+    r
+}
+
+fn techniques() -> Vec<(Technique, u32)> {
+    vec![(Technique::Hard, 3), (Technique::Pcf2x2, 3), (Technique::Pcf, 3), (Technique::Pcf, 7)]
+}
+
+#[test]
+fn square_occluder_under_a_sun_matches_the_analytic_projection() {
+    let (half, height) = (1.0, 1.5);
+    let center = Vec3::new(0.5, height, -0.5);
+    let mut scene = ground_scene("analytic sun", 12.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
+    scene.camera.target = Vec3::ZERO;
+    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
+    scene.sun.direction = sun_dir;
+    // The shadow is the square translated along the light by height / (−d.y).
+    let offset = Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    let shadow_center = Vec2::new(center.x, center.z) + offset;
+
+    for (technique, kernel) in techniques() {
+        let mut s = settings(640, 480, 1024);
+        s.shadow.filter.technique = technique;
+        s.shadow.filter.pcf_kernel = kernel;
+        let frame = render(&scene, &s);
+        let texel = frame.light_projection.texel_world_size(1024, 0.0);
+        let r =
+            check_boundary(&frame, |p| square_distance(Vec2::new(p.x, p.z), shadow_center, half), |_| texel);
+        let label = format!("{technique:?} {kernel}");
+        // The analytic shadow is 2 × 2 units, several thousand pixels here.
+        assert!(r.shadowed > 2000, "{label}: only {} shadowed pixels", r.shadowed);
+        assert!(r.compared > 100_000, "{label}: only {} ground pixels", r.compared);
+        assert!(
+            r.worst_excess <= 0.0,
+            "{label}: a mismatch lies {} beyond one texel ({texel}) plus one pixel of the edge ({} of {} pixels mismatched)",
+            r.worst_excess,
+            r.mismatched,
+            r.compared
+        );
+    }
+}
+
+#[test]
+fn spot_light_cone_and_shadow_match_the_perspective_projection() {
+    let (light_height, half, occluder_height) = (8.0, 0.75, 2.0);
+    let occluder_center = Vec3::new(1.0, occluder_height, 0.5);
+    let mut scene = ground_scene("analytic spot", 16.0);
+    add(
+        &mut scene,
+        "square",
+        geometry::plane(2.0 * half, 2.0 * half),
+        Mat4::from_translation(occluder_center),
+    );
+    scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
+    scene.camera.target = Vec3::ZERO;
+    scene.spot.position = Vec3::new(0.0, light_height, 0.0);
+    scene.spot.direction = Vec3::NEG_Y;
+    scene.spot.outer_angle_degrees = 30.0;
+    scene.spot.inner_angle_degrees = 25.0;
+    scene.spot.range = 20.0;
+    // Seen from a point light at height H, a square at height h projects onto the
+    // ground scaled by k = H / (H − h) about the light's foot.
+    let k = light_height / (light_height - occluder_height);
+    let shadow_center = Vec2::new(occluder_center.x, occluder_center.z) * k;
+    let cone_radius = light_height * 30f32.to_radians().tan();
+
+    for (technique, kernel) in techniques() {
+        let mut s = settings(640, 480, 1024);
+        s.light.kind = gnomon_scene::settings::LightKind::Spot;
+        s.shadow.filter.technique = technique;
+        s.shadow.filter.pcf_kernel = kernel;
+        let frame = render(&scene, &s);
+        let Light::Spot(spot) = frame.light else { panic!("spot expected") };
+        assert_eq!(spot.position, scene.spot.position);
+        let label = format!("{technique:?} {kernel}");
+
+        // Outside the cone: no light at all, so visibility 0 and only ambient colour.
+        let mut outside = 0;
+        for i in 0..frame.pixel_count() {
+            if frame.object_id[i] != 1 {
+                continue;
+            }
+            let p = frame.position[i];
+            let r = Vec2::new(p.x, p.z).length();
+            if r > cone_radius + pixel_footprint(&frame, i) {
+                outside += 1;
+                assert_eq!(frame.visibility[i], 0.0, "{label}: lit outside the cone at {p}");
+                let ambient = srgb_encode(scene.ambient.x * 0.7);
+                let c = frame.color[4 * i] as f32;
+                assert!(
+                    (c - ambient).abs() <= 2.0,
+                    "{label}: colour {c} outside the cone, ambient alone is {ambient}"
+                );
+            }
+        }
+        assert!(outside > 10_000, "{label}: the view must include ground outside the cone ({outside})");
+
+        // Inside the cone: the occluder's shadow is where the perspective projection puts it.
+        let r = check_boundary(
+            &frame,
+            |p| {
+                let in_cone = Vec2::new(p.x, p.z).length() < cone_radius;
+                if in_cone { square_distance(Vec2::new(p.x, p.z), shadow_center, half * k) } else { -1e9 }
+            },
+            |p| frame.shadow_texel_world_size(p),
+        );
+        assert!(r.shadowed > 2000, "{label}: only {} shadowed pixels", r.shadowed);
+        assert!(
+            r.worst_excess <= 0.0,
+            "{label}: a mismatch lies {} beyond one texel plus one pixel of the edge ({} of {} mismatched)",
+            r.worst_excess,
+            r.mismatched,
+            r.compared
+        );
+    }
+}
+
+/// Linear [0, 1] to an 8-bit sRGB value.
+fn srgb_encode(linear: f32) -> f32 {
+    let s = if linear <= 0.0031308 { 12.92 * linear } else { 1.055 * linear.powf(1.0 / 2.4) - 0.055 };
+    255.0 * s
+}

@@ -1,0 +1,135 @@
+//! Shared helpers for the GPU tests: one device per test binary, brute-force shadow
+//! rays for ground truth on small procedural scenes, and pixel footprints.
+#![allow(dead_code)]
+
+use std::sync::OnceLock;
+
+use glam::{Mat4, Vec3};
+use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
+use gnomon_scene::{Instance, Light, Material, Scene, Settings, geometry};
+
+/// The device shared by the tests in one binary (WGPU_BACKEND is honoured; CI sets vulkan).
+pub fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
+}
+
+pub fn render(scene: &Scene, settings: &Settings) -> Frame {
+    let mut renderer = Renderer::new(gpu()).expect("renderer");
+    renderer.render(scene, settings, &OutputRequest::default()).expect("render")
+}
+
+pub fn settings(width: u32, height: u32, resolution: u32) -> Settings {
+    let mut s = Settings::default();
+    s.image.width = width;
+    s.image.height = height;
+    s.shadow.map.resolution = resolution;
+    s
+}
+
+/// A ground plane of `size` at y = 0 and nothing else, lit by a sun from straight
+/// above, seen from above; callers add occluders and set the lights.
+pub fn ground_scene(name: &str, size: f32) -> Scene {
+    let mut scene = gnomon_scene::builtin::spheres();
+    scene.name = name.into();
+    scene.meshes = vec![geometry::plane(size, size)];
+    scene.materials =
+        vec![Material::new("ground", Vec3::splat(0.7)), Material::new("occluder", Vec3::new(0.8, 0.3, 0.2))];
+    scene.instances = vec![Instance {
+        name: "ground".into(),
+        mesh: 0,
+        material: 0,
+        world_from_object: Mat4::IDENTITY,
+        casts_shadow: true,
+    }];
+    scene
+}
+
+/// Adds a mesh and one instance of it.
+pub fn add(scene: &mut Scene, name: &str, mesh: gnomon_scene::Mesh, world_from_object: Mat4) {
+    scene.meshes.push(mesh);
+    scene.instances.push(Instance {
+        name: name.into(),
+        mesh: scene.meshes.len() - 1,
+        material: 1,
+        world_from_object,
+        casts_shadow: true,
+    });
+}
+
+/// Möller–Trumbore ray/triangle distance, if hit in (0, max_t).
+fn ray_triangle(origin: Vec3, dir: Vec3, a: Vec3, b: Vec3, c: Vec3, max_t: f32) -> bool {
+    let (e1, e2) = (b - a, c - a);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 {
+        return false;
+    }
+    let inv = 1.0 / det;
+    let s = origin - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let t = e2.dot(q) * inv;
+    t > 0.0 && t < max_t
+}
+
+fn ray_box(origin: Vec3, inv_dir: Vec3, min: Vec3, max: Vec3, max_t: f32) -> bool {
+    let t0 = (min - origin) * inv_dir;
+    let t1 = (max - origin) * inv_dir;
+    let near = t0.min(t1).max_element();
+    let far = t0.max(t1).min_element();
+    near <= far && far > 0.0 && near < max_t
+}
+
+/// Exact (brute-force) hard-shadow visibility of `point` with normal `normal`: true
+/// when nothing blocks the segment to the light. For small procedural scenes only.
+pub fn ray_traced_lit(scene: &Scene, light: &Light, point: Vec3, normal: Vec3) -> bool {
+    let origin = point + normal * 1e-4 * (1.0 + point.abs().max_element());
+    let (dir, max_t) = match light {
+        Light::Directional(sun) => (-sun.direction.normalize(), f32::INFINITY),
+        Light::Spot(spot) => {
+            let to = spot.position - origin;
+            (to.normalize(), to.length())
+        }
+    };
+    let inv_dir = dir.recip();
+    for inst in scene.instances.iter().filter(|i| i.casts_shadow) {
+        let mesh = &scene.meshes[inst.mesh];
+        let bounds = mesh.bounds().transformed(inst.world_from_object);
+        if !ray_box(origin, inv_dir, bounds.min - 1e-4, bounds.max + 1e-4, max_t) {
+            continue;
+        }
+        for t in mesh.indices.chunks(3) {
+            let [a, b, c] =
+                [0, 1, 2].map(|k| inst.world_from_object.transform_point3(mesh.positions[t[k] as usize]));
+            if ray_triangle(origin, dir, a, b, c, max_t) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// World size of pixel `i`: the largest distance to a horizontal or vertical
+/// neighbour on the same object.
+pub fn pixel_footprint(frame: &Frame, i: usize) -> f32 {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let (x, y) = (i % w, i / w);
+    let mut size = 0.0f32;
+    for (nx, ny) in [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)] {
+        if nx < w && ny < h {
+            let j = ny * w + nx;
+            if frame.object_id[j] == frame.object_id[i] {
+                size = size.max(frame.position[j].distance(frame.position[i]));
+            }
+        }
+    }
+    size
+}
