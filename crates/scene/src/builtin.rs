@@ -108,7 +108,7 @@ fn spot(position: Vec3, target: Vec3, outer_degrees: f32, range: f32) -> SpotLig
         outer_angle_degrees: outer_degrees,
         range,
         color: Vec3::new(1.0, 0.95, 0.85),
-        intensity: 1.6,
+        intensity: 1.0,
     }
 }
 
