@@ -4,8 +4,15 @@
 # Does nothing when a Vulkan driver (ICD) is already installed.
 set -eu
 
-if ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 \
-    && ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+have_icd=no
+for f in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json; do
+    [ -e "$f" ] && have_icd=yes
+done
+have_loader=no
+for f in /usr/lib/*/libvulkan.so.1 /usr/lib/libvulkan.so.1 /usr/lib64/libvulkan.so.1; do
+    [ -e "$f" ] && have_loader=yes
+done
+if [ "$have_icd" = yes ] && [ "$have_loader" = yes ]; then
     exit 0
 fi
 

@@ -1,7 +1,12 @@
 //! `gnomon`: the command-line front end. Parses flags (generated from the typed
 //! settings in `gnomon-scene`), runs the renderer, and writes images and float outputs.
 
+mod cache;
+mod compare_cmd;
+mod grid;
+mod lab;
 mod output;
+mod reference_cmd;
 mod render_cmd;
 
 use std::process::ExitCode;
@@ -20,6 +25,10 @@ struct Cli {
 enum Command {
     /// Render a scene with a shadow technique to a PNG (the default command).
     Render(Box<render_cmd::RenderArgs>),
+    /// Ray-trace the exact (or Monte Carlo area-light) visibility of the light.
+    Reference(Box<reference_cmd::ReferenceArgs>),
+    /// Render techniques and the reference; write metrics, heat-maps and a grid.
+    Compare(Box<compare_cmd::CompareArgs>),
     /// List the built-in scenes.
     Scenes,
     /// List the shadow techniques.
@@ -31,6 +40,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => render_cmd::run(&render_cmd::RenderArgs::default_from_cli()),
         Some(Command::Render(args)) => render_cmd::run(&args),
+        Some(Command::Reference(args)) => reference_cmd::run(&args),
+        Some(Command::Compare(args)) => compare_cmd::run(&args),
         Some(Command::Scenes) => {
             for b in gnomon_scene::builtin::BUILTINS {
                 println!("{:<10} {}", b.name, b.description);

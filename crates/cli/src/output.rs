@@ -141,6 +141,10 @@ impl Staged {
         })
     }
 
+    pub fn text(&mut self, path: &Path, text: &str) -> anyhow::Result<()> {
+        self.write_with(path, |temp| Ok(std::fs::write(temp, text)?))
+    }
+
     /// Moves every staged file into place and returns the destinations.
     pub fn commit(mut self) -> anyhow::Result<Vec<PathBuf>> {
         let files = std::mem::take(&mut self.files);
@@ -186,6 +190,22 @@ fn write_npy(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::Re
     }
     std::fs::write(path, bytes)?;
     Ok(())
+}
+
+/// Visibility as RGBA8 gray (V = 1 white), with background (NaN) dark blue-grey.
+pub fn visibility_rgba(visibility: &[f32]) -> Vec<u8> {
+    visibility
+        .iter()
+        .flat_map(|&v| {
+            if v.is_nan() {
+                let [r, g, b] = gnomon_reference::heatmap::BACKGROUND;
+                [r, g, b, 255]
+            } else {
+                let g = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+                [g, g, g, 255]
+            }
+        })
+        .collect()
 }
 
 /// The shadow map as 16-bit gray: depth linearized for perspective maps, then

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Args;
 use gnomon_render::{Gpu, OutputRequest, Renderer};
-use gnomon_scene::{Settings, builtin};
+use gnomon_scene::Settings;
 
 use crate::output::{self, Staged};
 
@@ -55,9 +55,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     let settings = &args.settings;
     settings.validate()?;
-    let scene = builtin::build(&args.scene).with_context(|| {
-        format!("unknown scene `{}`: the built-in scenes are {}", args.scene, builtin::names().join(", "))
-    })?;
+    let scene = crate::lab::load_scene(&args.scene)?;
 
     // Check every output location before any work, so that a typo costs nothing.
     output::check_file(&args.out, &["png"], "--out")?;

@@ -142,3 +142,76 @@ fn an_unwritable_output_fails_cleanly_and_writes_nothing() {
     assert!(stderr(&out).contains(".exr or .npy"), "{}", stderr(&out));
     assert_eq!(files_in(&dir), ["a-file"]);
 }
+
+#[test]
+fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
+    let dir = temp_dir("compare");
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_gnomon"))
+            .current_dir(&dir)
+            .env("GNOMON_CACHE_DIR", dir.join("cache"))
+            .args(["compare", "contact", "--width", "160", "--height", "90", "--shadow-res", "512"])
+            .args(["--techniques", "hard,pcf2x2", "--out", "cmp", "--timing-frames", "2"])
+            .output()
+            .unwrap()
+    };
+    let out = run();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(table.contains("| hard |") && table.contains("| pcf2x2 |"), "{table}");
+    assert_eq!(
+        files_in(&dir.join("cmp")),
+        [
+            "grid.png",
+            "hard-error.png",
+            "hard.png",
+            "metrics.json",
+            "metrics.md",
+            "pcf2x2-error.png",
+            "pcf2x2.png",
+            "reference.png"
+        ]
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cmp/metrics.json")).unwrap()).unwrap();
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for row in rows {
+        let compared = row["compared"].as_u64().unwrap();
+        assert!(compared > 5000, "{row}");
+        let rate = row["mismatch_rate"].as_f64().unwrap();
+        assert!((0.0..0.05).contains(&rate), "{row}");
+    }
+    let grid = image::open(dir.join("cmp/grid.png")).unwrap();
+    assert!(grid.width() > 960 && grid.height() > 3 * 270 / 2, "{}×{}", grid.width(), grid.height());
+    // The second run reuses the reference.
+    let again = run();
+    assert!(again.status.success());
+    assert!(stderr(&again).contains("loaded from the cache"), "{}", stderr(&again));
+    // Same metrics from the cached reference (the timings differ run to run).
+    let again: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cmp/metrics.json")).unwrap()).unwrap();
+    for (a, b) in rows.iter().zip(again["rows"].as_array().unwrap()) {
+        for key in ["compared", "silhouette", "false_shadow", "false_lit", "mae", "p99"] {
+            assert_eq!(a[key], b[key], "{key}");
+        }
+    }
+}
+
+#[test]
+fn reference_writes_visibility_and_standard_error() {
+    let dir = temp_dir("reference");
+    let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(&dir)
+        .env("GNOMON_CACHE_DIR", dir.join("cache"))
+        .args(["reference", "spheres", "--light", "spot", "--spot-radius", "0.4", "--samples", "16"])
+        .args(["--width", "96", "--height", "54", "--out", "r.exr", "--std-error-out", "se.npy"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("Mrays/s") && stderr(&out).contains("standard error"), "{}", stderr(&out));
+    let names = files_in(&dir);
+    assert!(names.contains(&"r.exr".to_string()) && names.contains(&"se.npy".to_string()), "{names:?}");
+    let bad = gnomon(&dir, &["reference", "--samples", "4"]);
+    assert!(!bad.status.success() && stderr(&bad).contains("--samples"), "{}", stderr(&bad));
+}

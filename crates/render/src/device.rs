@@ -29,6 +29,8 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     pub info: GpuInfo,
     pub limits: wgpu::Limits,
+    /// Nanoseconds per timestamp tick, when the device can time passes.
+    pub timestamp_period_ns: Option<f32>,
 }
 
 impl Gpu {
@@ -60,7 +62,8 @@ impl Gpu {
         adjust(&mut limits);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gnomon"),
-            required_features: wgpu::Features::empty(),
+            // Timestamps time each pass where the adapter has them (lavapipe does).
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: limits.clone(),
             ..Default::default()
         }))
@@ -68,6 +71,8 @@ impl Gpu {
             adapter: adapter_info.name.clone(),
             reason: e.to_string(),
         })?;
+        let timestamp_period_ns =
+            device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let info = GpuInfo {
             adapter: adapter_info.name,
             backend: format!("{:?}", adapter_info.backend),
@@ -75,7 +80,7 @@ impl Gpu {
             driver: adapter_info.driver,
             driver_info: adapter_info.driver_info,
         };
-        Ok(Self { device, queue, info, limits })
+        Ok(Self { device, queue, info, limits, timestamp_period_ns })
     }
 
     /// Runs `f`, turning any validation, out-of-memory or internal error it raises

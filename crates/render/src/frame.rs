@@ -56,6 +56,15 @@ pub struct Frame {
     pub light_projection: LightProjection,
     pub shadow_resolution: u32,
     pub shadow_map: Option<ShadowMapImage>,
+    /// GPU time of each pass, where the device has timestamp queries.
+    pub timings: Option<PassTimings>,
+}
+
+/// GPU time per pass, in milliseconds, from timestamp queries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassTimings {
+    pub shadow_ms: f64,
+    pub lighting_ms: f64,
 }
 
 impl Frame {
@@ -175,7 +184,7 @@ impl<'g> Renderer<'g> {
 
         let gpu = self.gpu;
         let device = &gpu.device;
-        let (pending, shadow_pending) = gpu.checked("rendering the frame", || {
+        let (pending, shadow_pending, timestamps) = gpu.checked("rendering the frame", || {
             let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("light"),
                 contents: bytemuck::bytes_of(&light_gpu),
@@ -235,6 +244,21 @@ impl<'g> Renderer<'g> {
             let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
             let depth_view = depth.create_view(&Default::default());
 
+            let queries = gpu.timestamp_period_ns.map(|_| {
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 4,
+                })
+            });
+            let pass_timestamps = |first: u32| {
+                queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(first),
+                    end_of_pass_write_index: Some(first + 1),
+                })
+            };
+
             let mut encoder = device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -248,7 +272,7 @@ impl<'g> Renderer<'g> {
                         }),
                         stencil_ops: None,
                     }),
-                    timestamp_writes: None,
+                    timestamp_writes: pass_timestamps(0),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -286,7 +310,7 @@ impl<'g> Renderer<'g> {
                         }),
                         stencil_ops: None,
                     }),
-                    timestamp_writes: None,
+                    timestamp_writes: pass_timestamps(2),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -303,8 +327,11 @@ impl<'g> Renderer<'g> {
             let shadow_pending = request
                 .shadow_map
                 .then(|| readback::record(device, &mut encoder, &shadow_map, wgpu::TextureAspect::DepthOnly));
+            let timestamps = queries
+                .as_ref()
+                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, 4));
             gpu.queue.submit([encoder.finish()]);
-            (pending, shadow_pending)
+            (pending, shadow_pending, timestamps)
         })?;
 
         let mut pending = pending.into_iter();
@@ -317,6 +344,15 @@ impl<'g> Renderer<'g> {
         let shadow_map = match shadow_pending {
             Some(p) => Some(ShadowMapImage { resolution, depth: p.read(gpu)? }),
             None => None,
+        };
+
+        let timings = match (timestamps, gpu.timestamp_period_ns) {
+            (Some(t), Some(period)) => {
+                let ticks = t.read(gpu)?;
+                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period as f64 * 1e-6;
+                Some(PassTimings { shadow_ms: ms(0, 1), lighting_ms: ms(2, 3) })
+            }
+            _ => None,
         };
 
         // Background pixels get NaN, as documented, decided by the object id (0).
@@ -352,6 +388,7 @@ impl<'g> Renderer<'g> {
             light_projection: projection,
             shadow_resolution: resolution,
             shadow_map,
+            timings,
         })
     }
 }

@@ -45,22 +45,73 @@ pub(crate) fn record(
     PendingReadback { buffer, width, height, bytes_per_texel, padded_bytes_per_row }
 }
 
+/// Maps `slice` for reading and waits until it is.
+fn map_blocking(gpu: &Gpu, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = sender.send(r);
+    });
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Gpu { during: "waiting for the GPU", message: e.to_string() })?;
+    receiver
+        .recv()
+        .map_err(|e| RenderError::Gpu { during: "reading back", message: e.to_string() })?
+        .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })
+}
+
+/// Timestamp queries resolved and copied into a mappable buffer.
+pub(crate) struct PendingTimestamps {
+    buffer: wgpu::Buffer,
+}
+
+/// Records the resolve of `count` timestamps from `query_set` and their copy out.
+pub(crate) fn record_timestamps(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    query_set: &wgpu::QuerySet,
+    count: u32,
+) -> PendingTimestamps {
+    let size = (count as u64) * wgpu::QUERY_SIZE as u64;
+    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("timestamp resolve"),
+        size,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("timestamp readback"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.resolve_query_set(query_set, 0..count, &resolve, 0);
+    encoder.copy_buffer_to_buffer(&resolve, 0, &buffer, 0, size);
+    PendingTimestamps { buffer }
+}
+
+impl PendingTimestamps {
+    /// The raw timestamp ticks, after the submission.
+    pub fn read(self, gpu: &Gpu) -> Result<Vec<u64>, RenderError> {
+        let slice = self.buffer.slice(..);
+        map_blocking(gpu, &slice)?;
+        let ticks = {
+            let mapped = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu { during: "mapping timestamps", message: e.to_string() })?;
+            bytemuck::cast_slice::<u8, u64>(&mapped).to_vec()
+        };
+        self.buffer.unmap();
+        Ok(ticks)
+    }
+}
+
 impl PendingReadback {
     /// Maps the buffer (after the copy's submission) and returns the tightly packed
     /// texels, top row first.
     pub fn read<T: bytemuck::Pod>(self, gpu: &Gpu) -> Result<Vec<T>, RenderError> {
         let slice = self.buffer.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = sender.send(r);
-        });
-        gpu.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu { during: "waiting for the frame", message: e.to_string() })?;
-        receiver
-            .recv()
-            .map_err(|e| RenderError::Gpu { during: "reading back", message: e.to_string() })?
-            .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })?;
+        map_blocking(gpu, &slice)?;
         let row = (self.width * self.bytes_per_texel) as usize;
         let mut bytes = Vec::with_capacity(row * self.height as usize);
         {

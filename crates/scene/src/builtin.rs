@@ -97,6 +97,7 @@ fn sun(elevation_degrees: f32, azimuth_degrees: f32) -> DirectionalLight {
         direction: -sun_direction(elevation_degrees, azimuth_degrees),
         color: Vec3::new(1.0, 0.97, 0.92),
         intensity: 1.0,
+        angular_diameter_degrees: 0.0,
     }
 }
 
@@ -109,6 +110,7 @@ fn spot(position: Vec3, target: Vec3, outer_degrees: f32, range: f32) -> SpotLig
         range,
         color: Vec3::new(1.0, 0.95, 0.85),
         intensity: 1.0,
+        radius: 0.0,
     }
 }
 

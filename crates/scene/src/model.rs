@@ -88,6 +88,9 @@ pub struct DirectionalLight {
     pub color: Vec3,
     /// Irradiance scale on a surface facing the light.
     pub intensity: f32,
+    /// Angular diameter of the sun's disk in degrees; 0 is a point at infinity (hard
+    /// shadows). The reference samples this disk of directions for soft shadows.
+    pub angular_diameter_degrees: f32,
 }
 
 /// A point light restricted to a cone.
@@ -104,6 +107,9 @@ pub struct SpotLight {
     pub range: f32,
     pub color: Vec3,
     pub intensity: f32,
+    /// Radius in world units of the light's emitting disk, facing along `direction`;
+    /// 0 is a point light (hard shadows). The reference samples this disk for soft shadows.
+    pub radius: f32,
 }
 
 impl SpotLight {

@@ -24,6 +24,24 @@ pub struct Settings {
     pub light: LightSettings,
     #[command(flatten)]
     pub shadow: ShadowSettings,
+    #[command(flatten)]
+    pub reference: ReferenceSettings,
+}
+
+/// The ray-traced reference.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReferenceSettings {
+    /// Shadow rays per pixel for an area light (a spot with --spot-radius > 0 or a sun
+    /// with --sun-angular-diameter > 0): 8 to 65536, stratified. A point light needs one.
+    #[arg(long, value_name = "N", default_value_t = ReferenceSettings::default().samples, help_heading = "Reference")]
+    pub samples: u32,
+}
+
+impl Default for ReferenceSettings {
+    fn default() -> Self {
+        Self { samples: 256 }
+    }
 }
 
 /// The output image.
@@ -104,6 +122,14 @@ pub struct LightSettings {
     /// Spot light range in world units, > 0; also the shadow map's far plane [default: the scene's].
     #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
     pub spot_range: Option<f32>,
+    /// Radius of the spot light's emitting disk in world units, ≥ 0; 0 is a point
+    /// light with hard shadows [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub spot_radius: Option<f32>,
+    /// Angular diameter of the sun's disk in degrees, in [0, 30]; 0 gives hard
+    /// shadows, the real sun is about 0.53 [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_angular_diameter: Option<f32>,
 }
 
 /// How the shadow map is sampled and filtered.
@@ -333,6 +359,13 @@ impl Settings {
             "in [0, outer angle] degrees",
         )?;
         check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.spot_radius, "--spot-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_opt(
+            l.sun_angular_diameter,
+            "--sun-angular-diameter",
+            |x| (0.0..=30.0).contains(&x),
+            "in [0, 30] degrees",
+        )?;
         let s = &self.shadow;
         check(
             matches!(s.filter.pcf_kernel, 3 | 5 | 7 | 9),
@@ -353,6 +386,8 @@ impl Settings {
             b.normal_offset,
             "a finite number of texels ≥ 0",
         )?;
+        let n = self.reference.samples;
+        check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
         let r = s.map.resolution;
         check(
             (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
@@ -402,6 +437,7 @@ impl Settings {
                         l.sun_azimuth.unwrap_or(azimuth),
                     );
                 }
+                sun.angular_diameter_degrees = l.sun_angular_diameter.unwrap_or(sun.angular_diameter_degrees);
                 Light::Directional(sun)
             }
             LightKind::Spot => {
@@ -432,6 +468,7 @@ impl Settings {
                     format!("at most the outer angle {}", spot.outer_angle_degrees),
                 )?;
                 spot.range = l.spot_range.unwrap_or(spot.range);
+                spot.radius = l.spot_radius.unwrap_or(spot.radius);
                 Light::Spot(spot)
             }
         })

@@ -80,6 +80,13 @@ fn light_geometry(world: vec3<f32>) -> vec4<f32> {
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
+    // The triangle's geometric normal, facing the camera: the derivatives of the world
+    // position are constant across a triangle, so this is its plane's normal. Taken
+    // first, in uniform control flow.
+    var geometric_n = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    if dot(geometric_n, camera.eye.xyz - in.world) < 0.0 {
+        geometric_n = -geometric_n;
+    }
     // Two-sided shading: a back face seen by the camera is lit as its flipped side, as
     // a ray tracer would see it.
     var n = normalize(in.normal);
@@ -97,6 +104,11 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     }
     if light.direction.w > 0.5 && cone <= 0.0 {
         // Outside a spot's cone or range no light arrives: visibility 0 by definition.
+        visibility = 0.0;
+    }
+    if dot(geometric_n, l) <= 0.0 {
+        // A surface turned away from the light is shadowed by itself, whatever the map
+        // says (the reference ray tracer uses the same geometric test).
         visibility = 0.0;
     }
 

@@ -1,0 +1,59 @@
+//! What the lab commands share: scene lookup and the cached, progress-reporting
+//! reference computation.
+
+use std::time::Instant;
+
+use anyhow::Context;
+use gnomon_reference::{ReferenceImage, ReferenceOptions, TracedScene, reference_visibility};
+use gnomon_scene::{Camera, Light, Scene, Settings, builtin};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::cache;
+
+/// The built-in scene called `name`, or an error naming the valid ones.
+pub fn load_scene(name: &str) -> anyhow::Result<Scene> {
+    builtin::build(name).with_context(|| {
+        format!("unknown scene `{name}`: the built-in scenes are {}", builtin::names().join(", "))
+    })
+}
+
+/// A reference and where it came from.
+pub struct Reference {
+    pub image: ReferenceImage,
+    /// Seconds spent tracing, or `None` when it came from the cache.
+    pub trace_seconds: Option<f64>,
+}
+
+/// Computes (or loads from the cache) the reference for `settings` on `scene`.
+pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow::Result<Reference> {
+    let camera: Camera = settings.resolve_camera(scene)?;
+    let light: Light = settings.resolve_light(scene)?;
+    let options = ReferenceOptions {
+        width: settings.image.width,
+        height: settings.image.height,
+        samples: settings.reference.samples,
+    };
+    let key = cache::key(scene, &camera, &light, &options);
+    let cached = if use_cache { cache::path_for(&key) } else { None };
+    if let Some(path) = &cached
+        && let Some(image) = cache::load(path, &options)
+    {
+        eprintln!("gnomon: reference loaded from the cache ({})", path.display());
+        return Ok(Reference { image, trace_seconds: None });
+    }
+    let started = Instant::now();
+    let traced = TracedScene::build(scene);
+    let bar = ProgressBar::new(options.height as u64).with_style(
+        ProgressStyle::with_template("reference {bar:40} {pos}/{len} rows, {elapsed} elapsed, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let image = reference_visibility(&traced, &camera, &light, &options, &|rows| bar.set_position(rows));
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(path) = &cached
+        && let Err(e) = cache::store(path, &image)
+    {
+        eprintln!("gnomon: warning: could not cache the reference at {}: {e}", path.display());
+    }
+    Ok(Reference { image, trace_seconds: Some(seconds) })
+}

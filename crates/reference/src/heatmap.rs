@@ -1,0 +1,85 @@
+//! Error pictures: where a technique is wrongly shadowed or wrongly lit (hard
+//! shadows), or how far off it is (soft shadows), with the colours their legends use.
+
+use crate::{ReferenceImage, metrics::PixelClass};
+
+/// Hard-shadow heat-map colours, with their legend labels.
+pub const FALSE_SHADOW: [u8; 3] = [235, 60, 50];
+pub const FALSE_LIT: [u8; 3] = [40, 140, 255];
+pub const SILHOUETTE: [u8; 3] = [230, 190, 30];
+pub const BACKGROUND: [u8; 3] = [28, 28, 34];
+pub const CORRECT_LIT: [u8; 3] = [190, 190, 190];
+pub const CORRECT_SHADOW: [u8; 3] = [85, 85, 85];
+
+pub const HARD_LEGEND: &[(&str, [u8; 3])] = &[
+    ("false shadow", FALSE_SHADOW),
+    ("false lit", FALSE_LIT),
+    ("silhouette", SILHOUETTE),
+    ("correct lit", CORRECT_LIT),
+    ("correct shadow", CORRECT_SHADOW),
+];
+
+/// RGBA8 image of the hard-shadow errors of `visibility` (thresholded at 0.5).
+pub fn hard(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClass]) -> Vec<u8> {
+    classes
+        .iter()
+        .enumerate()
+        .flat_map(|(i, class)| {
+            let c = match class {
+                PixelClass::Background => BACKGROUND,
+                PixelClass::Silhouette => SILHOUETTE,
+                PixelClass::Compared => match (reference.visibility[i] >= 0.5, visibility[i] >= 0.5) {
+                    (true, false) => FALSE_SHADOW,
+                    (false, true) => FALSE_LIT,
+                    (true, true) => CORRECT_LIT,
+                    (false, false) => CORRECT_SHADOW,
+                },
+            };
+            [c[0], c[1], c[2], 255]
+        })
+        .collect()
+}
+
+/// The soft-error colour ramp for |V − R| in [0, 1]: black, violet, orange, yellow
+/// (a coarse approximation of matplotlib's "inferno").
+pub fn ramp(e: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 5] =
+        [[0.0, 0.0, 0.02], [0.34, 0.06, 0.43], [0.73, 0.21, 0.33], [0.98, 0.55, 0.04], [0.99, 1.0, 0.64]];
+    let x = e.clamp(0.0, 1.0) * (STOPS.len() - 1) as f32;
+    let k = (x.floor() as usize).min(STOPS.len() - 2);
+    let t = x - k as f32;
+    std::array::from_fn(|c| ((STOPS[k][c] * (1.0 - t) + STOPS[k + 1][c] * t) * 255.0).round() as u8)
+}
+
+/// RGBA8 image of |V − R| through [`ramp`].
+pub fn soft(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClass]) -> Vec<u8> {
+    classes
+        .iter()
+        .enumerate()
+        .flat_map(|(i, class)| {
+            let c = match class {
+                PixelClass::Background => BACKGROUND,
+                PixelClass::Silhouette => SILHOUETTE,
+                PixelClass::Compared => ramp((visibility[i] - reference.visibility[i]).abs()),
+            };
+            [c[0], c[1], c[2], 255]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ramp_runs_dark_to_bright() {
+        let luma = |c: [u8; 3]| c[0] as u32 * 3 + c[1] as u32 * 6 + c[2] as u32;
+        let mut last = 0;
+        for k in 0..=10 {
+            let l = luma(ramp(k as f32 / 10.0));
+            assert!(l >= last, "ramp must brighten monotonically");
+            last = l;
+        }
+        assert_eq!(ramp(0.0), [0, 0, 5]);
+    }
+}

@@ -1,0 +1,13 @@
+//! Gnomon's ground truth, on the CPU: a ray tracer over a BVH of the scene's
+//! triangles that computes the exact (hard) or Monte Carlo (area-light) visibility of
+//! the light at the surface points the rasterizer shades, and the metrics that turn
+//! a technique's difference from it into numbers and pictures.
+
+pub mod heatmap;
+pub mod metrics;
+pub mod sampling;
+mod tracer;
+mod visibility;
+
+pub use tracer::{Hit, TracedScene};
+pub use visibility::{ReferenceImage, ReferenceOptions, reference_visibility};

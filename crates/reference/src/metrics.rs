@@ -1,0 +1,171 @@
+//! Error metrics of a technique's visibility V against the reference R, over the
+//! pixels where the rasterizer and the ray tracer see the same surface.
+
+use serde::Serialize;
+
+use crate::ReferenceImage;
+
+/// A technique's per-pixel output, as the metrics need it.
+#[derive(Clone, Copy)]
+pub struct RasterView<'a> {
+    /// Shadow factor in [0, 1]; NaN for background.
+    pub visibility: &'a [f32],
+    /// Instance index + 1; 0 for background.
+    pub object_id: &'a [u32],
+    /// View-space depth; NaN for background.
+    pub depth: &'a [f32],
+}
+
+/// How a pixel takes part in a comparison.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelClass {
+    /// Neither image sees a surface.
+    Background,
+    /// The two images see different surfaces (an object's outline, or a depth
+    /// difference beyond the tolerance): reported, never compared.
+    Silhouette,
+    /// Both see the same surface: compared.
+    Compared,
+}
+
+/// Relative depth difference under which two hits on the same object are one surface.
+pub const DEPTH_TOLERANCE: f32 = 1e-3;
+
+/// Classifies every pixel: same object and depth within [`DEPTH_TOLERANCE`] is compared.
+pub fn classify(raster: RasterView, reference: &ReferenceImage) -> Vec<PixelClass> {
+    (0..reference.pixel_count())
+        .map(|i| {
+            let (a, b) = (raster.object_id[i], reference.object_id[i]);
+            match (a, b) {
+                (0, 0) => PixelClass::Background,
+                _ if a != b => PixelClass::Silhouette,
+                _ => {
+                    let (da, db) = (raster.depth[i], reference.depth[i]);
+                    if (da - db).abs() <= DEPTH_TOLERANCE * db.abs().max(1e-6) {
+                        PixelClass::Compared
+                    } else {
+                        PixelClass::Silhouette
+                    }
+                }
+            }
+        })
+        .collect()
+}
+
+/// Everything measured for one technique.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Metrics {
+    /// Pixels compared.
+    pub compared: usize,
+    /// Pixels where the two images see different surfaces (not compared).
+    pub silhouette: usize,
+    /// Reference lit (R ≥ 0.5), technique shadowed (V < 0.5): acne, over-darkening.
+    pub false_shadow: usize,
+    /// Reference shadowed (R < 0.5), technique lit (V ≥ 0.5): leaks, peter-panning.
+    pub false_lit: usize,
+    /// `false_shadow / compared`.
+    pub false_shadow_rate: f64,
+    /// `false_lit / compared`.
+    pub false_lit_rate: f64,
+    /// `(false_shadow + false_lit) / compared`.
+    pub mismatch_rate: f64,
+    /// Mean |V − R|.
+    pub mae: f64,
+    /// √mean (V − R)².
+    pub rmse: f64,
+    /// 99th percentile of |V − R|.
+    pub p99: f64,
+}
+
+/// Measures `raster` against `reference` over the pixels `classes` marks compared.
+pub fn measure(raster: RasterView, reference: &ReferenceImage, classes: &[PixelClass]) -> Metrics {
+    let mut m = Metrics {
+        compared: 0,
+        silhouette: 0,
+        false_shadow: 0,
+        false_lit: 0,
+        false_shadow_rate: 0.0,
+        false_lit_rate: 0.0,
+        mismatch_rate: 0.0,
+        mae: 0.0,
+        rmse: 0.0,
+        p99: 0.0,
+    };
+    let mut errors = Vec::new();
+    let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+    for (i, class) in classes.iter().enumerate() {
+        match class {
+            PixelClass::Background => {}
+            PixelClass::Silhouette => m.silhouette += 1,
+            PixelClass::Compared => {
+                let (v, r) = (raster.visibility[i], reference.visibility[i]);
+                m.compared += 1;
+                match (r >= 0.5, v >= 0.5) {
+                    (true, false) => m.false_shadow += 1,
+                    (false, true) => m.false_lit += 1,
+                    _ => {}
+                }
+                let e = (v - r).abs() as f64;
+                sum += e;
+                sum_sq += e * e;
+                errors.push(e);
+            }
+        }
+    }
+    if m.compared > 0 {
+        let n = m.compared as f64;
+        m.false_shadow_rate = m.false_shadow as f64 / n;
+        m.false_lit_rate = m.false_lit as f64 / n;
+        m.mismatch_rate = (m.false_shadow + m.false_lit) as f64 / n;
+        m.mae = sum / n;
+        m.rmse = (sum_sq / n).sqrt();
+        errors.sort_by(f64::total_cmp);
+        // Nearest-rank percentile.
+        let rank = ((0.99 * n).ceil() as usize).clamp(1, errors.len());
+        m.p99 = errors[rank - 1];
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reference(visibility: Vec<f32>, object_id: Vec<u32>) -> ReferenceImage {
+        let n = visibility.len();
+        ReferenceImage {
+            width: n as u32,
+            height: 1,
+            samples: 1,
+            depth: object_id.iter().map(|&i| if i == 0 { f32::NAN } else { 10.0 }).collect(),
+            visibility,
+            std_error: vec![0.0; n],
+            object_id,
+            triangle: vec![0; n],
+            position: vec![glam::Vec3::ZERO; n],
+            rays: n as u64,
+        }
+    }
+
+    #[test]
+    fn counts_false_shadow_false_lit_and_silhouettes() {
+        let r = reference(vec![1.0, 1.0, 0.0, 0.0, 1.0, f32::NAN, 0.5], vec![1, 1, 1, 1, 2, 0, 1]);
+        let v = [1.0, 0.0, 0.0, 1.0, 1.0, f32::NAN, 0.4];
+        let ids = [1, 1, 1, 1, 1, 0, 1];
+        let depth = [10.0, 10.0, 10.0, 10.0005, 10.0, f32::NAN, 10.0];
+        let raster = RasterView { visibility: &v, object_id: &ids, depth: &depth };
+        let classes = classify(raster, &r);
+        assert_eq!(classes[4], PixelClass::Silhouette, "different objects");
+        assert_eq!(classes[5], PixelClass::Background);
+        assert_eq!(classes[3], PixelClass::Compared, "depth within tolerance");
+        let m = measure(raster, &r, &classes);
+        assert_eq!((m.compared, m.silhouette, m.false_shadow, m.false_lit), (5, 1, 2, 1));
+        assert!((m.mismatch_rate - 0.6).abs() < 1e-12);
+        assert!((m.mae - (1.0 + 1.0 + 0.1) / 5.0).abs() < 1e-6);
+        assert!((m.p99 - 1.0).abs() < 1e-12);
+        // A depth far off on the same object is a silhouette too.
+        let depth = [10.0, 10.0, 10.0, 12.0, 10.0, f32::NAN, 10.0];
+        let classes = classify(RasterView { visibility: &v, object_id: &ids, depth: &depth }, &r);
+        assert_eq!(classes[3], PixelClass::Silhouette);
+    }
+}

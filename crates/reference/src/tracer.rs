@@ -1,0 +1,314 @@
+//! The scene as a ray tracer sees it: every instance's triangles in world space, in
+//! one compressed wide BVH (obvhs' CWBVH), with closest-hit and occlusion queries.
+
+use glam::{Vec3, Vec3A};
+use gnomon_scene::Scene;
+use obvhs::{
+    BvhBuildParams,
+    aabb::Aabb,
+    cwbvh::{CwBvh, builder::build_cwbvh},
+    ray::{Ray, RayHit},
+    triangle::Triangle,
+};
+
+/// The closest surface along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub position: Vec3,
+    /// The triangle's geometric normal, unit length, facing the ray's origin.
+    pub normal: Vec3,
+    /// Instance index + 1, as the rasterizer's object id.
+    pub object_id: u32,
+    /// Index of the triangle within its instance's mesh.
+    pub triangle: u32,
+}
+
+/// A scene's triangles in a BVH, ready for parallel queries.
+pub struct TracedScene {
+    bvh: CwBvh,
+    /// World-space triangles, in BVH primitive order.
+    triangles: Vec<Triangle>,
+    /// For each triangle in BVH order: (instance index, triangle index in its mesh).
+    owners: Vec<(u32, u32)>,
+    /// Per instance: whether it occludes light.
+    casts_shadow: Vec<bool>,
+    triangle_count: usize,
+}
+
+impl TracedScene {
+    pub fn build(scene: &Scene) -> Self {
+        let mut triangles = Vec::with_capacity(scene.triangle_count());
+        let mut owners = Vec::with_capacity(scene.triangle_count());
+        for (i, inst) in scene.instances.iter().enumerate() {
+            let mesh = &scene.meshes[inst.mesh];
+            let world: Vec<Vec3A> =
+                mesh.positions.iter().map(|p| inst.world_from_object.transform_point3(*p).into()).collect();
+            for (t, tri) in mesh.indices.chunks_exact(3).enumerate() {
+                triangles.push(Triangle {
+                    v0: world[tri[0] as usize],
+                    v1: world[tri[1] as usize],
+                    v2: world[tri[2] as usize],
+                });
+                owners.push((i as u32, t as u32));
+            }
+        }
+        let triangle_count = triangles.len();
+        // The BVH is built over bounds inflated by a hair (a millionth of the scene's
+        // size, plus a few ulps of each coordinate), so that obvhs' slab tests stay
+        // conservative for rays grazing a box face; the exact triangles are tested.
+        // (T. Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013, §3.)
+        let scene_size = scene.bounds().extent().max_element().max(1e-3);
+        let inflated: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| {
+                let b = t.aabb();
+                let pad = Vec3A::splat(1e-6 * scene_size) + b.min.abs().max(b.max.abs()) * 4.0 * f32::EPSILON;
+                Aabb::new(b.min - pad, b.max + pad)
+            })
+            .collect();
+        let bvh = build_cwbvh(&inflated, BvhBuildParams::medium_build(), &mut Default::default());
+        // Reorder into BVH order, so that a primitive id indexes the arrays directly.
+        let order = &bvh.primitive_indices;
+        let triangles = order.iter().map(|&k| triangles[k as usize]).collect();
+        let owners = order.iter().map(|&k| owners[k as usize]).collect();
+        let casts_shadow = scene.instances.iter().map(|i| i.casts_shadow).collect();
+        Self { bvh, triangles, owners, casts_shadow, triangle_count }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangle_count
+    }
+
+    /// The closest surface along `direction` (unit length) between `t_min` and `t_max`.
+    pub fn intersect(&self, origin: Vec3, direction: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
+        let ray = traversal_ray(origin, direction, t_min, t_max);
+        let sheared = ShearedRay::new(origin, direction);
+        let mut hit = RayHit::none();
+        if !self
+            .bvh
+            .ray_traverse(ray, &mut hit, |ray, id| sheared.intersect(&self.triangles[id], ray.tmin, ray.tmax))
+        {
+            return None;
+        }
+        let id = hit.primitive_id as usize;
+        let tri = &self.triangles[id];
+        let mut normal: Vec3 = (tri.v1 - tri.v0).cross(tri.v2 - tri.v0).normalize_or_zero().into();
+        if normal.dot(direction) > 0.0 {
+            normal = -normal;
+        }
+        let (instance, triangle) = self.owners[id];
+        Some(Hit {
+            t: hit.t,
+            position: origin + direction * hit.t,
+            normal,
+            object_id: instance + 1,
+            triangle,
+        })
+    }
+
+    /// True when a shadow caster blocks the segment from `origin` along `direction`
+    /// (unit length) before `t_max`.
+    pub fn occluded(&self, origin: Vec3, direction: Vec3, t_max: f32) -> bool {
+        let ray = traversal_ray(origin, direction, 0.0, t_max);
+        let sheared = ShearedRay::new(origin, direction);
+        !self.bvh.ray_traverse_miss(ray, |ray, id| {
+            if self.casts_shadow[self.owners[id].0 as usize] {
+                sheared.intersect(&self.triangles[id], ray.tmin, ray.tmax)
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+}
+
+/// The ray obvhs traverses with. Its octant and slab tests read the sign bit of each
+/// direction component, and a `-0.0` component makes them cull boxes the ray passes
+/// through (measured: 68 of 2112 edge-aimed rays lost), so zeros are made `+0.0`.
+/// The triangle test still uses the exact direction.
+fn traversal_ray(origin: Vec3, direction: Vec3, t_min: f32, t_max: f32) -> Ray {
+    let d = Vec3::select(direction.cmpeq(Vec3::ZERO), Vec3::ZERO, direction);
+    Ray::new(origin.into(), d.into(), t_min, t_max)
+}
+
+/// A ray prepared for the watertight ray/triangle test of S. Woop, C. Benthin and
+/// I. Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013: the ray is made
+/// the +z axis by a permutation and a shear, so that edge tests on triangles sharing an
+/// edge are evaluated identically and a ray through an edge or vertex never slips
+/// between them (obvhs' Möller–Trumbore test can).
+struct ShearedRay {
+    origin: Vec3,
+    axes: [usize; 3],
+    shear: Vec3,
+}
+
+impl ShearedRay {
+    fn new(origin: Vec3, direction: Vec3) -> Self {
+        let kz = direction.abs().max_position();
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        // Keep the winding: swap when the dominant axis points backward.
+        if direction[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = direction[kz];
+        Self {
+            origin,
+            axes: [kx, ky, kz],
+            shear: Vec3::new(direction[kx] / dz, direction[ky] / dz, 1.0 / dz),
+        }
+    }
+
+    /// Distance along the ray to `tri` within [t_min, t_max], or infinity.
+    fn intersect(&self, tri: &Triangle, t_min: f32, t_max: f32) -> f32 {
+        let [kx, ky, kz] = self.axes;
+        let s = self.shear;
+        let rel = |v: Vec3A| Vec3::from(v) - self.origin;
+        let (a, b, c) = (rel(tri.v0), rel(tri.v1), rel(tri.v2));
+        let project = |p: Vec3| (p[kx] - s.x * p[kz], p[ky] - s.y * p[kz]);
+        let ((ax, ay), (bx, by), (cx, cy)) = (project(a), project(b), project(c));
+        let (mut u, mut v, mut w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
+        // On an exact zero, redo the edge functions in double precision (paper, §3).
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let d = |x: f32| x as f64;
+            u = (d(cx) * d(by) - d(cy) * d(bx)) as f32;
+            v = (d(ax) * d(cy) - d(ay) * d(cx)) as f32;
+            w = (d(bx) * d(ay) - d(by) * d(ax)) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return f32::INFINITY;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return f32::INFINITY;
+        }
+        let t = (u * s.z * a[kz] + v * s.z * b[kz] + w * s.z * c[kz]) / det;
+        if t >= t_min && t <= t_max { t } else { f32::INFINITY }
+    }
+}
+
+/// Moves a hit point off its surface, along the geometric normal `n` (facing the side
+/// the new ray leaves from), by a few units in the last place of its coordinates:
+/// C. Wächter and N. Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
+/// Ray Tracing Gems, ch. 6, 2019. The offset scales with the position's magnitude, so it
+/// is robust near the origin and far from it alike.
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let of_i = (n * INT_SCALE).as_ivec3();
+    let nudge = |x: f32, o: i32| f32::from_bits((x.to_bits() as i32 + if x < 0.0 { -o } else { o }) as u32);
+    let p_i = Vec3::new(nudge(p.x, of_i.x), nudge(p.y, of_i.y), nudge(p.z, of_i.z));
+    Vec3::new(
+        if p.x.abs() < ORIGIN { p.x + FLOAT_SCALE * n.x } else { p_i.x },
+        if p.y.abs() < ORIGIN { p.y + FLOAT_SCALE * n.y } else { p_i.y },
+        if p.z.abs() < ORIGIN { p.z + FLOAT_SCALE * n.z } else { p_i.z },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Mat4;
+    use gnomon_scene::{Instance, builtin, geometry};
+
+    #[test]
+    fn hits_the_ground_and_respects_casts_shadow() {
+        let mut scene = builtin::spheres();
+        scene.meshes = vec![geometry::plane(10.0, 10.0), geometry::cuboid(Vec3::splat(0.5))];
+        scene.instances = vec![
+            Instance {
+                name: "g".into(),
+                mesh: 0,
+                material: 0,
+                world_from_object: Mat4::IDENTITY,
+                casts_shadow: true,
+            },
+            Instance {
+                name: "b".into(),
+                mesh: 1,
+                material: 0,
+                world_from_object: Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0)),
+                casts_shadow: false,
+            },
+        ];
+        let traced = TracedScene::build(&scene);
+        assert_eq!(traced.triangle_count(), 14);
+        // Straight down from above the box: the box is hit first (it is visible even
+        // though it casts no shadow), at its top face y = 2.5.
+        let hit = traced.intersect(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y, 0.0, 100.0).unwrap();
+        assert_eq!(hit.object_id, 2);
+        assert!((hit.t - 2.5).abs() < 1e-5 && hit.normal.abs_diff_eq(Vec3::Y, 1e-5));
+        // Beside the box: the ground, normal up, facing the ray.
+        let hit = traced.intersect(Vec3::new(3.0, 5.0, 0.0), Vec3::NEG_Y, 0.0, 100.0).unwrap();
+        assert_eq!(hit.object_id, 1);
+        // Seen from below, the ground's normal faces down, toward the ray's origin.
+        let hit = traced.intersect(Vec3::new(3.0, -5.0, 0.0), Vec3::Y, 0.0, 100.0).unwrap();
+        assert!(hit.normal.abs_diff_eq(Vec3::NEG_Y, 1e-5));
+        // The non-casting box does not occlude; the ground does, from below.
+        assert!(!traced.occluded(Vec3::new(0.0, 0.01, 0.0), Vec3::Y, 100.0));
+        assert!(traced.occluded(Vec3::new(0.0, -1.0, 0.0), Vec3::Y, 100.0));
+        assert!(
+            !traced.occluded(Vec3::new(0.0, -1.0, 0.0), Vec3::Y, 0.5),
+            "t_max stops the ray short of the ground"
+        );
+    }
+
+    #[test]
+    fn rays_through_shared_edges_and_vertices_never_slip_through() {
+        // From inside a closed sphere, aim exactly at every vertex and every edge
+        // midpoint: each ray must hit. (A non-watertight test loses some of these.)
+        let mut scene = builtin::spheres();
+        let sphere = geometry::uv_sphere(1.0, 24, 12);
+        let targets: Vec<Vec3> = sphere
+            .indices
+            .chunks(3)
+            .flat_map(|t| {
+                let [a, b, c] = [0, 1, 2].map(|k| sphere.positions[t[k] as usize]);
+                [a, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)]
+            })
+            .collect();
+        scene.meshes = vec![sphere];
+        scene.instances = vec![Instance {
+            name: "s".into(),
+            mesh: 0,
+            material: 0,
+            world_from_object: Mat4::IDENTITY,
+            casts_shadow: true,
+        }];
+        let traced = TracedScene::build(&scene);
+        let brute = targets
+            .iter()
+            .filter(|t| {
+                let r = ShearedRay::new(Vec3::ZERO, t.normalize());
+                traced.triangles.iter().all(|tri| r.intersect(tri, 0.0, 10.0) == f32::INFINITY)
+            })
+            .count();
+        assert_eq!(brute, 0, "the triangle test itself is watertight");
+        let missed = targets
+            .iter()
+            .filter(|t| traced.intersect(Vec3::ZERO, t.normalize(), 0.0, 10.0).is_none())
+            .count();
+        assert_eq!(missed, 0, "{missed} of {} rays slipped through the mesh", targets.len());
+        // And the ground quad's diagonal, hit head-on from below and above.
+        let mut scene = builtin::spheres();
+        scene.meshes = vec![geometry::plane(10.0, 10.0)];
+        scene.instances.truncate(1);
+        scene.instances[0].mesh = 0;
+        scene.instances[0].world_from_object = Mat4::IDENTITY;
+        let traced = TracedScene::build(&scene);
+        for x in [-2.0f32, 0.0, 3.0] {
+            let p = Vec3::new(x, 0.0, -x);
+            assert!(traced.occluded(p - Vec3::Y, Vec3::Y, 10.0), "diagonal at {p}");
+            assert!(traced.intersect(p + Vec3::Y, Vec3::NEG_Y, 0.0, 10.0).is_some(), "diagonal at {p}");
+        }
+    }
+
+    #[test]
+    fn offset_origin_leaves_the_surface_on_the_normal_side() {
+        for p in [Vec3::new(0.001, 0.0, 0.0), Vec3::new(1234.5, 0.0, -77.0), Vec3::new(-3.0, 1e-3, 2.0)] {
+            let o = offset_ray_origin(p, Vec3::Y);
+            assert!(o.y > p.y, "{p} → {o}");
+            assert!((o - p).length() < 1e-2 * (1.0 + p.length()));
+        }
+    }
+}

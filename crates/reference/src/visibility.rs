@@ -1,0 +1,268 @@
+//! Reference visibility images: one primary ray through each pixel centre with the
+//! rasterizer's camera, then shadow rays to the light: one exact ray for a point or
+//! directional light, or N stratified samples of an area light.
+
+use glam::{Vec2, Vec3, Vec4};
+use gnomon_scene::{Camera, Light};
+use rayon::prelude::*;
+
+use crate::{
+    TracedScene,
+    sampling::{cmj, concentric_disk, cone_direction, hash},
+    tracer::offset_ray_origin,
+};
+
+/// How the reference is computed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceOptions {
+    pub width: u32,
+    pub height: u32,
+    /// Shadow rays per pixel for an area light (ignored for point lights, which need one).
+    pub samples: u32,
+}
+
+/// The reference, per pixel, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceImage {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel actually used: 1 for a point or directional light.
+    pub samples: u32,
+    /// Fraction of the light visible, in [0, 1]; NaN where the primary ray misses.
+    /// 0 outside a spot light's cone or range, and where the surface faces away
+    /// from the light, as in the rasterizer.
+    pub visibility: Vec<f32>,
+    /// Standard error of each pixel's estimate (0 for exact visibility).
+    pub std_error: Vec<f32>,
+    /// Instance index + 1 of the primary hit; 0 on a miss.
+    pub object_id: Vec<u32>,
+    /// Triangle index within the hit instance's mesh.
+    pub triangle: Vec<u32>,
+    /// View-space depth of the primary hit; NaN on a miss.
+    pub depth: Vec<f32>,
+    /// World position of the primary hit; NaN on a miss.
+    pub position: Vec<Vec3>,
+    /// Rays traced in all: one primary ray per pixel plus every shadow ray.
+    pub rays: u64,
+}
+
+impl ReferenceImage {
+    pub fn pixel_count(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+}
+
+/// Batches of independent stratified patterns a pixel's samples are split into, so
+/// that the spread of the batch means gives an honest standard error.
+const BATCHES: u32 = 8;
+
+/// The area of a light as the sampler sees it.
+enum Emitter {
+    /// Parallel rays toward `to_light`; with `half_angle` > 0, a cone of directions.
+    Sun { to_light: Vec3, half_angle: f32 },
+    /// A disk at `center` of `radius` facing along `axis`; 0 is a point.
+    Disk { center: Vec3, axis: Vec3, radius: f32, cos_outer: f32, range: f32 },
+}
+
+impl Emitter {
+    fn new(light: &Light) -> Self {
+        match light {
+            Light::Directional(sun) => Emitter::Sun {
+                to_light: -sun.direction.normalize(),
+                half_angle: 0.5 * sun.angular_diameter_degrees.to_radians(),
+            },
+            Light::Spot(spot) => Emitter::Disk {
+                center: spot.position,
+                axis: spot.direction.normalize(),
+                radius: spot.radius,
+                cos_outer: spot.outer_angle_degrees.to_radians().cos(),
+                range: spot.range,
+            },
+        }
+    }
+
+    fn is_point(&self) -> bool {
+        match self {
+            Emitter::Sun { half_angle, .. } => *half_angle <= 0.0,
+            Emitter::Disk { radius, .. } => *radius <= 0.0,
+        }
+    }
+
+    /// Direction to the light's centre, and whether the point receives any light at
+    /// all (inside a spot's cone and range).
+    fn centre(&self, p: Vec3) -> (Vec3, bool) {
+        match *self {
+            Emitter::Sun { to_light, .. } => (to_light, true),
+            Emitter::Disk { center, axis, cos_outer, range, .. } => {
+                let to = center - p;
+                let dist = to.length();
+                let l = to / dist;
+                (l, (-l).dot(axis) >= cos_outer && dist <= range)
+            }
+        }
+    }
+
+    /// A shadow ray toward the light sample `u` from `p`: (direction, length).
+    fn sample(&self, p: Vec3, u: Vec2) -> (Vec3, f32) {
+        match *self {
+            Emitter::Sun { to_light, half_angle } => {
+                let d = if half_angle > 0.0 { cone_direction(u, to_light, half_angle) } else { to_light };
+                (d, f32::INFINITY)
+            }
+            Emitter::Disk { center, axis, radius, .. } => {
+                let target = if radius > 0.0 {
+                    let (a, b) = axis.any_orthonormal_pair();
+                    let q = concentric_disk(u) * radius;
+                    center + a * q.x + b * q.y
+                } else {
+                    center
+                };
+                let to = target - p;
+                let len = to.length();
+                (to / len, len)
+            }
+        }
+    }
+}
+
+/// Computes the reference visibility of `light` for `camera`, in parallel over rows.
+/// `progress` is called with the number of rows finished so far (from any thread).
+/// The result depends only on the inputs, not on the thread count or scheduling.
+pub fn reference_visibility(
+    traced: &TracedScene,
+    camera: &Camera,
+    light: &Light,
+    options: &ReferenceOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> ReferenceImage {
+    let (w, h) = (options.width, options.height);
+    let aspect = w as f32 / h as f32;
+    let world_from_clip = camera.clip_from_world(aspect).inverse();
+    let view_from_world = camera.view_from_world();
+    let emitter = Emitter::new(light);
+    let samples = if emitter.is_point() { 1 } else { options.samples.max(BATCHES) };
+    let done = std::sync::atomic::AtomicU64::new(0);
+
+    let rows: Vec<Vec<PixelResult>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let row = (0..w)
+                .map(|x| {
+                    // The same pixel centre and camera as the rasterizer: NDC y up, row 0 at the top.
+                    let ndc = Vec2::new(
+                        (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                        1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                    );
+                    let near = world_from_clip * Vec4::new(ndc.x, ndc.y, 0.0, 1.0);
+                    let far = world_from_clip * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+                    let (near, far) = (near.truncate() / near.w, far.truncate() / far.w);
+                    let dir = (far - near).normalize();
+                    // Start on the near plane and stop at the far one, as the rasterizer clips.
+                    let Some(hit) = traced.intersect(near, dir, 0.0, (far - near).length()) else {
+                        return PixelResult::MISS;
+                    };
+                    let pixel_seed = hash(y * w + x);
+                    let (visibility, std_error, shadow_rays) =
+                        shade(traced, &emitter, &hit, samples, pixel_seed);
+                    PixelResult {
+                        rays: 1 + shadow_rays,
+                        visibility,
+                        std_error,
+                        object_id: hit.object_id,
+                        triangle: hit.triangle,
+                        depth: -view_from_world.transform_point3(hit.position).z,
+                        position: hit.position,
+                    }
+                })
+                .collect();
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n);
+            row
+        })
+        .collect();
+
+    let n = (w * h) as usize;
+    let mut image = ReferenceImage {
+        width: w,
+        height: h,
+        samples,
+        visibility: Vec::with_capacity(n),
+        std_error: Vec::with_capacity(n),
+        object_id: Vec::with_capacity(n),
+        triangle: Vec::with_capacity(n),
+        depth: Vec::with_capacity(n),
+        position: Vec::with_capacity(n),
+        rays: 0,
+    };
+    for p in rows.into_iter().flatten() {
+        image.rays += p.rays;
+        image.visibility.push(p.visibility);
+        image.std_error.push(p.std_error);
+        image.object_id.push(p.object_id);
+        image.triangle.push(p.triangle);
+        image.depth.push(p.depth);
+        image.position.push(p.position);
+    }
+    image
+}
+
+struct PixelResult {
+    rays: u64,
+    visibility: f32,
+    std_error: f32,
+    object_id: u32,
+    triangle: u32,
+    depth: f32,
+    position: Vec3,
+}
+
+impl PixelResult {
+    const MISS: PixelResult = PixelResult {
+        rays: 1,
+        visibility: f32::NAN,
+        std_error: 0.0,
+        object_id: 0,
+        triangle: 0,
+        depth: f32::NAN,
+        position: Vec3::NAN,
+    };
+}
+
+/// Visibility of the light at `hit`, the standard error of the estimate, and the
+/// number of shadow rays traced.
+fn shade(traced: &TracedScene, emitter: &Emitter, hit: &Hit, samples: u32, seed: u32) -> (f32, f32, u64) {
+    let (centre, receives) = emitter.centre(hit.position);
+    // Outside a spot's cone, or on a surface turned away from the light, nothing arrives.
+    if !receives || hit.normal.dot(centre) <= 0.0 {
+        return (0.0, 0.0, 0);
+    }
+    let origin = offset_ray_origin(hit.position, hit.normal);
+    let rays = std::cell::Cell::new(0u64);
+    let visible = |u: Vec2| {
+        let (d, len) = emitter.sample(hit.position, u);
+        // Light samples below the surface's horizon are blocked by the surface itself.
+        if d.dot(hit.normal) <= 0.0 {
+            return false;
+        }
+        rays.set(rays.get() + 1);
+        !traced.occluded(origin, d, len)
+    };
+    if samples == 1 {
+        let v = if visible(Vec2::splat(0.5)) { 1.0 } else { 0.0 };
+        return (v, 0.0, rays.get());
+    }
+    // Split the samples into independent stratified batches; the spread of the batch
+    // means estimates the standard error of their average.
+    let per_batch = samples / BATCHES;
+    let means: Vec<f32> = (0..BATCHES)
+        .map(|b| {
+            let pattern = hash(seed ^ hash(b + 1));
+            (0..per_batch).filter(|&s| visible(cmj(s, per_batch, pattern))).count() as f32 / per_batch as f32
+        })
+        .collect();
+    let mean = means.iter().sum::<f32>() / BATCHES as f32;
+    let variance = means.iter().map(|m| (m - mean).powi(2)).sum::<f32>() / (BATCHES - 1) as f32;
+    (mean, (variance / BATCHES as f32).sqrt(), rays.get())
+}
+
+use crate::Hit;

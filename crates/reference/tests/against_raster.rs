@@ -1,0 +1,104 @@
+//! Techniques against the reference: the metrics detect planted errors, and the
+//! foundation's techniques are accurate on `spheres`.
+
+use std::sync::OnceLock;
+
+use gnomon_reference::{
+    ReferenceImage, ReferenceOptions, TracedScene,
+    metrics::{self, Metrics, RasterView},
+    reference_visibility,
+};
+use gnomon_render::{Gpu, OutputRequest, Renderer};
+use gnomon_scene::{
+    Scene, Settings, builtin,
+    settings::{BiasSettings, Technique},
+};
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
+}
+
+fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
+    let options =
+        ReferenceOptions { width: s.image.width, height: s.image.height, samples: s.reference.samples };
+    let camera = s.resolve_camera(scene).unwrap();
+    let light = s.resolve_light(scene).unwrap();
+    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
+}
+
+fn measure(scene: &Scene, s: &Settings, reference: &ReferenceImage) -> Metrics {
+    let mut renderer = Renderer::new(gpu()).unwrap();
+    let frame = renderer.render(scene, s, &OutputRequest::default()).unwrap();
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let classes = metrics::classify(raster, reference);
+    metrics::measure(raster, reference, &classes)
+}
+
+fn settings(width: u32, height: u32, technique: Technique) -> Settings {
+    let mut s = Settings::default();
+    s.image.width = width;
+    s.image.height = height;
+    s.shadow.filter.technique = technique;
+    s
+}
+
+#[test]
+fn raising_the_bias_on_contact_raises_the_false_lit_rate() {
+    let scene = builtin::contact();
+    let s = settings(640, 360, Technique::Hard);
+    let truth = reference(&scene, &s);
+    let default = measure(&scene, &s, &truth);
+    let mut biased = s.clone();
+    biased.shadow.bias = BiasSettings { slope_bias: 40.0, ..Default::default() };
+    let planted = measure(&scene, &biased, &truth);
+    eprintln!(
+        "contact: false lit {:.4}% with the default bias, {:.4}% with slope bias 40",
+        100.0 * default.false_lit_rate,
+        100.0 * planted.false_lit_rate
+    );
+    assert!(planted.false_lit_rate > default.false_lit_rate + 0.001, "{default:?}\n{planted:?}");
+    assert!(planted.compared > 100_000 && planted.silhouette < planted.compared / 20);
+}
+
+#[test]
+fn dropping_the_bias_on_grazing_raises_the_false_shadow_rate() {
+    let scene = builtin::grazing();
+    let s = settings(640, 360, Technique::Hard);
+    let truth = reference(&scene, &s);
+    let default = measure(&scene, &s, &truth);
+    let mut unbiased = s.clone();
+    unbiased.shadow.bias = BiasSettings::none();
+    let planted = measure(&scene, &unbiased, &truth);
+    eprintln!(
+        "grazing: false shadow {:.4}% with the default bias, {:.2}% with none",
+        100.0 * default.false_shadow_rate,
+        100.0 * planted.false_shadow_rate
+    );
+    assert!(planted.false_shadow_rate > 0.05, "{planted:?}");
+    assert!(default.false_shadow_rate < 0.005, "{default:?}");
+}
+
+#[test]
+fn foundation_techniques_mismatch_under_one_percent_on_spheres() {
+    let scene = builtin::spheres();
+    let s = settings(1280, 720, Technique::Hard);
+    let truth = reference(&scene, &s);
+    for technique in [Technique::Hard, Technique::Pcf2x2, Technique::Pcf] {
+        let m = measure(&scene, &settings(1280, 720, technique), &truth);
+        eprintln!(
+            "spheres 1280×720, 2048², {}: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} compared, {} silhouette",
+            technique.name(),
+            100.0 * m.mismatch_rate,
+            100.0 * m.false_shadow_rate,
+            100.0 * m.false_lit_rate,
+            m.compared,
+            m.silhouette
+        );
+        assert!(m.mismatch_rate < 0.01, "{technique:?}: {m:?}");
+        // Nearly every surface pixel is compared, not set aside as a silhouette.
+        let surface = truth.object_id.iter().filter(|&&i| i != 0).count();
+        assert!(m.compared > 600_000 && m.silhouette * 100 < surface, "{m:?} of {surface} surface pixels");
+    }
+}
