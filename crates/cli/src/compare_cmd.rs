@@ -15,7 +15,7 @@ use image::RgbaImage;
 use serde::Serialize;
 
 use crate::{
-    grid::{self, Tile},
+    grid::{self, Downscale, Tile},
     lab, output,
 };
 
@@ -126,6 +126,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let mut tiles = vec![vec![Tile {
         image: rgba(w, h, output::visibility_rgba(&reference.visibility)),
         caption: caption_reference(&reference),
+        downscale: Downscale::Smooth,
     }]];
     let mut staged = output::Staged::default();
     std::fs::create_dir_all(&args.out)
@@ -154,19 +155,21 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         } else {
             format!("mismatch {:.3}%", 100.0 * m.mismatch_rate)
         };
-        let time = timing.map(|(s, l)| format!("shadow {s:.2} ms, lighting {l:.2} ms")).unwrap_or_default();
+        let mut caption = vec![name.to_string()];
+        if let Some((s, l)) = timing {
+            caption.push(format!("shadow pass {s:.2} ms"));
+            caption.push(format!("lighting pass {l:.2} ms"));
+        }
         tiles.push(vec![
-            Tile { image: rgba(w, h, frame.color.clone()), caption: vec![name.to_string(), time] },
+            Tile { image: rgba(w, h, frame.color.clone()), caption, downscale: Downscale::Smooth },
             Tile {
                 image: rgba(w, h, error),
                 caption: vec![
                     summary,
-                    format!(
-                        "false shadow {:.3}%  false lit {:.3}%",
-                        100.0 * m.false_shadow_rate,
-                        100.0 * m.false_lit_rate
-                    ),
+                    format!("false shadow {:.3}%", 100.0 * m.false_shadow_rate),
+                    format!("false lit {:.3}%", 100.0 * m.false_lit_rate),
                 ],
+                downscale: Downscale::Salient(if soft { soft_priority } else { hard_priority }),
             },
         ]);
         rows.push(Row {
@@ -202,6 +205,21 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     print!("{table}");
     eprintln!("gnomon: wrote {} files to {}", written.len(), args.out.display());
     Ok(())
+}
+
+/// Wrong pixels outrank silhouettes, which outrank correct ones.
+fn hard_priority(p: [u8; 4]) -> u32 {
+    let c = [p[0], p[1], p[2]];
+    if c == heatmap::FALSE_SHADOW || c == heatmap::FALSE_LIT {
+        2
+    } else {
+        u32::from(c == heatmap::SILHOUETTE)
+    }
+}
+
+/// Larger errors are brighter on the ramp.
+fn soft_priority(p: [u8; 4]) -> u32 {
+    3 * p[0] as u32 + 6 * p[1] as u32 + p[2] as u32
 }
 
 fn rgba(w: u32, h: u32, data: Vec<u8>) -> RgbaImage {

@@ -25,7 +25,8 @@ pub struct RenderArgs {
     pub shadow_map_out: Option<PathBuf>,
     /// Also write the per-pixel shadow factor as 32-bit float: `.exr` (one channel `Y`)
     /// or `.npy` (float32, shape (height, width), top row first). 1 is lit, 0 is
-    /// shadowed (and outside a spot light's cone); background pixels are NaN.
+    /// shadowed (also outside a spot light's cone and on surfaces turned away from
+    /// the light); background pixels are NaN.
     #[arg(long, value_name = "FILE.exr|FILE.npy", help_heading = "Outputs")]
     pub visibility_out: Option<PathBuf>,
     /// Also write per-pixel float images to this directory (created if missing):
