@@ -21,7 +21,7 @@ use crate::{
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Built-in scene (see `gnomon scenes`).
+    /// Scene: a glTF file (.gltf or .glb) or a built-in scene (see `gnomon scenes`).
     #[arg(default_value = "spheres")]
     pub scene: String,
     /// Techniques to compare, comma-separated (see `gnomon techniques`).

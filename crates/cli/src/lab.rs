@@ -10,18 +10,44 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cache;
 
-/// The built-in scene called `name`, or an error naming the valid ones.
+/// The scene `name`: a glTF file (`.gltf` or `.glb`) or a built-in scene, or an error
+/// that names the valid choices.
 pub fn load_scene(name: &str) -> anyhow::Result<Scene> {
+    let path = std::path::Path::new(name);
+    let is_gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    if is_gltf {
+        anyhow::ensure!(path.is_file(), "{name}: no such file");
+        let (scene, extras) = gnomon_scene::gltf_loader::load(path)?;
+        if extras.ignored_lights > 0 {
+            eprintln!(
+                "gnomon: {name}: {} point light(s) ignored (point lights come with cube maps)",
+                extras.ignored_lights
+            );
+        }
+        return Ok(scene);
+    }
     builtin::build(name).with_context(|| {
-        format!("unknown scene `{name}`: the built-in scenes are {}", builtin::names().join(", "))
+        format!(
+            "unknown scene `{name}`: give a glTF file (.gltf or .glb) or one of the built-in scenes {}",
+            builtin::names().join(", ")
+        )
     })
 }
 
 /// A reference and where it came from.
 pub struct Reference {
     pub image: ReferenceImage,
-    /// Seconds spent tracing, or `None` when it came from the cache.
-    pub trace_seconds: Option<f64>,
+    /// Seconds spent building the BVH and tracing, or `None` when it came from the cache.
+    pub timing: Option<ReferenceTiming>,
+}
+
+/// Where the reference's time went.
+pub struct ReferenceTiming {
+    pub build_seconds: f64,
+    pub trace_seconds: f64,
 }
 
 /// Computes (or loads from the cache) the reference for `settings` on `scene`.
@@ -39,21 +65,23 @@ pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow:
         && let Some(image) = cache::load(path, &options)
     {
         eprintln!("gnomon: reference loaded from the cache ({})", path.display());
-        return Ok(Reference { image, trace_seconds: None });
+        return Ok(Reference { image, timing: None });
     }
     let started = Instant::now();
     let traced = TracedScene::build(scene);
+    let build_seconds = started.elapsed().as_secs_f64();
+    let started = Instant::now();
     let bar = ProgressBar::new(options.height as u64).with_style(
         ProgressStyle::with_template("reference {bar:40} {pos}/{len} rows, {elapsed} elapsed, {eta} left")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let image = reference_visibility(&traced, &camera, &light, &options, &|rows| bar.set_position(rows));
     bar.finish_and_clear();
-    let seconds = started.elapsed().as_secs_f64();
+    let trace_seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &cached
         && let Err(e) = cache::store(path, &image)
     {
         eprintln!("gnomon: warning: could not cache the reference at {}: {e}", path.display());
     }
-    Ok(Reference { image, trace_seconds: Some(seconds) })
+    Ok(Reference { image, timing: Some(ReferenceTiming { build_seconds, trace_seconds }) })
 }

@@ -9,7 +9,7 @@ use crate::{lab, output};
 
 #[derive(Args, Debug)]
 pub struct ReferenceArgs {
-    /// Built-in scene (see `gnomon scenes`).
+    /// Scene: a glTF file (.gltf or .glb) or a built-in scene (see `gnomon scenes`).
     #[arg(default_value = "spheres")]
     pub scene: String,
     /// Output: `.exr` (float visibility, channel `Y`, NaN background) or `.png` (8-bit
@@ -56,8 +56,14 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     if image.samples > 1 {
         eprint!(", standard error mean {mean_se:.4}, max {max_se:.4}");
     }
-    match reference.trace_seconds {
-        Some(s) => eprintln!(", {} rays in {s:.2} s: {:.2} Mrays/s", image.rays, image.rays as f64 / s / 1e6),
+    match reference.timing {
+        Some(t) => eprintln!(
+            ", BVH built in {:.2} s, {} rays traced in {:.2} s: {:.2} Mrays/s",
+            t.build_seconds,
+            image.rays,
+            t.trace_seconds,
+            image.rays as f64 / t.trace_seconds / 1e6
+        ),
         None => eprintln!(" (cached)"),
     }
     Ok(())

@@ -12,7 +12,7 @@ use crate::output::{self, Staged};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Built-in scene to render (see `gnomon scenes`).
+    /// Scene: a glTF file (.gltf or .glb) or a built-in scene (see `gnomon scenes`).
     #[arg(default_value = "spheres")]
     pub scene: String,
     /// Output image (PNG, sRGB).
@@ -73,6 +73,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let gpu = Gpu::new_headless()?;
     if args.verbose {
         eprintln!("gnomon: {}", gpu.info);
+        let b = scene.bounds();
+        let camera = settings.resolve_camera(&scene)?;
+        eprintln!(
+            "gnomon: scene bounds {:.3} to {:.3}; camera at {:.3} looking at {:.3}",
+            b.min, b.max, camera.eye, camera.target
+        );
     }
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(settings)?;

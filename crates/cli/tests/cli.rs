@@ -99,7 +99,12 @@ fn an_unknown_scene_names_the_valid_ones() {
     let out = gnomon(&dir, &["render", "nope"]);
     assert!(!out.status.success());
     let e = stderr(&out);
-    assert!(e.contains("unknown scene `nope`") && e.contains("spheres, contact, grazing, columns"), "{e}");
+    assert!(
+        e.contains("unknown scene `nope`")
+            && e.contains("spheres, contact, grazing, columns")
+            && e.contains(".glb"),
+        "{e}"
+    );
     assert!(files_in(&dir).is_empty());
 }
 

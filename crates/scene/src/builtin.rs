@@ -88,6 +88,7 @@ impl SceneBuilder {
             sun,
             spot,
             ambient: Vec3::splat(0.12),
+            textures: Vec::new(),
         }
     }
 }

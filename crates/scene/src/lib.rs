@@ -3,10 +3,12 @@
 
 pub mod builtin;
 pub mod geometry;
+pub mod gltf_loader;
 mod model;
 pub mod settings;
 
 pub use model::{
-    Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight,
+    Texture, Wrap, sun_direction,
 };
 pub use settings::Settings;

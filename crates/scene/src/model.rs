@@ -24,12 +24,32 @@ impl Mesh {
     }
 }
 
+/// How a material's alpha is used (glTF 2.0 `alphaMode`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is solid.
+    Opaque,
+    /// The surface exists where alpha ≥ the cutoff, and nowhere else: cut-out leaves,
+    /// fences. Shadows are cut out the same way.
+    Mask { cutoff: f32 },
+    /// Partly transparent. Gnomon draws it solid in the image but it casts no
+    /// shadow: a shadow map stores one depth, and no threshold is right for glass.
+    Blend,
+}
+
 /// A surface's appearance for the lighting pass (Lambert + Blinn-Phong).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
     /// Linear RGB base colour (albedo), each channel in [0, 1].
     pub base_color: Vec3,
+    /// Base alpha, multiplied with the texture's alpha.
+    pub alpha: f32,
+    /// Base-colour texture: an index into [`Scene::textures`], multiplied with `base_color`.
+    pub base_color_texture: Option<usize>,
+    pub alpha_mode: AlphaMode,
+    /// Whether both sides are meant to be seen (glTF `doubleSided`).
+    pub double_sided: bool,
     /// Weight of the Blinn-Phong highlight.
     pub specular: f32,
     /// Blinn-Phong exponent.
@@ -38,8 +58,38 @@ pub struct Material {
 
 impl Material {
     pub fn new(name: &str, base_color: Vec3) -> Self {
-        Self { name: name.into(), base_color, specular: 0.25, shininess: 48.0 }
+        Self {
+            name: name.into(),
+            base_color,
+            alpha: 1.0,
+            base_color_texture: None,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+            specular: 0.25,
+            shininess: 48.0,
+        }
     }
+}
+
+/// How a texture coordinate outside [0, 1] wraps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    MirroredRepeat,
+    ClampToEdge,
+}
+
+/// An RGBA8 texture in memory (colour channels sRGB-encoded, alpha linear), with its sampler.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+    /// Nearest-texel magnification (glTF `NEAREST`); otherwise bilinear.
+    pub nearest: bool,
 }
 
 /// One placed copy of a mesh.
@@ -148,6 +198,8 @@ pub struct Scene {
     pub spot: SpotLight,
     /// Linear RGB ambient light, added unshadowed.
     pub ambient: Vec3,
+    /// Textures referred to by materials.
+    pub textures: Vec<Texture>,
 }
 
 /// A scene that is not well formed.
@@ -169,6 +221,14 @@ pub enum SceneError {
     BadIndices { scene: String, mesh: String, index: u32, vertices: usize },
     #[error("scene `{scene}`: mesh `{mesh}` has a non-finite position or normal")]
     NonFinite { scene: String, mesh: String },
+    #[error(
+        "scene `{scene}`: material `{material}` refers to texture {texture}, but there are {count} textures"
+    )]
+    TextureOutOfRange { scene: String, material: String, texture: usize, count: usize },
+    #[error(
+        "scene `{scene}`: texture `{texture}` is {width}×{height} but holds {bytes} bytes, not 4 per texel"
+    )]
+    BadTexture { scene: String, texture: String, width: u32, height: u32, bytes: usize },
 }
 
 impl Scene {
@@ -198,12 +258,37 @@ impl Scene {
                     uvs: t,
                 });
             }
-            if m.indices.len() % 3 != 0 || m.indices.iter().any(|&i| i as usize >= p) {
+            if !m.indices.len().is_multiple_of(3) || m.indices.iter().any(|&i| i as usize >= p) {
                 let index = m.indices.iter().copied().find(|&i| i as usize >= p).unwrap_or(0);
                 return Err(SceneError::BadIndices { scene, mesh: m.name.clone(), index, vertices: p });
             }
             if !m.positions.iter().chain(&m.normals).all(|v| v.is_finite()) {
                 return Err(SceneError::NonFinite { scene, mesh: m.name.clone() });
+            }
+        }
+        for m in &self.materials {
+            if let Some(t) = m.base_color_texture
+                && t >= self.textures.len()
+            {
+                let count = self.textures.len();
+                return Err(SceneError::TextureOutOfRange {
+                    scene,
+                    material: m.name.clone(),
+                    texture: t,
+                    count,
+                });
+            }
+        }
+        for t in &self.textures {
+            if t.rgba8.len() != 4 * (t.width as usize) * (t.height as usize) || t.width == 0 || t.height == 0
+            {
+                return Err(SceneError::BadTexture {
+                    scene,
+                    texture: t.name.clone(),
+                    width: t.width,
+                    height: t.height,
+                    bytes: t.rgba8.len(),
+                });
             }
         }
         for i in &self.instances {

@@ -405,6 +405,15 @@ impl Settings {
         cam.eye = c.eye.unwrap_or(cam.eye);
         cam.target = c.target.unwrap_or(cam.target);
         cam.fov_y_degrees = c.fov_y_degrees.unwrap_or(cam.fov_y_degrees);
+        if c.eye.is_some() || c.target.is_some() {
+            // The scene's planes were chosen for its own viewpoint; from a new one,
+            // fit them to the scene's bounds: far past the farthest corner, near a
+            // small fraction of that (Depth32Float keeps ample precision at 1e4).
+            let bounds = scene.bounds();
+            let farthest = bounds.corners().iter().map(|p| p.distance(cam.eye)).fold(0.0f32, f32::max);
+            cam.far = 1.01 * farthest.max(1e-3);
+            cam.near = cam.far * 1e-4;
+        }
         cam.near = c.near.unwrap_or(cam.near);
         cam.far = c.far.unwrap_or(cam.far);
         check(

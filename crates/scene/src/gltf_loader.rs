@@ -1,0 +1,447 @@
+//! Loading glTF 2.0 (`.gltf` with embedded or external buffers and images, and `.glb`)
+//! into a [`Scene`]: every mesh primitive, the node hierarchy with its transforms,
+//! base-colour factors and textures with their samplers and texcoord sets, alpha
+//! modes, the double-sided flag, and cameras and `KHR_lights_punctual` lights.
+//!
+//! Every malformed input gives a [`LoadError`] naming the file and the problem; the
+//! loader never panics on bad data (a panic inside the `gltf` crate is caught and
+//! reported as an error too).
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec2, Vec3};
+use gltf::image::Format;
+
+use crate::{
+    AlphaMode, Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, Texture, Wrap,
+    sun_direction,
+};
+
+/// A glTF file that could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {problem}", path.display())]
+pub struct LoadError {
+    pub path: PathBuf,
+    pub problem: String,
+}
+
+/// Lights and views a file may carry besides geometry.
+#[derive(Clone, Debug, Default)]
+pub struct FileExtras {
+    /// Whether the file had a camera (else the scene's camera was fitted to its bounds).
+    pub has_camera: bool,
+    /// Whether the file had a directional light (else a default sun was placed).
+    pub has_sun: bool,
+    /// Whether the file had a spot light (else a default spot was placed).
+    pub has_spot: bool,
+    /// Lights the file has that Gnomon does not draw yet (point lights).
+    pub ignored_lights: usize,
+}
+
+/// Loads `path` into a scene. The camera and the lights come from the file when it
+/// has them; otherwise the camera is fitted to the bounds and a default sun (45° up)
+/// and spot light are placed.
+pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
+    let fail = |problem: String| LoadError { path: path.to_path_buf(), problem };
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    // A first look without validation, for the problems validation would misname.
+    if let Ok(raw) = gltf::Gltf::from_slice_without_validation(&bytes) {
+        if raw.extensions_used().any(|e| e == "KHR_draco_mesh_compression") {
+            return Err(fail(
+                "uses KHR_draco_mesh_compression, which Gnomon does not support; re-export the file without \
+                 Draco compression"
+                    .into(),
+            ));
+        }
+        let base = path.parent().unwrap_or(Path::new("."));
+        for (kind, uri) in raw
+            .buffers()
+            .filter_map(|b| match b.source() {
+                gltf::buffer::Source::Uri(u) => Some(("buffer", u)),
+                gltf::buffer::Source::Bin => None,
+            })
+            .chain(raw.images().filter_map(|i| match i.source() {
+                gltf::image::Source::Uri { uri, .. } => Some(("image", uri)),
+                gltf::image::Source::View { .. } => None,
+            }))
+        {
+            if !uri.starts_with("data:") && !base.join(uri).is_file() {
+                return Err(fail(format!(
+                    "its {kind} file `{uri}` is missing (looked in {})",
+                    base.display()
+                )));
+            }
+        }
+    }
+    // The gltf crate validates the JSON and the buffer and accessor ranges; guard
+    // against a panic on data it does not check all the same.
+    let imported = std::panic::catch_unwind(|| gltf::import(path))
+        .map_err(|_| fail("the glTF importer failed on malformed data".into()))?;
+    let (document, buffers, images) = match imported {
+        Ok(i) => i,
+        Err(e) => {
+            // Validation insists on min/max for positions, which files with NaN or
+            // infinite positions often lack; say what is really wrong when we can.
+            if let Some(problem) = non_finite_positions(path, &bytes) {
+                return Err(fail(problem));
+            }
+            return Err(fail(describe(&e)));
+        }
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| build(path, &document, &buffers, &images)))
+        .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
+        .map_err(fail)
+}
+
+/// Reads the positions of an unvalidated file and reports the first NaN or infinity.
+fn non_finite_positions(path: &Path, bytes: &[u8]) -> Option<String> {
+    std::panic::catch_unwind(|| {
+        let raw = gltf::Gltf::from_slice_without_validation(bytes).ok()?;
+        let buffers = gltf::import_buffers(&raw.document, path.parent(), raw.blob.clone()).ok()?;
+        for mesh in raw.document.meshes() {
+            for (k, prim) in mesh.primitives().enumerate() {
+                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                if let Some(p) = reader.read_positions()?.find(|p| !p.iter().all(|c| c.is_finite())) {
+                    return Some(format!(
+                        "mesh {} primitive {k} has a non-finite vertex position {p:?} (NaN or infinite)",
+                        mesh.index()
+                    ));
+                }
+            }
+        }
+        None
+    })
+    .ok()
+    .flatten()
+}
+
+fn describe(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(errors) => {
+            let list: Vec<String> =
+                errors.iter().take(5).map(|(path, err)| format!("{path}: {err}")).collect();
+            format!("invalid glTF: {}", list.join("; "))
+        }
+        gltf::Error::Io(io) => format!("cannot read a file it refers to: {io}"),
+        other => other.to_string(),
+    }
+}
+
+fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+    }
+}
+
+/// Converts a decoded glTF image to RGBA8.
+fn to_rgba8(image: &gltf::image::Data) -> Result<Vec<u8>, String> {
+    let p = &image.pixels;
+    let n = (image.width as usize) * (image.height as usize);
+    let rgba: Vec<u8> = match image.format {
+        Format::R8 => p.iter().flat_map(|&r| [r, r, r, 255]).collect(),
+        Format::R8G8 => p.chunks_exact(2).flat_map(|c| [c[0], c[0], c[0], c[1]]).collect(),
+        Format::R8G8B8 => p.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
+        Format::R8G8B8A8 => p.clone(),
+        Format::R16G16B16A16 => p.chunks_exact(2).map(|c| c[1]).collect(),
+        Format::R16G16B16 => p.chunks_exact(6).flat_map(|c| [c[1], c[3], c[5], 255]).collect(),
+        other => return Err(format!("an image in the unsupported pixel format {other:?}")),
+    };
+    if rgba.len() != 4 * n {
+        return Err(format!("an image of {}×{} with {} bytes of pixels", image.width, image.height, p.len()));
+    }
+    Ok(rgba)
+}
+
+fn build(
+    path: &Path,
+    document: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    images: &[gltf::image::Data],
+) -> Result<(Scene, FileExtras), String> {
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+
+    // Textures: one per glTF texture, with its image and sampler.
+    let mut textures = Vec::new();
+    for t in document.textures() {
+        let image =
+            images.get(t.source().index()).ok_or_else(|| format!("texture {} has no image", t.index()))?;
+        let sampler = t.sampler();
+        textures.push(Texture {
+            name: t.name().unwrap_or("texture").to_string(),
+            width: image.width,
+            height: image.height,
+            rgba8: to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
+            wrap_u: wrap(sampler.wrap_s()),
+            wrap_v: wrap(sampler.wrap_t()),
+            nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
+        });
+    }
+
+    // Materials, plus a default one (last) for primitives without a material.
+    let mut materials = Vec::new();
+    let mut texcoord_sets = Vec::new();
+    for m in document.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, b, a] = pbr.base_color_factor();
+        let texture = pbr.base_color_texture();
+        let mut material = Material::new(m.name().unwrap_or("material"), Vec3::new(r, g, b));
+        material.alpha = a;
+        material.base_color_texture = texture.as_ref().map(|t| t.texture().index());
+        material.alpha_mode = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        material.double_sided = m.double_sided();
+        texcoord_sets.push(texture.map(|t| t.tex_coord()).unwrap_or(0));
+        materials.push(material);
+    }
+    let default_material = materials.len();
+    materials.push(Material::new("default", Vec3::splat(0.8)));
+    texcoord_sets.push(0);
+
+    // Meshes: one per primitive, with the texcoord set its material samples.
+    let mut meshes = Vec::new();
+    // For each glTF mesh: its primitives as (mesh index, material index, blend).
+    let mut primitives_of = Vec::new();
+    for mesh in document.meshes() {
+        let mut list = Vec::new();
+        for (k, prim) in mesh.primitives().enumerate() {
+            let label = format!("mesh {} (`{}`) primitive {k}", mesh.index(), mesh.name().unwrap_or(""));
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                // Points and lines cast no shadow; skip them rather than fail.
+                continue;
+            }
+            let material = prim.material().index().unwrap_or(default_material);
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| format!("{label} has no POSITION attribute"))?
+                .map(Vec3::from_array)
+                .collect();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(format!(
+                    "{label}: index {bad} is out of range for its {} vertices",
+                    positions.len()
+                ));
+            }
+            if !indices.len().is_multiple_of(3) {
+                return Err(format!("{label}: {} indices is not a whole number of triangles", indices.len()));
+            }
+            if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+                return Err(format!("{label}: a vertex position is not finite ({p})"));
+            }
+            let normals: Vec<Vec3> = match reader.read_normals() {
+                Some(n) => n.map(|n| Vec3::from_array(n).normalize_or_zero()).collect(),
+                None => smooth_normals(&positions, &indices),
+            };
+            if normals.len() != positions.len() {
+                return Err(format!("{label}: {} normals for {} positions", normals.len(), positions.len()));
+            }
+            let set = texcoord_sets[material];
+            let uvs: Vec<Vec2> = match reader.read_tex_coords(set) {
+                Some(t) => t.into_f32().map(Vec2::from_array).collect(),
+                None => vec![Vec2::ZERO; positions.len()],
+            };
+            if uvs.len() != positions.len() {
+                return Err(format!(
+                    "{label}: {} texture coordinates for {} positions",
+                    uvs.len(),
+                    positions.len()
+                ));
+            }
+            meshes.push(Mesh { name: label, positions, normals, uvs, indices });
+            list.push((meshes.len() - 1, material));
+        }
+        primitives_of.push(list);
+    }
+
+    // The node hierarchy, from the default scene's roots (or every root node).
+    let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let mut is_child = vec![false; document.nodes().len()];
+            for n in document.nodes() {
+                for c in n.children() {
+                    is_child[c.index()] = true;
+                }
+            }
+            document.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+    let mut instances = Vec::new();
+    let mut camera = None;
+    let (mut sun, mut spot) = (None, None);
+    let mut extras = FileExtras::default();
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut visits = 0usize;
+    while let Some((node, parent, depth)) = stack.pop() {
+        visits += 1;
+        // A node graph with a cycle would expand forever; glTF requires a forest.
+        if depth > 256 || visits > 4 * document.nodes().len() + 16 {
+            return Err(format!(
+                "node {} is part of a cycle in the node hierarchy (nodes must form trees)",
+                node.index()
+            ));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !local.is_finite() {
+            return Err(format!("node {} has a non-finite transform", node.index()));
+        }
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            for &(mesh_index, material) in &primitives_of[mesh.index()] {
+                instances.push(Instance {
+                    name: format!("node {} `{}`", node.index(), node.name().unwrap_or("")),
+                    mesh: mesh_index,
+                    material,
+                    world_from_object: world,
+                    casts_shadow: materials[material].alpha_mode != AlphaMode::Blend,
+                });
+            }
+        }
+        let node_camera = node.camera();
+        if camera.is_none()
+            && let Some(gltf::camera::Projection::Perspective(p)) =
+                node_camera.as_ref().map(|c| c.projection())
+        {
+            let eye = world.transform_point3(Vec3::ZERO);
+            let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+            if forward != Vec3::ZERO {
+                camera = Some(Camera {
+                    eye,
+                    target: eye + forward,
+                    up,
+                    fov_y_degrees: p.yfov().to_degrees(),
+                    near: p.znear(),
+                    far: p.zfar().unwrap_or(p.znear() * 1e5),
+                });
+            }
+        }
+        if let Some(light) = node.light() {
+            let color = Vec3::from_array(light.color());
+            let position = world.transform_point3(Vec3::ZERO);
+            let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+            match light.kind() {
+                gltf::khr_lights_punctual::Kind::Directional if sun.is_none() && direction != Vec3::ZERO => {
+                    sun = Some(DirectionalLight {
+                        direction,
+                        color,
+                        intensity: 1.0,
+                        angular_diameter_degrees: 0.0,
+                    });
+                }
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle }
+                    if spot.is_none() && direction != Vec3::ZERO =>
+                {
+                    spot = Some(SpotLight {
+                        position,
+                        direction,
+                        inner_angle_degrees: inner_cone_angle.to_degrees(),
+                        outer_angle_degrees: outer_cone_angle.to_degrees().clamp(1.0, 89.0),
+                        range: light.range().unwrap_or(f32::INFINITY),
+                        color,
+                        intensity: 1.0,
+                        radius: 0.0,
+                    });
+                }
+                _ => extras.ignored_lights += 1,
+            }
+        }
+        for child in node.children() {
+            stack.push((child, world, depth + 1));
+        }
+    }
+    if instances.is_empty() {
+        return Err("has no triangle meshes in its scene".into());
+    }
+
+    let mut scene = Scene {
+        name,
+        meshes,
+        materials,
+        instances,
+        camera: Camera {
+            eye: Vec3::ONE,
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_degrees: 45.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        sun: DirectionalLight {
+            direction: -sun_direction(45.0, 30.0),
+            color: Vec3::new(1.0, 0.97, 0.92),
+            intensity: 1.0,
+            angular_diameter_degrees: 0.0,
+        },
+        spot: SpotLight {
+            position: Vec3::ONE,
+            direction: Vec3::NEG_Y,
+            inner_angle_degrees: 28.0,
+            outer_angle_degrees: 35.0,
+            range: 10.0,
+            color: Vec3::new(1.0, 0.95, 0.85),
+            intensity: 1.0,
+            radius: 0.0,
+        },
+        ambient: Vec3::splat(0.12),
+        textures,
+    };
+    scene.validate().map_err(|e| e.to_string())?;
+    let bounds = scene.bounds();
+    let (center, radius) = (bounds.center(), bounds.bounding_radius().max(1e-3));
+    extras.has_camera = camera.is_some();
+    extras.has_sun = sun.is_some();
+    extras.has_spot = spot.is_some();
+    scene.camera = camera.unwrap_or_else(|| fitted_camera(center, radius));
+    if let Some(s) = sun {
+        scene.sun = s;
+    }
+    scene.spot = spot.unwrap_or(SpotLight {
+        position: center + Vec3::new(0.3, 1.6, 0.5) * radius,
+        direction: (center - (center + Vec3::new(0.3, 1.6, 0.5) * radius)).normalize(),
+        range: 4.0 * radius,
+        ..scene.spot
+    });
+    if !scene.spot.range.is_finite() {
+        scene.spot.range = 4.0 * radius + scene.spot.position.distance(center);
+    }
+    Ok((scene, extras))
+}
+
+/// A camera looking at the bounding sphere from 30° azimuth and 25° elevation, far
+/// enough to see all of it with a 45° field of view.
+pub fn fitted_camera(center: Vec3, radius: f32) -> Camera {
+    let fov: f32 = 45.0;
+    let distance = radius / (0.5 * fov.to_radians()).sin() * 1.05;
+    Camera {
+        eye: center + sun_direction(25.0, 30.0) * distance,
+        target: center,
+        up: Vec3::Y,
+        fov_y_degrees: fov,
+        near: (distance - radius).max(distance * 1e-3) * 0.5,
+        far: distance + 2.0 * radius,
+    }
+}
+
+/// Area-weighted vertex normals, for meshes that come without them.
+fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        for i in [a, b, c] {
+            normals[i] += n;
+        }
+    }
+    normals.iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect()
+}
