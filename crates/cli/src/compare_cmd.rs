@@ -9,7 +9,7 @@ use gnomon_reference::{
     heatmap,
     metrics::{self, Metrics, PixelClass, RasterView},
 };
-use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
 use gnomon_scene::{Settings, settings::Technique};
 use image::RgbaImage;
 use serde::Serialize;
@@ -89,7 +89,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
     );
-    let scene = lab::load_scene(&args.scene)?;
+    let scene = lab::load_scene(&args.scene, &args.settings)?;
     output::check_dir(&args.out, "--out")?;
 
     let gpu = Gpu::new_headless()?;
@@ -98,7 +98,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     }
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(settings)?;
-    let uploaded = GpuScene::upload(&gpu, &scene)?;
+    let uploaded = renderer.upload(&scene)?;
 
     let mut frames: Vec<Rendered> = Vec::new();
     for &technique in &args.techniques {

@@ -10,9 +10,18 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cache;
 
+/// The scene `name`, with the scene options of `settings` applied.
+pub fn load_scene(name: &str, settings: &Settings) -> anyhow::Result<Scene> {
+    let mut scene = load_scene_file(name)?;
+    if settings.scene.ground {
+        scene.add_ground_plane();
+    }
+    Ok(scene)
+}
+
 /// The scene `name`: a glTF file (`.gltf` or `.glb`) or a built-in scene, or an error
 /// that names the valid choices.
-pub fn load_scene(name: &str) -> anyhow::Result<Scene> {
+fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
     let path = std::path::Path::new(name);
     let is_gltf = path
         .extension()

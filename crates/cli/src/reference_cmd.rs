@@ -28,7 +28,7 @@ pub struct ReferenceArgs {
 
 pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
-    let scene = lab::load_scene(&args.scene)?;
+    let scene = lab::load_scene(&args.scene, &args.settings)?;
     output::check_file(&args.out, &["exr", "png"], "--out")?;
     if let Some(p) = &args.std_error_out {
         output::check_file(p, &["exr", "npy"], "--std-error-out")?;

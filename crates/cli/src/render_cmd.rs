@@ -56,7 +56,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     let settings = &args.settings;
     settings.validate()?;
-    let scene = crate::lab::load_scene(&args.scene)?;
+    let scene = crate::lab::load_scene(&args.scene, &args.settings)?;
 
     // Check every output location before any work, so that a typo costs nothing.
     output::check_file(&args.out, &["png"], "--out")?;

@@ -6,6 +6,7 @@
 pub mod heatmap;
 pub mod metrics;
 pub mod sampling;
+pub mod texture;
 mod tracer;
 mod visibility;
 

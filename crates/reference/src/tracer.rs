@@ -1,8 +1,8 @@
 //! The scene as a ray tracer sees it: every instance's triangles in world space, in
 //! one compressed wide BVH (obvhs' CWBVH), with closest-hit and occlusion queries.
 
-use glam::{Vec3, Vec3A};
-use gnomon_scene::Scene;
+use glam::{Vec2, Vec3, Vec3A};
+use gnomon_scene::{AlphaMode, Scene, Texture};
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
@@ -10,6 +10,8 @@ use obvhs::{
     ray::{Ray, RayHit},
     triangle::Triangle,
 };
+
+use crate::texture::sample_alpha;
 
 /// The closest surface along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,6 +26,14 @@ pub struct Hit {
     pub triangle: u32,
 }
 
+/// What the alpha test needs of a triangle of an alpha-masked (glTF MASK) material.
+struct AlphaTriangle {
+    uv: [Vec2; 3],
+    texture: Option<usize>,
+    base_alpha: f32,
+    cutoff: f32,
+}
+
 /// A scene's triangles in a BVH, ready for parallel queries.
 pub struct TracedScene {
     bvh: CwBvh,
@@ -31,6 +41,9 @@ pub struct TracedScene {
     triangles: Vec<Triangle>,
     /// For each triangle in BVH order: (instance index, triangle index in its mesh).
     owners: Vec<(u32, u32)>,
+    /// For each triangle in BVH order: its alpha test, if its material is masked.
+    alpha: Vec<Option<AlphaTriangle>>,
+    textures: Vec<Texture>,
     /// Per instance: whether it occludes light.
     casts_shadow: Vec<bool>,
     triangle_count: usize,
@@ -40,8 +53,10 @@ impl TracedScene {
     pub fn build(scene: &Scene) -> Self {
         let mut triangles = Vec::with_capacity(scene.triangle_count());
         let mut owners = Vec::with_capacity(scene.triangle_count());
+        let mut alpha = Vec::with_capacity(scene.triangle_count());
         for (i, inst) in scene.instances.iter().enumerate() {
             let mesh = &scene.meshes[inst.mesh];
+            let material = &scene.materials[inst.material];
             let world: Vec<Vec3A> =
                 mesh.positions.iter().map(|p| inst.world_from_object.transform_point3(*p).into()).collect();
             for (t, tri) in mesh.indices.chunks_exact(3).enumerate() {
@@ -51,6 +66,15 @@ impl TracedScene {
                     v2: world[tri[2] as usize],
                 });
                 owners.push((i as u32, t as u32));
+                alpha.push(match material.alpha_mode {
+                    AlphaMode::Mask { cutoff } => Some(AlphaTriangle {
+                        uv: [0, 1, 2].map(|k| mesh.uvs[tri[k] as usize]),
+                        texture: material.base_color_texture,
+                        base_alpha: material.alpha,
+                        cutoff,
+                    }),
+                    AlphaMode::Opaque | AlphaMode::Blend => None,
+                });
             }
         }
         let triangle_count = triangles.len();
@@ -72,8 +96,27 @@ impl TracedScene {
         let order = &bvh.primitive_indices;
         let triangles = order.iter().map(|&k| triangles[k as usize]).collect();
         let owners = order.iter().map(|&k| owners[k as usize]).collect();
+        let mut alpha_by_input: Vec<Option<Option<AlphaTriangle>>> = alpha.into_iter().map(Some).collect();
+        let alpha = order.iter().map(|&k| alpha_by_input[k as usize].take().flatten()).collect();
         let casts_shadow = scene.instances.iter().map(|i| i.casts_shadow).collect();
-        Self { bvh, triangles, owners, casts_shadow, triangle_count }
+        Self { bvh, triangles, owners, alpha, textures: scene.textures.clone(), casts_shadow, triangle_count }
+    }
+
+    /// Distance to triangle `id` along `ray`, or infinity; alpha-masked triangles are
+    /// missed where their texture's alpha is below the cutoff, looked up exactly as
+    /// the GPU does (mip 0, the material's sampler).
+    fn hit_distance(&self, sheared: &ShearedRay, id: usize, t_min: f32, t_max: f32) -> f32 {
+        let Some((t, barycentric)) = sheared.intersect(&self.triangles[id], t_min, t_max) else {
+            return f32::INFINITY;
+        };
+        if let Some(a) = &self.alpha[id] {
+            let uv = a.uv[0] * barycentric.x + a.uv[1] * barycentric.y + a.uv[2] * barycentric.z;
+            let texture_alpha = a.texture.map_or(1.0, |k| sample_alpha(&self.textures[k], uv));
+            if a.base_alpha * texture_alpha < a.cutoff {
+                return f32::INFINITY;
+            }
+        }
+        t
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -87,7 +130,7 @@ impl TracedScene {
         let mut hit = RayHit::none();
         if !self
             .bvh
-            .ray_traverse(ray, &mut hit, |ray, id| sheared.intersect(&self.triangles[id], ray.tmin, ray.tmax))
+            .ray_traverse(ray, &mut hit, |ray, id| self.hit_distance(&sheared, id, ray.tmin, ray.tmax))
         {
             return None;
         }
@@ -114,7 +157,7 @@ impl TracedScene {
         let sheared = ShearedRay::new(origin, direction);
         !self.bvh.ray_traverse_miss(ray, |ray, id| {
             if self.casts_shadow[self.owners[id].0 as usize] {
-                sheared.intersect(&self.triangles[id], ray.tmin, ray.tmax)
+                self.hit_distance(&sheared, id, ray.tmin, ray.tmax)
             } else {
                 f32::INFINITY
             }
@@ -158,8 +201,9 @@ impl ShearedRay {
         }
     }
 
-    /// Distance along the ray to `tri` within [t_min, t_max], or infinity.
-    fn intersect(&self, tri: &Triangle, t_min: f32, t_max: f32) -> f32 {
+    /// Distance along the ray to `tri` within [t_min, t_max] and the barycentric
+    /// weights of its vertices there, or `None`.
+    fn intersect(&self, tri: &Triangle, t_min: f32, t_max: f32) -> Option<(f32, Vec3)> {
         let [kx, ky, kz] = self.axes;
         let s = self.shear;
         let rel = |v: Vec3A| Vec3::from(v) - self.origin;
@@ -175,14 +219,15 @@ impl ShearedRay {
             w = (d(bx) * d(ay) - d(by) * d(ax)) as f32;
         }
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return f32::INFINITY;
+            return None;
         }
         let det = u + v + w;
         if det == 0.0 {
-            return f32::INFINITY;
+            return None;
         }
         let t = (u * s.z * a[kz] + v * s.z * b[kz] + w * s.z * c[kz]) / det;
-        if t >= t_min && t <= t_max { t } else { f32::INFINITY }
+        // U weighs the vertex opposite edge BC (A), V the one opposite CA (B), W C.
+        (t >= t_min && t <= t_max).then(|| (t, Vec3::new(u, v, w) / det))
     }
 }
 
@@ -280,7 +325,7 @@ mod tests {
             .iter()
             .filter(|t| {
                 let r = ShearedRay::new(Vec3::ZERO, t.normalize());
-                traced.triangles.iter().all(|tri| r.intersect(tri, 0.0, 10.0) == f32::INFINITY)
+                traced.triangles.iter().all(|tri| r.intersect(tri, 0.0, 10.0).is_none())
             })
             .count();
         assert_eq!(brute, 0, "the triangle test itself is watertight");

@@ -120,7 +120,7 @@ impl<'g> Renderer<'g> {
     }
 
     /// Uploads `scene` and renders it. To render one scene many times, upload it once
-    /// with [`GpuScene::upload`] and call [`Renderer::render_uploaded`].
+    /// with [`Renderer::upload`] and call [`Renderer::render_uploaded`].
     pub fn render(
         &mut self,
         scene: &Scene,
@@ -128,8 +128,13 @@ impl<'g> Renderer<'g> {
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
         settings.validate()?;
-        let uploaded = GpuScene::upload(self.gpu, scene)?;
+        let uploaded = self.upload(scene)?;
         self.render_uploaded(&uploaded, scene, settings, request)
+    }
+
+    /// Uploads a scene's geometry, instances and textures.
+    pub fn upload(&self, scene: &Scene) -> Result<GpuScene, RenderError> {
+        GpuScene::upload(self.gpu, scene, &self.layouts)
     }
 
     /// Checks `settings` against the device's limits.
@@ -276,9 +281,26 @@ impl<'g> Renderer<'g> {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(self.shadow_pass.pipeline(device, &shadow.bias));
                 pass.set_bind_group(0, &scene_group, &[]);
-                uploaded.draw(&mut pass, true);
+                uploaded.bind_geometry(&mut pass);
+                // Opaque casters first (no bind group changes at all), then the
+                // alpha-masked ones, texture by texture.
+                for masked in [false, true] {
+                    let mut bound = None;
+                    for d in uploaded.draws.iter().filter(|d| d.casts_shadow && d.masked == masked) {
+                        pass.set_pipeline(self.shadow_pass.pipeline(
+                            device,
+                            &shadow.bias,
+                            d.double_sided,
+                            masked,
+                        ));
+                        if masked && bound != Some(d.material_group) {
+                            pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
+                            bound = Some(d.material_group);
+                        }
+                        GpuScene::draw_one(&mut pass, d);
+                    }
+                }
             }
             {
                 let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
@@ -318,7 +340,15 @@ impl<'g> Renderer<'g> {
                 pass.set_bind_group(0, &scene_group, &[]);
                 pass.set_bind_group(1, &camera_group, &[]);
                 pass.set_bind_group(2, &shadow_group, &[]);
-                uploaded.draw(&mut pass, false);
+                uploaded.bind_geometry(&mut pass);
+                let mut bound = None;
+                for d in &uploaded.draws {
+                    if bound != Some(d.material_group) {
+                        pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
+                        bound = Some(d.material_group);
+                    }
+                    GpuScene::draw_one(&mut pass, d);
+                }
             }
             let pending: Vec<_> = targets
                 .iter()

@@ -3,12 +3,13 @@
 //! vertex buffer, only the index range and the instance index.
 
 use glam::{Mat3, Mat4, Vec4};
-use gnomon_scene::Scene;
+use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
 use wgpu::util::DeviceExt;
 
 use crate::{
     Gpu, RenderError,
     gpu_types::{InstanceGpu, VertexGpu},
+    passes::Layouts,
 };
 
 /// Where one mesh lives in the shared buffers.
@@ -27,18 +28,27 @@ pub(crate) struct Draw {
     pub base_vertex: i32,
     pub instance: u32,
     pub casts_shadow: bool,
+    /// Alpha-tested (glTF MASK): the shadow pass must sample the texture.
+    pub masked: bool,
+    /// Both faces cast shadows (glTF `doubleSided`), whatever the cull setting.
+    pub double_sided: bool,
+    /// Index into [`GpuScene::material_groups`]: the texture this draw samples.
+    pub material_group: usize,
 }
 
-/// The GPU copy of a [`Scene`]'s geometry and instances.
+/// The GPU copy of a [`Scene`]'s geometry, instances and textures.
 pub struct GpuScene {
     pub(crate) vertices: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
     pub(crate) instances: wgpu::Buffer,
+    /// Draws sorted by material group, so a bind group changes only between groups.
     pub(crate) draws: Vec<Draw>,
+    /// One bind group per texture, plus a 1×1 white one (index 0) for untextured draws.
+    pub(crate) material_groups: Vec<wgpu::BindGroup>,
 }
 
 impl GpuScene {
-    pub fn upload(gpu: &Gpu, scene: &Scene) -> Result<Self, RenderError> {
+    pub(crate) fn upload(gpu: &Gpu, scene: &Scene, layouts: &Layouts) -> Result<Self, RenderError> {
         scene.validate()?;
         if scene.instances.is_empty() || scene.triangle_count() == 0 {
             return Err(RenderError::EmptyScene(scene.name.clone()));
@@ -64,30 +74,45 @@ impl GpuScene {
             .map(|(i, inst)| {
                 let material = &scene.materials[inst.material];
                 let normal = Mat3::from_mat4(inst.world_from_object).inverse().transpose();
+                let cutoff = match material.alpha_mode {
+                    AlphaMode::Mask { cutoff } => cutoff,
+                    AlphaMode::Opaque | AlphaMode::Blend => -1.0,
+                };
                 InstanceGpu {
                     world_from_object: inst.world_from_object,
                     normal_from_object: Mat4::from_mat3(normal),
-                    base_color: material.base_color.extend(1.0),
-                    material: Vec4::new(material.specular, material.shininess, (i + 1) as f32, 0.0),
+                    base_color: material.base_color.extend(material.alpha),
+                    material: Vec4::new(material.specular, material.shininess, (i + 1) as f32, cutoff),
+                    texturing: Vec4::new(
+                        f32::from(u8::from(material.base_color_texture.is_some())),
+                        0.0,
+                        0.0,
+                        0.0,
+                    ),
                 }
             })
             .collect();
-        let draws = scene
+        let mut draws: Vec<Draw> = scene
             .instances
             .iter()
             .enumerate()
             .filter(|(_, inst)| !scene.meshes[inst.mesh].indices.is_empty())
             .map(|(i, inst)| {
                 let r = ranges[inst.mesh];
+                let material = &scene.materials[inst.material];
                 Draw {
                     first_index: r.first_index,
                     index_count: r.index_count,
                     base_vertex: r.base_vertex,
                     instance: i as u32,
                     casts_shadow: inst.casts_shadow,
+                    masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
+                    double_sided: material.double_sided,
+                    material_group: material.base_color_texture.map_or(0, |t| t + 1),
                 }
             })
             .collect();
+        draws.sort_by_key(|d| (d.material_group, d.instance));
         let device = &gpu.device;
         gpu.checked("uploading the scene", || Self {
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -106,20 +131,84 @@ impl GpuScene {
                 usage: wgpu::BufferUsages::STORAGE,
             }),
             draws,
+            material_groups: material_groups(gpu, scene, layouts),
         })
     }
 
-    /// Issues every draw (or only the shadow casters) into `pass`, whose pipeline and
-    /// bind groups are already set.
-    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>, casters_only: bool) {
+    /// Binds the shared vertex and index buffers.
+    pub(crate) fn bind_geometry(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for d in self.draws.iter().filter(|d| d.casts_shadow || !casters_only) {
-            pass.draw_indexed(
-                d.first_index..d.first_index + d.index_count,
-                d.base_vertex,
-                d.instance..d.instance + 1,
-            );
-        }
     }
+
+    /// Issues one draw.
+    pub(crate) fn draw_one(pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
+        pass.draw_indexed(
+            d.first_index..d.first_index + d.index_count,
+            d.base_vertex,
+            d.instance..d.instance + 1,
+        );
+    }
+}
+
+/// A bind group per texture (after a white 1×1 default at index 0), each texture
+/// with the sampler its glTF sampler asks for.
+fn material_groups(gpu: &Gpu, scene: &Scene, layouts: &Layouts) -> Vec<wgpu::BindGroup> {
+    let device = &gpu.device;
+    let white = Texture {
+        name: "white".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![255; 4],
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        nearest: true,
+    };
+    std::iter::once(&white)
+        .chain(&scene.textures)
+        .map(|t| {
+            let texture = device.create_texture_with_data(
+                &gpu.queue,
+                &wgpu::TextureDescriptor {
+                    label: Some(&t.name),
+                    size: wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                &t.rgba8,
+            );
+            let address = |w: Wrap| match w {
+                Wrap::Repeat => wgpu::AddressMode::Repeat,
+                Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+                Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+            };
+            let filter = if t.nearest { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
+            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(&t.name),
+                address_mode_u: address(t.wrap_u),
+                address_mode_v: address(t.wrap_v),
+                mag_filter: filter,
+                min_filter: filter,
+                ..Default::default()
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(&t.name),
+                layout: &layouts.material,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(
+                            &texture.create_view(&Default::default()),
+                        ),
+                    },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
+                ],
+            })
+        })
+        .collect()
 }

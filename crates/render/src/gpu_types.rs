@@ -9,9 +9,13 @@ use glam::{Mat4, Vec4};
 pub struct InstanceGpu {
     pub world_from_object: Mat4,
     pub normal_from_object: Mat4,
+    /// rgb: base colour (linear); a: base alpha.
     pub base_color: Vec4,
-    /// x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1).
+    /// x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1),
+    /// w: alpha cutoff for MASK materials, −1 for none.
     pub material: Vec4,
+    /// x: 1 when the base colour is multiplied by the bound texture.
+    pub texturing: Vec4,
 }
 
 /// The light uniform (`Light` in `scene_common.wgsl`).

@@ -244,6 +244,24 @@ impl Scene {
         self.instances.iter().map(|i| self.meshes[i.mesh].triangle_count()).sum()
     }
 
+    /// Adds a light grey ground plane at the scene's lowest point, three times as wide
+    /// as the scene, and lets the camera's far plane reach across it.
+    pub fn add_ground_plane(&mut self) {
+        let b = self.bounds();
+        let size = 3.0 * b.extent().x.max(b.extent().z).max(1e-3);
+        self.meshes.push(crate::geometry::plane(size, size));
+        self.materials.push(Material::new("ground", Vec3::splat(0.72)));
+        self.instances.push(Instance {
+            name: "ground".into(),
+            mesh: self.meshes.len() - 1,
+            material: self.materials.len() - 1,
+            world_from_object: Mat4::from_translation(Vec3::new(b.center().x, b.min.y, b.center().z)),
+            casts_shadow: true,
+        });
+        let reach = self.camera.eye.distance(b.center()) + 2.0 * size;
+        self.camera.far = self.camera.far.max(reach);
+    }
+
     /// Checks every cross-reference and attribute so that later stages can index freely.
     pub fn validate(&self) -> Result<(), SceneError> {
         let scene = self.name.clone();

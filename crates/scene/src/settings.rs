@@ -17,6 +17,8 @@ use crate::{Camera, Light, Scene, sun_direction};
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     #[command(flatten)]
+    pub scene: SceneOptions,
+    #[command(flatten)]
     pub image: ImageSettings,
     #[command(flatten)]
     pub camera: CameraSettings,
@@ -26,6 +28,16 @@ pub struct Settings {
     pub shadow: ShadowSettings,
     #[command(flatten)]
     pub reference: ReferenceSettings,
+}
+
+/// Changes to the scene itself.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct SceneOptions {
+    /// Add a ground plane under the scene: at its lowest point, three times its
+    /// width, for models that come without a floor to receive their shadows.
+    #[arg(long, help_heading = "Scene")]
+    pub ground: bool,
 }
 
 /// The ray-traced reference.

@@ -34,7 +34,12 @@ impl LightingPass {
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lighting"),
-            bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.camera), Some(&layouts.shadow)],
+            bind_group_layouts: &[
+                Some(&layouts.scene),
+                Some(&layouts.camera),
+                Some(&layouts.shadow),
+                Some(&layouts.material),
+            ],
             immediate_size: 0,
         });
         Self { layout, pipelines: HashMap::new() }

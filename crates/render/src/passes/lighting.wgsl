@@ -14,12 +14,15 @@ struct Camera {
 @group(1) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(0) var shadow_map: texture_depth_2d;
 @group(2) @binding(1) var shadow_compare: sampler_comparison;
+@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
+@group(3) @binding(1) var base_color_sampler: sampler;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) instance: u32,
+    @location(3) uv: vec2<f32>,
 };
 
 @vertex
@@ -31,6 +34,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexO
     out.world = world.xyz;
     out.normal = (inst.normal_from_object * vec4<f32>(v.normal, 0.0)).xyz;
     out.instance = instance_index;
+    out.uv = v.uv;
     return out;
 }
 
@@ -112,7 +116,10 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
         visibility = 0.0;
     }
 
-    let albedo = inst.base_color.rgb;
+    if alpha_cut(inst, in.uv) {
+        discard;
+    }
+    let albedo = base_color_of(inst, in.uv).rgb;
     let n_dot_l = max(dot(n, l), 0.0);
     let v = normalize(camera.eye.xyz - in.world);
     let h = normalize(l + v);

@@ -24,6 +24,9 @@ pub(crate) struct Layouts {
     pub camera: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler.
     pub shadow: wgpu::BindGroupLayout,
+    /// A material's base-colour texture and sampler: group 3 of the lighting pass,
+    /// group 1 of the alpha-masked shadow pass.
+    pub material: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -70,7 +73,29 @@ impl Layouts {
                 },
             ],
         });
-        Self { scene, camera, shadow }
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("material"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        Self { scene, camera, shadow, material }
     }
 }
 

@@ -6,9 +6,11 @@ struct Instance {
     world_from_object: mat4x4<f32>,
     // Inverse transpose of world_from_object's upper 3×3, stored as a mat4 for alignment.
     normal_from_object: mat4x4<f32>,
-    base_color: vec4<f32>,
-    // x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1).
+    base_color: vec4<f32>,  // rgb: base colour, a: base alpha
+    // x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1),
+    // w: alpha cutoff of a MASK material, −1 for none.
     material: vec4<f32>,
+    texturing: vec4<f32>,   // x: 1 when the base colour texture is used
 };
 
 struct VertexIn {
@@ -32,3 +34,18 @@ struct Light {
 
 @group(0) @binding(0) var<storage, read> instances: array<Instance>;
 @group(0) @binding(1) var<uniform> light: Light;
+
+// The base colour of an instance, with alpha: the factor times the texture when it
+// has one. Sampled at mip 0, as the reference ray tracer samples it.
+fn base_color_of(inst: Instance, uv: vec2<f32>) -> vec4<f32> {
+    var c = inst.base_color;
+    if inst.texturing.x > 0.5 {
+        c *= textureSampleLevel(base_color_texture, base_color_sampler, uv, 0.0);
+    }
+    return c;
+}
+
+// Whether an instance's surface is cut away at this point (alpha-masked materials).
+fn alpha_cut(inst: Instance, uv: vec2<f32>) -> bool {
+    return inst.material.w >= 0.0 && base_color_of(inst, uv).a < inst.material.w;
+}

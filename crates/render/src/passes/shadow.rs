@@ -14,12 +14,16 @@ struct ShadowPipelineKey {
     cull: CullMode,
     depth_bias: i32,
     slope_bias_bits: u32,
+    masked: bool,
 }
 
-/// Shadow-pass pipelines, built on first use for each bias and cull combination.
+/// Shadow-pass pipelines, built on first use for each bias, cull and alpha-test
+/// combination. Opaque casters use a vertex-only pipeline; alpha-masked casters add a
+/// fragment stage that discards cut-out texels.
 pub(crate) struct ShadowPass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
+    masked_layout: wgpu::PipelineLayout,
     pipelines: HashMap<ShadowPipelineKey, wgpu::RenderPipeline>,
 }
 
@@ -35,23 +39,38 @@ impl ShadowPass {
             bind_group_layouts: &[Some(&layouts.scene)],
             immediate_size: 0,
         });
-        Self { module, layout, pipelines: HashMap::new() }
+        let masked_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow depth, alpha-masked"),
+            bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.material)],
+            immediate_size: 0,
+        });
+        Self { module, layout, masked_layout, pipelines: HashMap::new() }
     }
 
-    pub fn pipeline(&mut self, device: &wgpu::Device, bias: &BiasSettings) -> &wgpu::RenderPipeline {
+    /// The pipeline for casters with these bias settings; `double_sided` casters are
+    /// never culled, and `masked` ones run the alpha test.
+    pub fn pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        bias: &BiasSettings,
+        double_sided: bool,
+        masked: bool,
+    ) -> &wgpu::RenderPipeline {
         let key = ShadowPipelineKey {
-            cull: bias.cull,
+            cull: if double_sided { CullMode::None } else { bias.cull },
             depth_bias: bias.depth_bias,
             slope_bias_bits: bias.slope_bias.to_bits(),
+            masked,
         };
-        let (module, layout) = (&self.module, &self.layout);
+        let module = &self.module;
+        let layout = if masked { &self.masked_layout } else { &self.layout };
         self.pipelines.entry(key).or_insert_with(|| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("shadow depth"),
+                label: Some(if masked { "shadow depth, alpha-masked" } else { "shadow depth" }),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module,
-                    entry_point: Some("vs_shadow"),
+                    entry_point: Some(if masked { "vs_shadow_masked" } else { "vs_shadow" }),
                     compilation_options: Default::default(),
                     buffers: &[Some(VertexGpu::layout())],
                 },
@@ -77,7 +96,12 @@ impl ShadowPass {
                     },
                 }),
                 multisample: Default::default(),
-                fragment: None,
+                fragment: masked.then_some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_shadow_masked"),
+                    compilation_options: Default::default(),
+                    targets: &[],
+                }),
                 multiview_mask: None,
                 cache: None,
             })

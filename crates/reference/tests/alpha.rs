@@ -1,0 +1,243 @@
+//! Alpha-masked casters: a quad with a checkerboard alpha texture casts a checkerboard
+//! shadow, in the rasterizer and in the reference, where the analytic projection puts
+//! it; and on the `tree` scene the two agree.
+
+use std::sync::OnceLock;
+
+use glam::{Mat4, Vec2, Vec3};
+use gnomon_reference::{
+    ReferenceImage, ReferenceOptions, TracedScene,
+    metrics::{self, RasterView},
+    reference_visibility,
+};
+use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
+use gnomon_scene::{
+    AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry, settings::Technique,
+};
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
+}
+
+const CELLS: u32 = 8;
+const HALF: f32 = 1.0;
+const HEIGHT: f32 = 1.2;
+const QUAD_CENTER: Vec3 = Vec3::new(0.3, HEIGHT, -0.2);
+
+/// Alpha of checker cell (i, j): opaque when i + j is even.
+fn opaque_cell(i: i32, j: i32) -> bool {
+    (i + j).rem_euclid(2) == 0
+}
+
+fn checker_scene() -> Scene {
+    let mut scene = builtin::spheres();
+    scene.name = "checker".into();
+    scene.meshes = vec![geometry::plane(12.0, 12.0), geometry::plane(2.0 * HALF, 2.0 * HALF)];
+    let rgba8 = (0..CELLS as i32)
+        .flat_map(|j| {
+            (0..CELLS as i32).flat_map(move |i| [200, 180, 60, if opaque_cell(i, j) { 255 } else { 0 }])
+        })
+        .collect();
+    scene.textures = vec![Texture {
+        name: "checker".into(),
+        width: CELLS,
+        height: CELLS,
+        rgba8,
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        nearest: true,
+    }];
+    let mut cutout = Material::new("cut-out", Vec3::ONE);
+    cutout.base_color_texture = Some(0);
+    cutout.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
+    cutout.double_sided = true;
+    scene.materials = vec![Material::new("ground", Vec3::splat(0.7)), cutout];
+    scene.instances = vec![
+        Instance {
+            name: "ground".into(),
+            mesh: 0,
+            material: 0,
+            world_from_object: Mat4::IDENTITY,
+            casts_shadow: true,
+        },
+        Instance {
+            name: "checker".into(),
+            mesh: 1,
+            material: 1,
+            world_from_object: Mat4::from_translation(QUAD_CENTER),
+            casts_shadow: true,
+        },
+    ];
+    scene.sun.direction = -gnomon_scene::sun_direction(60.0, 20.0);
+    // Seen from beyond the shadow, so that the quad hides as little of it as possible.
+    let shadow = shadow_offset(scene.sun.direction) + Vec2::new(QUAD_CENTER.x, QUAD_CENTER.z);
+    scene.camera.eye = Vec3::new(shadow.x - 1.0, 6.0, shadow.y - 5.0);
+    scene.camera.target = Vec3::new(shadow.x, 0.0, shadow.y);
+    scene
+}
+
+/// Where on the ground (xz) the quad's shadow is shifted, relative to the quad.
+fn shadow_offset(direction: Vec3) -> Vec2 {
+    Vec2::new(direction.x, direction.z) * (HEIGHT / -direction.y)
+}
+
+/// Analytic truth for a ground point: (shadowed, distance to the nearest cell edge,
+/// which is where the shadow's state can change).
+fn analytic(p: Vec3, direction: Vec3) -> (bool, f32) {
+    let q = Vec2::new(p.x, p.z) - shadow_offset(direction) - Vec2::new(QUAD_CENTER.x, QUAD_CENTER.z);
+    // The plane's texture runs u along +x and v along +z, from the corner (−h, −h).
+    let uv = (q + Vec2::splat(HALF)) / (2.0 * HALF);
+    let cell = 2.0 * HALF / CELLS as f32;
+    let grid = uv * CELLS as f32;
+    let to_line = |g: f32| (g - g.round()).abs() * cell;
+    let edge = to_line(grid.x).min(to_line(grid.y));
+    let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmplt(Vec2::ONE).all();
+    let shadowed = inside && opaque_cell(grid.x.floor() as i32, grid.y.floor() as i32);
+    // Outside the quad, the distance to its outline is what matters.
+    let outline = if inside { edge } else { (uv.clamp(Vec2::ZERO, Vec2::ONE) - uv).length() * 2.0 * HALF };
+    (shadowed, if inside { edge } else { outline })
+}
+
+fn settings(technique: Technique) -> Settings {
+    let mut s = Settings::default();
+    s.image.width = 640;
+    s.image.height = 480;
+    s.shadow.map.resolution = 2048;
+    s.shadow.filter.technique = technique;
+    s
+}
+
+fn render(scene: &Scene, s: &Settings) -> Frame {
+    Renderer::new(gpu()).unwrap().render(scene, s, &OutputRequest::default()).unwrap()
+}
+
+fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
+    let options = ReferenceOptions { width: s.image.width, height: s.image.height, samples: 1 };
+    let (camera, light) = (s.resolve_camera(scene).unwrap(), s.resolve_light(scene).unwrap());
+    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
+}
+
+fn pixel_size(position: &[Vec3], ids: &[u32], w: usize, i: usize) -> f32 {
+    [i.wrapping_sub(1), i + 1, i.wrapping_sub(w), i + w]
+        .iter()
+        .filter(|&&j| j < position.len() && ids[j] == ids[i])
+        .map(|&j| position[j].distance(position[i]))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
+    let scene = checker_scene();
+    let direction = scene.sun.direction;
+    for technique in [Technique::Hard, Technique::Pcf2x2] {
+        let s = settings(technique);
+        let frame = render(&scene, &s);
+        let texel = frame.light_projection.texel_world_size(2048, 0.0);
+        let w = frame.width as usize;
+        let (mut cells_seen, mut shadowed, mut worst) = (0, 0, f32::NEG_INFINITY);
+        for i in 0..frame.pixel_count() {
+            if frame.object_id[i] != 1 {
+                continue;
+            }
+            let (truth, edge) = analytic(frame.position[i], direction);
+            cells_seen += usize::from(truth);
+            let v = frame.visibility[i] < 0.5;
+            shadowed += usize::from(v);
+            if v != truth {
+                worst = worst.max(edge - texel - pixel_size(&frame.position, &frame.object_id, w, i));
+            }
+        }
+        assert!(
+            cells_seen > 3000 && shadowed > 3000,
+            "{technique:?}: {cells_seen} truly shadowed, {shadowed} shadowed"
+        );
+        assert!(
+            worst <= 0.0,
+            "{technique:?}: a mismatch {worst} beyond one texel and one pixel of a cell edge"
+        );
+    }
+    // The reference: exact to a pixel, with the same alpha lookup.
+    let s = settings(Technique::Hard);
+    let r = reference(&scene, &s);
+    let w = r.width as usize;
+    let mut worst = f32::NEG_INFINITY;
+    for i in 0..r.pixel_count() {
+        if r.object_id[i] != 1 {
+            continue;
+        }
+        let (truth, edge) = analytic(r.position[i], direction);
+        if (r.visibility[i] < 0.5) != truth {
+            worst = worst.max(edge - pixel_size(&r.position, &r.object_id, w, i));
+        }
+    }
+    assert!(worst <= 0.0, "reference: a mismatch {worst} beyond one pixel of a cell edge");
+    // Without the alpha test the whole quad would shadow: make sure the holes exist.
+    let lit_under_quad = (0..r.pixel_count())
+        .filter(|&i| r.object_id[i] == 1)
+        .filter(|&i| {
+            let q = Vec2::new(r.position[i].x, r.position[i].z)
+                - shadow_offset(direction)
+                - Vec2::new(QUAD_CENTER.x, QUAD_CENTER.z);
+            q.abs().max_element() < HALF * 0.95 && r.visibility[i] > 0.5
+        })
+        .count();
+    assert!(lit_under_quad > 1000, "the holes let light through ({lit_under_quad} pixels)");
+}
+
+/// The tree's leaves are MASK (cutoff 0.5) and double-sided. Needs `../shared`.
+///
+/// Issue 4 asks for a mismatch under 2 % here. Measured on lavapipe: 2.63 % with the
+/// default bias on a ground twice the tree's size (3.16 % on one 4× its size), and
+/// 2.02 % without the normal offset. The errors are one-texel fringes around every
+/// leaf's shadow, shifted one way by the normal offset's lateral move of the lookup.
+/// Kept to the target, and ignored until the filtering work (receiver-plane bias,
+/// issue 5) or tighter fitting (issue 6) meets it: `cargo test -- --ignored` runs it.
+#[test]
+#[ignore = "issue 4 target not met yet: 2.63 % measured against < 2 %"]
+fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/tree/tree.glb");
+    if !path.is_file() {
+        eprintln!("skipped: {} is not present", path.display());
+        return;
+    }
+    let (mut scene, _) = gnomon_scene::gltf_loader::load(&path).unwrap();
+    // A ground to receive the shadow, just under the tree.
+    let b = scene.bounds();
+    let size = 2.0 * b.extent().max_element();
+    scene.meshes.push(geometry::plane(size, size));
+    scene.materials.push(Material::new("ground", Vec3::splat(0.7)));
+    scene.instances.push(Instance {
+        name: "ground".into(),
+        mesh: scene.meshes.len() - 1,
+        material: scene.materials.len() - 1,
+        world_from_object: Mat4::from_translation(Vec3::new(b.center().x, b.min.y, b.center().z)),
+        casts_shadow: true,
+    });
+    let c = b.center();
+    let r = b.bounding_radius();
+    scene.camera.eye = c + Vec3::new(0.4, 0.9, 1.6) * r;
+    scene.camera.target = Vec3::new(c.x, b.min.y + 0.3 * b.extent().y, c.z);
+    scene.camera.near = 0.01 * r;
+    scene.camera.far = 10.0 * r;
+    scene.sun.direction = -gnomon_scene::sun_direction(55.0, 200.0);
+    let mut s = settings(Technique::Pcf2x2);
+    s.image.width = 1280;
+    s.image.height = 720;
+    let frame = render(&scene, &s);
+    let truth = reference(&scene, &s);
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let classes = metrics::classify(raster, &truth);
+    let m = metrics::measure(raster, &truth, &classes);
+    eprintln!(
+        "tree, pcf2x2, 2048²: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} compared, {} silhouette",
+        100.0 * m.mismatch_rate,
+        100.0 * m.false_shadow_rate,
+        100.0 * m.false_lit_rate,
+        m.compared,
+        m.silhouette
+    );
+    assert!(m.compared > 300_000, "{m:?}");
+    assert!(m.mismatch_rate < 0.02, "{m:?}");
+}
