@@ -21,9 +21,13 @@ use crate::{
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Scene: a glTF file (.gltf or .glb) or a built-in scene (see `gnomon scenes`).
+    /// Scene: a scene file (.toml), a glTF file (.gltf or .glb) or a built-in scene
+    /// (see `gnomon scenes`).
     #[arg(default_value = "spheres")]
     pub scene: String,
+    /// Camera view of a scene file (.toml) to use [default: its first view].
+    #[arg(long, value_name = "NAME")]
+    pub view: Option<String>,
     /// Techniques to compare, comma-separated (see `gnomon techniques`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "hard,pcf2x2,pcf")]
     pub techniques: Vec<Technique>,
@@ -78,8 +82,7 @@ struct Report<'a> {
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
-    let settings = &args.settings;
-    settings.validate()?;
+    args.settings.validate()?;
     anyhow::ensure!(
         (1..=100).contains(&args.timing_frames),
         "--timing-frames = {} is invalid: 1 to 100",
@@ -89,7 +92,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
     );
-    let scene = lab::load_scene(&args.scene, &args.settings)?;
+    let (scene, settings) = lab::load(&args.scene, args.view.as_deref(), &args.settings)?;
+    let settings = &settings;
     output::check_dir(&args.out, "--out")?;
 
     let gpu = Gpu::new_headless()?;

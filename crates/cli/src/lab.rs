@@ -10,18 +10,37 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cache;
 
-/// The scene `name`, with the scene options of `settings` applied.
-pub fn load_scene(name: &str, settings: &Settings) -> anyhow::Result<Scene> {
-    let mut scene = load_scene_file(name)?;
-    if settings.scene.ground {
+/// The scene `name` (a scene file, a glTF file or a built-in scene) and the settings
+/// to render it with: a scene file's `[settings]` with the command line's changes laid
+/// over them, or the command line's alone. `view` picks a scene file's camera view.
+pub fn load(name: &str, view: Option<&str>, command_line: &Settings) -> anyhow::Result<(Scene, Settings)> {
+    let path = std::path::Path::new(name);
+    let is_toml = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let (mut scene, settings) = if is_toml {
+        anyhow::ensure!(path.is_file(), "{name}: no such file");
+        let loaded = gnomon_scene::scene_file::load(path, view)?;
+        let settings = match &loaded.settings {
+            Some(table) => gnomon_scene::scene_file::merge_settings(table, command_line)
+                .map_err(|e| anyhow::anyhow!("{name}: [settings]: {e}"))?,
+            None => command_line.clone(),
+        };
+        (loaded.scene, settings)
+    } else {
+        if let Some(v) = view {
+            anyhow::bail!("--view {v}: views come from scene files (.toml), and `{name}` is not one");
+        }
+        (load_scene_file(name)?, command_line.clone())
+    };
+    settings.validate()?;
+    if settings.scene.ground && !scene.instances.iter().any(|i| i.name == "ground") {
         scene.add_ground_plane();
     }
-    Ok(scene)
+    Ok((scene, settings))
 }
 
 /// The scene `name`: a glTF file (`.gltf` or `.glb`) or a built-in scene, or an error
 /// that names the valid choices.
-fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
+pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
     let path = std::path::Path::new(name);
     let is_gltf = path
         .extension()
@@ -40,7 +59,7 @@ fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
     }
     builtin::build(name).with_context(|| {
         format!(
-            "unknown scene `{name}`: give a glTF file (.gltf or .glb) or one of the built-in scenes {}",
+            "unknown scene `{name}`: give a scene file (.toml), a glTF file (.gltf or .glb) or one of the built-in scenes {}",
             builtin::names().join(", ")
         )
     })

@@ -12,9 +12,13 @@ use crate::output::{self, Staged};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene: a glTF file (.gltf or .glb) or a built-in scene (see `gnomon scenes`).
+    /// Scene: a scene file (.toml), a glTF file (.gltf or .glb) or a built-in scene
+    /// (see `gnomon scenes`).
     #[arg(default_value = "spheres")]
     pub scene: String,
+    /// Camera view of a scene file (.toml) to use [default: its first view].
+    #[arg(long, value_name = "NAME")]
+    pub view: Option<String>,
     /// Output image (PNG, sRGB).
     #[arg(long, short, default_value = "gnomon.png", help_heading = "Outputs")]
     pub out: PathBuf,
@@ -54,9 +58,9 @@ impl RenderArgs {
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
-    let settings = &args.settings;
-    settings.validate()?;
-    let scene = crate::lab::load_scene(&args.scene, &args.settings)?;
+    args.settings.validate()?;
+    let (scene, settings) = crate::lab::load(&args.scene, args.view.as_deref(), &args.settings)?;
+    let settings = &settings;
 
     // Check every output location before any work, so that a typo costs nothing.
     output::check_file(&args.out, &["png"], "--out")?;

@@ -220,3 +220,55 @@ fn reference_writes_visibility_and_standard_error() {
     let bad = gnomon(&dir, &["reference", "--samples", "4"]);
     assert!(!bad.status.success() && stderr(&bad).contains("--samples"), "{}", stderr(&bad));
 }
+
+/// A one-triangle glTF with its buffer embedded as a data URI.
+const TRIANGLE_GLTF: &str = r#"{
+  "asset": {"version": "2.0"},
+  "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIC/", "byteLength": 36}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, -1], "max": [1, 0, 0]}]
+}"#;
+
+#[test]
+fn a_scene_file_renders_with_its_views_and_settings() {
+    let dir = temp_dir("scene-file");
+    std::fs::write(dir.join("tri.gltf"), TRIANGLE_GLTF).unwrap();
+    // The flat triangle is stood upright (90° about x), so that the ground, placed at
+    // the scene's lowest point, meets its bottom edge and catches its shadow.
+    std::fs::write(
+        dir.join("scene.toml"),
+        "ground = true\n[[model]]\nfile = \"tri.gltf\"\ntranslation = [0.0, 0.5, 0.0]\nrotation_degrees = [90.0, 0.0, 0.0]\n\
+         [[view]]\nname = \"above\"\neye = [0.3, 4.0, 0.5]\ntarget = [0.3, 0.0, -0.3]\n\
+         [settings.image]\nwidth = 96\nheight = 54\n",
+    )
+    .unwrap();
+    let out = gnomon(
+        &dir,
+        &["render", "scene.toml", "--view", "above", "--out", "s.png", "--visibility-out", "v.npy"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let image = image::open(dir.join("s.png")).unwrap();
+    assert_eq!((image.width(), image.height()), (96, 54), "the file's [settings.image] applies");
+    // The command line overrides the file.
+    let out = gnomon(&dir, &["render", "scene.toml", "--width", "64", "--out", "s.png"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(image::open(dir.join("s.png")).unwrap().width(), 64);
+    // The triangle's shadow falls on the ground: some ground pixels are shadowed.
+    let bytes = std::fs::read(dir.join("v.npy")).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let shadowed = bytes[10 + header_len..]
+        .chunks(4)
+        .filter(|c| f32::from_le_bytes((*c).try_into().unwrap()) < 0.5)
+        .count();
+    assert!(shadowed > 20, "{shadowed}");
+    let bad = gnomon(&dir, &["render", "scene.toml", "--view", "below"]);
+    assert!(!bad.status.success() && stderr(&bad).contains("no view `below`"), "{}", stderr(&bad));
+    let bad = gnomon(&dir, &["render", "spheres", "--view", "above"]);
+    assert!(
+        !bad.status.success() && stderr(&bad).contains("views come from scene files"),
+        "{}",
+        stderr(&bad)
+    );
+}

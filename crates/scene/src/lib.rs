@@ -5,6 +5,7 @@ pub mod builtin;
 pub mod geometry;
 pub mod gltf_loader;
 mod model;
+pub mod scene_file;
 pub mod settings;
 
 pub use model::{

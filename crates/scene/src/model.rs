@@ -244,6 +244,24 @@ impl Scene {
         self.instances.iter().map(|i| self.meshes[i.mesh].triangle_count()).sum()
     }
 
+    /// Appends `other`'s meshes, materials, textures and instances, placing its
+    /// instances with `world_from_other`. Its camera and lights are dropped.
+    pub fn append(&mut self, other: Scene, world_from_other: Mat4) {
+        let (meshes, materials, textures) = (self.meshes.len(), self.materials.len(), self.textures.len());
+        self.meshes.extend(other.meshes);
+        self.textures.extend(other.textures);
+        self.materials.extend(other.materials.into_iter().map(|mut m| {
+            m.base_color_texture = m.base_color_texture.map(|t| t + textures);
+            m
+        }));
+        self.instances.extend(other.instances.into_iter().map(|mut i| {
+            i.mesh += meshes;
+            i.material += materials;
+            i.world_from_object = world_from_other * i.world_from_object;
+            i
+        }));
+    }
+
     /// Adds a light grey ground plane at the scene's lowest point, three times as wide
     /// as the scene, and lets the camera's far plane reach across it.
     pub fn add_ground_plane(&mut self) {

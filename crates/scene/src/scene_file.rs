@@ -1,0 +1,267 @@
+//! Scene files (TOML): glTF models with transforms, the lights, named camera views,
+//! and default render settings, in one human-edited file.
+//!
+//! ```toml
+//! ground = true                          # add a floor under the models
+//!
+//! [[model]]
+//! file = "tree.glb"                      # relative to this file
+//! translation = [0.0, 0.0, 0.0]
+//! rotation_degrees = [0.0, 45.0, 0.0]    # about x, then y, then z
+//! scale = 1.0
+//!
+//! [sun]
+//! elevation = 55.0                       # degrees above the horizon
+//! azimuth = 200.0                        # degrees from +z toward +x
+//! angular_diameter = 0.53                # degrees; 0 for hard shadows
+//!
+//! [spot]
+//! position = [2.0, 6.0, 1.0]
+//! target = [0.0, 0.0, 0.0]
+//! outer_angle = 40.0
+//! range = 30.0
+//! radius = 0.1
+//!
+//! [[view]]
+//! name = "front"
+//! eye = [0.0, 3.0, 9.0]
+//! target = [0.0, 1.5, 0.0]
+//! fov = 45.0
+//!
+//! [settings.shadow.filter]               # any of the render settings
+//! technique = "pcf"
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use serde::Deserialize;
+
+use crate::{Camera, Scene, Settings, SpotLight, gltf_loader, sun_direction};
+
+/// A scene file that could not be used.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {problem}", path.display())]
+pub struct SceneFileError {
+    pub path: PathBuf,
+    pub problem: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    #[serde(default)]
+    ground: bool,
+    #[serde(default)]
+    model: Vec<ModelEntry>,
+    sun: Option<SunEntry>,
+    spot: Option<SpotEntry>,
+    #[serde(default)]
+    view: Vec<ViewEntry>,
+    settings: Option<toml::Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelEntry {
+    file: PathBuf,
+    #[serde(default)]
+    translation: [f32; 3],
+    #[serde(default)]
+    rotation_degrees: [f32; 3],
+    #[serde(default = "one")]
+    scale: f32,
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SunEntry {
+    elevation: f32,
+    azimuth: f32,
+    #[serde(default)]
+    angular_diameter: f32,
+    color: Option<[f32; 3]>,
+    intensity: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpotEntry {
+    position: [f32; 3],
+    target: [f32; 3],
+    outer_angle: f32,
+    inner_angle: Option<f32>,
+    range: f32,
+    #[serde(default)]
+    radius: f32,
+    color: Option<[f32; 3]>,
+    intensity: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ViewEntry {
+    name: String,
+    eye: [f32; 3],
+    target: [f32; 3],
+    fov: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+}
+
+/// A loaded scene file: the scene, with the chosen view as its camera, and the
+/// file's default settings (a TOML table in the shape of [`Settings`]).
+pub struct LoadedSceneFile {
+    pub scene: Scene,
+    pub view_names: Vec<String>,
+    pub settings: Option<toml::Value>,
+}
+
+/// Loads the scene file at `path`, using the view called `view` (or the first).
+pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFileError> {
+    let fail = |problem: String| SceneFileError { path: path.to_path_buf(), problem };
+    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let file: SceneFile = toml::from_str(&text).map_err(|e| fail(e.to_string()))?;
+    if file.model.is_empty() {
+        return Err(fail("lists no models: add at least one [[model]] with a `file`".into()));
+    }
+    if let Some(table) = &file.settings {
+        // Check the settings now, so that a typo is reported against this file.
+        table.clone().try_into::<Settings>().map_err(|e| fail(format!("[settings]: {e}")))?;
+    }
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut scene: Option<Scene> = None;
+    for model in &file.model {
+        let model_path = base.join(&model.file);
+        let (loaded, _) = gltf_loader::load(&model_path).map_err(|e| fail(format!("model: {e}")))?;
+        let [rx, ry, rz] = model.rotation_degrees.map(f32::to_radians);
+        let world_from_model = Mat4::from_scale_rotation_translation(
+            Vec3::splat(model.scale),
+            Quat::from_euler(EulerRot::ZYX, rz, ry, rx),
+            Vec3::from_array(model.translation),
+        );
+        if !world_from_model.is_finite() || model.scale <= 0.0 {
+            return Err(fail(format!(
+                "model `{}`: the transform must be finite with a scale > 0",
+                model.file.display()
+            )));
+        }
+        match &mut scene {
+            None => {
+                let mut first = loaded;
+                for inst in &mut first.instances {
+                    inst.world_from_object = world_from_model * inst.world_from_object;
+                }
+                scene = Some(first);
+            }
+            Some(s) => s.append(loaded, world_from_model),
+        }
+    }
+    let mut scene = scene.expect("at least one model");
+    scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let bounds = scene.bounds();
+    scene.camera = gltf_loader::fitted_camera(bounds.center(), bounds.bounding_radius().max(1e-3));
+    if file.ground {
+        scene.add_ground_plane();
+    }
+    if let Some(sun) = &file.sun {
+        scene.sun.direction = -sun_direction(sun.elevation, sun.azimuth);
+        scene.sun.angular_diameter_degrees = sun.angular_diameter;
+        scene.sun.color = sun.color.map(Vec3::from_array).unwrap_or(scene.sun.color);
+        scene.sun.intensity = sun.intensity.unwrap_or(scene.sun.intensity);
+    }
+    if let Some(spot) = &file.spot {
+        let position = Vec3::from_array(spot.position);
+        scene.spot = SpotLight {
+            position,
+            direction: (Vec3::from_array(spot.target) - position).normalize_or(Vec3::NEG_Y),
+            inner_angle_degrees: spot.inner_angle.unwrap_or(0.8 * spot.outer_angle),
+            outer_angle_degrees: spot.outer_angle,
+            range: spot.range,
+            color: spot.color.map(Vec3::from_array).unwrap_or(scene.spot.color),
+            intensity: spot.intensity.unwrap_or(scene.spot.intensity),
+            radius: spot.radius,
+        };
+    }
+    let view_names: Vec<String> = file.view.iter().map(|v| v.name.clone()).collect();
+    let chosen = match view {
+        Some(name) => Some(file.view.iter().find(|v| v.name == name).ok_or_else(|| {
+            fail(if view_names.is_empty() {
+                format!("has no views, so --view {name} cannot be used")
+            } else {
+                format!("has no view `{name}`; its views are {}", view_names.join(", "))
+            })
+        })?),
+        None => file.view.first(),
+    };
+    if let Some(v) = chosen {
+        let eye = Vec3::from_array(v.eye);
+        let far = bounds.corners().iter().map(|p| p.distance(eye)).fold(0.0f32, f32::max) * 1.01;
+        scene.camera = Camera {
+            eye,
+            target: Vec3::from_array(v.target),
+            up: Vec3::Y,
+            fov_y_degrees: v.fov.unwrap_or(45.0),
+            near: v.near.unwrap_or(far.max(1e-3) * 1e-4),
+            far: v.far.unwrap_or(far.max(1e-3)),
+        };
+    }
+    scene.validate().map_err(|e| fail(e.to_string()))?;
+    Ok(LoadedSceneFile { scene, view_names, settings: file.settings })
+}
+
+/// `file`'s settings with every command-line value that differs from its default laid
+/// over them: a flag given on the command line wins over the file, a flag left alone
+/// does not. (A flag set explicitly to its default value cannot override the file.)
+pub fn merge_settings(file: &toml::Value, command_line: &Settings) -> Result<Settings, String> {
+    let defaults = toml::Value::try_from(Settings::default()).map_err(|e| e.to_string())?;
+    let cli = toml::Value::try_from(command_line).map_err(|e| e.to_string())?;
+    let mut merged = toml::Value::try_from(Settings::default()).map_err(|e| e.to_string())?;
+    overlay(&mut merged, file);
+    overlay_changes(&mut merged, &cli, &defaults);
+    merged.try_into().map_err(|e: toml::de::Error| e.to_string())
+}
+
+/// Copies every value of `from` into `into`, recursing into tables.
+fn overlay(into: &mut toml::Value, from: &toml::Value) {
+    match (into, from) {
+        (toml::Value::Table(a), toml::Value::Table(b)) => {
+            for (k, v) in b {
+                match a.get_mut(k) {
+                    Some(slot) => overlay(slot, v),
+                    None => {
+                        a.insert(k.clone(), v.clone());
+                    }
+                }
+            }
+        }
+        (slot, v) => *slot = v.clone(),
+    }
+}
+
+/// Copies the values of `cli` that differ from `defaults` into `into`.
+fn overlay_changes(into: &mut toml::Value, cli: &toml::Value, defaults: &toml::Value) {
+    match (into, cli) {
+        (toml::Value::Table(a), toml::Value::Table(c)) => {
+            for (k, v) in c {
+                let d = defaults.get(k).cloned().unwrap_or(toml::Value::Table(Default::default()));
+                match a.get_mut(k) {
+                    Some(slot) => overlay_changes(slot, v, &d),
+                    None if *v != d => {
+                        a.insert(k.clone(), v.clone());
+                    }
+                    None => {}
+                }
+            }
+        }
+        (slot, v) => {
+            if v != defaults {
+                *slot = v.clone();
+            }
+        }
+    }
+}

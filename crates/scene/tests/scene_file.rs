@@ -1,0 +1,98 @@
+//! Scene files: models placed by their transforms, lights, named views, and settings
+//! merged with the command line.
+
+mod common;
+
+use glam::Vec3;
+use gnomon_scene::{Settings, scene_file, settings::Technique};
+
+use common::{glb, hierarchy_json, temp_dir, triangle_bytes};
+
+fn write_scene(dir: &std::path::Path, text: &str) -> std::path::PathBuf {
+    std::fs::write(dir.join("tri.glb"), glb(&hierarchy_json(None), &triangle_bytes())).unwrap();
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+const SCENE: &str = r#"
+ground = true
+
+[[model]]
+file = "tri.glb"
+
+[[model]]
+file = "tri.glb"
+translation = [10.0, 0.0, 0.0]
+scale = 2.0
+
+[sun]
+elevation = 30.0
+azimuth = 90.0
+angular_diameter = 0.5
+
+[[view]]
+name = "front"
+eye = [0.0, 3.0, 9.0]
+target = [0.0, 1.0, 0.0]
+
+[[view]]
+name = "top"
+eye = [5.0, 20.0, 0.1]
+target = [5.0, 0.0, 0.0]
+fov = 30.0
+
+[settings.shadow.filter]
+technique = "pcf"
+pcf_kernel = 5
+"#;
+
+#[test]
+fn models_lights_views_and_settings_come_from_the_file() {
+    let dir = temp_dir("scene-file");
+    let path = write_scene(&dir, SCENE);
+    let loaded = scene_file::load(&path, None).unwrap();
+    let scene = &loaded.scene;
+    // Two models of one instance each, and the ground.
+    assert_eq!(scene.instances.len(), 3);
+    assert_eq!(loaded.view_names, ["front", "top"]);
+    // The first view is the default.
+    assert_eq!(scene.camera.eye, Vec3::new(0.0, 3.0, 9.0));
+    // The second model is scaled by 2 about its origin, then moved 10 along x: its
+    // child's origin (0, 2, −2) in the model becomes (10, 4, −4).
+    let second = scene.instances[1].world_from_object.transform_point3(Vec3::ZERO);
+    assert!(second.abs_diff_eq(Vec3::new(10.0, 4.0, -4.0), 1e-4), "{second}");
+    assert!(((-scene.sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
+    assert_eq!(scene.sun.angular_diameter_degrees, 0.5);
+    let top = scene_file::load(&path, Some("top")).unwrap().scene.camera;
+    assert_eq!((top.eye, top.fov_y_degrees), (Vec3::new(5.0, 20.0, 0.1), 30.0));
+
+    // File settings apply; a command-line value that differs from its default wins.
+    let table = loaded.settings.unwrap();
+    let merged = scene_file::merge_settings(&table, &Settings::default()).unwrap();
+    assert_eq!((merged.shadow.filter.technique, merged.shadow.filter.pcf_kernel), (Technique::Pcf, 5));
+    let mut cli = Settings::default();
+    cli.shadow.filter.pcf_kernel = 7;
+    cli.shadow.map.resolution = 1024;
+    let merged = scene_file::merge_settings(&table, &cli).unwrap();
+    assert_eq!(merged.shadow.filter.technique, Technique::Pcf, "kept from the file");
+    assert_eq!(merged.shadow.filter.pcf_kernel, 7, "the command line wins");
+    assert_eq!(merged.shadow.map.resolution, 1024);
+}
+
+#[test]
+fn bad_scene_files_name_the_file_and_the_problem() {
+    let dir = temp_dir("scene-file-bad");
+    let check = |text: &str, expected: &str| {
+        let path = write_scene(&dir, text);
+        let e = scene_file::load(&path, None).err().expect(expected).to_string();
+        assert!(e.contains("scene.toml") && e.contains(expected), "{e}");
+    };
+    check("[[model]]\nfile = \"missing.glb\"\n", "missing.glb");
+    check("[[model]]\nfile = \"tri.glb\"\nsclae = 2.0\n", "unknown field `sclae`");
+    check("ground = true\n", "lists no models");
+    check("[[model]]\nfile = \"tri.glb\"\n[settings.shadow.filter]\ntechnique = \"nope\"\n", "[settings]");
+    let path = write_scene(&dir, SCENE);
+    let e = scene_file::load(&path, Some("side")).err().unwrap().to_string();
+    assert!(e.contains("no view `side`") && e.contains("front, top"), "{e}");
+}
