@@ -19,25 +19,30 @@ pub const HARD_LEGEND: &[(&str, [u8; 3])] = &[
     ("correct shadow", CORRECT_SHADOW),
 ];
 
-/// RGBA8 image of the hard-shadow errors of `visibility` (thresholded at 0.5).
-pub fn hard(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClass]) -> Vec<u8> {
+/// RGBA8 pixels: background and silhouette colours, and `compared(i)` elsewhere.
+fn paint(classes: &[PixelClass], compared: impl Fn(usize) -> [u8; 3]) -> Vec<u8> {
     classes
         .iter()
         .enumerate()
         .flat_map(|(i, class)| {
-            let c = match class {
+            let [r, g, b] = match class {
                 PixelClass::Background => BACKGROUND,
                 PixelClass::Silhouette => SILHOUETTE,
-                PixelClass::Compared => match (reference.visibility[i] >= 0.5, visibility[i] >= 0.5) {
-                    (true, false) => FALSE_SHADOW,
-                    (false, true) => FALSE_LIT,
-                    (true, true) => CORRECT_LIT,
-                    (false, false) => CORRECT_SHADOW,
-                },
+                PixelClass::Compared => compared(i),
             };
-            [c[0], c[1], c[2], 255]
+            [r, g, b, 255]
         })
         .collect()
+}
+
+/// RGBA8 image of the hard-shadow errors of `visibility` (thresholded at 0.5).
+pub fn hard(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClass]) -> Vec<u8> {
+    paint(classes, |i| match (reference.visibility[i] >= 0.5, visibility[i] >= 0.5) {
+        (true, false) => FALSE_SHADOW,
+        (false, true) => FALSE_LIT,
+        (true, true) => CORRECT_LIT,
+        (false, false) => CORRECT_SHADOW,
+    })
 }
 
 /// The soft-error colour ramp for |V − R| in [0, 1]: black, violet, orange, yellow
@@ -53,18 +58,7 @@ pub fn ramp(e: f32) -> [u8; 3] {
 
 /// RGBA8 image of |V − R| through [`ramp`].
 pub fn soft(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClass]) -> Vec<u8> {
-    classes
-        .iter()
-        .enumerate()
-        .flat_map(|(i, class)| {
-            let c = match class {
-                PixelClass::Background => BACKGROUND,
-                PixelClass::Silhouette => SILHOUETTE,
-                PixelClass::Compared => ramp((visibility[i] - reference.visibility[i]).abs()),
-            };
-            [c[0], c[1], c[2], 255]
-        })
-        .collect()
+    paint(classes, |i| ramp((visibility[i] - reference.visibility[i]).abs()))
 }
 
 #[cfg(test)]
