@@ -101,6 +101,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             frame.shadow_resolution,
             render_started.elapsed().as_secs_f64() * 1e3
         );
+        let st = frame.stats;
+        eprintln!(
+            "gnomon: draws: {} in the shadow pass, {} in the lighting pass; {} pipeline and {} bind group changes",
+            st.shadow_draws, st.lighting_draws, st.pipeline_changes, st.bind_group_changes
+        );
+        if let Some(t) = frame.timings {
+            eprintln!(
+                "gnomon: GPU time: shadow pass {:.2} ms, lighting pass {:.2} ms",
+                t.shadow_ms, t.lighting_ms
+            );
+        }
     }
 
     // Encode everything to temporary files first; rename only when all succeeded.

@@ -58,6 +58,21 @@ pub struct Frame {
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
     pub timings: Option<PassTimings>,
+    /// Draw calls and state changes.
+    pub stats: DrawStats,
+}
+
+/// What a frame submitted: the CPU-side cost of drawing the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Draw calls in the shadow pass.
+    pub shadow_draws: u32,
+    /// Draw calls in the lighting pass.
+    pub lighting_draws: u32,
+    /// Pipeline changes, both passes together.
+    pub pipeline_changes: u32,
+    /// Bind group changes, both passes together.
+    pub bind_group_changes: u32,
 }
 
 /// GPU time per pass, in milliseconds, from timestamp queries.
@@ -189,7 +204,7 @@ impl<'g> Renderer<'g> {
 
         let gpu = self.gpu;
         let device = &gpu.device;
-        let (pending, shadow_pending, timestamps) = gpu.checked("rendering the frame", || {
+        let (pending, shadow_pending, timestamps, stats) = gpu.checked("rendering the frame", || {
             let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("light"),
                 contents: bytemuck::bytes_of(&light_gpu),
@@ -265,6 +280,7 @@ impl<'g> Renderer<'g> {
             };
 
             let mut encoder = device.create_command_encoder(&Default::default());
+            let mut stats = DrawStats::default();
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("shadow"),
@@ -282,23 +298,31 @@ impl<'g> Renderer<'g> {
                     multiview_mask: None,
                 });
                 pass.set_bind_group(0, &scene_group, &[]);
+                stats.bind_group_changes += 1;
                 uploaded.bind_geometry(&mut pass);
                 // Opaque casters first (no bind group changes at all), then the
                 // alpha-masked ones, texture by texture.
+                let mut pipeline = None;
                 for masked in [false, true] {
                     let mut bound = None;
                     for d in uploaded.draws.iter().filter(|d| d.casts_shadow && d.masked == masked) {
-                        pass.set_pipeline(self.shadow_pass.pipeline(
-                            device,
-                            &shadow.bias,
-                            d.double_sided,
-                            masked,
-                        ));
+                        if pipeline != Some((d.double_sided, masked)) {
+                            pass.set_pipeline(self.shadow_pass.pipeline(
+                                device,
+                                &shadow.bias,
+                                d.double_sided,
+                                masked,
+                            ));
+                            pipeline = Some((d.double_sided, masked));
+                            stats.pipeline_changes += 1;
+                        }
                         if masked && bound != Some(d.material_group) {
                             pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
                             bound = Some(d.material_group);
+                            stats.bind_group_changes += 1;
                         }
                         GpuScene::draw_one(&mut pass, d);
+                        stats.shadow_draws += 1;
                     }
                 }
             }
@@ -340,14 +364,18 @@ impl<'g> Renderer<'g> {
                 pass.set_bind_group(0, &scene_group, &[]);
                 pass.set_bind_group(1, &camera_group, &[]);
                 pass.set_bind_group(2, &shadow_group, &[]);
+                stats.pipeline_changes += 1;
+                stats.bind_group_changes += 3;
                 uploaded.bind_geometry(&mut pass);
                 let mut bound = None;
                 for d in &uploaded.draws {
                     if bound != Some(d.material_group) {
                         pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
                         bound = Some(d.material_group);
+                        stats.bind_group_changes += 1;
                     }
                     GpuScene::draw_one(&mut pass, d);
+                    stats.lighting_draws += 1;
                 }
             }
             let pending: Vec<_> = targets
@@ -361,7 +389,7 @@ impl<'g> Renderer<'g> {
                 .as_ref()
                 .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, 4));
             gpu.queue.submit([encoder.finish()]);
-            (pending, shadow_pending, timestamps)
+            (pending, shadow_pending, timestamps, stats)
         })?;
 
         let mut pending = pending.into_iter();
@@ -419,6 +447,7 @@ impl<'g> Renderer<'g> {
             shadow_resolution: resolution,
             shadow_map,
             timings,
+            stats,
         })
     }
 }

@@ -26,7 +26,9 @@ pub(crate) struct Draw {
     pub first_index: u32,
     pub index_count: u32,
     pub base_vertex: i32,
+    /// The first instance; the draw covers `instance .. instance + instance_count`.
     pub instance: u32,
+    pub instance_count: u32,
     pub casts_shadow: bool,
     /// Alpha-tested (glTF MASK): the shadow pass must sample the texture.
     pub masked: bool,
@@ -105,6 +107,7 @@ impl GpuScene {
                     index_count: r.index_count,
                     base_vertex: r.base_vertex,
                     instance: i as u32,
+                    instance_count: 1,
                     casts_shadow: inst.casts_shadow,
                     masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
                     double_sided: material.double_sided,
@@ -113,6 +116,7 @@ impl GpuScene {
             })
             .collect();
         draws.sort_by_key(|d| (d.material_group, d.instance));
+        let draws = coalesce(draws);
         let device = &gpu.device;
         gpu.checked("uploading the scene", || Self {
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -146,9 +150,30 @@ impl GpuScene {
         pass.draw_indexed(
             d.first_index..d.first_index + d.index_count,
             d.base_vertex,
-            d.instance..d.instance + 1,
+            d.instance..d.instance + d.instance_count,
         );
     }
+}
+
+/// Merges runs of draws of the same mesh with consecutive instances and the same
+/// state into one instanced draw: a row of identical columns is one draw call.
+fn coalesce(draws: Vec<Draw>) -> Vec<Draw> {
+    let mut out: Vec<Draw> = Vec::with_capacity(draws.len());
+    for d in draws {
+        if let Some(last) = out.last_mut()
+            && last.first_index == d.first_index
+            && last.index_count == d.index_count
+            && last.base_vertex == d.base_vertex
+            && last.instance + last.instance_count == d.instance
+            && (last.casts_shadow, last.masked, last.double_sided, last.material_group)
+                == (d.casts_shadow, d.masked, d.double_sided, d.material_group)
+        {
+            last.instance_count += 1;
+            continue;
+        }
+        out.push(d);
+    }
+    out
 }
 
 /// A bind group per texture (after a white 1×1 default at index 0), each texture

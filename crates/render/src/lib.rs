@@ -21,7 +21,7 @@ mod readback;
 pub mod techniques;
 
 pub use device::{Gpu, GpuInfo};
-pub use frame::{Frame, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection};
+pub use frame::{DrawStats, Frame, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection};
 pub use gpu_scene::GpuScene;
 
 use gnomon_scene::{SceneError, settings::SettingsError};
