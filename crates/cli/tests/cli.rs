@@ -272,3 +272,19 @@ fn a_scene_file_renders_with_its_views_and_settings() {
         stderr(&bad)
     );
 }
+
+#[test]
+fn no_adapter_says_how_to_get_one() {
+    // An empty WGPU_BACKEND enables no backend: the same as a machine with no driver.
+    let dir = temp_dir("no-adapter");
+    let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(&dir)
+        .env("WGPU_BACKEND", "")
+        .arg("render")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(e.contains("no GPU adapter found") && e.contains("apt-get install mesa-vulkan-drivers"), "{e}");
+    assert!(files_in(&dir).is_empty());
+}
