@@ -112,8 +112,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let mut shadow = Vec::new();
         let mut lighting = Vec::new();
         for _ in 0..args.timing_frames {
-            let f = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
-            if let Some(t) = f.timings {
+            if let (Some(t), _) = renderer.time_passes(&uploaded, &scene, &s)? {
                 shadow.push(t.shadow_ms);
                 lighting.push(t.lighting_ms);
             }

@@ -184,6 +184,32 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
+        let submitted = self.submit(uploaded, scene, settings, true, request.shadow_map)?;
+        self.read_frame(submitted, settings)
+    }
+
+    /// Renders an uploaded scene for its pass times and draw counts alone: nothing is
+    /// read back but the timestamps, so timing loops don't pay for image copies.
+    pub fn time_passes(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<(Option<PassTimings>, DrawStats), RenderError> {
+        let submitted = self.submit(uploaded, scene, settings, false, false)?;
+        Ok((submitted.timings, submitted.stats))
+    }
+
+    /// Records and submits the shadow and lighting passes, copying the render targets
+    /// (and the shadow map) out when asked, and reads the pass timestamps.
+    fn submit(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        read_images: bool,
+        read_shadow_map: bool,
+    ) -> Result<Submitted, RenderError> {
         settings.validate()?;
         self.check_limits(settings)?;
         let camera = settings.resolve_camera(scene)?;
@@ -378,12 +404,15 @@ impl<'g> Renderer<'g> {
                     stats.lighting_draws += 1;
                 }
             }
-            let pending: Vec<_> = targets
-                .iter()
-                .map(|t| readback::record(device, &mut encoder, t, wgpu::TextureAspect::All))
-                .collect();
-            let shadow_pending = request
-                .shadow_map
+            let pending: Vec<_> = if read_images {
+                targets
+                    .iter()
+                    .map(|t| readback::record(device, &mut encoder, t, wgpu::TextureAspect::All))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let shadow_pending = read_shadow_map
                 .then(|| readback::record(device, &mut encoder, &shadow_map, wgpu::TextureAspect::DepthOnly));
             let timestamps = queries
                 .as_ref()
@@ -392,6 +421,23 @@ impl<'g> Renderer<'g> {
             (pending, shadow_pending, timestamps, stats)
         })?;
 
+        let timings = match (timestamps, gpu.timestamp_period_ns) {
+            (Some(t), Some(period)) => {
+                let ticks = t.read(gpu)?;
+                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period as f64 * 1e-6;
+                Some(PassTimings { shadow_ms: ms(0, 1), lighting_ms: ms(2, 3) })
+            }
+            _ => None,
+        };
+        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, projection })
+    }
+
+    /// Reads a submitted frame's images back and assembles the [`Frame`].
+    fn read_frame(&self, submitted: Submitted, settings: &Settings) -> Result<Frame, RenderError> {
+        let gpu = self.gpu;
+        let Submitted { pending, shadow_pending, timings, stats, camera, light, projection } = submitted;
+        let (width, height) = (settings.image.width, settings.image.height);
+        let resolution = settings.shadow.map.resolution;
         let mut pending = pending.into_iter();
         let mut next = || pending.next().expect("one readback per target");
         let color: Vec<u8> = next().read(gpu)?;
@@ -402,15 +448,6 @@ impl<'g> Renderer<'g> {
         let shadow_map = match shadow_pending {
             Some(p) => Some(ShadowMapImage { resolution, depth: p.read(gpu)? }),
             None => None,
-        };
-
-        let timings = match (timestamps, gpu.timestamp_period_ns) {
-            (Some(t), Some(period)) => {
-                let ticks = t.read(gpu)?;
-                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period as f64 * 1e-6;
-                Some(PassTimings { shadow_ms: ms(0, 1), lighting_ms: ms(2, 3) })
-            }
-            _ => None,
         };
 
         // Background pixels get NaN, as documented, decided by the object id (0).
@@ -454,6 +491,17 @@ impl<'g> Renderer<'g> {
 
 /// Background colour of the image, linear RGB.
 const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
+
+/// A frame submitted to the GPU, waiting to be read back.
+struct Submitted {
+    pending: Vec<readback::PendingReadback>,
+    shadow_pending: Option<readback::PendingReadback>,
+    timings: Option<PassTimings>,
+    stats: DrawStats,
+    camera: Camera,
+    light: Light,
+    projection: LightProjection,
+}
 
 fn render_target(
     device: &wgpu::Device,

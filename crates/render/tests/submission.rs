@@ -55,3 +55,18 @@ fn thousands_of_distinct_meshes_add_no_state_changes() {
         "state changes do not grow with the mesh count: {few:?} vs {many:?}"
     );
 }
+
+#[test]
+fn timing_alone_submits_the_same_frame_as_a_full_render() {
+    let gpu = Gpu::new_headless().unwrap();
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let scene = builtin::spheres();
+    let uploaded = renderer.upload(&scene).unwrap();
+    let frame = renderer.render_uploaded(&uploaded, &scene, &small(), &OutputRequest::default()).unwrap();
+    let (timings, stats) = renderer.time_passes(&uploaded, &scene, &small()).unwrap();
+    assert_eq!(stats, frame.stats);
+    assert_eq!(timings.is_some(), gpu.timestamp_period_ns.is_some());
+    if let Some(t) = timings {
+        assert!(t.shadow_ms > 0.0 && t.lighting_ms > 0.0, "{t:?}");
+    }
+}
