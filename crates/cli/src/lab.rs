@@ -32,7 +32,7 @@ pub fn load(name: &str, view: Option<&str>, command_line: &Settings) -> anyhow::
         (load_scene_file(name)?, command_line.clone())
     };
     settings.validate()?;
-    if settings.scene.ground && !scene.instances.iter().any(|i| i.name == "ground") {
+    if settings.scene.ground {
         scene.add_ground_plane();
     }
     Ok((scene, settings))

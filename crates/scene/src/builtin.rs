@@ -89,6 +89,7 @@ impl SceneBuilder {
             spot,
             ambient: Vec3::splat(0.12),
             textures: Vec::new(),
+            has_ground: true,
         }
     }
 }
@@ -272,6 +273,20 @@ mod tests {
             let lowest = scene.meshes[i.mesh].bounds().transformed(i.world_from_object).min.y;
             assert!(lowest.abs() < 1e-5, "{} floats at {lowest}", i.name);
         }
+    }
+
+    #[test]
+    fn a_ground_is_added_once_and_never_to_a_built_in() {
+        let mut scene = spheres();
+        let n = scene.instances.len();
+        scene.add_ground_plane();
+        assert_eq!(scene.instances.len(), n, "the built-ins have a ground");
+        scene.has_ground = false;
+        scene.add_ground_plane();
+        scene.add_ground_plane();
+        assert_eq!(scene.instances.len(), n + 1, "added once");
+        let ground = scene.instances.last().unwrap();
+        assert_eq!(ground.world_from_object.transform_point3(Vec3::ZERO).y, scene.bounds().min.y);
     }
 
     #[test]

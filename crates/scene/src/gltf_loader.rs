@@ -395,6 +395,7 @@ fn build(
         },
         ambient: Vec3::splat(0.12),
         textures,
+        has_ground: false,
     };
     scene.validate().map_err(|e| e.to_string())?;
     let bounds = scene.bounds();

@@ -200,6 +200,9 @@ pub struct Scene {
     pub ambient: Vec3,
     /// Textures referred to by materials.
     pub textures: Vec<Texture>,
+    /// Whether the scene has a floor to catch shadows (the built-ins do; a glTF
+    /// model gets one from [`Scene::add_ground_plane`]).
+    pub has_ground: bool,
 }
 
 /// A scene that is not well formed.
@@ -263,8 +266,13 @@ impl Scene {
     }
 
     /// Adds a light grey ground plane at the scene's lowest point, three times as wide
-    /// as the scene, and lets the camera's far plane reach across it.
+    /// as the scene, and lets the camera's far plane reach across it. Does nothing when
+    /// the scene already has a ground.
     pub fn add_ground_plane(&mut self) {
+        if self.has_ground {
+            return;
+        }
+        self.has_ground = true;
         let b = self.bounds();
         let size = 3.0 * b.extent().x.max(b.extent().z).max(1e-3);
         self.meshes.push(crate::geometry::plane(size, size));

@@ -35,7 +35,8 @@ pub struct Settings {
 #[serde(default, deny_unknown_fields)]
 pub struct SceneOptions {
     /// Add a ground plane under the scene: at its lowest point, three times its
-    /// width, for models that come without a floor to receive their shadows.
+    /// width, for models that come without a floor to receive their shadows (the
+    /// built-in scenes have one already).
     #[arg(long, help_heading = "Scene")]
     pub ground: bool,
 }
