@@ -21,13 +21,8 @@ use crate::{
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Scene: a scene file (.toml), a glTF file (.gltf or .glb) or a built-in scene
-    /// (see `gnomon scenes`).
-    #[arg(default_value = "spheres")]
-    pub scene: String,
-    /// Camera view of a scene file (.toml) to use [default: its first view].
-    #[arg(long, value_name = "NAME")]
-    pub view: Option<String>,
+    #[command(flatten)]
+    pub scene: crate::lab::SceneArgs,
     /// Techniques to compare, comma-separated (see `gnomon techniques`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "hard,pcf2x2,pcf")]
     pub techniques: Vec<Technique>,
@@ -92,7 +87,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
     );
-    let (scene, settings) = lab::load(&args.scene, args.view.as_deref(), &args.settings)?;
+    let (scene, settings) = lab::load(&args.scene, &args.settings)?;
     let settings = &settings;
     output::check_dir(&args.out, "--out")?;
 

@@ -10,10 +10,23 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cache;
 
-/// The scene `name` (a scene file, a glTF file or a built-in scene) and the settings
-/// to render it with: a scene file's `[settings]` with the command line's changes laid
-/// over them, or the command line's alone. `view` picks a scene file's camera view.
-pub fn load(name: &str, view: Option<&str>, command_line: &Settings) -> anyhow::Result<(Scene, Settings)> {
+/// Which scene the lab commands work on.
+#[derive(clap::Args, Debug)]
+pub struct SceneArgs {
+    /// Scene: a scene file (.toml), a glTF file (.gltf or .glb) or a built-in scene
+    /// (see `gnomon scenes`).
+    #[arg(default_value = "spheres")]
+    pub scene: String,
+    /// Camera view of a scene file (.toml) to use [default: its first view].
+    #[arg(long, value_name = "NAME")]
+    pub view: Option<String>,
+}
+
+/// The scene `args` names (a scene file, a glTF file or a built-in scene) and the
+/// settings to render it with: a scene file's `[settings]` with the command line's
+/// changes laid over them, or the command line's alone.
+pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene, Settings)> {
+    let (name, view) = (args.scene.as_str(), args.view.as_deref());
     let path = std::path::Path::new(name);
     let is_toml = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let (mut scene, settings) = if is_toml {

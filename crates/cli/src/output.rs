@@ -82,34 +82,27 @@ impl Staged {
         write(&temp).with_context(|| format!("cannot write {}", path.display()))
     }
 
-    pub fn png_rgba(&mut self, path: &Path, width: u32, height: u32, rgba: &[u8]) -> anyhow::Result<()> {
+    fn png(
+        &mut self,
+        path: &Path,
+        width: u32,
+        height: u32,
+        bytes: &[u8],
+        color: image::ExtendedColorType,
+    ) -> anyhow::Result<()> {
         self.write_with(path, |temp| {
-            image::save_buffer_with_format(
-                temp,
-                rgba,
-                width,
-                height,
-                image::ExtendedColorType::Rgba8,
-                image::ImageFormat::Png,
-            )?;
+            image::save_buffer_with_format(temp, bytes, width, height, color, image::ImageFormat::Png)?;
             Ok(())
         })
     }
 
+    pub fn png_rgba(&mut self, path: &Path, width: u32, height: u32, rgba: &[u8]) -> anyhow::Result<()> {
+        self.png(path, width, height, rgba, image::ExtendedColorType::Rgba8)
+    }
+
     pub fn png_gray16(&mut self, path: &Path, width: u32, height: u32, gray: &[u16]) -> anyhow::Result<()> {
-        self.write_with(path, |temp| {
-            // `image` takes 16-bit samples in native byte order and writes PNG's big-endian.
-            let bytes: &[u8] = bytemuck::cast_slice(gray);
-            image::save_buffer_with_format(
-                temp,
-                bytes,
-                width,
-                height,
-                image::ExtendedColorType::L16,
-                image::ImageFormat::Png,
-            )?;
-            Ok(())
-        })
+        // `image` takes 16-bit samples in native byte order and writes PNG's big-endian.
+        self.png(path, width, height, bytemuck::cast_slice(gray), image::ExtendedColorType::L16)
     }
 
     /// One float channel, by the path's extension: `.exr` (channel `Y`) or `.npy`.

@@ -9,13 +9,8 @@ use crate::{lab, output};
 
 #[derive(Args, Debug)]
 pub struct ReferenceArgs {
-    /// Scene: a scene file (.toml), a glTF file (.gltf or .glb) or a built-in scene
-    /// (see `gnomon scenes`).
-    #[arg(default_value = "spheres")]
-    pub scene: String,
-    /// Camera view of a scene file (.toml) to use [default: its first view].
-    #[arg(long, value_name = "NAME")]
-    pub view: Option<String>,
+    #[command(flatten)]
+    pub scene: crate::lab::SceneArgs,
     /// Output: `.exr` (float visibility, channel `Y`, NaN background) or `.png` (8-bit
     /// gray visibility, background dark blue-grey).
     #[arg(long, short, default_value = "reference.png", help_heading = "Outputs")]
@@ -32,7 +27,7 @@ pub struct ReferenceArgs {
 
 pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
-    let (scene, settings) = lab::load(&args.scene, args.view.as_deref(), &args.settings)?;
+    let (scene, settings) = lab::load(&args.scene, &args.settings)?;
     output::check_file(&args.out, &["exr", "png"], "--out")?;
     if let Some(p) = &args.std_error_out {
         output::check_file(p, &["exr", "npy"], "--std-error-out")?;
