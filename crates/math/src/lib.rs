@@ -1,6 +1,6 @@
 //! Pure shadow-mapping math, with no GPU: bounding boxes, camera and light
 //! projections, and the mapping from normalized device coordinates to shadow-map
-//! texture coordinates.
+//! texture coordinates; and the filter kernels the shaders use ([`kernels`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -11,6 +11,7 @@
 //! - Matrices are named `to_from_from`: `clip_from_world` maps world points to clip space.
 
 mod aabb;
+pub mod kernels;
 mod light;
 mod projection;
 

@@ -62,8 +62,10 @@ impl Gpu {
         adjust(&mut limits);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gnomon"),
-            // Timestamps time each pass where the adapter has them (lavapipe does).
-            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+            // Timestamps time each pass where the adapter has them (lavapipe does);
+            // 32-bit float filtering lets moment maps keep full precision.
+            required_features: adapter.features()
+                & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE),
             required_limits: limits.clone(),
             ..Default::default()
         }))

@@ -3,7 +3,10 @@
 
 use glam::{Vec3, Vec4};
 use gnomon_math::{LightProjection, directional_light_projection, spot_light_projection};
-use gnomon_scene::{Camera, Light, Scene, Settings};
+use gnomon_scene::{
+    Camera, Light, Scene, Settings,
+    settings::{KernelUnit, MomentFormat},
+};
 use wgpu::util::DeviceExt;
 
 use crate::{
@@ -12,6 +15,7 @@ use crate::{
     passes::{
         Layouts, SHADOW_FORMAT,
         lighting::{self, LightingPass},
+        moments::MomentPass,
         shadow::ShadowPass,
     },
     readback, techniques,
@@ -60,6 +64,8 @@ pub struct Frame {
     pub timings: Option<PassTimings>,
     /// Draw calls and state changes.
     pub stats: DrawStats,
+    /// The moment map's texel format, for the filterable techniques.
+    pub moment_format: Option<wgpu::TextureFormat>,
 }
 
 /// What a frame submitted: the CPU-side cost of drawing the scene.
@@ -79,6 +85,8 @@ pub struct DrawStats {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassTimings {
     pub shadow_ms: f64,
+    /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
+    pub filter_ms: Option<f64>,
     pub lighting_ms: f64,
 }
 
@@ -100,7 +108,11 @@ pub struct Renderer<'g> {
     layouts: Layouts,
     shadow_pass: ShadowPass,
     lighting_pass: LightingPass,
+    moment_pass: MomentPass,
     compare_sampler: wgpu::Sampler,
+    moment_sampler: wgpu::Sampler,
+    /// Bound in place of a moment map for the depth-comparison techniques.
+    placeholder_moments: wgpu::TextureView,
 }
 
 impl<'g> Renderer<'g> {
@@ -121,12 +133,39 @@ impl<'g> Renderer<'g> {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
+        let moment_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("moment map"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let placeholder_moments = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("no moment map"),
+                size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
         Self {
             gpu,
             shadow_pass: ShadowPass::new(device, &layouts),
             lighting_pass: LightingPass::new(device, &layouts),
+            moment_pass: MomentPass::new(device),
             layouts,
             compare_sampler,
+            moment_sampler,
+            placeholder_moments,
         }
     }
 
@@ -165,6 +204,7 @@ impl<'g> Renderer<'g> {
         if width > max || height > max {
             return Err(RenderError::ImageTooLarge { width, height, max, adapter });
         }
+        self.moment_format(settings)?;
         let needed = lighting::target_bytes_per_pixel();
         if limits.max_color_attachment_bytes_per_sample < needed {
             return Err(RenderError::AttachmentsTooLarge {
@@ -174,6 +214,20 @@ impl<'g> Renderer<'g> {
             });
         }
         Ok(())
+    }
+
+    /// The moment map's format for these settings on this device.
+    pub fn moment_format(&self, settings: &Settings) -> Result<wgpu::TextureFormat, RenderError> {
+        let filterable = self.gpu.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        match settings.shadow.filter.moments.moment_format {
+            MomentFormat::Rgba16float => Ok(wgpu::TextureFormat::Rgba16Float),
+            MomentFormat::Auto if !filterable => Ok(wgpu::TextureFormat::Rgba16Float),
+            MomentFormat::Auto => Ok(wgpu::TextureFormat::Rgba32Float),
+            MomentFormat::Rgba32float if filterable => Ok(wgpu::TextureFormat::Rgba32Float),
+            MomentFormat::Rgba32float => {
+                Err(RenderError::MomentFormatUnsupported { adapter: self.gpu.info.adapter.clone() })
+            }
+        }
     }
 
     /// Renders an uploaded scene. `scene` must be the one `uploaded` was made from.
@@ -218,8 +272,9 @@ impl<'g> Renderer<'g> {
         let resolution = shadow.map.resolution;
         let projection = light_projection(scene, &light);
         let technique = techniques::lookup(shadow.filter.technique);
-        let light_gpu =
-            light_uniform(scene, &light, &projection, settings, technique.filter_params(&shadow.filter));
+        let filterable_map = technique.filterable_map(&shadow.filter);
+        let moment_format = self.moment_format(settings)?;
+        let light_gpu = light_uniform(scene, &light, &projection, settings, technique.params(&shadow.filter));
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
         let camera_gpu = CameraGpu {
@@ -267,6 +322,50 @@ impl<'g> Renderer<'g> {
                 view_formats: &[],
             });
             let shadow_view = shadow_map.create_view(&Default::default());
+            let queries = gpu.timestamp_period_ns.map(|_| {
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: TIMESTAMPS,
+                })
+            });
+            let pass_timestamps = |first: u32| {
+                queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(first),
+                    end_of_pass_write_index: Some(first + 1),
+                })
+            };
+            let mut encoder = device.create_command_encoder(&Default::default());
+            let mut stats = DrawStats::default();
+            self.record_shadow_pass(
+                &mut encoder,
+                uploaded,
+                settings,
+                &scene_group,
+                &shadow_view,
+                pass_timestamps(0),
+                &mut stats,
+            );
+            let moment_map = filterable_map.map(|map| {
+                self.moment_pass.record(
+                    device,
+                    &mut encoder,
+                    shadow.filter.technique,
+                    map,
+                    &shadow.filter.moments,
+                    moment_format,
+                    resolution,
+                    &shadow_view,
+                    &light_buffer,
+                    queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: Some(4),
+                        end_of_pass_write_index: Some(5),
+                    }),
+                )
+            });
+            let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
             let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shadow map"),
                 layout: &self.layouts.shadow,
@@ -279,6 +378,14 @@ impl<'g> Renderer<'g> {
                         binding: 1,
                         resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(moment_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
+                    },
                 ],
             });
             let targets: Vec<wgpu::Texture> = lighting::TARGETS
@@ -290,68 +397,6 @@ impl<'g> Renderer<'g> {
             let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
             let depth_view = depth.create_view(&Default::default());
 
-            let queries = gpu.timestamp_period_ns.map(|_| {
-                device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 4,
-                })
-            });
-            let pass_timestamps = |first: u32| {
-                queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(first),
-                    end_of_pass_write_index: Some(first + 1),
-                })
-            };
-
-            let mut encoder = device.create_command_encoder(&Default::default());
-            let mut stats = DrawStats::default();
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("shadow"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &shadow_view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: pass_timestamps(0),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, &scene_group, &[]);
-                stats.bind_group_changes += 1;
-                uploaded.bind_geometry(&mut pass);
-                // Opaque casters first (no bind group changes at all), then the
-                // alpha-masked ones, texture by texture.
-                let mut pipeline = None;
-                for masked in [false, true] {
-                    let mut bound = None;
-                    for d in uploaded.draws.iter().filter(|d| d.casts_shadow && d.masked == masked) {
-                        if pipeline != Some((d.double_sided, masked)) {
-                            pass.set_pipeline(self.shadow_pass.pipeline(
-                                device,
-                                &shadow.bias,
-                                d.double_sided,
-                                masked,
-                            ));
-                            pipeline = Some((d.double_sided, masked));
-                            stats.pipeline_changes += 1;
-                        }
-                        if masked && bound != Some(d.material_group) {
-                            pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
-                            bound = Some(d.material_group);
-                            stats.bind_group_changes += 1;
-                        }
-                        GpuScene::draw_one(&mut pass, d);
-                        stats.shadow_draws += 1;
-                    }
-                }
-            }
             {
                 let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
                     .iter()
@@ -416,7 +461,7 @@ impl<'g> Renderer<'g> {
                 .then(|| readback::record(device, &mut encoder, &shadow_map, wgpu::TextureAspect::DepthOnly));
             let timestamps = queries
                 .as_ref()
-                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, 4));
+                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, TIMESTAMPS));
             gpu.queue.submit([encoder.finish()]);
             (pending, shadow_pending, timestamps, stats)
         })?;
@@ -425,17 +470,23 @@ impl<'g> Renderer<'g> {
             (Some(t), Some(period)) => {
                 let ticks = t.read(gpu)?;
                 let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period as f64 * 1e-6;
-                Some(PassTimings { shadow_ms: ms(0, 1), lighting_ms: ms(2, 3) })
+                Some(PassTimings {
+                    shadow_ms: ms(0, 1),
+                    filter_ms: filterable_map.is_some().then(|| ms(4, 5)),
+                    lighting_ms: ms(2, 3),
+                })
             }
             _ => None,
         };
-        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, projection })
+        let moment_format = filterable_map.is_some().then_some(moment_format);
+        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, projection, moment_format })
     }
 
     /// Reads a submitted frame's images back and assembles the [`Frame`].
     fn read_frame(&self, submitted: Submitted, settings: &Settings) -> Result<Frame, RenderError> {
         let gpu = self.gpu;
-        let Submitted { pending, shadow_pending, timings, stats, camera, light, projection } = submitted;
+        let Submitted { pending, shadow_pending, timings, stats, camera, light, projection, moment_format } =
+            submitted;
         let (width, height) = (settings.image.width, settings.image.height);
         let resolution = settings.shadow.map.resolution;
         let mut pending = pending.into_iter();
@@ -485,9 +536,74 @@ impl<'g> Renderer<'g> {
             shadow_map,
             timings,
             stats,
+            moment_format,
         })
     }
+
+    /// Records the shadow pass: every caster, depth only, from the light.
+    #[allow(clippy::too_many_arguments)]
+    fn record_shadow_pass(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        settings: &Settings,
+        scene_group: &wgpu::BindGroup,
+        shadow_view: &wgpu::TextureView,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
+        stats: &mut DrawStats,
+    ) {
+        let device = &self.gpu.device;
+        let shadow = &settings.shadow;
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: shadow_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, scene_group, &[]);
+            stats.bind_group_changes += 1;
+            uploaded.bind_geometry(&mut pass);
+            // Opaque casters first (no bind group changes at all), then the
+            // alpha-masked ones, texture by texture.
+            let mut pipeline = None;
+            for masked in [false, true] {
+                let mut bound = None;
+                for d in uploaded.draws.iter().filter(|d| d.casts_shadow && d.masked == masked) {
+                    if pipeline != Some((d.double_sided, masked)) {
+                        pass.set_pipeline(self.shadow_pass.pipeline(
+                            device,
+                            &shadow.bias,
+                            d.double_sided,
+                            masked,
+                        ));
+                        pipeline = Some((d.double_sided, masked));
+                        stats.pipeline_changes += 1;
+                    }
+                    if masked && bound != Some(d.material_group) {
+                        pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
+                        bound = Some(d.material_group);
+                        stats.bind_group_changes += 1;
+                    }
+                    GpuScene::draw_one(&mut pass, d);
+                    stats.shadow_draws += 1;
+                }
+            }
+        }
+    }
 }
+
+/// Timestamp queries per frame: begin and end of the shadow, lighting and moment passes.
+const TIMESTAMPS: u32 = 6;
 
 /// Background colour of the image, linear RGB.
 const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
@@ -501,6 +617,7 @@ struct Submitted {
     camera: Camera,
     light: Light,
     projection: LightProjection,
+    moment_format: Option<wgpu::TextureFormat>,
 }
 
 fn render_target(
@@ -541,10 +658,16 @@ fn light_uniform(
     light: &Light,
     projection: &LightProjection,
     settings: &Settings,
-    filter: [f32; 4],
+    params: [Vec4; 2],
 ) -> LightGpu {
     let resolution = settings.shadow.map.resolution;
     let (texel_ortho, texel_per_distance) = projection.texel_size_coefficients(resolution);
+    let f = &settings.shadow.filter;
+    // PCSS's light size, the same quantity the reference's area light uses.
+    let light_size = match light {
+        Light::Directional(sun) => (0.5 * sun.angular_diameter_degrees.to_radians()).tan(),
+        Light::Spot(spot) => spot.radius,
+    };
     let common = LightGpu {
         clip_from_world: projection.clip_from_world(),
         light_from_world: projection.light_from_world,
@@ -554,7 +677,19 @@ fn light_uniform(
             settings.shadow.bias.normal_offset,
             resolution as f32,
         ),
-        params: Vec4::from_array(filter),
+        kernel: Vec4::new(
+            f.pcf_kernel,
+            (f.kernel_unit == KernelUnit::World) as u8 as f32,
+            f.poisson_samples.min(techniques::POISSON_DISK_SIZE as u32) as f32,
+            f.receiver_plane_bias as u8 as f32,
+        ),
+        pcss: Vec4::new(
+            light_size,
+            f.pcss.blocker_samples.min(techniques::POISSON_DISK_SIZE as u32) as f32,
+            f.pcss.max_radius,
+            0.0,
+        ),
+        params,
         ambient: scene.ambient.extend(0.0),
         cone: Vec4::new(1.0, -1.0, projection.near, projection.far),
         ..Default::default()

@@ -35,8 +35,14 @@ pub struct LightGpu {
     /// x: texel world size of an orthographic map; y: texel world size per unit of
     /// distance for a perspective map; z: normal offset in texels; w: map resolution.
     pub texel: Vec4,
+    /// The PCF kernel: x: width, y: 1 when the width is in world units, z: Poisson
+    /// taps, w: 1 for receiver-plane depth bias.
+    pub kernel: Vec4,
+    /// PCSS: x: light size (spot disk radius in world units, or tan of the sun's
+    /// angular radius), y: blocker-search taps, z: largest radius in texels.
+    pub pcss: Vec4,
     /// Technique parameters, defined by each technique module.
-    pub params: Vec4,
+    pub params: [Vec4; 2],
     /// rgb: ambient light.
     pub ambient: Vec4,
 }

@@ -53,6 +53,11 @@ pub enum RenderError {
          pass needs {needed}"
     )]
     AttachmentsTooLarge { available: u32, needed: u32, adapter: String },
+    #[error(
+        "--moment-format rgba32float needs 32-bit float filtering, which adapter `{adapter}` does not \
+         have; use --moment-format rgba16float or auto"
+    )]
+    MomentFormatUnsupported { adapter: String },
     #[error(transparent)]
     Settings(#[from] SettingsError),
     #[error(transparent)]

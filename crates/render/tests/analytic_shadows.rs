@@ -72,7 +72,7 @@ fn square_occluder_under_a_sun_matches_the_analytic_projection() {
     for (technique, kernel) in techniques() {
         let mut s = settings(640, 480, 1024);
         s.shadow.filter.technique = technique;
-        s.shadow.filter.pcf_kernel = kernel;
+        s.shadow.filter.pcf_kernel = kernel as f32;
         let frame = render(&scene, &s);
         let texel = frame.light_projection.texel_world_size(1024, 0.0);
         let r =
@@ -119,7 +119,7 @@ fn spot_light_cone_and_shadow_match_the_perspective_projection() {
         let mut s = settings(640, 480, 1024);
         s.light.kind = gnomon_scene::settings::LightKind::Spot;
         s.shadow.filter.technique = technique;
-        s.shadow.filter.pcf_kernel = kernel;
+        s.shadow.filter.pcf_kernel = kernel as f32;
         let frame = render(&scene, &s);
         let Light::Spot(spot) = frame.light else { panic!("spot expected") };
         assert_eq!(spot.position, scene.spot.position);

@@ -147,20 +147,42 @@ pub struct LightSettings {
 
 /// How the shadow map is sampled and filtered.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum Technique {
     /// One point-sampled depth comparison: Williams (1978), the textbook algorithm.
-    #[value(name = "hard")]
-    #[serde(rename = "hard")]
     Hard,
     /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
     #[default]
     #[value(name = "pcf2x2")]
     #[serde(rename = "pcf2x2")]
     Pcf2x2,
-    /// N×N box PCF (N = --pcf-kernel) built from bilinear comparison taps one texel apart.
-    #[value(name = "pcf")]
-    #[serde(rename = "pcf")]
+    /// Box PCF of width --pcf-kernel, from bilinear comparison taps with exact area
+    /// weights (Castaño 2013): a W×W box in ⌈(W+1)/2⌉² taps.
     Pcf,
+    /// Tent PCF of width --pcf-kernel from bilinear comparison taps (Castaño 2013):
+    /// smoother edges than the box at the same cost.
+    PcfTent,
+    /// PCF over a Poisson disk of diameter --pcf-kernel, rotated per pixel by
+    /// interleaved gradient noise (Jimenez 2014): noise instead of banding.
+    PcfPoisson,
+    /// Percentage-closer soft shadows (Fernando 2005): a blocker search, then PCF
+    /// whose width follows the light's size and the blocker distance.
+    Pcss,
+    /// Variance shadow maps (Donnelly & Lauritzen 2006): blurred (d, d²) and
+    /// Chebyshev's bound.
+    Vsm,
+    /// Exponential shadow maps (Annen et al. 2008): exp(c·d), filtered in log space.
+    Esm,
+    /// Exponential variance shadow maps, positive exponent only (Lauritzen 2008).
+    Evsm2,
+    /// Exponential variance shadow maps with positive and negative exponents.
+    Evsm4,
+    /// Moment shadow maps (Peters & Klein 2015), four moments, Hamburger bound.
+    MsmHamburger,
+    /// Moment shadow maps, four moments, Hausdorff bound (depths in [0, 1]).
+    MsmHausdorff,
+    /// Convolution shadow maps (Annen et al. 2007): a Fourier series of the depth test.
+    Convolution,
 }
 
 impl Technique {
@@ -170,12 +192,49 @@ impl Technique {
             Technique::Hard => "hard",
             Technique::Pcf2x2 => "pcf2x2",
             Technique::Pcf => "pcf",
+            Technique::PcfTent => "pcf-tent",
+            Technique::PcfPoisson => "pcf-poisson",
+            Technique::Pcss => "pcss",
+            Technique::Vsm => "vsm",
+            Technique::Esm => "esm",
+            Technique::Evsm2 => "evsm2",
+            Technique::Evsm4 => "evsm4",
+            Technique::MsmHamburger => "msm-hamburger",
+            Technique::MsmHausdorff => "msm-hausdorff",
+            Technique::Convolution => "convolution",
         }
     }
 
     pub fn all() -> &'static [Technique] {
         Technique::value_variants()
     }
+
+    /// Whether the technique filters a map of moments (or other functions of depth)
+    /// instead of comparing depths.
+    pub fn is_filterable(self) -> bool {
+        matches!(
+            self,
+            Technique::Vsm
+                | Technique::Esm
+                | Technique::Evsm2
+                | Technique::Evsm4
+                | Technique::MsmHamburger
+                | Technique::MsmHausdorff
+                | Technique::Convolution
+        )
+    }
+}
+
+/// The unit of a PCF kernel's width.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum KernelUnit {
+    /// Shadow-map texels: the same blur everywhere in the map.
+    #[default]
+    Texels,
+    /// World units at the receiver: the same softness in the world whatever the
+    /// map's resolution or, for a spot light, the distance (capped at 32 texels).
+    World,
 }
 
 /// The filter axis: which technique, and its parameters.
@@ -185,14 +244,143 @@ pub struct FilterSettings {
     /// Shadow filtering technique.
     #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
     pub technique: Technique,
-    /// Kernel width N of `pcf`, in shadow texels: 3, 5, 7 or 9.
-    #[arg(long, value_name = "N", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter")]
-    pub pcf_kernel: u32,
+    /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
+    /// 1 to 32 texels, or a world width > 0.
+    #[arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter")]
+    pub pcf_kernel: f32,
+    /// Unit of --pcf-kernel.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    pub kernel_unit: KernelUnit,
+    /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64.
+    #[arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter")]
+    pub poisson_samples: u32,
+    /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
+    /// across the kernel along the receiver's plane, from the screen-space derivatives
+    /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
+    #[arg(long, help_heading = "Shadow filter")]
+    pub receiver_plane_bias: bool,
+    #[command(flatten)]
+    pub pcss: PcssSettings,
+    #[command(flatten)]
+    pub moments: MomentSettings,
 }
 
 impl Default for FilterSettings {
     fn default() -> Self {
-        Self { technique: Technique::default(), pcf_kernel: 3 }
+        Self {
+            technique: Technique::default(),
+            pcf_kernel: 3.0,
+            kernel_unit: KernelUnit::default(),
+            poisson_samples: 32,
+            receiver_plane_bias: false,
+            pcss: PcssSettings::default(),
+            moments: MomentSettings::default(),
+        }
+    }
+}
+
+/// PCSS: the light's size comes from the light (--spot-radius or
+/// --sun-angular-diameter), the same parameter the reference's area light uses.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PcssSettings {
+    /// Depth taps of PCSS's blocker search: 8 to 64.
+    #[arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS")]
+    pub blocker_samples: u32,
+    /// Largest blocker-search and penumbra radius, in texels: 1 to 64. Wider
+    /// penumbrae are clipped to it.
+    #[arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS")]
+    pub max_radius: f32,
+}
+
+impl Default for PcssSettings {
+    fn default() -> Self {
+        Self { blocker_samples: 32, max_radius: 32.0 }
+    }
+}
+
+/// Storage format of a filterable moment map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MomentFormat {
+    /// 32-bit float where the adapter can filter it, else 16-bit (the GL backend).
+    #[default]
+    Auto,
+    /// 32-bit float per channel (needs FLOAT32_FILTERABLE).
+    Rgba32float,
+    /// 16-bit float per channel: half the memory and bandwidth; needs a larger
+    /// --moment-bias and smaller exponents (at most 5.5 for EVSM, 10 for ESM).
+    Rgba16float,
+}
+
+/// Parameters of the filterable techniques: VSM, ESM, EVSM, MSM and convolution.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MomentSettings {
+    /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):
+    /// 0 (no blur) to 16.
+    #[arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps")]
+    pub blur_radius: u32,
+    /// Build mipmaps of the moment map and sample them trilinearly (VSM, EVSM, MSM,
+    /// convolution), against aliasing when the map is minified on screen.
+    #[arg(long, help_heading = "Filterable maps")]
+    pub mipmaps: bool,
+    /// Texel format of the moment map.
+    #[arg(long, value_enum, default_value_t, help_heading = "Filterable maps")]
+    pub moment_format: MomentFormat,
+    /// Smallest variance Chebyshev's bound may use (VSM, EVSM), in units of the
+    /// normalised light depth squared: ≥ 0. Hides acne from quantisation.
+    #[arg(long, value_name = "VARIANCE", default_value_t = MomentSettings::default().min_variance, help_heading = "Filterable maps")]
+    pub min_variance: f32,
+    /// Light-bleeding reduction (VSM, EVSM, MSM): the bound below this is cut to 0
+    /// and the rest rescaled to [0, 1] (Lauritzen's linstep). In [0, 1).
+    #[arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps")]
+    pub bleeding_reduction: f32,
+    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (10 for 16-bit).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps")]
+    pub esm_exponent: f32,
+    /// EVSM positive exponent: 0 to 42 (5.54 for 16-bit).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_positive, help_heading = "Filterable maps")]
+    pub evsm_positive: f32,
+    /// EVSM negative exponent (evsm4): 0 to 42 (5.54 for 16-bit).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps")]
+    pub evsm_negative: f32,
+    /// MSM moment bias α: the moments are blended toward those of a two-point
+    /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits). In [0, 0.1].
+    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps")]
+    pub moment_bias: f32,
+    /// Fourier terms M of convolution shadow maps: 1 to 16 (2M channels).
+    #[arg(long, value_name = "M", default_value_t = MomentSettings::default().csm_terms, help_heading = "Filterable maps")]
+    pub csm_terms: u32,
+    /// Ringing attenuation α of convolution shadow maps: term k is weighted by
+    /// exp(−α (k/M)²); 0 is the raw truncated series. ≥ 0.
+    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps")]
+    pub csm_attenuation: f32,
+    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. > 0.
+    #[arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps")]
+    pub csm_scale: f32,
+    /// Offset o of the convolution reconstruction (see --csm-scale): in [−0.5, 0.5].
+    #[arg(long, value_name = "O", default_value_t = MomentSettings::default().csm_offset, help_heading = "Filterable maps")]
+    pub csm_offset: f32,
+}
+
+impl Default for MomentSettings {
+    fn default() -> Self {
+        Self {
+            blur_radius: 2,
+            mipmaps: false,
+            moment_format: MomentFormat::default(),
+            min_variance: 1e-6,
+            bleeding_reduction: 0.2,
+            esm_exponent: 80.0,
+            evsm_positive: 40.0,
+            evsm_negative: 5.0,
+            moment_bias: 3e-5,
+            csm_terms: 8,
+            csm_attenuation: 2.0,
+            csm_scale: 2.0,
+            csm_offset: 0.25,
+        }
     }
 }
 
@@ -329,6 +517,52 @@ fn check_opt(
     }
 }
 
+impl MomentSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
+        check(self.blur_radius <= 16, "--blur-radius", self.blur_radius, "0 to 16 texels")?;
+        check(in_range(self.min_variance, 0.0, 1.0), "--min-variance", self.min_variance, "0 to 1")?;
+        check(
+            self.bleeding_reduction.is_finite() && (0.0..1.0).contains(&self.bleeding_reduction),
+            "--bleeding-reduction",
+            self.bleeding_reduction,
+            "in [0, 1)",
+        )?;
+        let half = self.moment_format == MomentFormat::Rgba16float;
+        let (esm_max, evsm_max) = if half { (10.0, 5.54) } else { (88.0, 42.0) };
+        let precision = if half { "with --moment-format rgba16float" } else { "at 32 bits" };
+        check(
+            in_range(self.esm_exponent, 1.0, esm_max),
+            "--esm-exponent",
+            self.esm_exponent,
+            format!("1 to {esm_max} {precision}"),
+        )?;
+        check(
+            in_range(self.evsm_positive, 0.0, evsm_max),
+            "--evsm-positive",
+            self.evsm_positive,
+            format!("0 to {evsm_max} {precision}"),
+        )?;
+        check(
+            in_range(self.evsm_negative, 0.0, evsm_max),
+            "--evsm-negative",
+            self.evsm_negative,
+            format!("0 to {evsm_max} {precision}"),
+        )?;
+        check(in_range(self.moment_bias, 0.0, 0.1), "--moment-bias", self.moment_bias, "0 to 0.1")?;
+        check((1..=16).contains(&self.csm_terms), "--csm-terms", self.csm_terms, "1 to 16")?;
+        check(
+            in_range(self.csm_attenuation, 0.0, 1e3),
+            "--csm-attenuation",
+            self.csm_attenuation,
+            "0 to 1000",
+        )?;
+        check(self.csm_scale.is_finite() && self.csm_scale > 0.0, "--csm-scale", self.csm_scale, "> 0")?;
+        check(in_range(self.csm_offset, -0.5, 0.5), "--csm-offset", self.csm_offset, "-0.5 to 0.5")?;
+        Ok(())
+    }
+}
+
 fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
     match v {
         Some(p) => check(p.is_finite(), flag, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
@@ -380,12 +614,35 @@ impl Settings {
             "in [0, 30] degrees",
         )?;
         let s = &self.shadow;
+        let f = &s.filter;
+        match f.kernel_unit {
+            KernelUnit::Texels => check(
+                f.pcf_kernel.is_finite() && (1.0..=32.0).contains(&f.pcf_kernel),
+                "--pcf-kernel",
+                f.pcf_kernel,
+                "1 to 32 texels (or a world width with --kernel-unit world)",
+            )?,
+            KernelUnit::World => check(
+                f.pcf_kernel.is_finite() && f.pcf_kernel > 0.0,
+                "--pcf-kernel",
+                f.pcf_kernel,
+                "a world width > 0",
+            )?,
+        }
+        check((8..=64).contains(&f.poisson_samples), "--poisson-samples", f.poisson_samples, "8 to 64")?;
         check(
-            matches!(s.filter.pcf_kernel, 3 | 5 | 7 | 9),
-            "--pcf-kernel",
-            s.filter.pcf_kernel,
-            "3, 5, 7 or 9",
+            (8..=64).contains(&f.pcss.blocker_samples),
+            "--blocker-samples",
+            f.pcss.blocker_samples,
+            "8 to 64",
         )?;
+        check(
+            f.pcss.max_radius.is_finite() && (1.0..=64.0).contains(&f.pcss.max_radius),
+            "--max-radius",
+            f.pcss.max_radius,
+            "1 to 64 texels",
+        )?;
+        f.moments.validate()?;
         let b = &s.bias;
         check(
             b.slope_bias.is_finite() && b.slope_bias >= 0.0,
@@ -581,7 +838,7 @@ mod tests {
         assert_eq!(e.flag, "--shadow-res");
         assert!(e.to_string().contains("256 to 8192"), "{e}");
         let mut s = Settings::default();
-        s.shadow.filter.pcf_kernel = 4;
+        s.shadow.filter.pcf_kernel = 40.0;
         assert_eq!(s.validate().unwrap_err().flag, "--pcf-kernel");
         let mut s = Settings::default();
         s.camera.fov_y_degrees = Some(180.0);
@@ -593,7 +850,13 @@ mod tests {
     #[test]
     fn technique_names_are_the_flag_values() {
         let names: Vec<_> = Technique::all().iter().map(|t| t.name()).collect();
-        assert_eq!(names, ["hard", "pcf2x2", "pcf"]);
+        assert_eq!(&names[..3], ["hard", "pcf2x2", "pcf"]);
+        for t in Technique::all() {
+            let parsed = <Technique as ValueEnum>::from_str(t.name(), false).unwrap();
+            assert_eq!(parsed, *t);
+            let toml_name: toml::Value = toml::Value::try_from(t).unwrap();
+            assert_eq!(toml_name.as_str(), Some(t.name()), "serde and clap agree");
+        }
     }
 
     #[test]

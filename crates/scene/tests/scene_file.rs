@@ -70,13 +70,13 @@ fn models_lights_views_and_settings_come_from_the_file() {
     // File settings apply; a command-line value that differs from its default wins.
     let table = loaded.settings.unwrap();
     let merged = scene_file::merge_settings(&table, &Settings::default()).unwrap();
-    assert_eq!((merged.shadow.filter.technique, merged.shadow.filter.pcf_kernel), (Technique::Pcf, 5));
+    assert_eq!((merged.shadow.filter.technique, merged.shadow.filter.pcf_kernel), (Technique::Pcf, 5.0));
     let mut cli = Settings::default();
-    cli.shadow.filter.pcf_kernel = 7;
+    cli.shadow.filter.pcf_kernel = 7.0;
     cli.shadow.map.resolution = 1024;
     let merged = scene_file::merge_settings(&table, &cli).unwrap();
     assert_eq!(merged.shadow.filter.technique, Technique::Pcf, "kept from the file");
-    assert_eq!(merged.shadow.filter.pcf_kernel, 7, "the command line wins");
+    assert_eq!(merged.shadow.filter.pcf_kernel, 7.0, "the command line wins");
     assert_eq!(merged.shadow.map.resolution, 1024);
 }
 

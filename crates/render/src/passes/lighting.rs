@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use gnomon_scene::settings::Technique;
 
-use super::{Layouts, SCENE_COMMON_WGSL, compose_wgsl};
+use super::{LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, compose_wgsl};
 use crate::{gpu_types::VertexGpu, techniques};
 
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -48,11 +48,12 @@ impl LightingPass {
     pub fn pipeline(&mut self, device: &wgpu::Device, technique: Technique) -> &wgpu::RenderPipeline {
         let layout = &self.layout;
         self.pipelines.entry(technique).or_insert_with(|| {
-            let source = compose_wgsl(&[
-                SCENE_COMMON_WGSL,
-                include_str!("lighting.wgsl"),
-                techniques::lookup(technique).wgsl(),
-            ]);
+            let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned(), SCENE_COMMON_WGSL.to_owned()];
+            parts.extend(techniques::shared_wgsl());
+            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            parts.push(include_str!("lighting.wgsl").to_owned());
+            let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+            let source = compose_wgsl(&refs);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(technique.name()),
                 source: wgpu::ShaderSource::Wgsl(source.into()),

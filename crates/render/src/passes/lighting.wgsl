@@ -2,8 +2,7 @@
 // factor of the selected technique multiplying only the direct term. Also writes the
 // per-pixel visibility, world position, normal, view depth and object id.
 //
-// A technique provides `fn sample_shadow(coords: vec3<f32>) -> f32`, where coords is
-// (u, v, depth) in the shadow map's texture space (v down, depth in [0, 1]).
+// A technique provides `fn sample_shadow(q: ShadowQuery) -> f32` (techniques/common.wgsl).
 
 struct Camera {
     clip_from_world: mat4x4<f32>,
@@ -12,8 +11,6 @@ struct Camera {
 };
 
 @group(1) @binding(0) var<uniform> camera: Camera;
-@group(2) @binding(0) var shadow_map: texture_depth_2d;
-@group(2) @binding(1) var shadow_compare: sampler_comparison;
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
 @group(3) @binding(1) var base_color_sampler: sampler;
 
@@ -102,9 +99,17 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let cone = geometry.w;
 
     let coords = shadow_coords(in.world, n);
+    // The lookup's screen derivatives, for receiver-plane bias and mip selection, are
+    // taken here, before any branch.
+    var query: ShadowQuery;
+    query.coords = coords.xyz;
+    query.coords_dx = dpdx(coords.xyz);
+    query.coords_dy = dpdy(coords.xyz);
+    query.pixel = in.clip.xy;
+    query.distance = -(light.light_from_world * vec4<f32>(in.world, 1.0)).z;
     var visibility = 1.0;
     if coords.w > 0.5 {
-        visibility = sample_shadow(coords.xyz);
+        visibility = sample_shadow(query);
     }
     if light.direction.w > 0.5 && cone <= 0.0 {
         // Outside a spot's cone or range no light arrives: visibility 0 by definition.

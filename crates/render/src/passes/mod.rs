@@ -2,6 +2,7 @@
 //! composition, and the pipeline caches.
 
 pub(crate) mod lighting;
+pub(crate) mod moments;
 pub(crate) mod shadow;
 
 /// The shadow map's texel format.
@@ -13,7 +14,10 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     parts.join("\n")
 }
 
-/// The WGSL every geometry pass starts with.
+/// The light uniform's struct and depth conventions, shared by every pass.
+pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
+
+/// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
 
 /// Bind group layouts shared by the passes.
@@ -22,7 +26,8 @@ pub(crate) struct Layouts {
     pub scene: wgpu::BindGroupLayout,
     /// Group 1 of the lighting pass: the camera.
     pub camera: wgpu::BindGroupLayout,
-    /// Group 2 of the lighting pass: the shadow map and its comparison sampler.
+    /// Group 2 of the lighting pass: the shadow map and its comparison sampler, and
+    /// the filterable techniques' moment map and its sampler.
     pub shadow: wgpu::BindGroupLayout,
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
@@ -69,6 +74,22 @@ impl Layouts {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
             ],

@@ -1,6 +1,6 @@
 // Declarations shared by every pass that draws scene geometry: the per-instance
-// data, the vertex layout, and the light uniform. Concatenated before a pass's own
-// WGSL by `passes::compose_wgsl`.
+// data, the vertex layout, and the light uniform's binding (its struct is in
+// light.wgsl). Concatenated before a pass's own WGSL by `passes::compose_wgsl`.
 
 struct Instance {
     world_from_object: mat4x4<f32>,
@@ -17,19 +17,6 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
-};
-
-// The light and its shadow map. Field meanings are documented in `gpu_types.rs`.
-struct Light {
-    clip_from_world: mat4x4<f32>,
-    light_from_world: mat4x4<f32>,
-    radiance: vec4<f32>,     // rgb: colour × intensity
-    direction: vec4<f32>,    // xyz: travel direction (sun) or cone axis (spot); w: 0 sun, 1 spot
-    position: vec4<f32>,     // xyz: spot position; w: range
-    cone: vec4<f32>,         // x: cos inner, y: cos outer, z: near, w: far
-    texel: vec4<f32>,        // x: ortho texel size, y: texel size per unit distance, z: normal offset (texels), w: map size
-    params: vec4<f32>,       // technique parameters, see each technique
-    ambient: vec4<f32>,      // rgb: ambient light
 };
 
 @group(0) @binding(0) var<storage, read> instances: array<Instance>;

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use gnomon_scene::settings::{BiasSettings, CullMode};
 
-use super::{Layouts, SCENE_COMMON_WGSL, SHADOW_FORMAT, compose_wgsl};
+use super::{LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADOW_FORMAT, compose_wgsl};
 use crate::gpu_types::VertexGpu;
 
 /// What makes two shadow pipelines differ.
@@ -29,7 +29,7 @@ pub(crate) struct ShadowPass {
 
 impl ShadowPass {
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let source = compose_wgsl(&[SCENE_COMMON_WGSL, include_str!("shadow_depth.wgsl")]);
+        let source = compose_wgsl(&[LIGHT_WGSL, SCENE_COMMON_WGSL, include_str!("shadow_depth.wgsl")]);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow depth"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -1,7 +1,7 @@
 //! `hard`: Williams' original depth comparison, one point sample, no filtering.
 //! L. Williams, "Casting curved shadows on curved surfaces", SIGGRAPH 1978.
 
-use gnomon_scene::settings::{FilterSettings, Technique};
+use gnomon_scene::settings::Technique;
 
 use super::ShadowTechnique;
 
@@ -12,11 +12,7 @@ impl ShadowTechnique for Hard {
         Technique::Hard
     }
 
-    fn wgsl(&self) -> &'static str {
-        include_str!("hard.wgsl")
-    }
-
-    fn filter_params(&self, _: &FilterSettings) -> [f32; 4] {
-        [0.0; 4]
+    fn wgsl(&self) -> &'static [&'static str] {
+        &[include_str!("hard.wgsl")]
     }
 }

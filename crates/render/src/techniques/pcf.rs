@@ -1,29 +1,32 @@
 //! The percentage-closer filtering family: compare first, then filter the binary
 //! results. W. Reeves, D. Salesin, R. Cook, "Rendering antialiased shadows with depth
-//! maps", SIGGRAPH 1987. Both variants use the comparison sampler, whose linear
-//! filter is the hardware's 2×2 bilinear PCF.
+//! maps", SIGGRAPH 1987. Every variant reads the comparison sampler, whose linear
+//! filter is the hardware's 2×2 bilinear PCF; the kernel width and receiver-plane
+//! bias are common settings, carried in `light.kernel`.
 
-use gnomon_scene::settings::{FilterSettings, Technique};
+use gnomon_scene::settings::Technique;
 
 use super::ShadowTechnique;
 
 /// `pcf2x2`: one hardware bilinear comparison tap.
 pub struct Pcf2x2;
-
-/// `pcf`: an N×N box of bilinear comparison taps spaced one texel apart.
+/// `pcf`: a box kernel from bilinear taps with exact weights (Castaño 2013).
 pub struct PcfBox;
+/// `pcf-tent`: a tent kernel from bilinear taps with exact weights.
+pub struct PcfTent;
+/// `pcf-poisson`: a rotated Poisson disk of bilinear taps.
+pub struct PcfPoisson;
+
+const PCF_WGSL: &str = include_str!("pcf.wgsl");
 
 impl ShadowTechnique for Pcf2x2 {
     fn technique(&self) -> Technique {
         Technique::Pcf2x2
     }
 
-    fn wgsl(&self) -> &'static str {
-        include_str!("pcf.wgsl")
-    }
-
-    fn filter_params(&self, _: &FilterSettings) -> [f32; 4] {
-        [0.0; 4]
+    fn wgsl(&self) -> &'static [&'static str] {
+        &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
+           return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.coords.z);\n}\n"]
     }
 }
 
@@ -32,11 +35,34 @@ impl ShadowTechnique for PcfBox {
         Technique::Pcf
     }
 
-    fn wgsl(&self) -> &'static str {
-        include_str!("pcf.wgsl")
+    fn wgsl(&self) -> &'static [&'static str] {
+        &[
+            PCF_WGSL,
+            "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), false);\n}\n",
+        ]
+    }
+}
+
+impl ShadowTechnique for PcfTent {
+    fn technique(&self) -> Technique {
+        Technique::PcfTent
     }
 
-    fn filter_params(&self, settings: &FilterSettings) -> [f32; 4] {
-        [settings.pcf_kernel as f32, 0.0, 0.0, 0.0]
+    fn wgsl(&self) -> &'static [&'static str] {
+        &[
+            PCF_WGSL,
+            "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), true);\n}\n",
+        ]
+    }
+}
+
+impl ShadowTechnique for PcfPoisson {
+    fn technique(&self) -> Technique {
+        Technique::PcfPoisson
+    }
+
+    fn wgsl(&self) -> &'static [&'static str] {
+        &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
+           return pcf_poisson(q, 0.5 * kernel_width_texels(q), u32(light.kernel.z));\n}\n"]
     }
 }

@@ -1,20 +1,64 @@
-// The PCF family (Reeves, Salesin & Cook 1987), on the comparison sampler:
-// light.params.x = 0: one bilinear comparison tap (hardware 2×2 PCF);
-// light.params.x = N > 0: an N×N box of bilinear taps one texel apart.
+// The PCF family (Reeves, Salesin & Cook 1987) on the comparison sampler, whose
+// linear filter is the hardware's 2×2 bilinear PCF.
+//
+// Box and tent kernels are built from bilinear taps (Castaño, "Shadow mapping
+// summary, part 1", 2013): along each axis the kernel gives every texel cell an
+// exact weight (the kernel's integral over the cell); two neighbouring cells i and
+// i + 1 with weights a and b are read by one bilinear tap placed b / (a + b) of the
+// way from texel centre i to centre i + 1, weighted a + b. A width-W kernel touches
+// ⌈W⌉ + 1 cells per axis, so it costs ⌈(⌈W⌉ + 1) / 2⌉² taps instead of (⌈W⌉ + 1)².
 
-fn sample_shadow(coords: vec3<f32>) -> f32 {
-    let n = i32(light.params.x);
-    if n <= 0 {
-        return textureSampleCompareLevel(shadow_map, shadow_compare, coords.xy, coords.z);
+// Integral from −∞ to t of the unit-area box of half-width h.
+fn box_cdf(t: f32, h: f32) -> f32 {
+    return clamp((t + h) / (2.0 * h), 0.0, 1.0);
+}
+
+// Integral from −∞ to t of the unit-area tent of half-width h.
+fn tent_cdf(t: f32, h: f32) -> f32 {
+    let s = clamp(t, -h, h);
+    if s < 0.0 {
+        return 0.5 * (s + h) * (s + h) / (h * h);
     }
-    let texel = 1.0 / light.texel.w;
-    let r = (n - 1) / 2;
+    return 1.0 - 0.5 * (h - s) * (h - s) / (h * h);
+}
+
+// Weight of texel cell [i, i + 1] for a kernel centred at p (texel units).
+fn cell_weight(p: f32, i: f32, h: f32, tent: bool) -> f32 {
+    if tent {
+        return tent_cdf(i + 1.0 - p, h) - tent_cdf(i - p, h);
+    }
+    return box_cdf(i + 1.0 - p, h) - box_cdf(i - p, h);
+}
+
+// Position (texel units, relative to p) and weight of the bilinear tap covering
+// cells i and i + 1.
+fn pair_tap(p: f32, i: f32, h: f32, tent: bool) -> vec2<f32> {
+    let a = cell_weight(p, i, h, tent);
+    let b = cell_weight(p, i + 1.0, h, tent);
+    let w = a + b;
+    let x = i + 0.5 + select(0.5, b / w, w > 0.0);
+    return vec2<f32>(x - p, w);
+}
+
+fn pcf_kernel(q: ShadowQuery, width: f32, tent: bool) -> f32 {
+    let gradient = receiver_depth_gradient(q);
+    let h = 0.5 * width;
+    let p = q.coords.xy * light.texel.w;
+    let first = floor(p - vec2<f32>(h));
+    let cells = i32(floor(p.x + h) - first.x) + 1;
+    let rows = i32(floor(p.y + h) - first.y) + 1;
     var sum = 0.0;
-    for (var y = -r; y <= r; y++) {
-        for (var x = -r; x <= r; x++) {
-            let uv = coords.xy + vec2<f32>(f32(x), f32(y)) * texel;
-            sum += textureSampleCompareLevel(shadow_map, shadow_compare, uv, coords.z);
+    var total = 0.0;
+    for (var j = 0; j < rows; j += 2) {
+        let ty = pair_tap(p.y, first.y + f32(j), h, tent);
+        for (var i = 0; i < cells; i += 2) {
+            let tx = pair_tap(p.x, first.x + f32(i), h, tent);
+            let w = tx.y * ty.y;
+            if w > 0.0 {
+                sum += w * compare_tap(q, gradient, vec2<f32>(tx.x, ty.x));
+                total += w;
+            }
         }
     }
-    return sum / f32(n * n);
+    return sum / max(total, 1e-12);
 }

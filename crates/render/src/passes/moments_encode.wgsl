@@ -1,0 +1,15 @@
+// Moment-map encoding: every texel's stored depth, made linear (`moment_depth`),
+// becomes the technique's RGBA layers (`encode_moments`).
+
+@group(0) @binding(1) var<uniform> light: Light;
+@group(1) @binding(0) var encoded: texture_storage_2d_array<MOMENT_FORMAT, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn encode_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(shadow_map);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let d = moment_depth(textureLoad(shadow_map, vec2<i32>(id.xy), 0));
+    textureStore(encoded, vec2<i32>(id.xy), i32(id.z), encode_moments(d, id.z));
+}

@@ -1,0 +1,24 @@
+//! `esm`: exponential shadow maps (Annen et al. 2008), filtered in log space.
+
+use glam::Vec4;
+use gnomon_scene::settings::{FilterSettings, Technique};
+
+use super::{FilterableMap, ShadowTechnique};
+
+pub struct Esm;
+
+impl ShadowTechnique for Esm {
+    fn technique(&self) -> Technique {
+        Technique::Esm
+    }
+    fn wgsl(&self) -> &'static [&'static str] {
+        &[include_str!("esm.wgsl")]
+    }
+    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+        [Vec4::new(s.moments.esm_exponent, 0.0, 0.0, 0.0), Vec4::ZERO]
+    }
+    fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {
+        // The lookup filters bilinearly in log space by hand, at the top level only.
+        Some(FilterableMap { layers: 1, log_space_exponent: Some(s.moments.esm_exponent), mipmapped: false })
+    }
+}

@@ -1,0 +1,19 @@
+//! `pcss`: percentage-closer soft shadows (Fernando 2005). The light's size is the
+//! light's own (spot disk radius or sun angular diameter), the same parameter the
+//! reference's area light uses; the search settings are carried in `light.pcss`.
+
+use gnomon_scene::settings::Technique;
+
+use super::ShadowTechnique;
+
+pub struct Pcss;
+
+impl ShadowTechnique for Pcss {
+    fn technique(&self) -> Technique {
+        Technique::Pcss
+    }
+
+    fn wgsl(&self) -> &'static [&'static str] {
+        &[include_str!("pcss.wgsl")]
+    }
+}

@@ -1,0 +1,72 @@
+// Percentage-closer soft shadows (R. Fernando, "Percentage-closer soft shadows",
+// SIGGRAPH 2005 sketch), for a light of size w_light (light.pcss.x: the spot's disk
+// radius in world units, or tan of the sun's angular radius):
+// 1. Blocker search: average the distance d_blocker of the map texels nearer the
+//    light than the receiver, over the region where a blocker could hide part of
+//    the light from the receiver.
+// 2. Penumbra estimate from similar triangles: w = (d_receiver − d_blocker) ·
+//    w_light / d_blocker for a spot (distances from the light), or
+//    (d_receiver − d_blocker) · tan(angular radius) for a sun.
+// 3. PCF over a Poisson disk of that radius.
+// Both the search region and the penumbra are converted to texels with the map's
+// projection: perspective texels grow with distance, orthographic ones do not.
+
+// Radius in texels, at the receiver, of a world length `world` that lies at light
+// distance `at`.
+fn world_to_texels(world: f32, at: f32) -> f32 {
+    if light.direction.w < 0.5 {
+        return world / light.texel.x;
+    }
+    return world / (light.texel.y * at);
+}
+
+fn sample_shadow(q: ShadowQuery) -> f32 {
+    let size = light.pcss.x;
+    let max_radius = light.pcss.z;
+    let d_receiver = q.distance;
+    let near = light.cone.z;
+    let is_spot = light.direction.w > 0.5;
+
+    // 1. The search region: the cross-section at the near plane of the cone from the
+    // receiver to the light, where the nearest possible blockers lie.
+    var search = 0.0;
+    if is_spot {
+        search = world_to_texels(size * (d_receiver - near) / d_receiver, near);
+    } else {
+        search = world_to_texels(size * (d_receiver - near), near);
+    }
+    search = clamp(search, 1.0, max_radius);
+
+    let gradient = receiver_depth_gradient(q);
+    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
+    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let dims = vec2<i32>(textureDimensions(shadow_map));
+    let taps = u32(light.pcss.y);
+    var blocker_sum = 0.0;
+    var blockers = 0.0;
+    for (var i = 0u; i < taps; i++) {
+        let offset = rotation * POISSON_DISK[i] * search;
+        let duv = offset / light.texel.w;
+        let uv = q.coords.xy + duv;
+        let texel = clamp(vec2<i32>(floor(uv * light.texel.w)), vec2<i32>(0), dims - vec2<i32>(1));
+        let stored = textureLoad(shadow_map, texel, 0);
+        if stored < q.coords.z + dot(gradient, duv) {
+            blocker_sum += light_distance_from_depth(stored);
+            blockers += 1.0;
+        }
+    }
+    if blockers == 0.0 {
+        return 1.0;
+    }
+    let d_blocker = blocker_sum / blockers;
+
+    // 2. The penumbra's radius at the receiver.
+    var penumbra = 0.0;
+    if is_spot {
+        penumbra = world_to_texels(size * max(d_receiver - d_blocker, 0.0) / d_blocker, d_receiver);
+    } else {
+        penumbra = world_to_texels(size * max(d_receiver - d_blocker, 0.0), d_receiver);
+    }
+    // 3. At least the bilinear tap's own half-texel footprint.
+    return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), u32(light.kernel.z));
+}
