@@ -50,6 +50,13 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     let z3 = -0.5 * p + r;
 
     var intensity = 0.0;
+    if z <= z2 {
+        intensity = 0.0;
+    } else if z <= z3 {
+        intensity = atom_weight(z2, z, z3, b.x, b.y);
+    } else {
+        intensity = 1.0 - atom_weight(z, z2, z3, b.x, b.y);
+    }
     if light.params[0].y > 0.5 && (z2 < 0.0 || z3 > 1.0) {
         // Four atoms at {0, z, z_free, 1}. Weighting each atom by its depth gives a
         // measure on {1, z, z_free} with moments (b₁, b₂, b₃, b₄), whence z_free, and
@@ -60,13 +67,17 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
         let w_z = (b.z - (1.0 + z_free) * b.y + z_free * b.x) / (zc * (zc - 1.0) * (zc - z_free));
         let w_free = (b.z - (1.0 + zc) * b.y + zc * b.x) / (z_free * (z_free - 1.0) * (z_free - zc));
         let w_zero = 1.0 - w_one - w_z - w_free;
-        intensity = w_zero + select(0.0, w_free, z_free < zc);
-    } else if z <= z2 {
-        intensity = 0.0;
-    } else if z <= z3 {
-        intensity = atom_weight(z2, z, z3, b.x, b.y);
-    } else {
-        intensity = 1.0 - atom_weight(z, z2, z3, b.x, b.y);
+        // Rounding can leave the roots just outside [0, 1] when the moments are those
+        // of three atoms {0, z, 1} (a flat occluder plus the moment bias): then the
+        // four-atom system is degenerate (z_free = 0/0). Its answer is used only when
+        // it is a distribution on [0, 1]; otherwise the three-atom bound, valid for
+        // any support, stands.
+        let weights = vec4<f32>(w_zero, w_one, w_z, w_free);
+        let valid = z_free >= 0.0 && z_free <= 1.0 && all(weights >= vec4<f32>(-1e-3))
+            && all(weights <= vec4<f32>(1.001));
+        if valid {
+            intensity = w_zero + select(0.0, w_free, z_free < zc);
+        }
     }
     return 1.0 - clamp(intensity, 0.0, 1.0);
 }

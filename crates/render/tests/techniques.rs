@@ -1,0 +1,173 @@
+//! One GPU test per technique: under an analytic square occluder, the umbra is dark
+//! (visibility below 0.1) and the fully lit ground stays lit (above 0.9), for a sun
+//! with a small angular size and a spot light with a small disk. Pixels within the
+//! analytic penumbra plus the technique's filter footprint are left out.
+
+mod support;
+
+use glam::{Mat4, Vec2, Vec3};
+use gnomon_scene::{
+    Scene, geometry,
+    settings::{LightKind, Settings, Technique},
+};
+use support::*;
+
+const RESOLUTION: u32 = 1024;
+
+/// Signed distance from `p` to the axis-aligned square of half-size `half` at
+/// `center` (negative inside).
+fn square_distance(p: Vec2, center: Vec2, half: f32) -> f32 {
+    let d = (p - center).abs() - Vec2::splat(half);
+    d.max(Vec2::ZERO).length() + d.max_element().min(0.0)
+}
+
+/// How far from the exact shadow edge a technique may blur: the blur radius or
+/// kernel half-width, the bilinear tap, and the texel itself, in texels.
+fn footprint_texels(s: &Settings) -> f32 {
+    let f = &s.shadow.filter;
+    match f.technique {
+        Technique::Hard | Technique::Pcf2x2 => 1.5,
+        Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => 0.5 * f.pcf_kernel + 1.5,
+        // The penumbra estimate is analytic, but its blocker search and taps add noise.
+        Technique::Pcss => 2.5,
+        // Gaussian blur of σ = radius/2 truncated at the radius, then bilinear.
+        _ => f.moments.blur_radius as f32 + 1.5,
+    }
+}
+
+struct Outcome {
+    umbra: usize,
+    dark_umbra: usize,
+    lit: usize,
+    lit_lit: usize,
+    worst_umbra: f32,
+    worst_lit: f32,
+}
+
+/// Renders `scene` with `s` and classifies ground pixels by their signed distance to
+/// the analytic shadow edge (`edge_distance`, negative inside), leaving out those
+/// closer than the penumbra half-width plus the filter footprint plus a pixel.
+fn classify(
+    scene: &Scene,
+    s: &Settings,
+    edge_distance: impl Fn(Vec3) -> Option<f32>,
+    penumbra_half: f32,
+) -> Outcome {
+    let frame = render(scene, s);
+    let mut o = Outcome { umbra: 0, dark_umbra: 0, lit: 0, lit_lit: 0, worst_umbra: 0.0, worst_lit: 1.0 };
+    for i in 0..frame.pixel_count() {
+        if frame.object_id[i] != 1 {
+            continue;
+        }
+        let p = frame.position[i];
+        let Some(d) = edge_distance(p) else { continue };
+        let margin = penumbra_half
+            + footprint_texels(s) * frame.shadow_texel_world_size(p)
+            + pixel_footprint(&frame, i);
+        let v = frame.visibility[i];
+        if d < -margin {
+            o.umbra += 1;
+            o.dark_umbra += (v < 0.1) as usize;
+            o.worst_umbra = o.worst_umbra.max(v);
+        } else if d > margin {
+            o.lit += 1;
+            o.lit_lit += (v > 0.9) as usize;
+            o.worst_lit = o.worst_lit.min(v);
+        }
+    }
+    o
+}
+
+fn check(label: &str, o: &Outcome) {
+    assert!(o.umbra > 1000 && o.lit > 20_000, "{label}: too few pixels ({} umbra, {} lit)", o.umbra, o.lit);
+    assert_eq!(
+        o.dark_umbra,
+        o.umbra,
+        "{label}: {} of {} umbra pixels are not below 0.1 (brightest {})",
+        o.umbra - o.dark_umbra,
+        o.umbra,
+        o.worst_umbra
+    );
+    assert_eq!(
+        o.lit_lit,
+        o.lit,
+        "{label}: {} of {} lit pixels are not above 0.9 (darkest {})",
+        o.lit - o.lit_lit,
+        o.lit,
+        o.worst_lit
+    );
+}
+
+#[test]
+fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() {
+    let (half, height, angular_diameter) = (1.0f32, 1.5f32, 1.0f32);
+    let center = Vec3::new(0.5, height, -0.5);
+    let mut scene = ground_scene("technique sun", 12.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
+    scene.camera.target = Vec3::ZERO;
+    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
+    scene.sun.direction = sun_dir;
+    scene.sun.angular_diameter_degrees = angular_diameter;
+    let offset = Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    let shadow_center = Vec2::new(center.x, center.z) + offset;
+    // The penumbra's half-width on the ground: the occluder's distance along the ray
+    // times the tangent of the sun's angular radius, stretched by the ground's slant.
+    let along_ray = height / -sun_dir.y;
+    let penumbra_half = along_ray * (0.5 * angular_diameter).to_radians().tan() / -sun_dir.y;
+
+    for technique in Technique::all() {
+        let mut s = settings(640, 480, RESOLUTION);
+        s.shadow.filter.technique = *technique;
+        let o = classify(
+            &scene,
+            &s,
+            |p| Some(square_distance(Vec2::new(p.x, p.z), shadow_center, half)),
+            penumbra_half,
+        );
+        check(&format!("{} (sun)", technique.name()), &o);
+    }
+}
+
+#[test]
+fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot() {
+    let (light_height, half, occluder_height, radius) = (8.0f32, 0.75f32, 2.0f32, 0.1f32);
+    let occluder_center = Vec3::new(1.0, occluder_height, 0.5);
+    let mut scene = ground_scene("technique spot", 16.0);
+    add(
+        &mut scene,
+        "square",
+        geometry::plane(2.0 * half, 2.0 * half),
+        Mat4::from_translation(occluder_center),
+    );
+    scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
+    scene.camera.target = Vec3::ZERO;
+    scene.spot.position = Vec3::new(0.0, light_height, 0.0);
+    scene.spot.direction = Vec3::NEG_Y;
+    scene.spot.outer_angle_degrees = 30.0;
+    scene.spot.inner_angle_degrees = 25.0;
+    scene.spot.range = 20.0;
+    scene.spot.radius = radius;
+    let k = light_height / (light_height - occluder_height);
+    let shadow_center = Vec2::new(occluder_center.x, occluder_center.z) * k;
+    let cone_radius = light_height * 30f32.to_radians().tan();
+    // Similar triangles: the disk's radius scaled by h / (H − h) on the ground.
+    let penumbra_half = radius * occluder_height / (light_height - occluder_height);
+
+    for technique in Technique::all() {
+        let mut s = settings(640, 480, RESOLUTION);
+        s.light.kind = LightKind::Spot;
+        s.shadow.filter.technique = *technique;
+        let o = classify(
+            &scene,
+            &s,
+            |p| {
+                // Only well inside the cone, where the light is not cut by the cone itself.
+                (Vec2::new(p.x, p.z).length() < cone_radius - 0.5)
+                    .then(|| square_distance(Vec2::new(p.x, p.z), shadow_center, half * k))
+            },
+            penumbra_half,
+        );
+        check(&format!("{} (spot)", technique.name()), &o);
+    }
+}
