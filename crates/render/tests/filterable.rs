@@ -151,10 +151,6 @@ fn attenuation_reduces_convolution_ringing() {
         assert!(count.iter().all(|&c| c > 100), "pixels per bin: {count:?}");
         sum.iter().zip(&count).map(|(s, &c)| s / c as f32).collect::<Vec<f32>>()
     };
-    for alpha in [0.0, 1.0, 2.0, 4.0] {
-        let p = profile(alpha);
-        println!("alpha {alpha}: ringing {} mean {} {:?}", ringing(&p), mean(&p), p);
-    }
     let raw = ringing(&profile(0.0));
     let damped = ringing(&profile(2.0));
     assert!(raw > 0.01, "the raw series must ring here: ringing {raw}");
