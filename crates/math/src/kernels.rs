@@ -46,23 +46,23 @@ pub fn gaussian_weights(radius: u32, sigma: f32) -> Vec<f32> {
     raw.into_iter().map(|w| w / sum).collect()
 }
 
-/// Frequencies c_k = π(2k − 1)/2, k = 1..=terms, of the Fourier series of the depth
+/// Frequencies c_k = π(2k − 1), k = 1..=terms, of the Fourier series of the depth
 /// test used by convolution shadow maps (Annen et al., "Convolution shadow maps",
-/// EGSR 2007): for x = d − z in (−2, 2),
+/// EGSR 2007): for x = d − z in (−1, 1),
 ///
-///   H(x) ≈ ½ + Σ_k sin(c_k x) / c_k,
+///   H(x) ≈ ½ + 2 Σ_k sin(c_k x) / c_k,
 ///
-/// the odd square wave of period 4. Depths
-/// d, z ∈ [0, 1] give x ∈ [−1, 1], well inside one period, so a receiver far behind
-/// its occluder (x → −1) is not caught by the wave's next jump at x = ±2, as it would
-/// be with period 2. sin(c_k (d − z)) splits into sin(c_k d)·cos(c_k z) −
+/// the odd square wave of period 2. Depths d, z ∈ [0, 1] keep x in [−1, 1]; only a
+/// receiver at the far plane behind an occluder at the near plane meets the wave's
+/// next jump at x = −1 (a period of 4 would avoid it at the cost of halving the
+/// sharpness everywhere). sin(c_k (d − z)) splits into sin(c_k d)·cos(c_k z) −
 /// cos(c_k d)·sin(c_k z), so the map stores sin and cos of c_k·d, which filter linearly.
 pub fn convolution_frequencies(terms: u32) -> Vec<f32> {
-    (1..=terms).map(|k| 0.5 * std::f32::consts::PI * (2 * k - 1) as f32).collect()
+    (1..=terms).map(|k| std::f32::consts::PI * (2 * k - 1) as f32).collect()
 }
 
 /// The truncated, attenuated series of [`convolution_frequencies`] evaluated at
-/// x = d − z: ½ + Σ_k exp(−α (k/M)²) sin(c_k x) / c_k.
+/// x = d − z: ½ + 2 Σ_k exp(−α (k/M)²) sin(c_k x) / c_k.
 pub fn convolution_step(x: f32, terms: u32, attenuation: f32) -> f32 {
     let m = terms as f32;
     0.5 + convolution_frequencies(terms)
@@ -70,7 +70,7 @@ pub fn convolution_step(x: f32, terms: u32, attenuation: f32) -> f32 {
         .enumerate()
         .map(|(i, c)| {
             let k = (i + 1) as f32;
-            (-attenuation * (k / m).powi(2)).exp() * (c * x).sin() / c
+            2.0 * (-attenuation * (k / m).powi(2)).exp() * (c * x).sin() / c
         })
         .sum::<f32>()
 }

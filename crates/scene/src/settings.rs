@@ -257,7 +257,7 @@ pub struct FilterSettings {
     /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
     /// across the kernel along the receiver's plane, from the screen-space derivatives
     /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
-    #[arg(long, help_heading = "Shadow filter")]
+    #[arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter")]
     pub receiver_plane_bias: bool,
     #[command(flatten)]
     pub pcss: PcssSettings,
@@ -272,7 +272,7 @@ impl Default for FilterSettings {
             pcf_kernel: 3.0,
             kernel_unit: KernelUnit::default(),
             poisson_samples: 32,
-            receiver_plane_bias: false,
+            receiver_plane_bias: true,
             pcss: PcssSettings::default(),
             moments: MomentSettings::default(),
         }

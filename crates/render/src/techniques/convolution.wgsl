@@ -1,8 +1,8 @@
 // Convolution shadow maps (T. Annen, T. Mertens, P. Bekaert, H.-P. Seidel & J. Kautz,
 // "Convolution shadow maps", EGSR 2007). The depth test is expanded in the Fourier
 // series of a square wave (see `gnomon_math::kernels::convolution_frequencies`):
-//   H(d − z) ≈ ½ + Σₖ aₖ/cₖ · (sin(cₖd)·cos(cₖz) − cos(cₖd)·sin(cₖz)),
-// cₖ = π(2k − 1)/2 (period 4, so d − z ∈ [−1, 1] stays inside one period), which is linear in the stored sin(cₖd) and cos(cₖd), so filtering
+//   H(d − z) ≈ ½ + 2 Σₖ aₖ/cₖ · (sin(cₖd)·cos(cₖz) − cos(cₖd)·sin(cₖz)),
+// cₖ = π(2k − 1) (period 2, as in the paper), which is linear in the stored sin(cₖd) and cos(cₖd), so filtering
 // the map filters the test. Truncation rings (Gibbs); aₖ = exp(−α (k/M)²) damps the
 // high terms. The reconstruction f is then sharpened: visibility = s·(f − ½ + o) + ½.
 //
@@ -12,7 +12,7 @@
 const PI: f32 = 3.14159265;
 
 fn frequency(k: u32) -> f32 {
-    return 0.5 * PI * f32(2u * k + 1u);
+    return PI * f32(2u * k + 1u);
 }
 
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
@@ -38,7 +38,7 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
             let a = exp(-alpha * pow(f32(k + 1u) / m, 2.0));
             let sin_d = select(s.x, s.z, t == 1u);
             let cos_d = select(s.y, s.w, t == 1u);
-            f += a / c * (sin_d * cos(c * z) - cos_d * sin(c * z));
+            f += 2.0 * a / c * (sin_d * cos(c * z) - cos_d * sin(c * z));
         }
     }
     return clamp(light.params[0].z * (f - 0.5 + light.params[0].w) + 0.5, 0.0, 1.0);
