@@ -274,7 +274,12 @@ impl<'g> Renderer<'g> {
         let technique = techniques::lookup(shadow.filter.technique);
         let filterable_map = technique.filterable_map(&shadow.filter);
         let moment_format = self.moment_format(settings)?;
-        let light_gpu = light_uniform(scene, &light, &projection, settings, technique.params(&shadow.filter));
+        let precision = match moment_format {
+            wgpu::TextureFormat::Rgba16Float => techniques::MapPrecision::Half,
+            _ => techniques::MapPrecision::Single,
+        };
+        let light_gpu =
+            light_uniform(scene, &light, &projection, settings, technique.params(&shadow.filter, precision));
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
         let camera_gpu = CameraGpu {

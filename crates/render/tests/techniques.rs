@@ -171,3 +171,37 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot()
         check(&format!("{} (spot)", technique.name()), &o);
     }
 }
+
+#[test]
+fn filterable_techniques_also_work_with_16_bit_moment_maps() {
+    // The portable format, where 32-bit float is not filterable (the GL backend):
+    // exponents and the moment bias are set for half precision, as documented.
+    let (half, height) = (1.0f32, 1.5f32);
+    let center = Vec3::new(0.5, height, -0.5);
+    let mut scene = ground_scene("technique sun, 16-bit", 12.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
+    scene.camera.target = Vec3::ZERO;
+    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
+    scene.sun.direction = sun_dir;
+    let shadow_center =
+        Vec2::new(center.x, center.z) + Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    for technique in Technique::all().iter().filter(|t| t.is_filterable()) {
+        let mut s = settings(640, 480, RESOLUTION);
+        s.shadow.filter.technique = *technique;
+        let m = &mut s.shadow.filter.moments;
+        m.moment_format = gnomon_scene::settings::MomentFormat::Rgba16float;
+        m.evsm_positive = 5.54;
+        m.evsm_negative = 5.54;
+        m.moment_bias = 6e-5;
+        s.validate().unwrap();
+        let frame_format = {
+            let mut renderer = gnomon_render::Renderer::new(gpu()).unwrap();
+            renderer.moment_format(&s).unwrap()
+        };
+        assert_eq!(frame_format, wgpu::TextureFormat::Rgba16Float);
+        let o =
+            classify(&scene, &s, |p| Some(square_distance(Vec2::new(p.x, p.z), shadow_center, half)), 0.0);
+        check(&format!("{} (16-bit)", technique.name()), &o);
+    }
+}

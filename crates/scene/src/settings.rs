@@ -308,8 +308,9 @@ pub enum MomentFormat {
     Auto,
     /// 32-bit float per channel (needs FLOAT32_FILTERABLE).
     Rgba32float,
-    /// 16-bit float per channel: half the memory and bandwidth; needs a larger
-    /// --moment-bias and smaller exponents (at most 5.5 for EVSM, 10 for ESM).
+    /// 16-bit float per channel: half the memory and bandwidth. MSM then stores its
+    /// moments in Peters & Klein's optimised basis (use --moment-bias 6e-5), and EVSM
+    /// exponents must be at most 5.54.
     Rgba16float,
 }
 
@@ -336,7 +337,8 @@ pub struct MomentSettings {
     /// and the rest rescaled to [0, 1] (Lauritzen's linstep). In [0, 1).
     #[arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps")]
     pub bleeding_reduction: f32,
-    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (10 for 16-bit).
+    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (the map
+    /// stores d and filters in log space, so c is not limited by the format).
     #[arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps")]
     pub esm_exponent: f32,
     /// EVSM positive exponent: 0 to 42 (5.54 for 16-bit).
@@ -346,7 +348,8 @@ pub struct MomentSettings {
     #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps")]
     pub evsm_negative: f32,
     /// MSM moment bias α: the moments are blended toward those of a two-point
-    /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits). In [0, 0.1].
+    /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits, 6e-5 at 16).
+    /// In [0, 0.1].
     #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps")]
     pub moment_bias: f32,
     /// Fourier terms M of convolution shadow maps: 1 to 16 (2M channels).
@@ -529,7 +532,9 @@ impl MomentSettings {
             "in [0, 1)",
         )?;
         let half = self.moment_format == MomentFormat::Rgba16float;
-        let (esm_max, evsm_max) = if half { (10.0, 5.54) } else { (88.0, 42.0) };
+        // ESM stores d itself and exponentiates in the shader, so only EVSM, which
+        // stores exp(c·d) and its square, is limited by the storage format's range.
+        let (esm_max, evsm_max) = (88.0, if half { 5.54 } else { 42.0 });
         let precision = if half { "with --moment-format rgba16float" } else { "at 32 bits" };
         check(
             in_range(self.esm_exponent, 1.0, esm_max),

@@ -4,7 +4,7 @@
 use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, ShadowTechnique};
 
 pub struct Convolution;
 
@@ -15,7 +15,7 @@ impl ShadowTechnique for Convolution {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("convolution.wgsl")]
     }
-    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
         let m = &s.moments;
         [Vec4::new(m.csm_terms as f32, m.csm_attenuation, m.csm_scale, m.csm_offset), Vec4::ZERO]
     }

@@ -3,7 +3,7 @@
 use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, ShadowTechnique};
 
 pub struct Esm;
 
@@ -14,7 +14,7 @@ impl ShadowTechnique for Esm {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("esm.wgsl")]
     }
-    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
         [Vec4::new(s.moments.esm_exponent, 0.0, 0.0, 0.0), Vec4::ZERO]
     }
     fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {

@@ -31,6 +31,15 @@ pub struct FilterableMap {
     pub mipmapped: bool,
 }
 
+/// The precision of the filterable map's channels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapPrecision {
+    /// 32-bit float.
+    Single,
+    /// 16-bit float: techniques may store their values in a better-conditioned basis.
+    Half,
+}
+
 /// A shadow technique as the renderer sees it.
 pub trait ShadowTechnique: Sync {
     /// The settings value that selects this technique.
@@ -38,7 +47,7 @@ pub trait ShadowTechnique: Sync {
     /// WGSL sources, concatenated after the shared ones, defining `sample_shadow`.
     fn wgsl(&self) -> &'static [&'static str];
     /// The technique's parameters, passed to the shader as `light.params`.
-    fn params(&self, _settings: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, _settings: &FilterSettings, _precision: MapPrecision) -> [Vec4; 2] {
         [Vec4::ZERO; 2]
     }
     /// The filterable map the technique samples, if any.

@@ -13,11 +13,36 @@
 // leaves [0, 1] the extremal distribution instead puts atoms at 0, z, 1 and a fourth
 // free point, fixed by all four moments.
 //
-// params[0]: x: moment bias α, y: 1 for the Hausdorff bound.
+// 16-bit maps store the moments in the optimised basis of Peters & Klein (2015,
+// section 4.3): an affine map chosen so that rounding to half floats perturbs the
+// reconstructed moments as little as possible. Filtering commutes with it.
+//
+// params[0]: x: moment bias α, y: 1 for the Hausdorff bound, z: 1 for the
+// optimised 16-bit basis.
+
+// Columns are the rows of the paper's matrix: b_opt = QUANTISE · b + (0.0359558848, 0, 0, 0).
+const QUANTISE: mat4x4<f32> = mat4x4<f32>(
+    vec4<f32>(-2.07224649, 13.7948857237, 0.105877704, 9.7924062118),
+    vec4<f32>(32.23703778, -59.4683975703, -1.9077466311, -33.7652110555),
+    vec4<f32>(-68.571074599, 82.0359750338, 9.3496555107, 47.9456096605),
+    vec4<f32>(39.3703274134, -35.364903257, -6.6543490743, -23.9728048165),
+);
+// Its inverse: b = DEQUANTISE · (b_opt − (0.0359558848, 0, 0, 0)).
+const DEQUANTISE: mat4x4<f32> = mat4x4<f32>(
+    vec4<f32>(0.2227744146, 0.1549679261, 0.1451988946, 0.163127443),
+    vec4<f32>(0.0771972861, 0.1394629426, 0.2120202157, 0.2591432266),
+    vec4<f32>(0.7926986636, 0.7963415838, 0.7258694464, 0.6539092497),
+    vec4<f32>(0.0319417555, -0.1722823173, -0.2758014811, -0.3376131734),
+);
+const QUANTISE_OFFSET: vec4<f32> = vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
 
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
     let d2 = d * d;
-    return vec4<f32>(d, d2, d2 * d, d2 * d2);
+    let b = vec4<f32>(d, d2, d2 * d, d2 * d2);
+    if light.params[0].z > 0.5 {
+        return QUANTISE * b + QUANTISE_OFFSET;
+    }
+    return b;
 }
 
 // Weight of the atom at `a` of a three-atom distribution on {a, u, v} with
@@ -29,7 +54,11 @@ fn atom_weight(a: f32, u: f32, v: f32, m1: f32, m2: f32) -> f32 {
 fn sample_shadow(q: ShadowQuery) -> f32 {
     // The moment bias pulls the moments toward those of ½δ₀ + ½δ₁, strictly inside
     // the moment space, so the system stays well-conditioned after quantisation.
-    let b = mix(sample_moments(q, 0u), vec4<f32>(0.5), light.params[0].x);
+    var stored = sample_moments(q, 0u);
+    if light.params[0].z > 0.5 {
+        stored = DEQUANTISE * (stored - QUANTISE_OFFSET);
+    }
+    let b = mix(stored, vec4<f32>(0.5), light.params[0].x);
     let z = receiver_moment_depth(q);
 
     // LDLᵀ of the Hankel matrix (first column (1, b₁, b₂), d₁ = 1).

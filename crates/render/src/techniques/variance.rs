@@ -5,7 +5,7 @@
 use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, ShadowTechnique};
 
 pub struct Vsm;
 pub struct Evsm2;
@@ -31,7 +31,7 @@ impl ShadowTechnique for Vsm {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
         params(0.0, s)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
@@ -46,7 +46,7 @@ impl ShadowTechnique for Evsm2 {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
         params(2.0, s)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
@@ -61,7 +61,7 @@ impl ShadowTechnique for Evsm4 {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings) -> [Vec4; 2] {
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
         params(4.0, s)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
