@@ -196,7 +196,7 @@ fn filterable_techniques_also_work_with_16_bit_moment_maps() {
         m.moment_bias = 6e-5;
         s.validate().unwrap();
         let frame_format = {
-            let mut renderer = gnomon_render::Renderer::new(gpu()).unwrap();
+            let renderer = gnomon_render::Renderer::new(gpu()).unwrap();
             renderer.moment_format(&s).unwrap()
         };
         assert_eq!(frame_format, wgpu::TextureFormat::Rgba16Float);
