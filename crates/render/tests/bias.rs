@@ -41,11 +41,16 @@ fn near_shadow_edge(
 /// away from shadow edges (see [`near_shadow_edge`]).
 /// Also returns the fraction of lit-facing pixels wrongly shadowed on shadow edges.
 fn acne_fraction(technique: Technique, bias: BiasSettings) -> (f64, f64, usize) {
-    let scene = builtin::grazing();
     let mut s = settings(640, 360, 2048);
     s.shadow.filter.technique = technique;
     s.shadow.bias = bias;
-    let frame = render(&scene, &s);
+    acne_fraction_with(&s, 0.5)
+}
+
+/// Like [`acne_fraction`], counting pixels darker than `threshold` as shadowed.
+fn acne_fraction_with(s: &gnomon_scene::Settings, threshold: f32) -> (f64, f64, usize) {
+    let scene = builtin::grazing();
+    let frame = render(&scene, s);
     let gnomon_scene::Light::Directional(sun) = frame.light else { panic!() };
     let to_light = -sun.direction;
     let (mut facing, mut wrong, mut edge) = (0usize, 0usize, 0usize);
@@ -55,9 +60,16 @@ fn acne_fraction(technique: Technique, bias: BiasSettings) -> (f64, f64, usize) 
         }
         facing += 1;
         let (p, n) = (frame.position[i], frame.normal[i]);
-        if frame.visibility[i] < 0.5 && ray_traced_lit(&scene, &frame.light, p, n) {
+        if frame.visibility[i] < threshold && ray_traced_lit(&scene, &frame.light, p, n) {
             let texel = frame.light_projection.texel_world_size(2048, 0.0);
-            if !near_shadow_edge(&scene, &frame.light, p, n, 1.5 * texel) {
+            // A kernel of width W legitimately greys pixels within W/2 of an edge.
+            let reach = match s.shadow.filter.technique {
+                Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => {
+                    0.5 * s.shadow.filter.pcf_kernel
+                }
+                _ => 0.0,
+            };
+            if !near_shadow_edge(&scene, &frame.light, p, n, (1.5 + reach) * texel) {
                 wrong += 1;
             } else {
                 edge += 1;
@@ -98,6 +110,35 @@ fn default_bias_removes_acne_for_filtered_techniques_too() {
             100.0 * biased
         );
         assert!(edge < 0.005, "{technique:?}: {:.3}% wrongly shadowed along shadow edges", 100.0 * edge);
+    }
+}
+
+#[test]
+fn receiver_plane_bias_keeps_wide_kernels_off_their_own_receiver() {
+    // A 25-texel kernel on `grazing` reaches 12.5 texels from the lookup, where the
+    // plane's depth differs by far more than the slope bias allows for one texel:
+    // the outer taps shadow the receiver itself, and lit ground greys. Any pixel of
+    // truly lit ground below 0.9 counts.
+    for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
+        let mut s = settings(640, 360, 2048);
+        s.shadow.filter.technique = technique;
+        s.shadow.filter.pcf_kernel = 25.0;
+        s.shadow.filter.receiver_plane_bias = false;
+        let (flat, _, _) = acne_fraction_with(&s, 0.9);
+        s.shadow.filter.receiver_plane_bias = true;
+        let (tilted, _, _) = acne_fraction_with(&s, 0.9);
+        eprintln!(
+            "{}: {:.3}% self-shadowed without receiver-plane bias, {:.4}% with it",
+            technique.name(),
+            100.0 * flat,
+            100.0 * tilted
+        );
+        assert!(flat > 0.01, "{technique:?}: the wide kernel should self-shadow without it ({flat})");
+        assert!(
+            tilted < 0.001,
+            "{technique:?}: {:.4}% self-shadowed with receiver-plane bias",
+            100.0 * tilted
+        );
     }
 }
 
