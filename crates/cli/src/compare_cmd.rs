@@ -48,7 +48,7 @@ pub struct CompareArgs {
 struct Rendered {
     technique: Technique,
     frame: Frame,
-    timing: Option<(f64, f64)>,
+    timing: Option<(f64, Option<f64>, f64)>,
 }
 
 /// One technique's row of the report.
@@ -59,6 +59,11 @@ struct Row {
     metrics: Metrics,
     /// Median GPU milliseconds of the shadow pass, where the adapter has timestamps.
     shadow_ms: Option<f64>,
+    /// Median GPU milliseconds of the moment pass (encoding, blur, mipmaps) of the
+    /// filterable techniques.
+    filter_ms: Option<f64>,
+    /// The moment map's texel format, for the filterable techniques.
+    moment_format: Option<String>,
     /// Median GPU milliseconds of the lighting pass.
     lighting_ms: Option<f64>,
 }
@@ -104,15 +109,18 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let mut s = settings.clone();
         s.shadow.filter.technique = technique;
         let frame = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
-        let mut shadow = Vec::new();
-        let mut lighting = Vec::new();
+        let (mut shadow, mut filter, mut lighting) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.timing_frames {
             if let (Some(t), _) = renderer.time_passes(&uploaded, &scene, &s)? {
                 shadow.push(t.shadow_ms);
+                filter.extend(t.filter_ms);
                 lighting.push(t.lighting_ms);
             }
         }
-        let timing = (!shadow.is_empty()).then(|| (median(&mut shadow), median(&mut lighting)));
+        let timing = (!shadow.is_empty()).then(|| {
+            let filter = (!filter.is_empty()).then(|| median(&mut filter));
+            (median(&mut shadow), filter, median(&mut lighting))
+        });
         frames.push(Rendered { technique, frame, timing });
     }
 
@@ -154,8 +162,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             format!("mismatch {:.3}%", 100.0 * m.mismatch_rate)
         };
         let mut caption = vec![name.to_string()];
-        if let Some((s, l)) = timing {
+        if let Some((s, f, l)) = timing {
             caption.push(format!("shadow pass {s:.2} ms"));
+            if let Some(f) = f {
+                caption.push(format!("moment pass {f:.2} ms"));
+            }
             caption.push(format!("lighting pass {l:.2} ms"));
         }
         tiles.push(vec![
@@ -174,7 +185,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             technique: name,
             metrics: m,
             shadow_ms: timing.map(|t| t.0),
-            lighting_ms: timing.map(|t| t.1),
+            filter_ms: timing.and_then(|t| t.1),
+            lighting_ms: timing.map(|t| t.2),
+            moment_format: frame.moment_format.map(|f| format!("{f:?}").to_lowercase()),
         });
     }
     let legend: Vec<(String, [u8; 3])> = if soft {
@@ -234,6 +247,14 @@ fn median(values: &mut [f64]) -> f64 {
     values[values.len() / 2]
 }
 
+/// The technique's name, with its moment map's format when that is not 32-bit float.
+fn technique_label(r: &Row) -> String {
+    match &r.moment_format {
+        Some(f) if f != "rgba32float" => format!("{} ({f})", r.technique),
+        _ => r.technique.to_string(),
+    }
+}
+
 fn markdown_table(report: &Report, soft: bool) -> String {
     let mut s = format!(
         "`{}` at {}×{}, shadow map {}², reference {} on {} ({})\n\n",
@@ -245,14 +266,14 @@ fn markdown_table(report: &Report, soft: bool) -> String {
         report.adapter,
         report.backend
     );
-    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | silhouette | shadow ms | lighting ms |\n");
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | silhouette | shadow ms | filter ms | lighting ms |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     let ms = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into());
     for r in &report.rows {
         let m = &r.metrics;
         s.push_str(&format!(
-            "| {} | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.3} | {} | {} | {} | {} |\n",
-            r.technique,
+            "| {} | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.3} | {} | {} | {} | {} | {} |\n",
+            technique_label(r),
             100.0 * m.mismatch_rate,
             100.0 * m.false_shadow_rate,
             100.0 * m.false_lit_rate,
@@ -262,6 +283,7 @@ fn markdown_table(report: &Report, soft: bool) -> String {
             m.compared,
             m.silhouette,
             ms(r.shadow_ms),
+            if r.filter_ms.is_some() { ms(r.filter_ms) } else { "–".into() },
             ms(r.lighting_ms)
         ));
     }

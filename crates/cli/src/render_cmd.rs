@@ -101,9 +101,21 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             "gnomon: draws: {} in the shadow pass, {} in the lighting pass; {} pipeline and {} bind group changes",
             st.shadow_draws, st.lighting_draws, st.pipeline_changes, st.bind_group_changes
         );
+        if let Some(format) = frame.moment_format {
+            let why = match format {
+                gnomon_render::wgpu::TextureFormat::Rgba16Float
+                    if !gpu.device.features().contains(gnomon_render::wgpu::Features::FLOAT32_FILTERABLE) =>
+                {
+                    " (this adapter cannot filter 32-bit floats)"
+                }
+                _ => "",
+            };
+            eprintln!("gnomon: moment map {format:?}{why}");
+        }
         if let Some(t) = frame.timings {
+            let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
             eprintln!(
-                "gnomon: GPU time: shadow pass {:.2} ms, lighting pass {:.2} ms",
+                "gnomon: GPU time: shadow pass {:.2} ms{filter}, lighting pass {:.2} ms",
                 t.shadow_ms, t.lighting_ms
             );
         }

@@ -23,6 +23,7 @@ pub mod techniques;
 pub use device::{Gpu, GpuInfo};
 pub use frame::{DrawStats, Frame, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection};
 pub use gpu_scene::GpuScene;
+pub use wgpu;
 
 use gnomon_scene::{SceneError, settings::SettingsError};
 

@@ -521,7 +521,7 @@ fn check_opt(
 }
 
 impl MomentSettings {
-    fn validate(&self) -> Result<(), SettingsError> {
+    fn validate(&self, technique: Technique) -> Result<(), SettingsError> {
         let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
         check(self.blur_radius <= 16, "--blur-radius", self.blur_radius, "0 to 16 texels")?;
         check(in_range(self.min_variance, 0.0, 1.0), "--min-variance", self.min_variance, "0 to 1")?;
@@ -531,7 +531,10 @@ impl MomentSettings {
             self.bleeding_reduction,
             "in [0, 1)",
         )?;
-        let half = self.moment_format == MomentFormat::Rgba16float;
+        // Only EVSM stores exponentials, so only its exponents are bounded by the
+        // format (with `auto` on a 16-bit adapter the renderer clamps them).
+        let evsm = matches!(technique, Technique::Evsm2 | Technique::Evsm4);
+        let half = evsm && self.moment_format == MomentFormat::Rgba16float;
         // ESM stores d itself and exponentiates in the shader, so only EVSM, which
         // stores exp(c·d) and its square, is limited by the storage format's range.
         let (esm_max, evsm_max) = (88.0, if half { 5.54 } else { 42.0 });
@@ -647,7 +650,7 @@ impl Settings {
             f.pcss.max_radius,
             "1 to 64 texels",
         )?;
-        f.moments.validate()?;
+        f.moments.validate(f.technique)?;
         let b = &s.bias;
         check(
             b.slope_bias.is_finite() && b.slope_bias >= 0.0,

@@ -13,11 +13,17 @@ pub struct Evsm4;
 
 const WGSL: &[&str] = &[include_str!("variance.wgsl")];
 
+/// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
+/// 16-bit float (max 65504): ln(65504) / 2.
+pub const HALF_MAX_EXPONENT: f32 = 5.54;
+
 /// params[0] = (variant, c⁺, c⁻, minimum variance), params[1].x = bleeding reduction.
-fn params(variant: f32, s: &FilterSettings) -> [Vec4; 2] {
+/// At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
+fn params(variant: f32, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
     let m = &s.moments;
+    let limit = if precision == MapPrecision::Half { HALF_MAX_EXPONENT } else { f32::MAX };
     [
-        Vec4::new(variant, m.evsm_positive, m.evsm_negative, m.min_variance),
+        Vec4::new(variant, m.evsm_positive.min(limit), m.evsm_negative.min(limit), m.min_variance),
         Vec4::new(m.bleeding_reduction, 0.0, 0.0, 0.0),
     ]
 }
@@ -31,8 +37,8 @@ impl ShadowTechnique for Vsm {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
-        params(0.0, s)
+    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
+        params(0.0, s, p)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(MAP)
@@ -46,8 +52,8 @@ impl ShadowTechnique for Evsm2 {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
-        params(2.0, s)
+    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
+        params(2.0, s, p)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(MAP)
@@ -61,8 +67,8 @@ impl ShadowTechnique for Evsm4 {
     fn wgsl(&self) -> &'static [&'static str] {
         WGSL
     }
-    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
-        params(4.0, s)
+    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
+        params(4.0, s, p)
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(MAP)
