@@ -195,6 +195,14 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     } else {
         heatmap::HARD_LEGEND.iter().map(|(l, c)| (l.to_string(), *c)).collect()
     };
+    // Many techniques go two to a row, so the grid stays a page, not a scroll.
+    if tiles.len() > 5 {
+        let mut techniques = tiles.split_off(1);
+        while !techniques.is_empty() {
+            let n = techniques.len().min(2);
+            tiles.push(techniques.drain(..n).flatten().collect());
+        }
+    }
     let grid = grid::compose(&tiles, 480, &legend);
     staged.png_rgba(&args.out.join("grid.png"), grid.width(), grid.height(), grid.as_raw())?;
 

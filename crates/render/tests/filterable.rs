@@ -153,6 +153,7 @@ fn attenuation_reduces_convolution_ringing() {
     };
     let raw = ringing(&profile(0.0));
     let damped = ringing(&profile(2.0));
+    println!("convolution ringing: {raw} raw, {damped} with attenuation 2");
     assert!(raw > 0.01, "the raw series must ring here: ringing {raw}");
     assert!(damped < 0.5 * raw, "ringing {damped} attenuated vs {raw} raw");
 }
