@@ -205,3 +205,78 @@ fn filterable_techniques_also_work_with_16_bit_moment_maps() {
         check(&format!("{} (16-bit)", technique.name()), &o);
     }
 }
+
+/// The square-occluder sun scene of the tests above.
+fn sun_square_scene() -> (Scene, Vec2, f32) {
+    let (half, height) = (1.0f32, 1.5f32);
+    let center = Vec3::new(0.5, height, -0.5);
+    let mut scene = ground_scene("technique sun", 12.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
+    scene.camera.target = Vec3::ZERO;
+    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
+    scene.sun.direction = sun_dir;
+    let shadow_center =
+        Vec2::new(center.x, center.z) + Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    (scene, shadow_center, half)
+}
+
+#[test]
+fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
+    // Under a sun the map is orthographic: one texel is the same world size
+    // everywhere, so W texels and W·texel world units are the same kernel.
+    let (scene, _, _) = sun_square_scene();
+    for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
+        let mut s = settings(320, 240, RESOLUTION);
+        s.shadow.filter.technique = technique;
+        s.shadow.filter.pcf_kernel = 5.0;
+        let in_texels = render(&scene, &s);
+        let texel = in_texels.light_projection.texel_world_size(RESOLUTION, 0.0);
+        s.shadow.filter.kernel_unit = gnomon_scene::settings::KernelUnit::World;
+        s.shadow.filter.pcf_kernel = 5.0 * texel;
+        let in_world = render(&scene, &s);
+        let worst = in_texels
+            .visibility
+            .iter()
+            .zip(&in_world.visibility)
+            .filter(|(a, _)| !a.is_nan())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-3, "{}: visibilities differ by up to {worst}", technique.name());
+        // And the width does matter: a kernel twice as wide changes the image.
+        s.shadow.filter.pcf_kernel = 10.0 * texel;
+        let wider = render(&scene, &s);
+        let changed =
+            in_world.visibility.iter().zip(&wider.visibility).filter(|(a, b)| (*a - *b).abs() > 0.05).count();
+        assert!(
+            changed > 100,
+            "{}: doubling the world width changed only {changed} pixels",
+            technique.name()
+        );
+    }
+}
+
+#[test]
+fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
+    let (scene, shadow_center, half) = sun_square_scene();
+    for technique in [Technique::Vsm, Technique::Evsm4, Technique::MsmHamburger, Technique::Convolution] {
+        let mut s = settings(640, 480, RESOLUTION);
+        s.shadow.filter.technique = technique;
+        s.shadow.filter.moments.mipmaps = true;
+        let o =
+            classify(&scene, &s, |p| Some(square_distance(Vec2::new(p.x, p.z), shadow_center, half)), 0.0);
+        check(&format!("{} (mipmapped)", technique.name()), &o);
+    }
+    // The mip levels are really sampled: where the map is minified (far ground seen
+    // at a grazing angle, from a low camera) the result differs from the top level's.
+    let mut low = scene.clone();
+    low.camera.eye = Vec3::new(0.0, 1.2, 6.0);
+    let mut s = settings(320, 240, 2048);
+    s.shadow.filter.technique = Technique::Vsm;
+    let top = render(&low, &s);
+    s.shadow.filter.moments.mipmaps = true;
+    let mipped = render(&low, &s);
+    let changed =
+        top.visibility.iter().zip(&mipped.visibility).filter(|(a, b)| (*a - *b).abs() > 0.02).count();
+    assert!(changed > 50, "mipmaps changed only {changed} pixels");
+}

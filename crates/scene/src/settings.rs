@@ -814,6 +814,17 @@ mod tests {
             "spot",
             "--camera-eye",
             "1,2,3",
+            "--kernel-unit",
+            "world",
+            "--receiver-plane-bias",
+            "false",
+            "--blur-radius",
+            "4",
+            "--mipmaps",
+            "--moment-format",
+            "rgba16float",
+            "--csm-terms",
+            "12",
         ])
         .unwrap()
         .settings;
@@ -825,6 +836,13 @@ mod tests {
             [shadow.filter]
             technique = "pcf"
             pcf_kernel = 5
+            kernel_unit = "world"
+            receiver_plane_bias = false
+            [shadow.filter.moments]
+            blur_radius = 4
+            mipmaps = true
+            moment_format = "rgba16float"
+            csm_terms = 12
             [shadow.bias]
             slope_bias = 2.5
             cull = "front"
