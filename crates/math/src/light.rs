@@ -59,29 +59,7 @@ impl LightProjection {
 /// only when the fitted width and height are equal; the shader uses the larger one
 /// for the texel size, so biases stay conservative.
 pub fn directional_light_projection(direction: Vec3, bounds: &Aabb) -> LightProjection {
-    let direction = direction.normalize();
-    let center = bounds.center();
-    let radius = bounds.bounding_radius().max(1e-3);
-    // The eye only fixes the orientation and the origin of depth; any point behind the
-    // bounds along −direction works. Putting it one radius out keeps numbers small.
-    let eye = center - direction * (2.0 * radius);
-    let light_from_world = view_from_world_look_at(eye, center, Vec3::Y);
-    let in_light = bounds.transformed(light_from_world);
-    // A small margin so that geometry exactly on the fitted boundary is not clipped.
-    let margin = 1e-3 * radius;
-    let (left, right) = (in_light.min.x - margin, in_light.max.x + margin);
-    let (bottom, top) = (in_light.min.y - margin, in_light.max.y + margin);
-    // View space looks down −z: the nearest point has the largest z.
-    let near = -in_light.max.z - margin;
-    let far = -in_light.min.z + margin;
-    let clip_from_light = glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far);
-    LightProjection {
-        light_from_world,
-        clip_from_light,
-        kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
-        near,
-        far,
-    }
+    crate::fitting::fit_directional_to_receivers(direction, bounds, &[])
 }
 
 /// A perspective projection for a spot light at `position` pointing along

@@ -216,6 +216,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let mut s = settings(Technique::Pcf2x2);
     s.image.width = 1280;
     s.image.height = 720;
+    s.shadow.map.fit = gnomon_scene::settings::Fit::Receivers;
     let frame = render(&scene, &s);
     let truth = reference(&scene, &s);
     let raster =

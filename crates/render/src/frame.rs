@@ -2,10 +2,14 @@
 //! and read every output back.
 
 use glam::{Vec3, Vec4};
-use gnomon_math::{LightProjection, directional_light_projection, spot_light_projection};
+use gnomon_math::{
+    LightProjection, directional_light_projection,
+    fitting::{Hexahedron, fit_directional_to_receivers, intersection_vertices},
+    spot_light_projection,
+};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{KernelUnit, MomentFormat},
+    settings::{Fit, KernelUnit, MomentFormat},
 };
 use wgpu::util::DeviceExt;
 
@@ -270,7 +274,9 @@ impl<'g> Renderer<'g> {
         let light = settings.resolve_light(scene)?;
         let shadow = &settings.shadow;
         let resolution = shadow.map.resolution;
-        let projection = light_projection(scene, &light);
+        let (width, height) = (settings.image.width, settings.image.height);
+        let aspect = width as f32 / height as f32;
+        let projection = light_projection(scene, &light, &camera, aspect, settings.shadow.map.fit);
         let technique = techniques::lookup(shadow.filter.technique);
         let filterable_map = technique.filterable_map(&shadow.filter);
         let moment_format = self.moment_format(settings)?;
@@ -280,8 +286,6 @@ impl<'g> Renderer<'g> {
         };
         let light_gpu =
             light_uniform(scene, &light, &projection, settings, technique.params(&shadow.filter, precision));
-        let (width, height) = (settings.image.width, settings.image.height);
-        let aspect = width as f32 / height as f32;
         let camera_gpu = CameraGpu {
             clip_from_world: camera.clip_from_world(aspect),
             view_from_world: camera.view_from_world(),
@@ -644,9 +648,22 @@ fn render_target(
 }
 
 /// The shadow projection of `light`: for a sun, an orthographic box fitted to the
-/// scene's bounds; for a spot, the perspective frustum of its cone out to its range.
-pub fn light_projection(scene: &Scene, light: &Light) -> LightProjection {
+/// scene's bounds or to the receivers `camera` can see ([`Fit`]); for a spot, the
+/// perspective frustum of its cone out to its range.
+pub fn light_projection(
+    scene: &Scene,
+    light: &Light,
+    camera: &Camera,
+    aspect: f32,
+    fit: Fit,
+) -> LightProjection {
     match light {
+        Light::Directional(sun) if fit == Fit::Receivers => {
+            let bounds = scene.bounds();
+            let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+            let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
+            fit_directional_to_receivers(sun.direction, &bounds, &receivers)
+        }
         Light::Directional(sun) => directional_light_projection(sun.direction, &scene.bounds()),
         Light::Spot(spot) => spot_light_projection(
             spot.position,

@@ -417,7 +417,9 @@ pub struct BiasSettings {
     #[arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias")]
     pub slope_bias: f32,
     /// Normal-offset bias: the receiver is pushed along its surface normal by this many
-    /// shadow texels (world size of a texel at the receiver) before the lookup. ≥ 0.
+    /// shadow texels (world size of a texel at the receiver) times 1 − N·L before the
+    /// lookup, so surfaces facing the light are hardly moved and grazing ones fully
+    /// (Holbert, "Normal offset shadows", 2011). ≥ 0.
     #[arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias")]
     pub normal_offset: f32,
     /// Faces culled when drawing casters into the shadow map.
@@ -447,6 +449,19 @@ pub enum MapFormat {
     Depth32float,
 }
 
+/// What a directional light's map is fitted to.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Fit {
+    /// The whole scene's bounds, whatever the camera sees: stable, but texels are
+    /// spent on ground the camera never shows.
+    Scene,
+    /// The potential receivers: the intersection of the camera's view frustum with the
+    /// scene's bounds in x and y, extended toward the light to every caster in z.
+    #[default]
+    Receivers,
+}
+
 /// The map axis: the shadow map's size and format.
 #[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -458,11 +473,14 @@ pub struct MapSettings {
     /// Shadow map texel format.
     #[arg(long = "shadow-format", value_enum, default_value_t, help_heading = "Shadow map")]
     pub format: MapFormat,
+    /// What a sun's map covers (a spot's map always covers its cone).
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub fit: Fit,
 }
 
 impl Default for MapSettings {
     fn default() -> Self {
-        Self { resolution: 2048, format: MapFormat::default() }
+        Self { resolution: 2048, format: MapFormat::default(), fit: Fit::default() }
     }
 }
 

@@ -43,15 +43,22 @@ struct FragmentOut {
     @location(4) object_id: u32,
 };
 
-// Shadow-map coordinates of a receiver at `world` with unit normal `n`: the point is
-// first pushed along its normal by the normal-offset bias (in texels of the map at
-// the receiver), then projected: clip → NDC → texture space with v flipped.
+// Shadow-map coordinates of a receiver at `world` with unit normal `n`, lit from `l`:
+// the point is first pushed along its normal by the normal-offset bias (in texels of
+// the map at the receiver, times 1 − N·L: a surface facing the light needs no offset,
+// and offsetting it only shifts its shadows sideways), then projected: clip → NDC →
+// texture space with v flipped.
 // Returns (u, v, depth, inside) where inside is 1 when the point projects into the
 // map's frustum.
-fn shadow_coords(world: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+// A surface facing the light keeps this fraction of the offset, against the depth
+// quantisation that the slope bias (zero for it) cannot cover.
+const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
+
+fn shadow_coords(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
     let texel_world = light.texel.x + light.texel.y * max(distance, 0.0);
-    let p = world + n * (light.texel.z * texel_world);
+    let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
+    let p = world + n * (light.texel.z * texel_world * slope);
     let clip = light.clip_from_world * vec4<f32>(p, 1.0);
     if clip.w <= 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, 0.0);
@@ -98,7 +105,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let l = geometry.xyz;
     let cone = geometry.w;
 
-    let coords = shadow_coords(in.world, n);
+    let coords = shadow_coords(in.world, n, l);
     // The lookup's screen derivatives, for receiver-plane bias and mip selection, are
     // taken here, before any branch.
     var query: ShadowQuery;
