@@ -11,6 +11,7 @@
 //! - Matrices are named `to_from_from`: `clip_from_world` maps world points to clip space.
 
 mod aabb;
+pub mod cascades;
 pub mod fitting;
 pub mod kernels;
 mod light;

@@ -1,0 +1,257 @@
+//! Cascaded shadow maps for directional lights: where the view frustum is split
+//! along its depth, and how each slice's light projection is fitted, tightly to the
+//! slice's receivers or stably to its bounding sphere with texel snapping.
+
+use glam::{Mat4, Vec3};
+
+use crate::{
+    Aabb, LightProjection, ProjectionKind,
+    fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
+};
+
+/// How the view depth range is divided among the cascades.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SplitScheme {
+    /// Equal depth ranges: z_i = n + (f − n)·i/N.
+    Uniform,
+    /// Equal ratios: z_i = n·(f/n)^(i/N), which matches the perspective texel
+    /// density (Lloyd, Tuft, Yoon & Manocha 2006).
+    Logarithmic,
+    /// Parallel-split shadow maps (Zhang, Sun, Xu & Lo 2006): z_i = λ·log_i +
+    /// (1 − λ)·uniform_i. λ = 1 is fully logarithmic, λ = 0 uniform.
+    Practical { lambda: f32 },
+}
+
+/// The N + 1 view depths bounding N cascades, from `near` to `far` inclusive.
+pub fn split_distances(scheme: SplitScheme, count: usize, near: f32, far: f32) -> Vec<f32> {
+    let n = count.max(1);
+    (0..=n)
+        .map(|i| {
+            if i == 0 {
+                return near;
+            }
+            if i == n {
+                return far;
+            }
+            let t = i as f32 / n as f32;
+            let uniform = near + (far - near) * t;
+            let log = near * (far / near).powf(t);
+            match scheme {
+                SplitScheme::Uniform => uniform,
+                SplitScheme::Logarithmic => log,
+                SplitScheme::Practical { lambda } => lambda * log + (1.0 - lambda) * uniform,
+            }
+        })
+        .collect()
+}
+
+/// The slice of a view frustum (`view_frustum` from near to far, `near`..`far` in view
+/// depth) between view depths `from` and `to`. The frustum's edges run linearly in
+/// view depth from the near to the far face.
+pub fn frustum_slice(view_frustum: &Hexahedron, near: f32, far: f32, from: f32, to: f32) -> Hexahedron {
+    let t = |z: f32| (z - near) / (far - near);
+    view_frustum.slice(t(from), t(to))
+}
+
+/// A cascade's projection fitted tightly: the light's map covers exactly the slice's
+/// potential receivers (the slice ∩ the scene).
+pub fn fit_cascade_tight(direction: Vec3, scene: &Aabb, slice: &Hexahedron) -> LightProjection {
+    let receivers = intersection_vertices(slice, &Hexahedron::from_aabb(scene));
+    fit_directional_to_receivers(direction, scene, &receivers)
+}
+
+/// A cascade's projection fitted stably: a square window of the slice's bounding
+/// sphere's diameter, whose size does not change as the camera turns, placed on the
+/// texel grid of a `resolution`² map, so that moving the camera moves the window by
+/// whole texels and the rasterised shadow does not shimmer (Valient, "Stable cascaded
+/// shadow maps", ShaderX6 2008).
+pub fn fit_cascade_stable(
+    direction: Vec3,
+    scene: &Aabb,
+    slice: &Hexahedron,
+    resolution: u32,
+) -> LightProjection {
+    let light_from_world = directional_light_view(direction, scene);
+    let centre = slice.corners.iter().copied().sum::<Vec3>() / 8.0;
+    let radius = slice.corners.iter().map(|c| c.distance(centre)).fold(0.0f32, f32::max);
+    // Round the radius up to a fixed quantum so float noise in the corners cannot
+    // change the window's size from frame to frame.
+    let radius = (radius * 16.0).ceil() / 16.0;
+    let texel = 2.0 * radius / resolution as f32;
+    let c = light_from_world.transform_point3(centre);
+    let snapped = Vec3::new((c.x / texel).floor() * texel, (c.y / texel).floor() * texel, c.z);
+    let casters = scene.transformed(light_from_world);
+    let margin = 1e-3 * scene.bounding_radius().max(1e-3);
+    let near = -casters.max.z - margin;
+    let far = (-(c.z - radius)).max(-casters.min.z) + margin;
+    let (left, right) = (snapped.x - radius, snapped.x + radius);
+    let (bottom, top) = (snapped.y - radius, snapped.y + radius);
+    LightProjection {
+        light_from_world,
+        clip_from_light: glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far),
+        kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
+        near,
+        far,
+    }
+}
+
+/// The light-space x and y of an orthographic window's left-bottom corner, which
+/// stable fitting keeps on the texel grid.
+pub fn window_origin(projection: &LightProjection) -> (f32, f32) {
+    // orthographic(l, r, b, t): x_ndc = 2x/(r − l) − (r + l)/(r − l), so −1 at x = l.
+    let m: Mat4 = projection.clip_from_light;
+    let inverse = m.inverse();
+    let corner = inverse.project_point3(Vec3::new(-1.0, -1.0, 0.0));
+    (corner.x, corner.y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::view_from_world_look_at;
+
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f32 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn range(&mut self, lo: f32, hi: f32) -> f32 {
+            lo + (hi - lo) * self.next()
+        }
+    }
+
+    const SCHEMES: [SplitScheme; 5] = [
+        SplitScheme::Uniform,
+        SplitScheme::Logarithmic,
+        SplitScheme::Practical { lambda: 0.0 },
+        SplitScheme::Practical { lambda: 0.5 },
+        SplitScheme::Practical { lambda: 0.8 },
+    ];
+
+    #[test]
+    fn every_split_scheme_is_monotonic_and_covers_near_to_far() {
+        let mut rng = Lcg(3);
+        for _ in 0..500 {
+            let near = rng.range(0.01, 5.0);
+            let far = near * rng.range(1.5, 1e4);
+            let count = 1 + (rng.next() * 8.0) as usize % 8;
+            for scheme in SCHEMES {
+                let z = split_distances(scheme, count, near, far);
+                assert_eq!(z.len(), count + 1);
+                assert_eq!((z[0], z[count]), (near, far), "{scheme:?}");
+                assert!(z.windows(2).all(|w| w[1] > w[0]), "{scheme:?}: {z:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn splits_match_their_formulas() {
+        let u = split_distances(SplitScheme::Uniform, 4, 1.0, 101.0);
+        assert_eq!(u, vec![1.0, 26.0, 51.0, 76.0, 101.0]);
+        let l = split_distances(SplitScheme::Logarithmic, 2, 1.0, 100.0);
+        assert!((l[1] - 10.0).abs() < 1e-4);
+        // λ = 1 is fully logarithmic, λ = 0 uniform.
+        let p1 = split_distances(SplitScheme::Practical { lambda: 1.0 }, 2, 1.0, 100.0);
+        let p0 = split_distances(SplitScheme::Practical { lambda: 0.0 }, 2, 1.0, 100.0);
+        assert!((p1[1] - 10.0).abs() < 1e-4 && (p0[1] - 50.5).abs() < 1e-4);
+    }
+
+    fn random_view(rng: &mut Lcg) -> (Mat4, Mat4, f32, f32) {
+        let eye = Vec3::new(rng.range(-8.0, 8.0), rng.range(0.5, 6.0), rng.range(-8.0, 8.0));
+        let target = Vec3::new(rng.range(-4.0, 4.0), 0.0, rng.range(-4.0, 4.0));
+        let view = view_from_world_look_at(eye, target, Vec3::Y);
+        let (near, far) = (rng.range(0.05, 0.5), rng.range(10.0, 60.0));
+        let clip = crate::camera_clip_from_view(rng.range(0.5, 1.5), rng.range(1.0, 2.0), near, far) * view;
+        (view, clip, near, far)
+    }
+
+    #[test]
+    fn every_fitted_cascade_contains_every_receiver_of_its_slice() {
+        let mut rng = Lcg(5);
+        let scene = Aabb::new(Vec3::new(-20.0, 0.0, -20.0), Vec3::new(20.0, 4.0, 20.0));
+        for _ in 0..60 {
+            let (view, clip, near, far) = random_view(&mut rng);
+            let direction = Vec3::new(rng.range(-1.0, 1.0), -rng.range(0.2, 1.0), rng.range(-1.0, 1.0));
+            let frustum = Hexahedron::from_clip_from_world(clip);
+            let splits = split_distances(SplitScheme::Practical { lambda: 0.8 }, 4, near, far);
+            for w in splits.windows(2) {
+                let slice = frustum_slice(&frustum, near, far, w[0], w[1]);
+                for stable in [false, true] {
+                    let p = if stable {
+                        fit_cascade_stable(direction, &scene, &slice, 1024)
+                    } else {
+                        fit_cascade_tight(direction, &scene, &slice)
+                    };
+                    let m = p.clip_from_world();
+                    for _ in 0..200 {
+                        // A random point of the slice: random NDC x, y and a view depth
+                        // inside the slice, taken back to world space.
+                        let z_view = rng.range(w[0], w[1]);
+                        let (a, b) = (rng.next(), rng.next());
+                        let t = (z_view - w[0]) / (w[1] - w[0]);
+                        let at = |i: usize| slice.corners[i].lerp(slice.corners[i | 4], t);
+                        let x0 = at(0).lerp(at(1), a);
+                        let x1 = at(2).lerp(at(3), a);
+                        let p_world = x0.lerp(x1, b);
+                        if !scene.contains(p_world) {
+                            continue;
+                        }
+                        let depth = -view.transform_point3(p_world).z;
+                        assert!((depth - z_view).abs() < 1e-2 * z_view, "slice parametrisation");
+                        let ndc = m.project_point3(p_world);
+                        assert!(
+                            ndc.x.abs() <= 1.0001
+                                && ndc.y.abs() <= 1.0001
+                                && (-1e-4..=1.0001).contains(&ndc.z),
+                            "stable {stable}: receiver {p_world} of slice {w:?} maps to {ndc}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stable_cascades_move_by_whole_texels_and_keep_their_size() {
+        let mut rng = Lcg(9);
+        let scene = Aabb::new(Vec3::new(-20.0, 0.0, -20.0), Vec3::new(20.0, 4.0, 20.0));
+        let direction = Vec3::new(0.3, -0.8, 0.2);
+        let resolution = 1024;
+        for _ in 0..100 {
+            let eye = Vec3::new(rng.range(-5.0, 5.0), 2.0, rng.range(-5.0, 5.0));
+            let step = Vec3::new(rng.range(-0.3, 0.3), 0.0, rng.range(-0.3, 0.3));
+            let yaw = rng.range(0.0, 6.28);
+            let fit = |eye: Vec3, yaw: f32| {
+                let target = eye + Vec3::new(yaw.cos(), -0.3, yaw.sin());
+                let clip = crate::camera_clip_from_view(1.0, 1.6, 0.1, 40.0)
+                    * view_from_world_look_at(eye, target, Vec3::Y);
+                let frustum = Hexahedron::from_clip_from_world(clip);
+                fit_cascade_stable(
+                    direction,
+                    &scene,
+                    &frustum_slice(&frustum, 0.1, 40.0, 2.0, 8.0),
+                    resolution,
+                )
+            };
+            let a = fit(eye, yaw);
+            // Translating and turning the camera moves the window by whole texels and
+            // never changes its size.
+            let b = fit(eye + step, yaw + rng.range(-0.5, 0.5));
+            let (
+                ProjectionKind::Orthographic { width: wa, .. },
+                ProjectionKind::Orthographic { width: wb, .. },
+            ) = (a.kind, b.kind)
+            else {
+                unreachable!()
+            };
+            assert!((wa - wb).abs() < 1e-5 * wa, "window size changed: {wa} → {wb}");
+            let texel = wa / resolution as f32;
+            let (ax, ay) = window_origin(&a);
+            let (bx, by) = window_origin(&b);
+            for d in [(bx - ax) / texel, (by - ay) / texel] {
+                assert!((d - d.round()).abs() < 1e-2, "moved by {d} texels");
+            }
+        }
+    }
+}
