@@ -221,7 +221,7 @@ mod tests {
         for _ in 0..100 {
             let eye = Vec3::new(rng.range(-5.0, 5.0), 2.0, rng.range(-5.0, 5.0));
             let step = Vec3::new(rng.range(-0.3, 0.3), 0.0, rng.range(-0.3, 0.3));
-            let yaw = rng.range(0.0, 6.28);
+            let yaw = rng.range(0.0, std::f32::consts::TAU);
             let fit = |eye: Vec3, yaw: f32| {
                 let target = eye + Vec3::new(yaw.cos(), -0.3, yaw.sin());
                 let clip = crate::camera_clip_from_view(1.0, 1.6, 0.1, 40.0)
