@@ -40,6 +40,31 @@ impl LightProjection {
         }
     }
 
+    /// An orthographic projection's window in light view space: (left, right,
+    /// bottom, top). None for a perspective one.
+    pub fn orthographic_window(&self) -> Option<(f32, f32, f32, f32)> {
+        let ProjectionKind::Orthographic { .. } = self.kind else { return None };
+        let light_from_clip = self.clip_from_light.inverse();
+        let low = light_from_clip.project_point3(Vec3::new(-1.0, -1.0, 0.0));
+        let high = light_from_clip.project_point3(Vec3::new(1.0, 1.0, 0.0));
+        Some((low.x, high.x, low.y, high.y))
+    }
+
+    /// The same orthographic projection with its depth range replaced: cascades share
+    /// one range so that every layer stores depth with the same convention.
+    /// Perspective projections are returned unchanged.
+    pub fn with_depth_range(&self, near: f32, far: f32) -> LightProjection {
+        let Some((left, right, bottom, top)) = self.orthographic_window() else { return *self };
+        LightProjection {
+            clip_from_light: glam::camera::rh::proj::directx::orthographic(
+                left, right, bottom, top, near, far,
+            ),
+            near,
+            far,
+            ..*self
+        }
+    }
+
     /// For a perspective map, the factor k such that a texel at view distance d spans
     /// k·d world units; for an orthographic map, the constant texel size. The shader
     /// uses `texel = k_ortho + k_persp · d`.
@@ -92,6 +117,25 @@ mod tests {
     fn project(m: Mat4, p: Vec3) -> Vec3 {
         let c = m * p.extend(1.0);
         c.truncate() / c.w
+    }
+
+    #[test]
+    fn replacing_the_depth_range_keeps_the_window() {
+        let bounds = Aabb::new(Vec3::new(-2.0, 0.0, -3.0), Vec3::new(2.0, 1.0, 3.0));
+        let p = directional_light_projection(Vec3::new(0.3, -1.0, 0.1), &bounds);
+        let q = p.with_depth_range(p.near - 5.0, p.far + 7.0);
+        let (a, b) = (p.orthographic_window().unwrap(), q.orthographic_window().unwrap());
+        assert!(
+            (a.0 - b.0).abs() < 1e-4
+                && (a.1 - b.1).abs() < 1e-4
+                && (a.2 - b.2).abs() < 1e-4
+                && (a.3 - b.3).abs() < 1e-4
+        );
+        for c in bounds.corners() {
+            let (x, y) = (project(p.clip_from_world(), c), project(q.clip_from_world(), c));
+            assert!((x.truncate() - y.truncate()).length() < 1e-4);
+            assert!(y.z > 0.0 && y.z < 1.0 && (q.far - q.near - (p.far - p.near) - 12.0).abs() < 1e-3);
+        }
     }
 
     #[test]

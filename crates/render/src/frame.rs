@@ -3,19 +3,21 @@
 
 use glam::{Vec3, Vec4};
 use gnomon_math::{
-    LightProjection, directional_light_projection,
+    LightProjection, cascades, directional_light_projection,
     fitting::{Hexahedron, fit_directional_to_receivers, intersection_vertices},
     spot_light_projection,
 };
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{Fit, KernelUnit, MomentFormat},
+    settings::{
+        CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition, SplitScheme,
+    },
 };
 use wgpu::util::DeviceExt;
 
 use crate::{
     Gpu, GpuScene, RenderError,
-    gpu_types::{CameraGpu, LightGpu},
+    gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
         Layouts, SHADOW_FORMAT,
         lighting::{self, LightingPass},
@@ -60,8 +62,12 @@ pub struct Frame {
     pub object_id: Vec<u32>,
     pub camera: Camera,
     pub light: Light,
-    /// The shadow map's projection.
+    /// The shadow map's projection (the first cascade's, with cascades).
     pub light_projection: LightProjection,
+    /// Every layer's projection: one per cascade, or just `light_projection`.
+    pub cascades: Vec<LightProjection>,
+    /// The view depths bounding the cascades (one more than there are cascades).
+    pub cascade_splits: Vec<f32>,
     pub shadow_resolution: u32,
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
@@ -276,7 +282,8 @@ impl<'g> Renderer<'g> {
         let resolution = shadow.map.resolution;
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
-        let projection = light_projection(scene, &light, &camera, aspect, settings.shadow.map.fit);
+        let layout = shadow_layout(scene, &light, &camera, aspect, settings);
+        let layers = layout.projections.len() as u32;
         let technique = techniques::lookup(shadow.filter.technique);
         let filterable_map = technique.filterable_map(&shadow.filter);
         let moment_format = self.moment_format(settings)?;
@@ -284,12 +291,19 @@ impl<'g> Renderer<'g> {
             wgpu::TextureFormat::Rgba16Float => techniques::MapPrecision::Half,
             _ => techniques::MapPrecision::Single,
         };
-        let light_gpu =
-            light_uniform(scene, &light, &projection, settings, technique.params(&shadow.filter, precision));
+        let light_gpu = light_uniform(
+            scene,
+            &light,
+            &layout,
+            settings,
+            technique.params(&shadow.filter, precision),
+            filterable_map,
+        );
         let camera_gpu = CameraGpu {
             clip_from_world: camera.clip_from_world(aspect),
             view_from_world: camera.view_from_world(),
             eye: camera.eye.extend(1.0),
+            debug: Vec4::new((settings.image.debug_view == DebugView::Cascades) as u8 as f32, 0.0, 0.0, 0.0),
         };
 
         let gpu = self.gpu;
@@ -320,7 +334,7 @@ impl<'g> Renderer<'g> {
             });
             let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("shadow map"),
-                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -330,7 +344,10 @@ impl<'g> Renderer<'g> {
                     | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             });
-            let shadow_view = shadow_map.create_view(&Default::default());
+            let shadow_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
             let queries = gpu.timestamp_period_ns.map(|_| {
                 device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("pass timestamps"),
@@ -347,15 +364,50 @@ impl<'g> Renderer<'g> {
             };
             let mut encoder = device.create_command_encoder(&Default::default());
             let mut stats = DrawStats::default();
-            self.record_shadow_pass(
-                &mut encoder,
-                uploaded,
-                settings,
-                &scene_group,
-                &shadow_view,
-                pass_timestamps(0),
-                &mut stats,
-            );
+            // One depth pass per layer, each with the light uniform of its cascade; the
+            // timestamps bracket them all.
+            for layer in 0..layers {
+                let layer_light = LightGpu {
+                    clip_from_world: light_gpu.cascade_clip_from_world[layer as usize],
+                    ..light_gpu
+                };
+                let layer_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("light, one cascade"),
+                    contents: bytemuck::bytes_of(&layer_light),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let layer_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("scene, one cascade"),
+                    layout: &self.layouts.scene,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: uploaded.instances.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: layer_buffer.as_entire_binding() },
+                    ],
+                });
+                let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                });
+                let (first, last) = (layer == 0, layer + 1 == layers);
+                let timestamps = queries.as_ref().filter(|_| first || last).map(|query_set| {
+                    wgpu::RenderPassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: first.then_some(0),
+                        end_of_pass_write_index: last.then_some(1),
+                    }
+                });
+                self.record_shadow_pass(
+                    &mut encoder,
+                    uploaded,
+                    settings,
+                    &layer_group,
+                    &layer_view,
+                    timestamps,
+                    &mut stats,
+                );
+            }
             let moment_map = filterable_map.map(|map| {
                 self.moment_pass.record(
                     device,
@@ -365,6 +417,7 @@ impl<'g> Renderer<'g> {
                     &shadow.filter.moments,
                     moment_format,
                     resolution,
+                    layers,
                     &shadow_view,
                     &light_buffer,
                     queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
@@ -488,13 +541,13 @@ impl<'g> Renderer<'g> {
             _ => None,
         };
         let moment_format = filterable_map.is_some().then_some(moment_format);
-        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, projection, moment_format })
+        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, layout, moment_format })
     }
 
     /// Reads a submitted frame's images back and assembles the [`Frame`].
     fn read_frame(&self, submitted: Submitted, settings: &Settings) -> Result<Frame, RenderError> {
         let gpu = self.gpu;
-        let Submitted { pending, shadow_pending, timings, stats, camera, light, projection, moment_format } =
+        let Submitted { pending, shadow_pending, timings, stats, camera, light, layout, moment_format } =
             submitted;
         let (width, height) = (settings.image.width, settings.image.height);
         let resolution = settings.shadow.map.resolution;
@@ -540,7 +593,9 @@ impl<'g> Renderer<'g> {
             object_id,
             camera,
             light,
-            light_projection: projection,
+            light_projection: layout.projections[0],
+            cascades: layout.projections,
+            cascade_splits: layout.splits,
             shadow_resolution: resolution,
             shadow_map,
             timings,
@@ -625,8 +680,76 @@ struct Submitted {
     stats: DrawStats,
     camera: Camera,
     light: Light,
-    projection: LightProjection,
+    layout: ShadowLayout,
     moment_format: Option<wgpu::TextureFormat>,
+}
+
+/// The layers of a light's shadow map: their projections, and the view depths
+/// that bound them when they are cascades.
+#[derive(Clone, Debug)]
+pub struct ShadowLayout {
+    pub projections: Vec<LightProjection>,
+    /// One more than the projections: cascade i covers view depths splits[i] to
+    /// splits[i + 1]. A single map covers 0 to infinity.
+    pub splits: Vec<f32>,
+}
+
+/// The shadow layout of `light` under `settings`: one map, or for a sun with
+/// `--partition cascades`, one per slice of the view frustum, all sharing one depth
+/// range so that every layer stores depth the same way.
+pub fn shadow_layout(
+    scene: &Scene,
+    light: &Light,
+    camera: &Camera,
+    aspect: f32,
+    settings: &Settings,
+) -> ShadowLayout {
+    let single = || ShadowLayout {
+        projections: vec![light_projection(scene, light, camera, aspect, settings.shadow.map.fit)],
+        splits: vec![0.0, f32::INFINITY],
+    };
+    let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
+        return single();
+    };
+    let c = &settings.shadow.cascades;
+    let bounds = scene.bounds();
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    // The view depths that hold any of the scene: beyond them a cascade would cover
+    // nothing.
+    let view_from_world = camera.view_from_world();
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
+    if receivers.is_empty() {
+        return single();
+    }
+    let depths = receivers.iter().map(|p| -view_from_world.transform_point3(*p).z);
+    let (seen_near, seen_far) = depths.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let near = seen_near.max(camera.near);
+    let far = seen_far.min(camera.far).min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
+    let scheme = match c.split {
+        SplitScheme::Uniform => cascades::SplitScheme::Uniform,
+        SplitScheme::Log => cascades::SplitScheme::Logarithmic,
+        SplitScheme::Practical => cascades::SplitScheme::Practical { lambda: c.split_lambda },
+    };
+    let splits = cascades::split_distances(scheme, c.count as usize, near, far);
+    let resolution = settings.shadow.map.resolution;
+    let fitted: Vec<LightProjection> = splits
+        .windows(2)
+        .map(|w| {
+            let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, w[0], w[1]);
+            match c.cascade_fit {
+                CascadeFit::Tight => cascades::fit_cascade_tight(sun.direction, &bounds, &slice),
+                CascadeFit::Stable => {
+                    cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
+                }
+            }
+        })
+        .collect();
+    let near_plane = fitted.iter().map(|p| p.near).fold(f32::INFINITY, f32::min);
+    let far_plane = fitted.iter().map(|p| p.far).fold(f32::NEG_INFINITY, f32::max);
+    ShadowLayout {
+        projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
+        splits,
+    }
 }
 
 fn render_target(
@@ -678,11 +801,24 @@ pub fn light_projection(
 fn light_uniform(
     scene: &Scene,
     light: &Light,
-    projection: &LightProjection,
+    layout: &ShadowLayout,
     settings: &Settings,
     params: [Vec4; 2],
+    filterable_map: Option<techniques::FilterableMap>,
 ) -> LightGpu {
+    let projection = &layout.projections[0];
     let resolution = settings.shadow.map.resolution;
+    let mut cascade_clip_from_world = [projection.clip_from_world(); MAX_CASCADES];
+    let mut cascade_texel = [Vec4::ZERO; MAX_CASCADES];
+    for (i, p) in layout.projections.iter().enumerate() {
+        cascade_clip_from_world[i] = p.clip_from_world();
+        cascade_texel[i] = Vec4::new(p.texel_size_coefficients(resolution).0, 0.0, 0.0, 0.0);
+    }
+    let mut splits = [0.0f32; 12];
+    for (slot, z) in splits.iter_mut().zip(&layout.splits) {
+        *slot = z.min(f32::MAX);
+    }
+    let c = &settings.shadow.cascades;
     let (texel_ortho, texel_per_distance) = projection.texel_size_coefficients(resolution);
     let f = &settings.shadow.filter;
     // PCSS's light size, the same quantity the reference's area light uses.
@@ -713,6 +849,19 @@ fn light_uniform(
         ),
         params,
         ambient: scene.ambient.extend(0.0),
+        cascade_clip_from_world,
+        cascade_texel,
+        cascade_splits: [
+            Vec4::from_slice(&splits[0..4]),
+            Vec4::from_slice(&splits[4..8]),
+            Vec4::from_slice(&splits[8..12]),
+        ],
+        cascades: Vec4::new(
+            layout.projections.len() as f32,
+            (c.cascade_selection == CascadeSelection::Projection) as u8 as f32,
+            c.cascade_blend,
+            filterable_map.map_or(1, |m| m.layers) as f32,
+        ),
         cone: Vec4::new(1.0, -1.0, projection.near, projection.far),
         ..Default::default()
     };

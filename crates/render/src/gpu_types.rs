@@ -45,7 +45,20 @@ pub struct LightGpu {
     pub params: [Vec4; 2],
     /// rgb: ambient light.
     pub ambient: Vec4,
+    /// Each layer's (cascade's) clip_from_world; layer 0 equals `clip_from_world`.
+    pub cascade_clip_from_world: [Mat4; MAX_CASCADES],
+    /// x: each layer's orthographic texel world size (0 for a perspective map).
+    pub cascade_texel: [Vec4; MAX_CASCADES],
+    /// The view depths where the cascades start and end, packed four to a vector:
+    /// cascade i spans split i to split i + 1.
+    pub cascade_splits: [Vec4; 3],
+    /// x: layer count, y: 1 to select cascades by projection, z: blend band as a
+    /// fraction of a cascade's depth range, w: moment-map layers per cascade.
+    pub cascades: Vec4,
 }
+
+/// The most cascades a light may have (the size of the uniform arrays).
+pub const MAX_CASCADES: usize = 8;
 
 /// The camera uniform (`Camera` in `lighting.wgsl`).
 #[repr(C)]
@@ -54,6 +67,8 @@ pub struct CameraGpu {
     pub clip_from_world: Mat4,
     pub view_from_world: Mat4,
     pub eye: Vec4,
+    /// x: 1 to tint pixels by their cascade.
+    pub debug: Vec4,
 }
 
 /// One vertex: position, normal, texture coordinate (locations 0, 1, 2).

@@ -280,3 +280,61 @@ fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
         top.visibility.iter().zip(&mipped.visibility).filter(|(a, b)| (*a - *b).abs() > 0.02).count();
     assert!(changed > 50, "mipmaps changed only {changed} pixels");
 }
+
+#[test]
+fn techniques_stay_correct_with_cascades() {
+    use gnomon_scene::settings::{CascadeFit, CascadeSelection, Partition};
+    let (scene, shadow_center, half) = sun_square_scene();
+    for fit in [CascadeFit::Tight, CascadeFit::Stable] {
+        for selection in [CascadeSelection::Depth, CascadeSelection::Projection] {
+            for technique in [
+                Technique::Hard,
+                Technique::Pcf2x2,
+                Technique::PcfTent,
+                Technique::Pcss,
+                Technique::Vsm,
+                Technique::Esm,
+                Technique::MsmHamburger,
+            ] {
+                let mut s = settings(640, 480, RESOLUTION);
+                s.shadow.filter.technique = technique;
+                s.shadow.partition = Partition::Cascades;
+                s.shadow.cascades.cascade_fit = fit;
+                s.shadow.cascades.cascade_selection = selection;
+                let frame = render(&scene, &s);
+                assert_eq!(frame.cascades.len(), 4);
+                assert_eq!(frame.cascade_splits.len(), 5);
+                let o = classify(
+                    &scene,
+                    &s,
+                    |p| Some(square_distance(Vec2::new(p.x, p.z), shadow_center, half)),
+                    0.0,
+                );
+                check(&format!("{} ({fit:?} cascades by {selection:?})", technique.name()), &o);
+            }
+        }
+    }
+}
+
+#[test]
+fn cascades_put_finer_texels_near_the_camera() {
+    use gnomon_scene::settings::Partition;
+    let scene = gnomon_scene::builtin::columns();
+    let mut s = settings(320, 180, 1024);
+    s.shadow.partition = Partition::Cascades;
+    let frame = render(&scene, &s);
+    let texels: Vec<f32> = frame.cascades.iter().map(|c| c.texel_world_size(1024, 0.0)).collect();
+    assert!(texels.windows(2).all(|w| w[1] > w[0]), "texel sizes should grow with distance: {texels:?}");
+    let splits = &frame.cascade_splits;
+    assert!(splits.windows(2).all(|w| w[1] > w[0]), "{splits:?}");
+    let single = {
+        let mut s = settings(320, 180, 2048);
+        s.shadow.map.fit = gnomon_scene::settings::Fit::Scene;
+        render(&scene, &s).light_projection.texel_world_size(2048, 0.0)
+    };
+    assert!(
+        texels[0] < single,
+        "the nearest cascade's texels ({}) beat one 2048² map's ({single})",
+        texels[0]
+    );
+}

@@ -57,6 +57,18 @@ impl Default for ReferenceSettings {
     }
 }
 
+/// A diagnostic view drawn over the lit image.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DebugView {
+    /// The lit image alone.
+    #[default]
+    None,
+    /// Tint each pixel by the cascade that shades it: red, green, blue, yellow,
+    /// magenta, cyan, orange, violet for cascades 0 to 7.
+    Cascades,
+}
+
 /// The output image.
 #[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -67,11 +79,14 @@ pub struct ImageSettings {
     /// Image height in pixels (1 to 16384).
     #[arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image")]
     pub height: u32,
+    /// A diagnostic view over the image.
+    #[arg(long, value_enum, default_value_t, help_heading = "Image")]
+    pub debug_view: DebugView,
 }
 
 impl Default for ImageSettings {
     fn default() -> Self {
-        Self { width: 1280, height: 720 }
+        Self { width: 1280, height: 720, debug_view: DebugView::None }
     }
 }
 
@@ -488,9 +503,93 @@ impl Default for MapSettings {
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Partition {
-    /// One map covering everything the light sees (fitted to the scene bounds for a sun).
+    /// One map covering what the light must see (see --fit).
     #[default]
     Single,
+    /// Cascaded shadow maps for a sun: the view frustum split along its depth, one
+    /// --shadow-res map per slice, in a depth texture array (a spot keeps one map).
+    Cascades,
+}
+
+/// How the view depth range is divided among cascades.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum SplitScheme {
+    /// Equal depth ranges.
+    Uniform,
+    /// Equal depth ratios, matching perspective texel density.
+    Log,
+    /// Parallel-split shadow maps: λ·log + (1 − λ)·uniform (λ = 1 is fully log).
+    #[default]
+    Practical,
+}
+
+/// How each cascade's map is placed over its slice.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CascadeFit {
+    /// The slice's potential receivers exactly: the most texels on screen, but the
+    /// map's size and position change as the camera moves, so edges shimmer.
+    Tight,
+    /// The slice's bounding sphere, snapped to whole texels: a fixed size whatever the
+    /// camera's orientation, moving in texel steps, so edges hold still.
+    #[default]
+    Stable,
+}
+
+/// How a pixel picks its cascade.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CascadeSelection {
+    /// By the pixel's view depth against the split distances.
+    #[default]
+    Depth,
+    /// The first cascade whose map contains the pixel's projection: uses the finer
+    /// maps wherever their (stable, larger) windows reach.
+    Projection,
+}
+
+/// Cascaded shadow maps (--partition cascades).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CascadeSettings {
+    /// Number of cascades: 1 to 8.
+    #[arg(long = "cascades", value_name = "N", default_value_t = CascadeSettings::default().count, help_heading = "Cascades")]
+    pub count: u32,
+    /// Split scheme of the view depth range.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub split: SplitScheme,
+    /// λ of the practical split scheme, in [0, 1]: 1 is fully logarithmic.
+    #[arg(long, value_name = "LAMBDA", default_value_t = CascadeSettings::default().split_lambda, help_heading = "Cascades")]
+    pub split_lambda: f32,
+    /// Farthest view depth the cascades cover, in world units, > 0 [default: the
+    /// camera's far plane]. Beyond it a sun casts no shadow.
+    #[arg(long, value_name = "DISTANCE", help_heading = "Cascades")]
+    pub shadow_distance: Option<f32>,
+    /// How each cascade's map is fitted to its slice.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub cascade_fit: CascadeFit,
+    /// How a pixel chooses its cascade.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub cascade_selection: CascadeSelection,
+    /// Width of the band at the far end of each cascade over which it blends into the
+    /// next, as a fraction of the cascade's depth range: 0 to 0.5.
+    #[arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades")]
+    pub cascade_blend: f32,
+}
+
+impl Default for CascadeSettings {
+    fn default() -> Self {
+        Self {
+            count: 4,
+            split: SplitScheme::default(),
+            split_lambda: 0.8,
+            shadow_distance: None,
+            cascade_fit: CascadeFit::default(),
+            cascade_selection: CascadeSelection::default(),
+            cascade_blend: 0.1,
+        }
+    }
 }
 
 /// Shadow settings, one field per orthogonal axis.
@@ -506,6 +605,8 @@ pub struct ShadowSettings {
     /// Partition of the light's view into maps.
     #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
     pub partition: Partition,
+    #[command(flatten)]
+    pub cascades: CascadeSettings,
 }
 
 /// A setting outside its valid range. The message names the flag and what is valid.
@@ -669,6 +770,21 @@ impl Settings {
             "1 to 64 texels",
         )?;
         f.moments.validate(f.technique)?;
+        let c = &s.cascades;
+        check((1..=8).contains(&c.count), "--cascades", c.count, "1 to 8")?;
+        check(
+            c.split_lambda.is_finite() && (0.0..=1.0).contains(&c.split_lambda),
+            "--split-lambda",
+            c.split_lambda,
+            "0 to 1",
+        )?;
+        check(
+            c.cascade_blend.is_finite() && (0.0..=0.5).contains(&c.cascade_blend),
+            "--cascade-blend",
+            c.cascade_blend,
+            "0 to 0.5",
+        )?;
+        check_opt(c.shadow_distance, "--shadow-distance", |x| x > 0.0, "a distance > 0")?;
         let b = &s.bias;
         check(
             b.slope_bias.is_finite() && b.slope_bias >= 0.0,

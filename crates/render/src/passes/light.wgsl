@@ -14,7 +14,22 @@ struct Light {
     pcss: vec4<f32>,         // x: light size, y: blocker-search taps, z: largest radius (texels)
     params: array<vec4<f32>, 2>, // technique parameters, see each technique
     ambient: vec4<f32>,      // rgb: ambient light
+    // One layer of the shadow map per cascade (one in all for a single map).
+    cascade_clip_from_world: array<mat4x4<f32>, 8>,
+    cascade_texel: array<vec4<f32>, 8>,  // x: orthographic texel world size
+    cascade_splits: array<vec4<f32>, 3>, // view depth where cascade i starts (i) and ends (i + 1)
+    cascades: vec4<f32>,     // x: count, y: 1 to select by projection, z: blend band, w: moment layers per cascade
 };
+
+// The view depth where cascade `i` starts; `i + 1` where it ends.
+fn cascade_split(i: u32) -> f32 {
+    return light.cascade_splits[i / 4u][i % 4u];
+}
+
+// World size of one texel of layer `layer` at light distance `distance`.
+fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
+    return light.cascade_texel[layer].x + light.texel.y * max(distance, 0.0);
+}
 
 // Distance along the light's axis (light view −z) of a point whose shadow-map depth
 // is `depth`. Orthographic maps store it linearly between the near and far planes;

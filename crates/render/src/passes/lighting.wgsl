@@ -8,7 +8,14 @@ struct Camera {
     clip_from_world: mat4x4<f32>,
     view_from_world: mat4x4<f32>,
     eye: vec4<f32>,
+    debug: vec4<f32>,   // x: 1 to tint pixels by their cascade
 };
+
+// Cascade tints of the debug view.
+const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
+    vec3<f32>(1.0, 0.35, 0.35), vec3<f32>(0.35, 1.0, 0.35), vec3<f32>(0.4, 0.5, 1.0), vec3<f32>(1.0, 1.0, 0.3),
+    vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
+);
 
 @group(1) @binding(0) var<uniform> camera: Camera;
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
@@ -54,12 +61,12 @@ struct FragmentOut {
 // quantisation that the slope bias (zero for it) cannot cover.
 const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 
-fn shadow_coords(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
+fn shadow_coords(layer: u32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    let texel_world = light.texel.x + light.texel.y * max(distance, 0.0);
+    let texel_world = texel_world_size_at(layer, distance);
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
     let p = world + n * (light.texel.z * texel_world * slope);
-    let clip = light.clip_from_world * vec4<f32>(p, 1.0);
+    let clip = light.cascade_clip_from_world[layer] * vec4<f32>(p, 1.0);
     if clip.w <= 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, 0.0);
     }
@@ -85,6 +92,55 @@ fn light_geometry(world: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(l, select(0.0, falloff, inside));
 }
 
+// The cascade that shades a point at `view_depth`: by depth, the one whose split
+// range holds it; by projection, the first whose map holds its lookup.
+fn select_cascade(view_depth: f32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> u32 {
+    let count = u32(light.cascades.x);
+    if light.cascades.y < 0.5 {
+        var layer = 0u;
+        for (var i = 1u; i < count; i++) {
+            if view_depth > cascade_split(i) {
+                layer = i;
+            }
+        }
+        return layer;
+    }
+    for (var i = 0u; i + 1u < count; i++) {
+        let c = shadow_coords(i, world, n, l);
+        // A margin of a few texels keeps the filter's footprint inside the map.
+        let margin = 4.0 / light.texel.w;
+        if c.w > 0.5 && all(c.xy > vec2<f32>(margin)) && all(c.xy < vec2<f32>(1.0 - margin)) {
+            return i;
+        }
+    }
+    return count - 1u;
+}
+
+// The shadow lookup in layer `layer`: 1 (lit) outside the map.
+fn shadow_lookup(
+    layer: u32,
+    world: vec3<f32>,
+    n: vec3<f32>,
+    l: vec3<f32>,
+    world_dx: vec3<f32>,
+    world_dy: vec3<f32>,
+    pixel: vec2<f32>,
+) -> f32 {
+    let coords = shadow_coords(layer, world, n, l);
+    if coords.w < 0.5 {
+        return 1.0;
+    }
+    var query: ShadowQuery;
+    query.coords = coords.xyz;
+    // Screen derivatives of the lookup, for receiver-plane bias and mip selection.
+    query.coords_dx = shadow_coords(layer, world + world_dx, n, l).xyz - coords.xyz;
+    query.coords_dy = shadow_coords(layer, world + world_dy, n, l).xyz - coords.xyz;
+    query.pixel = pixel;
+    query.distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
+    query.layer = layer;
+    return sample_shadow(query);
+}
+
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
@@ -105,18 +161,23 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let l = geometry.xyz;
     let cone = geometry.w;
 
-    let coords = shadow_coords(in.world, n, l);
-    // The lookup's screen derivatives, for receiver-plane bias and mip selection, are
-    // taken here, before any branch.
-    var query: ShadowQuery;
-    query.coords = coords.xyz;
-    query.coords_dx = dpdx(coords.xyz);
-    query.coords_dy = dpdy(coords.xyz);
-    query.pixel = in.clip.xy;
-    query.distance = -(light.light_from_world * vec4<f32>(in.world, 1.0)).z;
-    var visibility = 1.0;
-    if coords.w > 0.5 {
-        visibility = sample_shadow(query);
+    // The world position's screen derivatives, taken here in uniform control flow;
+    // each lookup carries them into its own cascade's texture space.
+    let world_dx = dpdx(in.world);
+    let world_dy = dpdy(in.world);
+    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
+    let layer = select_cascade(view_depth, in.world, n, l);
+    var visibility = shadow_lookup(layer, in.world, n, l, world_dx, world_dy, in.clip.xy);
+    // Blend into the next cascade over the last `cascades.z` of this one's depth range.
+    let count = u32(light.cascades.x);
+    if light.cascades.y < 0.5 && layer + 1u < count && light.cascades.z > 0.0 {
+        let start = cascade_split(layer);
+        let end = cascade_split(layer + 1u);
+        let band = light.cascades.z * (end - start);
+        if view_depth > end - band {
+            let next = shadow_lookup(layer + 1u, in.world, n, l, world_dx, world_dy, in.clip.xy);
+            visibility = mix(visibility, next, clamp((view_depth - (end - band)) / band, 0.0, 1.0));
+        }
     }
     if light.direction.w > 0.5 && cone <= 0.0 {
         // Outside a spot's cone or range no light arrives: visibility 0 by definition.
@@ -137,12 +198,14 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let h = normalize(l + v);
     let specular = inst.material.x * pow(max(dot(n, h), 0.0), inst.material.y) * select(0.0, 1.0, n_dot_l > 0.0);
     let direct = light.radiance.rgb * cone * (albedo * n_dot_l + vec3<f32>(specular));
-    let color = light.ambient.rgb * albedo + visibility * direct;
+    var color = light.ambient.rgb * albedo + visibility * direct;
+    if camera.debug.x > 0.5 {
+        color *= CASCADE_TINTS[layer];
+    }
 
     var out: FragmentOut;
     out.color = vec4<f32>(color, 1.0);
     out.visibility = visibility;
-    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
     out.position = vec4<f32>(in.world, view_depth);
     out.normal = vec4<f32>(n, 0.0);
     out.object_id = u32(inst.material.z);

@@ -87,7 +87,7 @@ impl MomentPass {
                 0,
                 wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2,
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
                     multisampled: false,
                 },
             )],
@@ -204,6 +204,7 @@ impl MomentPass {
         settings: &MomentSettings,
         format: wgpu::TextureFormat,
         resolution: u32,
+        cascades: u32,
         depth_view: &wgpu::TextureView,
         light_buffer: &wgpu::Buffer,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
@@ -212,14 +213,12 @@ impl MomentPass {
         self.encode_pipeline(device, technique, format);
         let pipelines = &self.formats[&format];
         let mip_levels = if settings.mipmaps && map.mipmapped { resolution.ilog2() + 1 } else { 1 };
+        // The technique's layers, for every cascade in turn.
+        let layers = map.layers * cascades;
         let texture = |label, mips| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d {
-                    width: resolution,
-                    height: resolution,
-                    depth_or_array_layers: map.layers,
-                },
+                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
                 mip_level_count: mips,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -286,7 +285,7 @@ impl MomentPass {
         pass.set_bind_group(0, &light_group, &[]);
         pass.set_bind_group(1, &encode_group, &[]);
         pass.set_bind_group(2, &depth_group, &[]);
-        pass.dispatch_workgroups(groups(resolution), groups(resolution), map.layers);
+        pass.dispatch_workgroups(groups(resolution), groups(resolution), layers);
 
         if settings.blur_radius > 0 {
             let scratch = texture("moment map blur scratch", 1);
@@ -305,7 +304,7 @@ impl MomentPass {
             pass.set_pipeline(&pipelines.blur);
             for group in [&horizontal, &vertical] {
                 pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(groups(resolution), groups(resolution), map.layers);
+                pass.dispatch_workgroups(groups(resolution), groups(resolution), layers);
             }
         }
 
@@ -318,7 +317,7 @@ impl MomentPass {
                 let group =
                     filter_group(&level_view(&moments, level - 1), &level_view(&moments, level), params);
                 pass.set_bind_group(0, &group, &[]);
-                pass.dispatch_workgroups(groups(size), groups(size), map.layers);
+                pass.dispatch_workgroups(groups(size), groups(size), layers);
             }
         }
         drop(pass);

@@ -11,11 +11,13 @@ struct ShadowQuery {
     pixel: vec2<f32>,
     // Distance of the receiver along the light's axis (light view −z).
     distance: f32,
+    // The shadow map's layer: the cascade.
+    layer: u32,
 };
 
 // World size of one shadow texel at the receiver.
 fn texel_world_size(q: ShadowQuery) -> f32 {
-    return light.texel.x + light.texel.y * max(q.distance, 0.0);
+    return texel_world_size_at(q.layer, q.distance);
 }
 
 // Interleaved gradient noise in [0, 1) (Jimenez, "Next generation post processing in
@@ -59,7 +61,9 @@ fn receiver_depth_gradient(q: ShadowQuery) -> vec2<f32> {
 // depth moved along the receiver plane `gradient`.
 fn compare_tap(q: ShadowQuery, gradient: vec2<f32>, offset: vec2<f32>) -> f32 {
     let duv = offset / light.texel.w;
-    return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy + duv, q.coords.z + dot(gradient, duv));
+    return textureSampleCompareLevel(
+        shadow_map, shadow_compare, q.coords.xy + duv, q.layer, q.coords.z + dot(gradient, duv)
+    );
 }
 
 // Rotates the first `count` points of the Poisson disk by a per-pixel angle, scales

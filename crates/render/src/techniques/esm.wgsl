@@ -20,10 +20,11 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     let f = x - base;
     let i = vec2<i32>(base);
     let hi = dims - vec2<i32>(1);
-    let d00 = textureLoad(moment_map, clamp(i, vec2<i32>(0), hi), 0u, 0).x;
-    let d10 = textureLoad(moment_map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), hi), 0u, 0).x;
-    let d01 = textureLoad(moment_map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), hi), 0u, 0).x;
-    let d11 = textureLoad(moment_map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), hi), 0u, 0).x;
+    let layer = q.layer * u32(light.cascades.w);
+    let d00 = textureLoad(moment_map, clamp(i, vec2<i32>(0), hi), layer, 0).x;
+    let d10 = textureLoad(moment_map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), hi), layer, 0).x;
+    let d01 = textureLoad(moment_map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), hi), layer, 0).x;
+    let d11 = textureLoad(moment_map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), hi), layer, 0).x;
     let top = max(max(d00, d10), max(d01, d11));
     let sum = (1.0 - f.x) * (1.0 - f.y) * exp(c * (d00 - top)) + f.x * (1.0 - f.y) * exp(c * (d10 - top))
         + (1.0 - f.x) * f.y * exp(c * (d01 - top)) + f.x * f.y * exp(c * (d11 - top));

@@ -4,7 +4,8 @@
 // The filtered value of `layer` at the lookup, trilinear when the map has mipmaps
 // (the screen derivatives choose the level; they were taken in uniform control flow).
 fn sample_moments(q: ShadowQuery, layer: u32) -> vec4<f32> {
-    return textureSampleGrad(moment_map, moment_sampler, q.coords.xy, layer, q.coords_dx.xy, q.coords_dy.xy);
+    let index = q.layer * u32(light.cascades.w) + layer;
+    return textureSampleGrad(moment_map, moment_sampler, q.coords.xy, index, q.coords_dx.xy, q.coords_dy.xy);
 }
 
 // The receiver's depth in the moment map's convention (linear in [0, 1]).

@@ -26,7 +26,7 @@ impl ShadowTechnique for Pcf2x2 {
 
     fn wgsl(&self) -> &'static [&'static str] {
         &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
-           return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.coords.z);\n}\n"]
+           return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.layer, q.coords.z);\n}\n"]
     }
 }
 

@@ -11,13 +11,10 @@
 // Both the search region and the penumbra are converted to texels with the map's
 // projection: perspective texels grow with distance, orthographic ones do not.
 
-// Radius in texels, at the receiver, of a world length `world` that lies at light
+// Radius in texels of layer `layer` of a world length `world` that lies at light
 // distance `at`.
-fn world_to_texels(world: f32, at: f32) -> f32 {
-    if light.direction.w < 0.5 {
-        return world / light.texel.x;
-    }
-    return world / (light.texel.y * at);
+fn world_to_texels(layer: u32, world: f32, at: f32) -> f32 {
+    return world / texel_world_size_at(layer, at);
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
@@ -31,9 +28,9 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     // receiver to the light, where the nearest possible blockers lie.
     var search = 0.0;
     if is_spot {
-        search = world_to_texels(size * (d_receiver - near) / d_receiver, near);
+        search = world_to_texels(q.layer, size * (d_receiver - near) / d_receiver, near);
     } else {
-        search = world_to_texels(size * (d_receiver - near), near);
+        search = world_to_texels(q.layer, size * (d_receiver - near), near);
     }
     search = clamp(search, 1.0, max_radius);
 
@@ -49,7 +46,7 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
         let duv = offset / light.texel.w;
         let uv = q.coords.xy + duv;
         let texel = clamp(vec2<i32>(floor(uv * light.texel.w)), vec2<i32>(0), dims - vec2<i32>(1));
-        let stored = textureLoad(shadow_map, texel, 0);
+        let stored = textureLoad(shadow_map, texel, q.layer, 0);
         if stored < q.coords.z + dot(gradient, duv) {
             blocker_sum += light_distance_from_depth(stored);
             blockers += 1.0;
@@ -63,9 +60,9 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     // 2. The penumbra's radius at the receiver.
     var penumbra = 0.0;
     if is_spot {
-        penumbra = world_to_texels(size * max(d_receiver - d_blocker, 0.0) / d_blocker, d_receiver);
+        penumbra = world_to_texels(q.layer, size * max(d_receiver - d_blocker, 0.0) / d_blocker, d_receiver);
     } else {
-        penumbra = world_to_texels(size * max(d_receiver - d_blocker, 0.0), d_receiver);
+        penumbra = world_to_texels(q.layer, size * max(d_receiver - d_blocker, 0.0), d_receiver);
     }
     // 3. At least the bilinear tap's own half-texel footprint.
     return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), u32(light.kernel.z));
