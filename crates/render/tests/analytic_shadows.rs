@@ -4,16 +4,9 @@
 
 mod support;
 
-use glam::{Mat4, Vec2, Vec3};
-use gnomon_scene::{Light, geometry, settings::Technique};
+use glam::{Vec2, Vec3};
+use gnomon_scene::{Light, settings::Technique};
 use support::*;
-
-/// Signed distance from `p` to the axis-aligned square of half-size `half` at
-/// `center` (negative inside).
-fn square_distance(p: Vec2, center: Vec2, half: f32) -> f32 {
-    let d = (p - center).abs() - Vec2::splat(half);
-    d.max(Vec2::ZERO).length() + d.max_element().min(0.0)
-}
 
 struct BoundaryReport {
     compared: usize,
@@ -57,18 +50,7 @@ fn techniques() -> Vec<(Technique, u32)> {
 
 #[test]
 fn square_occluder_under_a_sun_matches_the_analytic_projection() {
-    let (half, height) = (1.0, 1.5);
-    let center = Vec3::new(0.5, height, -0.5);
-    let mut scene = ground_scene("analytic sun", 12.0);
-    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
-    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
-    scene.camera.target = Vec3::ZERO;
-    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
-    scene.sun.direction = sun_dir;
-    // The shadow is the square translated along the light by height / (−d.y).
-    let offset = Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
-    let shadow_center = Vec2::new(center.x, center.z) + offset;
-
+    let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
     for (technique, kernel) in techniques() {
         let mut s = settings(640, 480, 1024);
         s.shadow.filter.technique = technique;
@@ -93,27 +75,8 @@ fn square_occluder_under_a_sun_matches_the_analytic_projection() {
 
 #[test]
 fn spot_light_cone_and_shadow_match_the_perspective_projection() {
-    let (light_height, half, occluder_height) = (8.0, 0.75, 2.0);
-    let occluder_center = Vec3::new(1.0, occluder_height, 0.5);
-    let mut scene = ground_scene("analytic spot", 16.0);
-    add(
-        &mut scene,
-        "square",
-        geometry::plane(2.0 * half, 2.0 * half),
-        Mat4::from_translation(occluder_center),
-    );
-    scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
-    scene.camera.target = Vec3::ZERO;
-    scene.spot.position = Vec3::new(0.0, light_height, 0.0);
-    scene.spot.direction = Vec3::NEG_Y;
-    scene.spot.outer_angle_degrees = 30.0;
-    scene.spot.inner_angle_degrees = 25.0;
-    scene.spot.range = 20.0;
-    // Seen from a point light at height H, a square at height h projects onto the
-    // ground scaled by k = H / (H − h) about the light's foot.
-    let k = light_height / (light_height - occluder_height);
-    let shadow_center = Vec2::new(occluder_center.x, occluder_center.z) * k;
-    let cone_radius = light_height * 30f32.to_radians().tan();
+    let SquareOccluder { scene, shadow_center, shadow_half, .. } = square_under_spot();
+    let cone_radius = SPOT_HEIGHT * SPOT_OUTER_DEGREES.to_radians().tan();
 
     for (technique, kernel) in techniques() {
         let mut s = settings(640, 480, 1024);
@@ -151,7 +114,7 @@ fn spot_light_cone_and_shadow_match_the_perspective_projection() {
             &frame,
             |p| {
                 let in_cone = Vec2::new(p.x, p.z).length() < cone_radius;
-                if in_cone { square_distance(Vec2::new(p.x, p.z), shadow_center, half * k) } else { -1e9 }
+                if in_cone { square_distance(Vec2::new(p.x, p.z), shadow_center, shadow_half) } else { -1e9 }
             },
             |p| frame.shadow_texel_world_size(p),
         );

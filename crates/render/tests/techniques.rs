@@ -5,21 +5,14 @@
 
 mod support;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use gnomon_scene::{
-    Scene, geometry,
+    Scene,
     settings::{LightKind, Settings, Technique},
 };
 use support::*;
 
 const RESOLUTION: u32 = 1024;
-
-/// Signed distance from `p` to the axis-aligned square of half-size `half` at
-/// `center` (negative inside).
-fn square_distance(p: Vec2, center: Vec2, half: f32) -> f32 {
-    let d = (p - center).abs() - Vec2::splat(half);
-    d.max(Vec2::ZERO).length() + d.max_element().min(0.0)
-}
 
 /// How far from the exact shadow edge a technique may blur: the blur radius or
 /// kernel half-width, the bilinear tap, and the texel itself, in texels.
@@ -100,21 +93,13 @@ fn check(label: &str, o: &Outcome) {
 
 #[test]
 fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() {
-    let (half, height, angular_diameter) = (1.0f32, 1.5f32, 1.0f32);
-    let center = Vec3::new(0.5, height, -0.5);
-    let mut scene = ground_scene("technique sun", 12.0);
-    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
-    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
-    scene.camera.target = Vec3::ZERO;
-    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
-    scene.sun.direction = sun_dir;
+    let SquareOccluder { mut scene, shadow_center, shadow_half: half, height } = square_under_sun();
+    let angular_diameter = 1.0f32;
     scene.sun.angular_diameter_degrees = angular_diameter;
-    let offset = Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
-    let shadow_center = Vec2::new(center.x, center.z) + offset;
     // The penumbra's half-width on the ground: the occluder's distance along the ray
     // times the tangent of the sun's angular radius, stretched by the ground's slant.
-    let along_ray = height / -sun_dir.y;
-    let penumbra_half = along_ray * (0.5 * angular_diameter).to_radians().tan() / -sun_dir.y;
+    let slant = -scene.sun.direction.normalize().y;
+    let penumbra_half = height / slant * (0.5 * angular_diameter).to_radians().tan() / slant;
 
     for technique in Technique::all() {
         let mut s = settings(640, 480, RESOLUTION);
@@ -131,28 +116,12 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() 
 
 #[test]
 fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot() {
-    let (light_height, half, occluder_height, radius) = (8.0f32, 0.75f32, 2.0f32, 0.1f32);
-    let occluder_center = Vec3::new(1.0, occluder_height, 0.5);
-    let mut scene = ground_scene("technique spot", 16.0);
-    add(
-        &mut scene,
-        "square",
-        geometry::plane(2.0 * half, 2.0 * half),
-        Mat4::from_translation(occluder_center),
-    );
-    scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
-    scene.camera.target = Vec3::ZERO;
-    scene.spot.position = Vec3::new(0.0, light_height, 0.0);
-    scene.spot.direction = Vec3::NEG_Y;
-    scene.spot.outer_angle_degrees = 30.0;
-    scene.spot.inner_angle_degrees = 25.0;
-    scene.spot.range = 20.0;
+    let SquareOccluder { mut scene, shadow_center, shadow_half, height } = square_under_spot();
+    let radius = 0.1f32;
     scene.spot.radius = radius;
-    let k = light_height / (light_height - occluder_height);
-    let shadow_center = Vec2::new(occluder_center.x, occluder_center.z) * k;
-    let cone_radius = light_height * 30f32.to_radians().tan();
+    let cone_radius = SPOT_HEIGHT * SPOT_OUTER_DEGREES.to_radians().tan();
     // Similar triangles: the disk's radius scaled by h / (H − h) on the ground.
-    let penumbra_half = radius * occluder_height / (light_height - occluder_height);
+    let penumbra_half = radius * height / (SPOT_HEIGHT - height);
 
     for technique in Technique::all() {
         let mut s = settings(640, 480, RESOLUTION);
@@ -164,7 +133,7 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot()
             |p| {
                 // Only well inside the cone, where the light is not cut by the cone itself.
                 (Vec2::new(p.x, p.z).length() < cone_radius - 0.5)
-                    .then(|| square_distance(Vec2::new(p.x, p.z), shadow_center, half * k))
+                    .then(|| square_distance(Vec2::new(p.x, p.z), shadow_center, shadow_half))
             },
             penumbra_half,
         );
@@ -176,16 +145,7 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot()
 fn filterable_techniques_also_work_with_16_bit_moment_maps() {
     // The portable format, where 32-bit float is not filterable (the GL backend):
     // exponents and the moment bias are set for half precision, as documented.
-    let (half, height) = (1.0f32, 1.5f32);
-    let center = Vec3::new(0.5, height, -0.5);
-    let mut scene = ground_scene("technique sun, 16-bit", 12.0);
-    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
-    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
-    scene.camera.target = Vec3::ZERO;
-    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
-    scene.sun.direction = sun_dir;
-    let shadow_center =
-        Vec2::new(center.x, center.z) + Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
     for technique in Technique::all().iter().filter(|t| t.is_filterable()) {
         let mut s = settings(640, 480, RESOLUTION);
         s.shadow.filter.technique = *technique;
@@ -206,26 +166,11 @@ fn filterable_techniques_also_work_with_16_bit_moment_maps() {
     }
 }
 
-/// The square-occluder sun scene of the tests above.
-fn sun_square_scene() -> (Scene, Vec2, f32) {
-    let (half, height) = (1.0f32, 1.5f32);
-    let center = Vec3::new(0.5, height, -0.5);
-    let mut scene = ground_scene("technique sun", 12.0);
-    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
-    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
-    scene.camera.target = Vec3::ZERO;
-    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
-    scene.sun.direction = sun_dir;
-    let shadow_center =
-        Vec2::new(center.x, center.z) + Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
-    (scene, shadow_center, half)
-}
-
 #[test]
 fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
     // Under a sun the map is orthographic: one texel is the same world size
     // everywhere, so W texels and W·texel world units are the same kernel.
-    let (scene, _, _) = sun_square_scene();
+    let scene = square_under_sun().scene;
     for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
         let mut s = settings(320, 240, RESOLUTION);
         s.shadow.filter.technique = technique;
@@ -258,7 +203,7 @@ fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
 
 #[test]
 fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
-    let (scene, shadow_center, half) = sun_square_scene();
+    let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
     for technique in [Technique::Vsm, Technique::Evsm4, Technique::MsmHamburger, Technique::Convolution] {
         let mut s = settings(640, 480, RESOLUTION);
         s.shadow.filter.technique = technique;
@@ -284,7 +229,7 @@ fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
 #[test]
 fn techniques_stay_correct_with_cascades() {
     use gnomon_scene::settings::{CascadeFit, CascadeSelection, Partition};
-    let (scene, shadow_center, half) = sun_square_scene();
+    let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
     for fit in [CascadeFit::Tight, CascadeFit::Stable] {
         for selection in [CascadeSelection::Depth, CascadeSelection::Projection] {
             for technique in [

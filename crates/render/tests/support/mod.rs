@@ -133,3 +133,71 @@ pub fn pixel_footprint(frame: &Frame, i: usize) -> f32 {
     }
     size
 }
+
+/// Signed distance from `p` to the axis-aligned square of half-size `half` at
+/// `center` (negative inside).
+pub fn square_distance(p: glam::Vec2, center: glam::Vec2, half: f32) -> f32 {
+    let d = (p - center).abs() - glam::Vec2::splat(half);
+    d.max(glam::Vec2::ZERO).length() + d.max_element().min(0.0)
+}
+
+/// A square occluder over a ground plane, and where its hard shadow falls.
+pub struct SquareOccluder {
+    pub scene: Scene,
+    /// Centre of the shadow on the ground (x, z).
+    pub shadow_center: glam::Vec2,
+    /// Half-size of the shadow on the ground.
+    pub shadow_half: f32,
+    /// Height of the occluder above the ground.
+    pub height: f32,
+}
+
+/// A 2 × 2 square 1.5 above a 12 × 12 ground, under a sun 50° high at azimuth 30°,
+/// seen from above. Its shadow is the square translated along the light by
+/// height / (−d.y).
+pub fn square_under_sun() -> SquareOccluder {
+    let (half, height) = (1.0f32, 1.5f32);
+    let center = Vec3::new(0.5, height, -0.5);
+    let mut scene = ground_scene("square under a sun", 12.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
+    scene.camera.target = Vec3::ZERO;
+    let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
+    scene.sun.direction = sun_dir;
+    let offset = glam::Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
+    SquareOccluder {
+        scene,
+        shadow_center: glam::Vec2::new(center.x, center.z) + offset,
+        shadow_half: half,
+        height,
+    }
+}
+
+/// Height of the spot light of [`square_under_spot`] and its cone's half-angle.
+pub const SPOT_HEIGHT: f32 = 8.0;
+pub const SPOT_OUTER_DEGREES: f32 = 30.0;
+
+/// A 1.5 × 1.5 square 2 above a 16 × 16 ground, under a spot light 8 above the
+/// origin pointing down (outer cone 30°). Seen from a point light at height H, a
+/// square at height h projects onto the ground scaled by k = H / (H − h) about the
+/// light's foot.
+pub fn square_under_spot() -> SquareOccluder {
+    let (half, height) = (0.75f32, 2.0f32);
+    let center = Vec3::new(1.0, height, 0.5);
+    let mut scene = ground_scene("square under a spot", 16.0);
+    add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
+    scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
+    scene.camera.target = Vec3::ZERO;
+    scene.spot.position = Vec3::new(0.0, SPOT_HEIGHT, 0.0);
+    scene.spot.direction = Vec3::NEG_Y;
+    scene.spot.outer_angle_degrees = SPOT_OUTER_DEGREES;
+    scene.spot.inner_angle_degrees = 25.0;
+    scene.spot.range = 20.0;
+    let k = SPOT_HEIGHT / (SPOT_HEIGHT - height);
+    SquareOccluder {
+        scene,
+        shadow_center: glam::Vec2::new(center.x, center.z) * k,
+        shadow_half: half * k,
+        height,
+    }
+}
