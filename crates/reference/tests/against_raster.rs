@@ -1,39 +1,17 @@
 //! Techniques against the reference: the metrics detect planted errors, and the
 //! foundation's techniques are accurate on `spheres`.
 
-use std::sync::OnceLock;
+mod common;
 
-use gnomon_reference::{
-    ReferenceImage, ReferenceOptions, TracedScene,
-    metrics::{self, Metrics, RasterView},
-    reference_visibility,
-};
-use gnomon_render::{Gpu, OutputRequest, Renderer};
+use common::{compare, reference, render};
+use gnomon_reference::metrics::Metrics;
 use gnomon_scene::{
     Scene, Settings, builtin,
     settings::{BiasSettings, Technique},
 };
 
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
-
-fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
-    let options =
-        ReferenceOptions { width: s.image.width, height: s.image.height, samples: s.reference.samples };
-    let camera = s.resolve_camera(scene).unwrap();
-    let light = s.resolve_light(scene).unwrap();
-    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
-}
-
-fn measure(scene: &Scene, s: &Settings, reference: &ReferenceImage) -> Metrics {
-    let mut renderer = Renderer::new(gpu()).unwrap();
-    let frame = renderer.render(scene, s, &OutputRequest::default()).unwrap();
-    let raster =
-        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-    let classes = metrics::classify(raster, reference);
-    metrics::measure(raster, reference, &classes)
+fn measure(scene: &Scene, s: &Settings, truth: &gnomon_reference::ReferenceImage) -> Metrics {
+    compare(&render(scene, s), truth)
 }
 
 fn settings(width: u32, height: u32, technique: Technique) -> Settings {

@@ -2,23 +2,13 @@
 //! shadow, in the rasterizer and in the reference, where the analytic projection puts
 //! it; and on the `tree` scene the two agree.
 
-use std::sync::OnceLock;
+mod common;
 
+use common::{compare, reference, render};
 use glam::{Mat4, Vec2, Vec3};
-use gnomon_reference::{
-    ReferenceImage, ReferenceOptions, TracedScene,
-    metrics::{self, RasterView},
-    reference_visibility,
-};
-use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
 use gnomon_scene::{
     AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry, settings::Technique,
 };
-
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
 
 const CELLS: u32 = 8;
 const HALF: f32 = 1.0;
@@ -106,16 +96,6 @@ fn settings(technique: Technique) -> Settings {
     s.shadow.map.resolution = 2048;
     s.shadow.filter.technique = technique;
     s
-}
-
-fn render(scene: &Scene, s: &Settings) -> Frame {
-    Renderer::new(gpu()).unwrap().render(scene, s, &OutputRequest::default()).unwrap()
-}
-
-fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
-    let options = ReferenceOptions { width: s.image.width, height: s.image.height, samples: 1 };
-    let (camera, light) = (s.resolve_camera(scene).unwrap(), s.resolve_light(scene).unwrap());
-    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
 }
 
 fn pixel_size(position: &[Vec3], ids: &[u32], w: usize, i: usize) -> f32 {
@@ -216,10 +196,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     s.image.height = 720;
     let frame = render(&scene, &s);
     let truth = reference(&scene, &s);
-    let raster =
-        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-    let classes = metrics::classify(raster, &truth);
-    let m = metrics::measure(raster, &truth, &classes);
+    let m = compare(&frame, &truth);
     eprintln!(
         "tree, pcf2x2, 2048²: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} compared, {} silhouette",
         100.0 * m.mismatch_rate,

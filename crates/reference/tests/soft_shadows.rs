@@ -2,38 +2,18 @@
 //! follows the blocker distance, beats every fixed-width PCF kernel on `contact`,
 //! where penumbrae widen with the distance from each contact.
 
-use std::sync::OnceLock;
+mod common;
 
-use gnomon_reference::{
-    ReferenceImage, ReferenceOptions, TracedScene,
-    metrics::{self, Metrics, RasterView},
-    reference_visibility,
-};
-use gnomon_render::{Gpu, OutputRequest, Renderer};
+use common::{compare, gpu, reference};
+use gnomon_reference::{ReferenceImage, metrics::Metrics};
+use gnomon_render::{OutputRequest, Renderer};
 use gnomon_scene::{
     Scene, Settings, builtin,
     settings::{LightKind, Technique},
 };
 
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
-
-fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
-    let options =
-        ReferenceOptions { width: s.image.width, height: s.image.height, samples: s.reference.samples };
-    let camera = s.resolve_camera(scene).unwrap();
-    let light = s.resolve_light(scene).unwrap();
-    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
-}
-
-fn measure(renderer: &mut Renderer, scene: &Scene, s: &Settings, reference: &ReferenceImage) -> Metrics {
-    let frame = renderer.render(scene, s, &OutputRequest::default()).unwrap();
-    let raster =
-        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-    let classes = metrics::classify(raster, reference);
-    metrics::measure(raster, reference, &classes)
+fn measure(renderer: &mut Renderer, scene: &Scene, s: &Settings, truth: &ReferenceImage) -> Metrics {
+    compare(&renderer.render(scene, s, &OutputRequest::default()).unwrap(), truth)
 }
 
 #[test]

@@ -1,0 +1,41 @@
+//! What the tests comparing the rasterizer with the reference share: one device per
+//! test binary, a render, a reference trace and the comparison of the two.
+#![allow(dead_code)]
+
+use std::sync::OnceLock;
+
+use gnomon_reference::{
+    ReferenceImage, ReferenceOptions, TracedScene,
+    metrics::{self, Metrics, RasterView},
+    reference_visibility,
+};
+use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
+use gnomon_scene::{Scene, Settings};
+
+/// The device shared by the tests in one binary (WGPU_BACKEND is honoured; CI sets vulkan).
+pub fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
+}
+
+pub fn render(scene: &Scene, s: &Settings) -> Frame {
+    Renderer::new(gpu()).unwrap().render(scene, s, &OutputRequest::default()).unwrap()
+}
+
+/// The reference for the settings' camera and light, with `s.reference.samples` rays
+/// per pixel for an area light (one for a point or a sun without size).
+pub fn reference(scene: &Scene, s: &Settings) -> ReferenceImage {
+    let options =
+        ReferenceOptions { width: s.image.width, height: s.image.height, samples: s.reference.samples };
+    let camera = s.resolve_camera(scene).unwrap();
+    let light = s.resolve_light(scene).unwrap();
+    reference_visibility(&TracedScene::build(scene), &camera, &light, &options, &|_| {})
+}
+
+/// `gnomon compare`'s metrics of `frame` against `reference`.
+pub fn compare(frame: &Frame, reference: &ReferenceImage) -> Metrics {
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let classes = metrics::classify(raster, reference);
+    metrics::measure(raster, reference, &classes)
+}
