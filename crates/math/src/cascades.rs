@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::{
-    Aabb, LightProjection, ProjectionKind,
+    Aabb, LightProjection,
     fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
 };
 
@@ -86,13 +86,7 @@ pub fn fit_cascade_stable(
     let far = (-(c.z - radius)).max(-casters.min.z) + margin;
     let (left, right) = (snapped.x - radius, snapped.x + radius);
     let (bottom, top) = (snapped.y - radius, snapped.y + radius);
-    LightProjection {
-        light_from_world,
-        clip_from_light: glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far),
-        kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
-        near,
-        far,
-    }
+    LightProjection::orthographic(light_from_world, (left, right, bottom, top), near, far)
 }
 
 /// The light-space x and y of an orthographic window's left-bottom corner, which
@@ -108,7 +102,7 @@ pub fn window_origin(projection: &LightProjection) -> (f32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::view_from_world_look_at;
+    use crate::{ProjectionKind, projection::view_from_world_look_at};
 
     struct Lcg(u64);
     impl Lcg {

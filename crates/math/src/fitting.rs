@@ -6,7 +6,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::{Aabb, LightProjection, ProjectionKind, projection::view_from_world_look_at};
+use crate::{Aabb, LightProjection, projection::view_from_world_look_at};
 
 /// A convex hexahedron given by its eight corners, indexed by the bits (x, y, z) of
 /// the index as [`Aabb::corners`] are: the view frustum or a box.
@@ -143,18 +143,13 @@ pub fn fit_directional_to_receivers(direction: Vec3, scene: &Aabb, receivers: &[
     // View space looks down −z: the point nearest the light has the largest z.
     let near = -casters.max.z - margin;
     let far = -seen.min.z + margin;
-    LightProjection {
-        light_from_world,
-        clip_from_light: glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far),
-        kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
-        near,
-        far,
-    }
+    LightProjection::orthographic(light_from_world, (left, right, bottom, top), near, far)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ProjectionKind;
 
     /// A small deterministic generator for the property tests.
     struct Lcg(u64);

@@ -27,6 +27,25 @@ pub struct LightProjection {
 }
 
 impl LightProjection {
+    /// An orthographic projection of the light-space window left..right × bottom..top,
+    /// from distance `near` to `far` along the light's view axis.
+    pub fn orthographic(
+        light_from_world: Mat4,
+        (left, right, bottom, top): (f32, f32, f32, f32),
+        near: f32,
+        far: f32,
+    ) -> LightProjection {
+        LightProjection {
+            light_from_world,
+            clip_from_light: glam::camera::rh::proj::directx::orthographic(
+                left, right, bottom, top, near, far,
+            ),
+            kind: ProjectionKind::Orthographic { width: right - left, height: top - bottom },
+            near,
+            far,
+        }
+    }
+
     pub fn clip_from_world(&self) -> Mat4 {
         self.clip_from_light * self.light_from_world
     }
