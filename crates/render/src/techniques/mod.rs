@@ -64,12 +64,12 @@ pub static REGISTRY: &[&dyn ShadowTechnique] = &[
     &pcf::PcfTent,
     &pcf::PcfPoisson,
     &pcss::Pcss,
-    &variance::Vsm,
+    &variance::VSM,
     &esm::Esm,
-    &variance::Evsm2,
-    &variance::Evsm4,
-    &msm::MsmHamburger,
-    &msm::MsmHausdorff,
+    &variance::EVSM2,
+    &variance::EVSM4,
+    &msm::HAMBURGER,
+    &msm::HAUSDORFF,
     &convolution::Convolution,
 ];
 

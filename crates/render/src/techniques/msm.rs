@@ -6,42 +6,31 @@ use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
 
-pub struct MsmHamburger;
-pub struct MsmHausdorff;
-
-/// 16-bit maps store the moments in Peters & Klein's optimised basis (params[0].z = 1).
-fn quantised(precision: MapPrecision) -> f32 {
-    (precision == MapPrecision::Half) as u8 as f32
+/// One moment-map technique: the two differ only in the bound they reconstruct.
+pub struct Msm {
+    technique: Technique,
+    hausdorff: bool,
 }
 
-const MAP: FilterableMap = FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true };
+pub static HAMBURGER: Msm = Msm { technique: Technique::MsmHamburger, hausdorff: false };
+pub static HAUSDORFF: Msm = Msm { technique: Technique::MsmHausdorff, hausdorff: true };
 
-impl ShadowTechnique for MsmHamburger {
+impl ShadowTechnique for Msm {
     fn technique(&self) -> Technique {
-        Technique::MsmHamburger
+        self.technique
     }
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("msm.wgsl")]
     }
+    /// params[0] = (moment bias, 1 for Hausdorff, 1 for the optimised 16-bit basis, 0).
     fn params(&self, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
-        [Vec4::new(s.moments.moment_bias, 0.0, quantised(precision), 0.0), Vec4::ZERO]
+        let quantised = precision == MapPrecision::Half;
+        [
+            Vec4::new(s.moments.moment_bias, self.hausdorff as u8 as f32, quantised as u8 as f32, 0.0),
+            Vec4::ZERO,
+        ]
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
-        Some(MAP)
-    }
-}
-
-impl ShadowTechnique for MsmHausdorff {
-    fn technique(&self) -> Technique {
-        Technique::MsmHausdorff
-    }
-    fn wgsl(&self) -> &'static [&'static str] {
-        &[include_str!("msm.wgsl")]
-    }
-    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
-        [Vec4::new(s.moments.moment_bias, 1.0, quantised(precision), 0.0), Vec4::ZERO]
-    }
-    fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
-        Some(MAP)
+        Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })
     }
 }

@@ -7,70 +7,39 @@ use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
 
-pub struct Vsm;
-pub struct Evsm2;
-pub struct Evsm4;
-
-const WGSL: &[&str] = &[include_str!("variance.wgsl")];
-
 /// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
 /// 16-bit float (max 65504): ln(65504) / 2.
 pub const HALF_MAX_EXPONENT: f32 = 5.54;
 
-/// params[0] = (variant, c⁺, c⁻, minimum variance), params[1].x = bleeding reduction.
-/// At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
-fn params(variant: f32, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
-    let m = &s.moments;
-    let limit = if precision == MapPrecision::Half { HALF_MAX_EXPONENT } else { f32::MAX };
-    [
-        Vec4::new(variant, m.evsm_positive.min(limit), m.evsm_negative.min(limit), m.min_variance),
-        Vec4::new(m.bleeding_reduction, 0.0, 0.0, 0.0),
-    ]
+/// One technique of the family; they differ only in the warp `variant` selects in
+/// `variance.wgsl`: 0 none (VSM), 2 positive (EVSM2), 4 positive and negative (EVSM4).
+pub struct Chebyshev {
+    technique: Technique,
+    variant: f32,
 }
 
-const MAP: FilterableMap = FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true };
+pub static VSM: Chebyshev = Chebyshev { technique: Technique::Vsm, variant: 0.0 };
+pub static EVSM2: Chebyshev = Chebyshev { technique: Technique::Evsm2, variant: 2.0 };
+pub static EVSM4: Chebyshev = Chebyshev { technique: Technique::Evsm4, variant: 4.0 };
 
-impl ShadowTechnique for Vsm {
+impl ShadowTechnique for Chebyshev {
     fn technique(&self) -> Technique {
-        Technique::Vsm
+        self.technique
     }
     fn wgsl(&self) -> &'static [&'static str] {
-        WGSL
+        &[include_str!("variance.wgsl")]
     }
-    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
-        params(0.0, s, p)
-    }
-    fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
-        Some(MAP)
-    }
-}
-
-impl ShadowTechnique for Evsm2 {
-    fn technique(&self) -> Technique {
-        Technique::Evsm2
-    }
-    fn wgsl(&self) -> &'static [&'static str] {
-        WGSL
-    }
-    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
-        params(2.0, s, p)
+    /// params[0] = (variant, c⁺, c⁻, minimum variance), params[1].x = bleeding
+    /// reduction. At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
+    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
+        let m = &s.moments;
+        let limit = if precision == MapPrecision::Half { HALF_MAX_EXPONENT } else { f32::MAX };
+        [
+            Vec4::new(self.variant, m.evsm_positive.min(limit), m.evsm_negative.min(limit), m.min_variance),
+            Vec4::new(m.bleeding_reduction, 0.0, 0.0, 0.0),
+        ]
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
-        Some(MAP)
-    }
-}
-
-impl ShadowTechnique for Evsm4 {
-    fn technique(&self) -> Technique {
-        Technique::Evsm4
-    }
-    fn wgsl(&self) -> &'static [&'static str] {
-        WGSL
-    }
-    fn params(&self, s: &FilterSettings, p: MapPrecision) -> [Vec4; 2] {
-        params(4.0, s, p)
-    }
-    fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
-        Some(MAP)
+        Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })
     }
 }
