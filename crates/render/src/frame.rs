@@ -309,24 +309,8 @@ impl<'g> Renderer<'g> {
         let gpu = self.gpu;
         let device = &gpu.device;
         let (pending, shadow_pending, timestamps, stats) = gpu.checked("rendering the frame", || {
-            let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("light"),
-                contents: bytemuck::bytes_of(&light_gpu),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let camera_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("camera"),
-                contents: bytemuck::bytes_of(&camera_gpu),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("scene"),
-                layout: &self.layouts.scene,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uploaded.instances.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: light_buffer.as_entire_binding() },
-                ],
-            });
+            let (light_buffer, scene_group) = self.scene_group(uploaded, &light_gpu);
+            let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
             let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("camera"),
                 layout: &self.layouts.camera,
@@ -371,19 +355,7 @@ impl<'g> Renderer<'g> {
                     clip_from_world: light_gpu.cascade_clip_from_world[layer as usize],
                     ..light_gpu
                 };
-                let layer_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("light, one cascade"),
-                    contents: bytemuck::bytes_of(&layer_light),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-                let layer_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("scene, one cascade"),
-                    layout: &self.layouts.scene,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: uploaded.instances.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: layer_buffer.as_entire_binding() },
-                    ],
-                });
+                let (_, layer_group) = self.scene_group(uploaded, &layer_light);
                 let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(wgpu::TextureViewDimension::D2),
                     base_array_layer: layer,
@@ -604,6 +576,21 @@ impl<'g> Renderer<'g> {
         })
     }
 
+    /// Group 0 of the geometry passes: the instances and a uniform buffer holding
+    /// `light` (returned too, for the passes that bind it elsewhere).
+    fn scene_group(&self, uploaded: &GpuScene, light: &LightGpu) -> (wgpu::Buffer, wgpu::BindGroup) {
+        let buffer = uniform_buffer(&self.gpu.device, "light", light);
+        let group = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &self.layouts.scene,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uploaded.instances.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+            ],
+        });
+        (buffer, group)
+    }
+
     /// Records the shadow pass: every caster, depth only, from the light.
     #[allow(clippy::too_many_arguments)]
     fn record_shadow_pass(
@@ -668,6 +655,14 @@ impl<'g> Renderer<'g> {
 
 /// Timestamp queries per frame: begin and end of the shadow, lighting and moment passes.
 const TIMESTAMPS: u32 = 6;
+
+fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, contents: &T) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::bytes_of(contents),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
+}
 
 /// Background colour of the image, linear RGB.
 const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
