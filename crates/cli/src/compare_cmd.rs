@@ -6,11 +6,17 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use gnomon_reference::{
+    aliasing::{self, AliasingImage, AliasingInput},
+    flicker::{Flicker, FlickerCounter, PathFrame, shadow_states},
     heatmap,
     metrics::{self, Metrics, PixelClass, RasterView},
 };
-use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
-use gnomon_scene::{Settings, settings::Technique};
+use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_scene::{
+    Scene, Settings,
+    camera_path::{CameraPathKind, camera_on_path},
+    settings::{CameraSettings, CascadeSelection, Technique},
+};
 use image::RgbaImage;
 use serde::Serialize;
 
@@ -27,7 +33,8 @@ pub struct CompareArgs {
     #[arg(long, value_enum, value_delimiter = ',', default_value = "hard,pcf2x2,pcf")]
     pub techniques: Vec<Technique>,
     /// Output directory (created if missing): grid.png, metrics.json, metrics.md,
-    /// reference.png, and TECHNIQUE.png and TECHNIQUE-error.png per technique.
+    /// reference.png, aliasing.png (the heat-map of m), and TECHNIQUE.png and
+    /// TECHNIQUE-error.png per technique.
     #[arg(long, short, default_value = "compare", help_heading = "Outputs")]
     pub out: PathBuf,
     /// Frames rendered per technique to time its passes (the median is reported); 1 to 100.
@@ -39,6 +46,19 @@ pub struct CompareArgs {
     /// Print the adapter, driver and backend.
     #[arg(long, short)]
     pub verbose: bool,
+    /// Also measure temporal flicker: render every technique and the reference at
+    /// `--path-frames` frames along this camera path (the scene and light still), and
+    /// report how many pixels flip between shadow and light from frame to frame beyond
+    /// the reference's own flips.
+    #[arg(long, value_enum, help_heading = "Camera path")]
+    pub camera_path: Option<CameraPathKind>,
+    /// Frames along the camera path, 2 to 240.
+    #[arg(long, value_name = "K", default_value_t = 16, help_heading = "Camera path")]
+    pub path_frames: u32,
+    /// How far the eye travels over the whole path, as a fraction of its distance to
+    /// the target (an orbit's arc: that angle in radians); in (0, 1].
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.05, help_heading = "Camera path")]
+    pub path_travel: f32,
     #[command(flatten)]
     pub settings: Settings,
 }
@@ -66,6 +86,26 @@ struct Row {
     moment_format: Option<String>,
     /// Median GPU milliseconds of the lighting pass.
     lighting_ms: Option<f64>,
+    /// Flicker along `--camera-path`, when one was given.
+    flicker: Option<Flicker>,
+}
+
+/// Perspective aliasing of the shadow layout at the first frame (the same for every
+/// technique: the layout does not depend on the filter).
+#[derive(Serialize)]
+struct AliasingSummary {
+    /// Mean over the shaded pixels of m, the screen pixels one shadow texel covers.
+    mean: f32,
+    max: f32,
+}
+
+/// The camera path of a flicker measurement.
+#[derive(Serialize)]
+struct PathReport {
+    kind: CameraPathKind,
+    frames: u32,
+    travel: f32,
+    frozen_cascades: bool,
 }
 
 #[derive(Serialize)]
@@ -78,6 +118,8 @@ struct Report<'a> {
     reference_samples: u32,
     adapter: String,
     backend: String,
+    aliasing: AliasingSummary,
+    camera_path: Option<PathReport>,
     rows: Vec<Row>,
 }
 
@@ -91,6 +133,16 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
+    );
+    anyhow::ensure!(
+        (2..=240).contains(&args.path_frames),
+        "--path-frames = {} is invalid: 2 to 240",
+        args.path_frames
+    );
+    anyhow::ensure!(
+        args.path_travel > 0.0 && args.path_travel <= 1.0,
+        "--path-travel = {} is invalid: a fraction in (0, 1]",
+        args.path_travel
     );
     let (scene, settings) = lab::load(&args.scene, &args.settings)?;
     let settings = &settings;
@@ -124,6 +176,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         frames.push(Rendered { technique, frame, timing });
     }
 
+    let flicker = match args.camera_path {
+        Some(kind) => measure_flicker(args, kind, &mut renderer, &uploaded, &scene, settings)?,
+        None => vec![None; args.techniques.len()],
+    };
+    let aliasing = measure_aliasing(&frames[0].frame, settings);
+
     let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
     let soft = reference.samples > 1;
     let (w, h) = (reference.width, reference.height);
@@ -143,7 +201,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         h,
         &output::visibility_rgba(&reference.visibility),
     )?;
-    for Rendered { technique, frame, timing } in &frames {
+    staged.png_rgba(&args.out.join("aliasing.png"), w, h, &aliasing::heatmap(&aliasing))?;
+    for (Rendered { technique, frame, timing }, flicker) in frames.iter().zip(flicker) {
         let raster =
             RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
         let classes: Vec<PixelClass> = metrics::classify(raster, &reference);
@@ -188,6 +247,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             filter_ms: timing.and_then(|t| t.1),
             lighting_ms: timing.map(|t| t.2),
             moment_format: frame.moment_format.map(|f| format!("{f:?}").to_lowercase()),
+            flicker,
         });
     }
     let legend: Vec<(String, [u8; 3])> = if soft {
@@ -215,6 +275,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         reference_samples: reference.samples,
         adapter: gpu.info.adapter.clone(),
         backend: gpu.info.backend.clone(),
+        aliasing: AliasingSummary { mean: aliasing.mean, max: aliasing.max },
+        camera_path: args.camera_path.map(|kind| PathReport {
+            kind,
+            frames: args.path_frames,
+            travel: args.path_travel,
+            frozen_cascades: settings.shadow.cascades.freeze,
+        }),
         rows,
     };
     let table = markdown_table(&report, soft);
@@ -224,6 +291,91 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     print!("{table}");
     eprintln!("gnomon: wrote {} files to {}", written.len(), args.out.display());
     Ok(())
+}
+
+/// Lloyd's m over `frame`, with the cascade selection of `settings`.
+fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
+    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
+    aliasing::measure(&AliasingInput {
+        width: frame.width,
+        height: frame.height,
+        position: &frame.position,
+        normal: &frame.normal,
+        depth: &frame.depth,
+        camera: &frame.camera,
+        light: &frame.light,
+        layers: &layers,
+        splits: &frame.cascade_splits,
+        select_by_projection: settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
+        resolution: frame.shadow_resolution,
+    })
+}
+
+/// Renders every technique and the reference along the camera path and counts, for
+/// each technique, the shadow flips between consecutive frames.
+fn measure_flicker(
+    args: &CompareArgs,
+    kind: CameraPathKind,
+    renderer: &mut Renderer,
+    uploaded: &GpuScene,
+    scene: &Scene,
+    settings: &Settings,
+) -> anyhow::Result<Vec<Option<Flicker>>> {
+    let start = settings.resolve_camera(scene)?;
+    let mut counters = vec![FlickerCounter::default(); args.techniques.len()];
+    let mut previous: Vec<Option<PathFrame>> = vec![None; args.techniques.len()];
+    let mut frozen = None;
+    let bar = indicatif::ProgressBar::new(args.path_frames as u64).with_style(
+        indicatif::ProgressStyle::with_template("camera path {bar:40} {pos}/{len} frames, {eta} left")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    for k in 0..args.path_frames {
+        let fraction = k as f32 / (args.path_frames - 1) as f32;
+        let camera = camera_on_path(&start, kind, args.path_travel, fraction);
+        let mut s = settings.clone();
+        // Every camera field explicit, so that no plane is refitted along the path.
+        s.camera = CameraSettings {
+            eye: Some(camera.eye),
+            target: Some(camera.target),
+            fov_y_degrees: Some(camera.fov_y_degrees),
+            near: Some(camera.near),
+            far: Some(camera.far),
+        };
+        let reference = bar.suspend(|| lab::reference(scene, &s, !args.no_cache))?.image;
+        for (t, &technique) in args.techniques.iter().enumerate() {
+            s.shadow.filter.technique = technique;
+            let request = OutputRequest { fixed_layout: frozen.clone(), ..Default::default() };
+            let frame = renderer.render_uploaded(uploaded, scene, &s, &request)?;
+            if settings.shadow.cascades.freeze && frozen.is_none() {
+                frozen = Some(frame.shadow_layout());
+            }
+            let raster = RasterView {
+                visibility: &frame.visibility,
+                object_id: &frame.object_id,
+                depth: &frame.depth,
+            };
+            let classes = metrics::classify(raster, &reference);
+            let aspect = frame.width as f32 / frame.height as f32;
+            let current = PathFrame {
+                width: frame.width,
+                height: frame.height,
+                clip_from_world: frame.camera.clip_from_world(aspect),
+                view_from_world: frame.camera.view_from_world(),
+                technique: shadow_states(&frame.visibility, &classes),
+                reference: shadow_states(&reference.visibility, &classes),
+                position: frame.position,
+                object_id: frame.object_id,
+                depth: frame.depth,
+            };
+            if let Some(before) = &previous[t] {
+                counters[t].add_pair(before, &current);
+            }
+            previous[t] = Some(current);
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(counters.iter().map(|c| Some(c.result())).collect())
 }
 
 /// Wrong pixels outrank silhouettes, which outrank correct ones.
@@ -274,8 +426,24 @@ fn markdown_table(report: &Report, soft: bool) -> String {
         report.adapter,
         report.backend
     );
-    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | silhouette | shadow ms | filter ms | lighting ms |\n");
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str(&format!(
+        "Perspective aliasing m (pixels one shadow texel spans; 1 is ideal): mean {:.3}, max {:.1}\n\n",
+        report.aliasing.mean, report.aliasing.max
+    ));
+    if let Some(p) = &report.camera_path {
+        s.push_str(&format!(
+            "Flicker along a {:?} path of {} frames, the eye travelling {} of its distance to the target{}. Flips: the pixels that change between shadow and light from frame to frame, the technique's rate minus the reference's. Shimmer: of the pixels that reproject onto the same surface point of the previous frame, those that flip while the reference does not\n\n",
+            p.kind,
+            p.frames,
+            p.travel,
+            if p.frozen_cascades { ", cascades frozen at the first frame" } else { "" }
+        ));
+    }
+    let path = report.camera_path.is_some();
+    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | silhouette | shadow ms | filter ms | lighting ms |");
+    s.push_str(if path { " flips − reference | shimmer |\n" } else { "\n" });
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    s.push_str(if path { "---|---|\n" } else { "\n" });
     let ms = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into());
     for r in &report.rows {
         let m = &r.metrics;
@@ -294,6 +462,15 @@ fn markdown_table(report: &Report, soft: bool) -> String {
             if r.filter_ms.is_some() { ms(r.filter_ms) } else { "–".into() },
             ms(r.lighting_ms)
         ));
+        if let Some(f) = &r.flicker {
+            s.pop();
+            s.push_str(&format!(
+                " {:+.4}% of {:.4}% | {:.4}% |\n",
+                100.0 * f.excess_flip_rate,
+                100.0 * f.reference_flip_rate,
+                100.0 * f.shimmer_rate
+            ));
+        }
     }
     s
 }

@@ -81,7 +81,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(settings)?;
-    let request = OutputRequest { shadow_map: args.shadow_map_out.is_some() };
+    let request = OutputRequest { shadow_map: args.shadow_map_out.is_some(), ..Default::default() };
     let render_started = std::time::Instant::now();
     let frame = renderer.render(&scene, settings, &request)?;
     if args.verbose {

@@ -80,13 +80,26 @@ pub fn fit_cascade_stable(
     let texel = 2.0 * radius / resolution as f32;
     let c = light_from_world.transform_point3(centre);
     let snapped = Vec3::new((c.x / texel).floor() * texel, (c.y / texel).floor() * texel, c.z);
+    // Depth spans the whole scene along the light, whatever the slice: a depth range
+    // that followed the camera would change every stored depth a little each frame.
     let casters = scene.transformed(light_from_world);
     let margin = 1e-3 * scene.bounding_radius().max(1e-3);
     let near = -casters.max.z - margin;
-    let far = (-(c.z - radius)).max(-casters.min.z) + margin;
+    let far = -casters.min.z + margin;
     let (left, right) = (snapped.x - radius, snapped.x + radius);
     let (bottom, top) = (snapped.y - radius, snapped.y + radius);
     LightProjection::orthographic(light_from_world, (left, right, bottom, top), near, far)
+}
+
+/// A view depth range widened to steps of 2^(1/4): `near` down and `far` up to the
+/// nearest step. Stable cascades split this range, so that the splits (and with them
+/// the slices' bounding spheres) stay put while the camera moves, and jump only when
+/// the seen range crosses a step, instead of shimmering every frame.
+pub fn quantized_depth_range(near: f32, far: f32) -> (f32, f32) {
+    const STEPS_PER_OCTAVE: f32 = 4.0;
+    let down = |z: f32| (z.log2() * STEPS_PER_OCTAVE).floor() / STEPS_PER_OCTAVE;
+    let up = |z: f32| (z.log2() * STEPS_PER_OCTAVE).ceil() / STEPS_PER_OCTAVE;
+    (2f32.powf(down(near)), 2f32.powf(up(far)))
 }
 
 /// The light-space x and y of an orthographic window's left-bottom corner, which
@@ -103,6 +116,22 @@ pub fn window_origin(projection: &LightProjection) -> (f32, f32) {
 mod tests {
     use super::*;
     use crate::{ProjectionKind, projection::view_from_world_look_at};
+
+    #[test]
+    fn quantized_depth_ranges_contain_the_range_and_snap_to_steps() {
+        let mut rng = Lcg(7);
+        for _ in 0..500 {
+            let near = rng.range(0.01, 10.0);
+            let far = near + rng.range(0.1, 500.0);
+            let (n, f) = quantized_depth_range(near, far);
+            assert!(n <= near && f >= far, "{near}..{far} → {n}..{f}");
+            assert!(n > near / 2f32.powf(0.26) && f < far * 2f32.powf(0.26), "within one step");
+            // A small move of the range keeps the same steps, mostly.
+            let steps = |z: f32| z.log2() * 4.0;
+            assert!((steps(n) - steps(n).round()).abs() < 1e-3 && (steps(f) - steps(f).round()).abs() < 1e-3);
+        }
+        assert_eq!(quantized_depth_range(1.0, 2.0), (1.0, 2.0));
+    }
 
     struct Lcg(u64);
     impl Lcg {

@@ -32,6 +32,9 @@ use crate::{
 pub struct OutputRequest {
     /// Read the shadow map back (resolution² floats).
     pub shadow_map: bool,
+    /// Draw the shadow maps with this layout instead of fitting one to the camera:
+    /// frozen cascades, to watch how a layout fitted to one view serves another.
+    pub fixed_layout: Option<ShadowLayout>,
 }
 
 /// The light's depth map as rendered, with what is needed to interpret it.
@@ -103,6 +106,12 @@ pub struct PassTimings {
 impl Frame {
     pub fn pixel_count(&self) -> usize {
         (self.width * self.height) as usize
+    }
+
+    /// The shadow layout this frame was drawn with, to draw others with it
+    /// ([`OutputRequest::fixed_layout`]).
+    pub fn shadow_layout(&self) -> ShadowLayout {
+        ShadowLayout { projections: self.cascades.clone(), splits: self.cascade_splits.clone() }
     }
 
     /// World size of one shadow texel at `world` (which must be in front of the light).
@@ -248,7 +257,8 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
-        let submitted = self.submit(uploaded, scene, settings, true, request.shadow_map)?;
+        let submitted =
+            self.submit(uploaded, scene, settings, true, request.shadow_map, request.fixed_layout.as_ref())?;
         self.read_frame(submitted, settings)
     }
 
@@ -260,7 +270,7 @@ impl<'g> Renderer<'g> {
         scene: &Scene,
         settings: &Settings,
     ) -> Result<(Option<PassTimings>, DrawStats), RenderError> {
-        let submitted = self.submit(uploaded, scene, settings, false, false)?;
+        let submitted = self.submit(uploaded, scene, settings, false, false, None)?;
         Ok((submitted.timings, submitted.stats))
     }
 
@@ -273,6 +283,7 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         read_images: bool,
         read_shadow_map: bool,
+        fixed_layout: Option<&ShadowLayout>,
     ) -> Result<Submitted, RenderError> {
         settings.validate()?;
         self.check_limits(settings)?;
@@ -282,7 +293,10 @@ impl<'g> Renderer<'g> {
         let resolution = shadow.map.resolution;
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
-        let layout = shadow_layout(scene, &light, &camera, aspect, settings);
+        let layout = match fixed_layout {
+            Some(layout) => layout.clone(),
+            None => shadow_layout(scene, &light, &camera, aspect, settings),
+        };
         let layers = layout.projections.len() as u32;
         let technique = techniques::lookup(shadow.filter.technique);
         let filterable_map = technique.filterable_map(&shadow.filter);
@@ -720,6 +734,15 @@ pub fn shadow_layout(
     let (seen_near, seen_far) = depths.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
     let near = seen_near.max(camera.near);
     let far = seen_far.min(camera.far).min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
+    // Stable cascades split a range that moves in steps, so that their slices do not
+    // change size with every move of the camera.
+    let (near, far) = match c.cascade_fit {
+        CascadeFit::Stable => {
+            let (n, f) = cascades::quantized_depth_range(near, far);
+            (n.max(camera.near), f.min(camera.far))
+        }
+        CascadeFit::Tight => (near, far),
+    };
     let scheme = match c.split {
         SplitScheme::Uniform => cascades::SplitScheme::Uniform,
         SplitScheme::Log => cascades::SplitScheme::Logarithmic,

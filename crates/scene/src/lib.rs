@@ -2,6 +2,7 @@
 //! render settings, and the built-in procedural scenes. No GPU.
 
 pub mod builtin;
+pub mod camera_path;
 pub mod geometry;
 pub mod gltf_loader;
 mod model;

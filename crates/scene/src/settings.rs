@@ -576,6 +576,10 @@ pub struct CascadeSettings {
     /// next, as a fraction of the cascade's depth range: 0 to 0.5.
     #[arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades")]
     pub cascade_blend: f32,
+    /// Keep the cascades fitted to the first frame while the camera moves (along
+    /// `compare --camera-path`, or in the viewer), to see what refitting buys.
+    #[arg(long = "freeze-cascades", help_heading = "Cascades")]
+    pub freeze: bool,
 }
 
 impl Default for CascadeSettings {
@@ -588,6 +592,7 @@ impl Default for CascadeSettings {
             cascade_fit: CascadeFit::default(),
             cascade_selection: CascadeSelection::default(),
             cascade_blend: 0.1,
+            freeze: false,
         }
     }
 }
