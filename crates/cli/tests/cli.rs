@@ -190,6 +190,7 @@ fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
     assert_eq!(
         files_in(&dir.join("cmp")),
         [
+            "aliasing.png",
             "grid.png",
             "hard-error.png",
             "hard.png",
@@ -224,6 +225,39 @@ fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
             assert_eq!(a[key], b[key], "{key}");
         }
     }
+}
+
+#[test]
+fn compare_along_a_camera_path_reports_m_flips_and_shimmer() {
+    let dir = temp_dir("camera-path");
+    let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(&dir)
+        .env("GNOMON_CACHE_DIR", dir.join("cache"))
+        .args(["compare", "columns", "--width", "160", "--height", "90", "--shadow-res", "512"])
+        .args(["--techniques", "hard", "--out", "cmp", "--timing-frames", "1"])
+        .args(["--camera-path", "orbit", "--path-frames", "3", "--partition", "cascades"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cmp/metrics.json")).unwrap()).unwrap();
+    let m = json["aliasing"]["mean"].as_f64().unwrap();
+    assert!(m > 0.01 && m < 100.0, "mean m {m}");
+    let flicker = &json["rows"][0]["flicker"];
+    assert_eq!(flicker["pairs"].as_u64(), Some(2), "{flicker}");
+    // An orbit of 0.05 rad moves the shadows across the screen: the reference flips.
+    assert!(flicker["reference_flip_rate"].as_f64().unwrap() > 0.0, "{flicker}");
+    let shimmer = flicker["shimmer_rate"].as_f64().unwrap();
+    assert!((0.0..0.05).contains(&shimmer), "{flicker}");
+    // Bad path parameters name the flag and the valid range, and write nothing.
+    let bad = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(&dir)
+        .args(["compare", "columns", "--camera-path", "dolly", "--path-frames", "1", "--out", "bad"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("--path-frames = 1 is invalid: 2 to 240"), "{}", stderr(&bad));
+    assert!(!dir.join("bad").exists());
 }
 
 #[test]
