@@ -209,7 +209,8 @@ pub fn shadow_map_to_gray16(map: &ShadowMapImage, projection: &LightProjection) 
             let z = linearize_perspective_depth(d, projection.near, projection.far);
             (z - projection.near) / (projection.far - projection.near)
         }
-        ProjectionKind::Orthographic { .. } => d,
+        // Warped depth is monotonic along each ray, which is all a picture needs.
+        ProjectionKind::Orthographic { .. } | ProjectionKind::Warped { .. } => d,
     };
     let covered = map.depth.iter().copied().filter(|&d| d < 1.0).map(linear);
     let (lo, hi) = covered.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));

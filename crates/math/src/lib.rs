@@ -1,6 +1,7 @@
 //! Pure shadow-mapping math, with no GPU: bounding boxes, camera and light
 //! projections, and the mapping from normalized device coordinates to shadow-map
-//! texture coordinates; and the filter kernels the shaders use ([`kernels`]).
+//! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
+//! [`warping`]); and the filter kernels the shaders use ([`kernels`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -16,6 +17,7 @@ pub mod fitting;
 pub mod kernels;
 mod light;
 mod projection;
+pub mod warping;
 
 pub use aabb::Aabb;
 pub use light::{LightProjection, ProjectionKind, directional_light_projection, spot_light_projection};

@@ -12,6 +12,11 @@ pub enum ProjectionKind {
     Orthographic { width: f32, height: f32 },
     /// Rays from a point; `fov` is the full (square) field of view in radians.
     Perspective { fov: f32 },
+    /// Parallel rays through a perspective warp of the light's view plane
+    /// ([`crate::warping`]): texels vary in size across the map. `width` × `height` is
+    /// the world extent of the warped window's far edge and its depth along the warp's
+    /// axis; the true size of a texel is local (see [`LightProjection::texel_world_size`]).
+    Warped { width: f32, height: f32 },
 }
 
 /// Everything a renderer needs to draw and sample one shadow map.
@@ -56,6 +61,9 @@ impl LightProjection {
         match self.kind {
             ProjectionKind::Orthographic { width, height } => width.max(height) / resolution as f32,
             ProjectionKind::Perspective { fov } => 2.0 * distance * (0.5 * fov).tan() / resolution as f32,
+            // The largest texel, at the far edge: conservative for biases. The shader
+            // measures the local size from the projection itself.
+            ProjectionKind::Warped { width, height } => width.max(height) / resolution as f32,
         }
     }
 
@@ -89,7 +97,9 @@ impl LightProjection {
     /// uses `texel = k_ortho + k_persp · d`.
     pub fn texel_size_coefficients(&self, resolution: u32) -> (f32, f32) {
         match self.kind {
-            ProjectionKind::Orthographic { .. } => (self.texel_world_size(resolution, 0.0), 0.0),
+            ProjectionKind::Orthographic { .. } | ProjectionKind::Warped { .. } => {
+                (self.texel_world_size(resolution, 0.0), 0.0)
+            }
             ProjectionKind::Perspective { .. } => (0.0, self.texel_world_size(resolution, 1.0)),
         }
     }

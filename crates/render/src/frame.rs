@@ -3,14 +3,16 @@
 
 use glam::{Vec3, Vec4};
 use gnomon_math::{
-    LightProjection, cascades, directional_light_projection,
+    LightProjection, ProjectionKind, cascades, directional_light_projection,
     fitting::{Hexahedron, fit_directional_to_receivers, intersection_vertices},
     spot_light_projection,
+    warping::{Warp, WarpView, fit_warped},
 };
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
     settings::{
         CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition, SplitScheme,
+        WarpKind,
     },
 };
 use wgpu::util::DeviceExt;
@@ -717,6 +719,11 @@ pub fn shadow_layout(
         projections: vec![light_projection(scene, light, camera, aspect, settings.shadow.map.fit)],
         splits: vec![0.0, f32::INFINITY],
     };
+    if let (Light::Directional(sun), Partition::Single, Some(warp)) =
+        (light, settings.shadow.partition, warp_of(settings.shadow.map.warp))
+    {
+        return warped_layout(scene, sun.direction, camera, aspect, warp).unwrap_or_else(single);
+    }
     let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
         return single();
     };
@@ -725,15 +732,11 @@ pub fn shadow_layout(
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
     // The view depths that hold any of the scene: beyond them a cascade would cover
     // nothing.
-    let view_from_world = camera.view_from_world();
     let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
-    if receivers.is_empty() {
+    let Some((near, far)) = seen_depth_range(camera, &receivers) else {
         return single();
-    }
-    let depths = receivers.iter().map(|p| -view_from_world.transform_point3(*p).z);
-    let (seen_near, seen_far) = depths.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
-    let near = seen_near.max(camera.near);
-    let far = seen_far.min(camera.far).min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
+    };
+    let far = far.min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
     // Stable cascades split a range that moves in steps, so that their slices do not
     // change size with every move of the camera.
     let (near, far) = match c.cascade_fit {
@@ -768,6 +771,46 @@ pub fn shadow_layout(
         projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
         splits,
     }
+}
+
+fn warp_of(kind: WarpKind) -> Option<Warp> {
+    match kind {
+        WarpKind::None => None,
+        WarpKind::Lispsm => Some(Warp::LightSpacePerspective),
+        WarpKind::Tsm => Some(Warp::Trapezoidal),
+    }
+}
+
+/// A sun's single map warped over the receivers the camera sees; None when it sees
+/// none of the scene.
+fn warped_layout(
+    scene: &Scene,
+    direction: Vec3,
+    camera: &Camera,
+    aspect: f32,
+    warp: Warp,
+) -> Option<ShadowLayout> {
+    let bounds = scene.bounds();
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
+    let (near, far) = seen_depth_range(camera, &receivers)?;
+    let view = WarpView { eye: camera.eye, forward: (camera.target - camera.eye).normalize(), near, far };
+    Some(ShadowLayout {
+        projections: vec![fit_warped(warp, direction, &bounds, &receivers, &view)],
+        splits: vec![0.0, f32::INFINITY],
+    })
+}
+
+/// The view depths, within the camera's planes, that hold any of `receivers`.
+fn seen_depth_range(camera: &Camera, receivers: &[Vec3]) -> Option<(f32, f32)> {
+    if receivers.is_empty() {
+        return None;
+    }
+    let view_from_world = camera.view_from_world();
+    let depths = receivers.iter().map(|p| -view_from_world.transform_point3(*p).z);
+    let (seen_near, seen_far) = depths.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let near = seen_near.max(camera.near);
+    Some((near, seen_far.min(camera.far).max(near * 1.001)))
 }
 
 fn render_target(
@@ -830,7 +873,11 @@ fn light_uniform(
     let mut cascade_texel = [Vec4::ZERO; MAX_CASCADES];
     for (i, p) in layout.projections.iter().enumerate() {
         cascade_clip_from_world[i] = p.clip_from_world();
-        cascade_texel[i] = Vec4::new(p.texel_size_coefficients(resolution).0, 0.0, 0.0, 0.0);
+        // y flags a warped layer, whose texel size the shader measures locally, by
+        // differences z world units apart (about a texel at the far edge).
+        let warped = matches!(p.kind, ProjectionKind::Warped { .. });
+        let texel = p.texel_size_coefficients(resolution).0;
+        cascade_texel[i] = Vec4::new(texel, warped as u8 as f32, texel, 0.0);
     }
     let mut splits = [0.0f32; 12];
     for (slot, z) in splits.iter_mut().zip(&layout.splits) {

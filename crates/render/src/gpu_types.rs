@@ -47,7 +47,9 @@ pub struct LightGpu {
     pub ambient: Vec4,
     /// Each layer's (cascade's) clip_from_world; layer 0 equals `clip_from_world`.
     pub cascade_clip_from_world: [Mat4; MAX_CASCADES],
-    /// x: each layer's orthographic texel world size (0 for a perspective map).
+    /// x: each layer's texel world size (orthographic; the largest for a warped map;
+    /// 0 for a perspective map); y: 1 for a warped layer, whose texel size the shader
+    /// measures locally; z: the world step of that measurement.
     pub cascade_texel: [Vec4; MAX_CASCADES],
     /// The view depths where the cascades start and end, packed four to a vector:
     /// cascade i spans split i to split i + 1.

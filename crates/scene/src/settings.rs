@@ -491,12 +491,37 @@ pub struct MapSettings {
     /// What a sun's map covers (a spot's map always covers its cone).
     #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
     pub fit: Fit,
+    /// Perspective warp of a sun's single map, fitted to the receivers. Warped maps store
+    /// depth that is monotonic along each light ray but not linear in distance, so they
+    /// take the depth-comparison techniques (hard and the PCF family) with kernels in
+    /// texels; a spot's map is perspective already and ignores this.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub warp: WarpKind,
 }
 
 impl Default for MapSettings {
     fn default() -> Self {
-        Self { resolution: 2048, format: MapFormat::default(), fit: Fit::default() }
+        Self {
+            resolution: 2048,
+            format: MapFormat::default(),
+            fit: Fit::default(),
+            warp: WarpKind::default(),
+        }
     }
+}
+
+/// Perspective warps of a sun's map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum WarpKind {
+    /// No warp: an orthographic map.
+    #[default]
+    None,
+    /// Light-space perspective shadow maps (Wimmer, Scherzer & Purgathofer 2004), with
+    /// n_opt = (z_n + √(z_n·z_f)) / sin γ.
+    Lispsm,
+    /// Trapezoidal shadow maps (Martin & Tan 2004), with the 80 % rule.
+    Tsm,
 }
 
 /// How the light's view is split into shadow maps.
@@ -775,6 +800,37 @@ impl Settings {
             "1 to 64 texels",
         )?;
         f.moments.validate(f.technique)?;
+        if s.map.warp != WarpKind::None {
+            let warp = s.map.warp.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default();
+            check(
+                s.partition == Partition::Single,
+                "--warp",
+                &warp,
+                "a warp of a single map: with --partition cascades use --warp none",
+            )?;
+            check(
+                matches!(
+                    f.technique,
+                    Technique::Hard
+                        | Technique::Pcf2x2
+                        | Technique::Pcf
+                        | Technique::PcfTent
+                        | Technique::PcfPoisson
+                ),
+                "--warp",
+                &warp,
+                format!(
+                    "with --technique {}: a warped map takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson (its depth is not linear in distance)",
+                    f.technique.name()
+                ),
+            )?;
+            check(
+                f.kernel_unit == KernelUnit::Texels,
+                "--warp",
+                &warp,
+                "with --kernel-unit world: a warped map's kernels are in texels",
+            )?;
+        }
         let c = &s.cascades;
         check((1..=8).contains(&c.count), "--cascades", c.count, "1 to 8")?;
         check(
@@ -1010,6 +1066,26 @@ mod tests {
         assert_eq!(s.validate().unwrap_err().flag, "--fov");
         assert!(parse_vec3("1,2").is_err() && parse_vec3("1,x,3").is_err() && parse_vec3("1,inf,2").is_err());
         assert_eq!(parse_vec3(" 1, 2.5,-3").unwrap(), Vec3::new(1.0, 2.5, -3.0));
+    }
+
+    #[test]
+    fn warps_take_a_single_map_and_a_depth_comparison() {
+        let mut s = Settings::default();
+        s.shadow.map.warp = WarpKind::Lispsm;
+        s.validate().unwrap();
+        s.shadow.partition = Partition::Cascades;
+        let e = s.validate().unwrap_err();
+        assert_eq!(e.flag, "--warp");
+        assert!(e.to_string().contains("--warp none"), "{e}");
+        let mut s = Settings::default();
+        s.shadow.map.warp = WarpKind::Tsm;
+        s.shadow.filter.technique = Technique::Vsm;
+        let e = s.validate().unwrap_err();
+        assert!(e.to_string().contains("with --technique vsm"), "{e}");
+        s.shadow.filter.technique = Technique::PcfPoisson;
+        s.validate().unwrap();
+        s.shadow.filter.kernel_unit = KernelUnit::World;
+        assert!(s.validate().unwrap_err().to_string().contains("--kernel-unit world"));
     }
 
     #[test]

@@ -16,7 +16,7 @@ struct Light {
     ambient: vec4<f32>,      // rgb: ambient light
     // One layer of the shadow map per cascade (one in all for a single map).
     cascade_clip_from_world: array<mat4x4<f32>, 8>,
-    cascade_texel: array<vec4<f32>, 8>,  // x: orthographic texel world size
+    cascade_texel: array<vec4<f32>, 8>,  // x: orthographic texel world size; y: 1 when warped; z: warped difference step
     cascade_splits: array<vec4<f32>, 3>, // view depth where cascade i starts (i) and ends (i + 1)
     cascades: vec4<f32>,     // x: count, y: 1 to select by projection, z: blend band, w: moment layers per cascade
 };

@@ -61,9 +61,37 @@ struct FragmentOut {
 // quantisation that the slope bias (zero for it) cannot cover.
 const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 
+// Texture coordinates of `world` in layer `layer`, before any bias.
+fn project_to_map(layer: u32, world: vec3<f32>) -> vec2<f32> {
+    let clip = light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0);
+    return clip.xy / clip.w * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5, 0.5);
+}
+
+// World size of a texel of layer `layer` at `world`. Orthographic and spot maps have a
+// closed form; a warped map (LiSPSM, TSM) is measured: the largest extent of a texel
+// across the light's rays, 1 / σ_min of the Jacobian of texel coordinates along the
+// light's x and y axes, by differences `cascade_texel.z` world units apart.
+fn local_texel_world_size(layer: u32, world: vec3<f32>, distance: f32) -> f32 {
+    if light.cascade_texel[layer].y < 0.5 {
+        return texel_world_size_at(layer, distance);
+    }
+    let step = light.cascade_texel[layer].z;
+    // The light's x and y axes in world space: the first two rows of light_from_world.
+    let m = light.light_from_world;
+    let axis_x = vec3<f32>(m[0].x, m[1].x, m[2].x);
+    let axis_y = vec3<f32>(m[0].y, m[1].y, m[2].y);
+    let t = project_to_map(layer, world);
+    let dx = (project_to_map(layer, world + axis_x * step) - t) * light.texel.w / step;
+    let dy = (project_to_map(layer, world + axis_y * step) - t) * light.texel.w / step;
+    let squares = dot(dx, dx) + dot(dy, dy);
+    let det = abs(dx.x * dy.y - dy.x * dx.y);
+    let sigma_max = sqrt(0.5 * (squares + sqrt(max(squares * squares - 4.0 * det * det, 0.0))));
+    return sigma_max / max(det, 1e-20);
+}
+
 fn shadow_coords(layer: u32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    let texel_world = texel_world_size_at(layer, distance);
+    let texel_world = local_texel_world_size(layer, world, distance);
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
     let p = world + n * (light.texel.z * texel_world * slope);
     let clip = light.cascade_clip_from_world[layer] * vec4<f32>(p, 1.0);
