@@ -11,8 +11,8 @@ use gnomon_math::{
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
     settings::{
-        CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition, SplitScheme,
-        WarpKind,
+        BiasSettings, CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition,
+        SplitScheme, WarpKind,
     },
 };
 use wgpu::util::DeviceExt;
@@ -22,6 +22,7 @@ use crate::{
     gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
         Layouts, SHADOW_FORMAT,
+        depth_reduce::DepthReducePass,
         lighting::{self, LightingPass},
         moments::MomentPass,
         shadow::ShadowPass,
@@ -130,6 +131,7 @@ pub struct Renderer<'g> {
     shadow_pass: ShadowPass,
     lighting_pass: LightingPass,
     moment_pass: MomentPass,
+    depth_reduce: DepthReducePass,
     compare_sampler: wgpu::Sampler,
     moment_sampler: wgpu::Sampler,
     /// Bound in place of a moment map for the depth-comparison techniques.
@@ -183,6 +185,7 @@ impl<'g> Renderer<'g> {
             shadow_pass: ShadowPass::new(device, &layouts),
             lighting_pass: LightingPass::new(device, &layouts),
             moment_pass: MomentPass::new(device),
+            depth_reduce: DepthReducePass::new(device),
             layouts,
             compare_sampler,
             moment_sampler,
@@ -297,7 +300,15 @@ impl<'g> Renderer<'g> {
         let aspect = width as f32 / height as f32;
         let layout = match fixed_layout {
             Some(layout) => layout.clone(),
-            None => shadow_layout(scene, &light, &camera, aspect, settings),
+            None => {
+                let sampled = match (&light, shadow.partition, shadow.cascades.sdsm) {
+                    (Light::Directional(_), Partition::Cascades, true) => {
+                        self.sampled_depth_range(uploaded, settings, &camera, aspect)?
+                    }
+                    _ => None,
+                };
+                shadow_layout(scene, &light, &camera, aspect, settings, sampled)
+            }
         };
         let layers = layout.projections.len() as u32;
         let technique = techniques::lookup(shadow.filter.technique);
@@ -592,6 +603,54 @@ impl<'g> Renderer<'g> {
         })
     }
 
+    /// SDSM's sample distribution: draws the casters' depth from the camera and
+    /// reduces it on the GPU to the nearest and farthest view depth seen. Blocks on
+    /// the two numbers, which the cascades' fit needs before the shadow pass.
+    fn sampled_depth_range(
+        &mut self,
+        uploaded: &GpuScene,
+        settings: &Settings,
+        camera: &Camera,
+        aspect: f32,
+    ) -> Result<Option<(f32, f32)>, RenderError> {
+        let gpu = self.gpu;
+        let device = &gpu.device;
+        let pending = gpu.checked("reducing the camera's depth (SDSM)", || {
+            let (width, height) = (settings.image.width, settings.image.height);
+            let depth = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("camera depth prepass"),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: SHADOW_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            // The shadow pass's pipelines draw it, with the camera's projection and no
+            // bias; back faces (from the camera) culled.
+            let camera_as_light =
+                LightGpu { clip_from_world: camera.clip_from_world(aspect), ..Default::default() };
+            let (_, group) = self.scene_group(uploaded, &camera_as_light);
+            let mut prepass = settings.clone();
+            prepass.shadow.bias = BiasSettings::none();
+            let mut encoder = device.create_command_encoder(&Default::default());
+            self.record_shadow_pass(
+                &mut encoder,
+                uploaded,
+                &prepass,
+                &group,
+                &depth.create_view(&Default::default()),
+                None,
+                &mut DrawStats::default(),
+            );
+            let pending = self.depth_reduce.record(device, &mut encoder, &depth, camera.near, camera.far);
+            gpu.queue.submit([encoder.finish()]);
+            pending
+        })?;
+        pending.read(gpu)
+    }
+
     /// Group 0 of the geometry passes: the instances and a uniform buffer holding
     /// `light` (returned too, for the passes that bind it elsewhere).
     fn scene_group(&self, uploaded: &GpuScene, light: &LightGpu) -> (wgpu::Buffer, wgpu::BindGroup) {
@@ -708,12 +767,17 @@ pub struct ShadowLayout {
 /// The shadow layout of `light` under `settings`: one map, or for a sun with
 /// `--partition cascades`, one per slice of the view frustum, all sharing one depth
 /// range so that every layer stores depth the same way.
+///
+/// `sampled`, for SDSM, is the range of view depths the camera actually sees (from
+/// [`Renderer`]'s depth reduction); the cascades split it instead of the range where
+/// the view frustum meets the scene's bounds.
 pub fn shadow_layout(
     scene: &Scene,
     light: &Light,
     camera: &Camera,
     aspect: f32,
     settings: &Settings,
+    sampled: Option<(f32, f32)>,
 ) -> ShadowLayout {
     let single = || ShadowLayout {
         projections: vec![light_projection(scene, light, camera, aspect, settings.shadow.map.fit)],
@@ -735,6 +799,10 @@ pub fn shadow_layout(
     let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
     let Some((near, far)) = seen_depth_range(camera, &receivers) else {
         return single();
+    };
+    let (near, far) = match sampled {
+        Some((lo, hi)) => (lo.max(camera.near), hi.min(camera.far).max(lo.max(camera.near) * 1.001)),
+        None => (near, far),
     };
     let far = far.min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
     // Stable cascades split a range that moves in steps, so that their slices do not

@@ -131,3 +131,18 @@ impl PendingReadback {
         Ok(out)
     }
 }
+
+/// Maps `buffer` (a MAP_READ copy destination, after the copy's submission) and
+/// returns its contents.
+pub(crate) fn read_buffer<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<T>, RenderError> {
+    let slice = buffer.slice(..);
+    map_blocking(gpu, &slice)?;
+    let out = {
+        let mapped = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })?;
+        bytemuck::pod_collect_to_vec(&mapped)
+    };
+    buffer.unmap();
+    Ok(out)
+}

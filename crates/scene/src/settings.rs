@@ -605,6 +605,12 @@ pub struct CascadeSettings {
     /// `compare --camera-path`, or in the viewer), to see what refitting buys.
     #[arg(long = "freeze-cascades", help_heading = "Cascades")]
     pub freeze: bool,
+    /// Sample-distribution shadow maps (Lauritzen, Salvi & Lefohn 2011): split the view
+    /// depths the camera actually sees, reduced on the GPU from a depth prepass of the
+    /// shadow casters, instead of the depths where the view frustum meets the scene's
+    /// bounds. Costs a prepass and a read back of two numbers before the shadow pass.
+    #[arg(long, help_heading = "Cascades")]
+    pub sdsm: bool,
 }
 
 impl Default for CascadeSettings {
@@ -618,6 +624,7 @@ impl Default for CascadeSettings {
             cascade_selection: CascadeSelection::default(),
             cascade_blend: 0.1,
             freeze: false,
+            sdsm: false,
         }
     }
 }
