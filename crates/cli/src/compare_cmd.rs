@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use gnomon_reference::{
     aliasing::{self, AliasingImage, AliasingInput},
-    flicker::{Flicker, FlickerCounter, PathFrame, shadow_states},
+    flicker::{Flicker, FlickerCounter, PathFrame},
     heatmap,
     metrics::{self, Metrics, PixelClass, RasterView},
 };
@@ -354,19 +354,14 @@ fn measure_flicker(
                 object_id: &frame.object_id,
                 depth: &frame.depth,
             };
-            let classes = metrics::classify(raster, &reference);
-            let aspect = frame.width as f32 / frame.height as f32;
-            let current = PathFrame {
-                width: frame.width,
-                height: frame.height,
-                clip_from_world: frame.camera.clip_from_world(aspect),
-                view_from_world: frame.camera.view_from_world(),
-                technique: shadow_states(&frame.visibility, &classes),
-                reference: shadow_states(&reference.visibility, &classes),
-                position: frame.position,
-                object_id: frame.object_id,
-                depth: frame.depth,
-            };
+            let current = PathFrame::new(
+                &frame.camera,
+                frame.width,
+                frame.height,
+                raster,
+                frame.position.clone(),
+                &reference,
+            );
             if let Some(before) = &previous[t] {
                 counters[t].add_pair(before, &current);
             }

@@ -115,7 +115,7 @@ pub fn window_origin(projection: &LightProjection) -> (f32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{ProjectionKind, projection::view_from_world_look_at};
+    use crate::{ProjectionKind, projection::view_from_world_look_at, test_rng::Lcg};
 
     #[test]
     fn quantized_depth_ranges_contain_the_range_and_snap_to_steps() {
@@ -131,17 +131,6 @@ mod tests {
             assert!((steps(n) - steps(n).round()).abs() < 1e-3 && (steps(f) - steps(f).round()).abs() < 1e-3);
         }
         assert_eq!(quantized_depth_range(1.0, 2.0), (1.0, 2.0));
-    }
-
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f32 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn range(&mut self, lo: f32, hi: f32) -> f32 {
-            lo + (hi - lo) * self.next()
-        }
     }
 
     const SCHEMES: [SplitScheme; 5] = [

@@ -151,20 +151,7 @@ mod tests {
     use super::*;
     use crate::ProjectionKind;
 
-    /// A small deterministic generator for the property tests.
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f32 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn range(&mut self, lo: f32, hi: f32) -> f32 {
-            lo + (hi - lo) * self.next()
-        }
-        fn vec(&mut self, lo: f32, hi: f32) -> Vec3 {
-            Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
-        }
-    }
+    use crate::test_rng::Lcg;
 
     fn random_camera(rng: &mut Lcg) -> Mat4 {
         let eye = rng.vec(-12.0, 12.0);

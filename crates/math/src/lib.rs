@@ -17,6 +17,8 @@ pub mod fitting;
 pub mod kernels;
 mod light;
 mod projection;
+#[cfg(test)]
+mod test_rng;
 pub mod warping;
 
 pub use aabb::Aabb;

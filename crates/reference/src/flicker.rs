@@ -17,7 +17,12 @@
 use glam::{Mat4, Vec3, Vec4Swizzles};
 use serde::Serialize;
 
-use crate::metrics::{DEPTH_TOLERANCE, PixelClass};
+use gnomon_scene::Camera;
+
+use crate::{
+    ReferenceImage,
+    metrics::{self, DEPTH_TOLERANCE, PixelClass, RasterView},
+};
 
 /// Largest distance, in pixels along each axis, between a reprojected point and the
 /// centre of the pixel it lands in, for the pair to count as one surface point. Small,
@@ -48,6 +53,30 @@ pub struct PathFrame {
 }
 
 impl PathFrame {
+    /// A frame of `width` × `height` pixels seen by `camera`: the technique's output
+    /// (`raster`, with its world positions) classified against its frame's reference.
+    pub fn new(
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        raster: RasterView,
+        position: Vec<Vec3>,
+        reference: &ReferenceImage,
+    ) -> PathFrame {
+        let classes = metrics::classify(raster, reference);
+        PathFrame {
+            width,
+            height,
+            clip_from_world: camera.clip_from_world(width as f32 / height as f32),
+            view_from_world: camera.view_from_world(),
+            position,
+            object_id: raster.object_id.to_vec(),
+            depth: raster.depth.to_vec(),
+            technique: shadow_states(raster.visibility, &classes),
+            reference: shadow_states(&reference.visibility, &classes),
+        }
+    }
+
     /// The pixel of this frame that sees `world` within the tolerance of its centre,
     /// on the surface `object_id`, if any.
     fn pixel_seeing(&self, world: Vec3, object_id: u32) -> Option<usize> {

@@ -9,8 +9,8 @@ use glam::Vec3;
 use gnomon_reference::{
     TracedScene,
     aliasing::{self, AliasingInput},
-    flicker::{Flicker, FlickerCounter, PathFrame, shadow_states},
-    metrics::{self, RasterView},
+    flicker::{Flicker, FlickerCounter, PathFrame},
+    metrics::RasterView,
     reference_visibility,
 };
 use gnomon_render::{Frame, OutputRequest, Renderer};
@@ -101,19 +101,14 @@ fn flicker_along_truck(scene: &Scene, traced: &TracedScene, s: &Settings, frames
         let reference = reference_visibility(traced, &frame.camera, &light, &options, &|_| {});
         let raster =
             RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-        let classes = metrics::classify(raster, &reference);
-        let aspect = frame.width as f32 / frame.height as f32;
-        let after = PathFrame {
-            width: frame.width,
-            height: frame.height,
-            clip_from_world: frame.camera.clip_from_world(aspect),
-            view_from_world: frame.camera.view_from_world(),
-            technique: shadow_states(&frame.visibility, &classes),
-            reference: shadow_states(&reference.visibility, &classes),
-            position: frame.position,
-            object_id: frame.object_id,
-            depth: frame.depth,
-        };
+        let after = PathFrame::new(
+            &frame.camera,
+            frame.width,
+            frame.height,
+            raster,
+            frame.position.clone(),
+            &reference,
+        );
         if let Some(b) = &before {
             counter.add_pair(b, &after);
         }
