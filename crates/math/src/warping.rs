@@ -1,8 +1,9 @@
-//! Perspective warps of a directional light's map: light-space perspective shadow maps
+//! Perspective warps of a directional light's map: perspective shadow maps (PSM;
+//! Stamminger & Drettakis 2002, in [`psm`]), light-space perspective shadow maps
 //! (LiSPSM; Wimmer, Scherzer & Purgathofer, EGSR 2004) and trapezoidal shadow maps
 //! (TSM; Martin & Tan, EGSR 2004).
 //!
-//! Both apply a perspective transform in the light's view plane, along the camera's
+//! LiSPSM and TSM apply a perspective transform in the light's view plane, along the camera's
 //! view direction projected onto that plane, so that receivers near the camera get
 //! more texels than far ones. The transform's centre of projection q lies on the
 //! camera's axis, a distance η before the nearest receiver; the map's sides are the
@@ -20,7 +21,9 @@
 //! parallel to the view direction the warp has nothing to work with and both methods
 //! fall back to the orthographic receiver fit (η → ∞ is the orthographic limit).
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+mod psm;
+
+use glam::{DMat2, DVec3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::{
     Aabb, LightProjection, ProjectionKind,
@@ -30,6 +33,8 @@ use crate::{
 /// Which warp to apply.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Warp {
+    /// Perspective shadow maps: the map drawn in the camera's post-perspective space.
+    Perspective,
     /// Light-space perspective shadow maps, with Wimmer's n_opt.
     LightSpacePerspective,
     /// Trapezoidal shadow maps, with the 80 % rule.
@@ -62,6 +67,9 @@ pub fn fit_warped(
     view: &WarpView,
 ) -> LightProjection {
     let fallback = || fit_directional_to_receivers(direction, scene, receivers);
+    if warp == Warp::Perspective {
+        return psm::fit_perspective(direction, scene, receivers, view).unwrap_or_else(fallback);
+    }
     let light_from_world = directional_light_view(direction, scene);
     // The view direction in the light's view plane: its length is sin γ.
     let forward_light = light_from_world.transform_vector3(view.forward);
@@ -85,6 +93,7 @@ pub fn fit_warped(
     }
     let (z_n, z_f) = (view.near, view.far.max(view.near * (1.0 + 1e-4)));
     let eta = match warp {
+        Warp::Perspective => unreachable!("PSM is fitted above"),
         Warp::LightSpacePerspective => (z_n + (z_n * z_f).sqrt()) / sin_gamma,
         Warp::Trapezoidal => {
             // The focus point on the camera's axis, at the view depth √(z_n·z_f).
@@ -142,6 +151,30 @@ pub fn fit_warped(
     }
 }
 
+/// The world extent of the whole map at its coarsest among `points`: 2 / σ_min of the
+/// Jacobian of NDC x and y along the light's x and y axes, the largest over the points.
+/// A texel there spans this over the map's resolution.
+fn largest_texel_span(clip_from_world: Mat4, light_from_world: Mat4, points: &[DVec3]) -> f32 {
+    let clip_from_world = clip_from_world.as_dmat4();
+    let world_from_light = light_from_world.as_dmat4().inverse();
+    let (axis_x, axis_y) = (world_from_light.x_axis.truncate(), world_from_light.y_axis.truncate());
+    let span = |p: &DVec3| {
+        let clip = clip_from_world * p.extend(1.0);
+        // d(xy/w)/dv = ((M v).xy·w − xy·(M v).w) / w².
+        let along = |v: DVec3| {
+            let dv = clip_from_world * v.extend(0.0);
+            (dv.truncate().truncate() * clip.w - clip.truncate().truncate() * dv.w) / (clip.w * clip.w)
+        };
+        let jacobian = DMat2::from_cols(along(axis_x), along(axis_y));
+        // σ_min² is the smaller eigenvalue of JᵀJ.
+        let gram = jacobian.transpose() * jacobian;
+        let (trace, det) = (gram.x_axis.x + gram.y_axis.y, gram.determinant());
+        let sigma_min = (0.5 * (trace - (trace * trace - 4.0 * det).max(0.0).sqrt())).max(0.0).sqrt();
+        2.0 / sigma_min.max(1e-30)
+    };
+    points.iter().map(span).fold(0.0f64, f64::max) as f32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,7 +187,7 @@ mod tests {
         c.xyz() / c.w
     }
 
-    fn scene() -> (Aabb, Vec<Vec3>, WarpView) {
+    pub(super) fn scene() -> (Aabb, Vec<Vec3>, WarpView) {
         let scene = Aabb::new(Vec3::new(-50.0, 0.0, -100.0), Vec3::new(50.0, 10.0, 0.0));
         let eye = Vec3::new(0.0, 2.0, 2.0);
         let view_from_world = crate::view_from_world_look_at(eye, Vec3::new(0.0, 1.0, -50.0), Vec3::Y);
@@ -170,7 +203,7 @@ mod tests {
         let (bounds, receivers, view) = scene();
         // A sun from the side, well off the view direction.
         let direction = Vec3::new(1.0, -1.0, 0.2).normalize();
-        for warp in [Warp::LightSpacePerspective, Warp::Trapezoidal] {
+        for warp in [Warp::Perspective, Warp::LightSpacePerspective, Warp::Trapezoidal] {
             let p = fit_warped(warp, direction, &bounds, &receivers, &view);
             assert!(matches!(p.kind, ProjectionKind::Warped { .. }), "{warp:?} warps");
             for &r in &receivers {
@@ -190,7 +223,7 @@ mod tests {
     fn depth_increases_along_every_light_ray() {
         let (bounds, receivers, view) = scene();
         let direction = Vec3::new(0.3, -1.0, 0.5).normalize();
-        for warp in [Warp::LightSpacePerspective, Warp::Trapezoidal] {
+        for warp in [Warp::Perspective, Warp::LightSpacePerspective, Warp::Trapezoidal] {
             let p = fit_warped(warp, direction, &bounds, &receivers, &view);
             for &r in &receivers {
                 let (a, b) = (ndc(&p, r - direction * 3.0), ndc(&p, r));
@@ -203,10 +236,29 @@ mod tests {
     #[test]
     fn a_light_along_the_view_falls_back_to_the_orthographic_fit() {
         let (bounds, receivers, view) = scene();
-        let p = fit_warped(Warp::LightSpacePerspective, view.forward, &bounds, &receivers, &view);
-        assert!(matches!(p.kind, ProjectionKind::Orthographic { .. }));
-        let expected = fit_directional_to_receivers(view.forward, &bounds, &receivers);
-        assert_eq!(p, expected);
+        for warp in [Warp::Perspective, Warp::LightSpacePerspective, Warp::Trapezoidal] {
+            for direction in [view.forward, -view.forward] {
+                let p = fit_warped(warp, direction, &bounds, &receivers, &view);
+                let expected = fit_directional_to_receivers(direction, &bounds, &receivers);
+                assert_eq!(p, expected, "{warp:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn psm_warps_harder_than_lispsm() {
+        // PSM's warp is set by the camera's own near plane; LiSPSM moves the centre of
+        // projection back to n_opt to spread the error evenly, so its near texels are
+        // less dense and its far ones less sparse (here 30 against 10).
+        let (bounds, receivers, view) = scene();
+        let direction = Vec3::new(1.0, -1.0, 0.2).normalize();
+        let density_ratio = |warp| {
+            let p = fit_warped(warp, direction, &bounds, &receivers, &view);
+            let span = |at: Vec3| (ndc(&p, at + Vec3::X * 0.1) - ndc(&p, at)).truncate().length();
+            span(Vec3::new(0.0, 0.0, -1.0)) / span(Vec3::new(0.0, 0.0, -90.0))
+        };
+        let (psm, lispsm) = (density_ratio(Warp::Perspective), density_ratio(Warp::LightSpacePerspective));
+        assert!(psm > 2.0 * lispsm, "near/far texel density: PSM {psm}, LiSPSM {lispsm}");
     }
 
     #[test]

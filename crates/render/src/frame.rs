@@ -844,6 +844,7 @@ pub fn shadow_layout(
 fn warp_of(kind: WarpKind) -> Option<Warp> {
     match kind {
         WarpKind::None => None,
+        WarpKind::Psm => Some(Warp::Perspective),
         WarpKind::Lispsm => Some(Warp::LightSpacePerspective),
         WarpKind::Tsm => Some(Warp::Trapezoidal),
     }

@@ -517,6 +517,9 @@ pub enum WarpKind {
     /// No warp: an orthographic map.
     #[default]
     None,
+    /// Perspective shadow maps (Stamminger & Drettakis 2002): the map drawn in the
+    /// camera's post-perspective space, the camera slid back to take in every caster.
+    Psm,
     /// Light-space perspective shadow maps (Wimmer, Scherzer & Purgathofer 2004), with
     /// n_opt = (z_n + √(z_n·z_f)) / sin γ.
     Lispsm,
