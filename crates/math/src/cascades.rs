@@ -91,6 +91,36 @@ pub fn fit_cascade_stable(
     LightProjection::orthographic(light_from_world, (left, right, bottom, top), near, far)
 }
 
+/// A tight cascade narrowed to the light-space bounds of the samples it serves (SDSM;
+/// Lauritzen, Salvi & Lefohn 2011, §3.2): the window becomes `samples` (min x, min y,
+/// max x, max y in the light's view space) within the tight window, widened on each
+/// side by `margin_texels` texels of the result, so that filter kernels and normal
+/// offsets read inside the map. The depth range is the tight fit's.
+pub fn fit_cascade_to_samples(
+    tight: &LightProjection,
+    samples: [f32; 4],
+    margin_texels: f32,
+    resolution: u32,
+) -> LightProjection {
+    let Some((left, right, bottom, top)) = tight.orthographic_window() else { return *tight };
+    let (x0, x1) = (samples[0].max(left), samples[2].min(right));
+    let (y0, y1) = (samples[1].max(bottom), samples[3].min(top));
+    let texels = resolution as f32;
+    let margin_texels = margin_texels.clamp(0.0, 0.25 * texels);
+    if !(x0 <= x1 && y0 <= y1) {
+        return *tight;
+    }
+    // The margin is m texels of the widened window: w' = w + 2m·w'/R.
+    let widen = |extent: f32| margin_texels * extent.max(1e-6) / (texels - 2.0 * margin_texels);
+    let (mx, my) = (widen(x1 - x0), widen(y1 - y0));
+    LightProjection::orthographic(
+        tight.light_from_world,
+        (x0 - mx, x1 + mx, y0 - my, y1 + my),
+        tight.near,
+        tight.far,
+    )
+}
+
 /// A view depth range widened to steps of 2^(1/4): `near` down and `far` up to the
 /// nearest step. Stable cascades split this range, so that the splits (and with them
 /// the slices' bounding spheres) stay put while the camera moves, and jump only when
@@ -264,6 +294,31 @@ mod tests {
             for d in [(bx - ax) / texel, (by - ay) / texel] {
                 assert!((d - d.round()).abs() < 1e-2, "moved by {d} texels");
             }
+        }
+    }
+
+    #[test]
+    fn sample_fitted_cascades_hold_their_samples_with_the_margin_inside_the_tight_window() {
+        let scene = Aabb::new(Vec3::new(-20.0, 0.0, -20.0), Vec3::new(20.0, 5.0, 20.0));
+        let direction = Vec3::new(0.4, -1.0, 0.3).normalize();
+        let tight = crate::fitting::fit_directional_to_receivers(direction, &scene, &scene.corners());
+        let (l, r, b, t) = tight.orthographic_window().unwrap();
+        // Samples filling the left half, bottom quarter.
+        let samples = [l, b, 0.5 * (l + r), b + 0.25 * (t - b)];
+        let fitted = fit_cascade_to_samples(&tight, samples, 4.0, 1024);
+        let (fl, fr, fb, ft) = fitted.orthographic_window().unwrap();
+        let texel_x = (fr - fl) / 1024.0;
+        let texel_y = (ft - fb) / 1024.0;
+        assert!((samples[0] - fl - 4.0 * texel_x).abs() < 1e-3 * texel_x, "left margin");
+        assert!((fr - samples[2] - 4.0 * texel_x).abs() < 1e-3 * texel_x, "right margin");
+        assert!((ft - samples[3] - 4.0 * texel_y).abs() < 1e-3 * texel_y, "top margin");
+        assert!(fr - fl < 0.51 * (r - l) && ft - fb < 0.26 * (t - b), "narrower than the tight window");
+        assert_eq!((fitted.near, fitted.far), (tight.near, tight.far));
+        // Samples beyond the tight window (reconstruction noise) are clipped to it.
+        let wide = fit_cascade_to_samples(&tight, [l - 10.0, b - 10.0, r + 10.0, t + 10.0], 0.0, 1024);
+        let (wl, wr, wb, wt) = wide.orthographic_window().unwrap();
+        for (a, e) in [(wl, l), (wr, r), (wb, b), (wt, t)] {
+            assert!((a - e).abs() < 1e-4 * (r - l), "{a} against {e}");
         }
     }
 }

@@ -4,7 +4,7 @@
 use glam::{Vec3, Vec4};
 use gnomon_math::{
     LightProjection, ProjectionKind, cascades, directional_light_projection,
-    fitting::{Hexahedron, fit_directional_to_receivers, intersection_vertices},
+    fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
     spot_light_projection,
     warping::{Warp, WarpView, fit_warped},
 };
@@ -12,7 +12,7 @@ use gnomon_scene::{
     Camera, Light, Scene, Settings,
     settings::{
         BiasSettings, CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition,
-        SplitScheme, WarpKind,
+        SplitScheme, Technique, WarpKind,
     },
 };
 use wgpu::util::DeviceExt;
@@ -22,7 +22,7 @@ use crate::{
     gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
         Layouts, SHADOW_FORMAT,
-        depth_reduce::DepthReducePass,
+        depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingPass},
         moments::MomentPass,
         shadow::ShadowPass,
@@ -82,6 +82,27 @@ pub struct Frame {
     pub stats: DrawStats,
     /// The moment map's texel format, for the filterable techniques.
     pub moment_format: Option<wgpu::TextureFormat>,
+}
+
+/// Which draws a depth-only pass takes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Draws {
+    /// The shadow casters: the shadow pass.
+    Casters,
+    /// Every surface the camera can see: SDSM's prepass.
+    Everything,
+}
+
+/// What SDSM measured of the camera's samples (Lauritzen, Salvi & Lefohn 2011).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleDistribution {
+    /// The nearest and farthest view depth seen.
+    pub near: f32,
+    pub far: f32,
+    /// With --sdsm-bounds, per cascade: the light-space (min x, min y, max x, max y) of
+    /// the samples it serves, its blend band included; None for a cascade that serves
+    /// none.
+    pub light_bounds: Option<Vec<Option<[f32; 4]>>>,
 }
 
 /// What a frame submitted: the CPU-side cost of drawing the scene.
@@ -302,12 +323,12 @@ impl<'g> Renderer<'g> {
             Some(layout) => layout.clone(),
             None => {
                 let sampled = match (&light, shadow.partition, shadow.cascades.sdsm) {
-                    (Light::Directional(_), Partition::Cascades, true) => {
-                        self.sampled_depth_range(uploaded, settings, &camera, aspect)?
+                    (Light::Directional(sun), Partition::Cascades, true) => {
+                        self.sample_distribution(uploaded, scene, sun.direction, settings, &camera, aspect)?
                     }
                     _ => None,
                 };
-                shadow_layout(scene, &light, &camera, aspect, settings, sampled)
+                shadow_layout(scene, &light, &camera, aspect, settings, sampled.as_ref())
             }
         };
         let layers = layout.projections.len() as u32;
@@ -397,12 +418,13 @@ impl<'g> Renderer<'g> {
                         end_of_pass_write_index: last.then_some(1),
                     }
                 });
-                self.record_shadow_pass(
+                self.record_depth_pass(
                     &mut encoder,
                     uploaded,
                     settings,
                     &layer_group,
                     &layer_view,
+                    Draws::Casters,
                     timestamps,
                     &mut stats,
                 );
@@ -603,19 +625,22 @@ impl<'g> Renderer<'g> {
         })
     }
 
-    /// SDSM's sample distribution: draws the casters' depth from the camera and
-    /// reduces it on the GPU to the nearest and farthest view depth seen. Blocks on
-    /// the two numbers, which the cascades' fit needs before the shadow pass.
-    fn sampled_depth_range(
+    /// SDSM's sample distribution: draws the scene's depth from the camera and
+    /// reduces it on the GPU to the nearest and farthest view depth seen, then, with
+    /// --sdsm-bounds, to each cascade's light-space bounds of the samples it serves.
+    /// Blocks on the results, which the cascades' fit needs before the shadow pass.
+    fn sample_distribution(
         &mut self,
         uploaded: &GpuScene,
+        scene: &Scene,
+        sun_direction: Vec3,
         settings: &Settings,
         camera: &Camera,
         aspect: f32,
-    ) -> Result<Option<(f32, f32)>, RenderError> {
+    ) -> Result<Option<SampleDistribution>, RenderError> {
         let gpu = self.gpu;
         let device = &gpu.device;
-        let pending = gpu.checked("reducing the camera's depth (SDSM)", || {
+        let (depth, pending) = gpu.checked("reducing the camera's depth (SDSM)", || {
             let (width, height) = (settings.image.width, settings.image.height);
             let depth = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("camera depth prepass"),
@@ -628,27 +653,54 @@ impl<'g> Renderer<'g> {
                 view_formats: &[],
             });
             // The shadow pass's pipelines draw it, with the camera's projection and no
-            // bias; back faces (from the camera) culled.
+            // bias, receivers that cast no shadow included.
             let camera_as_light =
                 LightGpu { clip_from_world: camera.clip_from_world(aspect), ..Default::default() };
             let (_, group) = self.scene_group(uploaded, &camera_as_light);
             let mut prepass = settings.clone();
             prepass.shadow.bias = BiasSettings::none();
             let mut encoder = device.create_command_encoder(&Default::default());
-            self.record_shadow_pass(
+            self.record_depth_pass(
                 &mut encoder,
                 uploaded,
                 &prepass,
                 &group,
                 &depth.create_view(&Default::default()),
+                Draws::Everything,
                 None,
                 &mut DrawStats::default(),
             );
             let pending = self.depth_reduce.record(device, &mut encoder, &depth, camera.near, camera.far);
             gpu.queue.submit([encoder.finish()]);
-            pending
+            (depth, pending)
         })?;
-        pending.read(gpu)
+        let Some((near, far)) = pending.read(gpu)? else { return Ok(None) };
+        let c = &settings.shadow.cascades;
+        let light_bounds = match cascade_splits(scene, camera, aspect, settings, Some((near, far))) {
+            Some(splits) if c.sdsm_bounds => {
+                let blend = match c.cascade_selection {
+                    CascadeSelection::Depth => c.cascade_blend,
+                    CascadeSelection::Projection => 0.0,
+                };
+                let request = BoundsRequest {
+                    world_from_clip: camera.clip_from_world(aspect).inverse(),
+                    light_from_world: directional_light_view(sun_direction, &scene.bounds()),
+                    near: camera.near,
+                    far: camera.far,
+                    splits: &splits,
+                    blend,
+                };
+                let pending = gpu.checked("bounding the camera's samples in light space (SDSM)", || {
+                    let mut encoder = device.create_command_encoder(&Default::default());
+                    let pending = self.depth_reduce.record_bounds(device, &mut encoder, &depth, &request);
+                    gpu.queue.submit([encoder.finish()]);
+                    pending
+                })?;
+                Some(pending.read(gpu)?)
+            }
+            _ => None,
+        };
+        Ok(Some(SampleDistribution { near, far, light_bounds }))
     }
 
     /// Group 0 of the geometry passes: the instances and a uniform buffer holding
@@ -666,15 +718,17 @@ impl<'g> Renderer<'g> {
         (buffer, group)
     }
 
-    /// Records the shadow pass: every caster, depth only, from the light.
+    /// Records a depth-only pass through `scene_group`'s projection with the shadow
+    /// pipelines: the shadow pass (every caster, from the light) or SDSM's prepass.
     #[allow(clippy::too_many_arguments)]
-    fn record_shadow_pass(
+    fn record_depth_pass(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         uploaded: &GpuScene,
         settings: &Settings,
         scene_group: &wgpu::BindGroup,
         shadow_view: &wgpu::TextureView,
+        draws: Draws,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
         stats: &mut DrawStats,
     ) {
@@ -704,7 +758,11 @@ impl<'g> Renderer<'g> {
             let mut pipeline = None;
             for masked in [false, true] {
                 let mut bound = None;
-                for d in uploaded.draws.iter().filter(|d| d.casts_shadow && d.masked == masked) {
+                let drawn = |d: &&crate::gpu_scene::Draw| match draws {
+                    Draws::Casters => d.casts_shadow,
+                    Draws::Everything => true,
+                };
+                for d in uploaded.draws.iter().filter(drawn).filter(|d| d.masked == masked) {
                     if pipeline != Some((d.double_sided, masked)) {
                         pass.set_pipeline(self.shadow_pass.pipeline(
                             device,
@@ -768,16 +826,17 @@ pub struct ShadowLayout {
 /// `--partition cascades`, one per slice of the view frustum, all sharing one depth
 /// range so that every layer stores depth the same way.
 ///
-/// `sampled`, for SDSM, is the range of view depths the camera actually sees (from
-/// [`Renderer`]'s depth reduction); the cascades split it instead of the range where
-/// the view frustum meets the scene's bounds.
+/// `sampled`, for SDSM, is what [`Renderer`]'s reductions measured of the camera's
+/// samples: the cascades split the range of view depths it saw instead of the range
+/// where the view frustum meets the scene's bounds, and with --sdsm-bounds each tight
+/// cascade narrows to the light-space bounds of its own samples.
 pub fn shadow_layout(
     scene: &Scene,
     light: &Light,
     camera: &Camera,
     aspect: f32,
     settings: &Settings,
-    sampled: Option<(f32, f32)>,
+    sampled: Option<&SampleDistribution>,
 ) -> ShadowLayout {
     let single = || ShadowLayout {
         projections: vec![light_projection(scene, light, camera, aspect, settings.shadow.map.fit)],
@@ -791,15 +850,69 @@ pub fn shadow_layout(
     let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
         return single();
     };
+    let Some(splits) = cascade_splits(scene, camera, aspect, settings, sampled.map(|s| (s.near, s.far)))
+    else {
+        return single();
+    };
     let c = &settings.shadow.cascades;
     let bounds = scene.bounds();
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    let resolution = settings.shadow.map.resolution;
+    // With selection by depth, the lighting pass blends the far end of each cascade
+    // into the next one, so each slice starts at its predecessor's blend band.
+    let blend = match c.cascade_selection {
+        CascadeSelection::Depth => c.cascade_blend,
+        CascadeSelection::Projection => 0.0,
+    };
+    let samples = sampled.and_then(|s| s.light_bounds.as_ref());
+    let fitted: Vec<LightProjection> = (0..splits.len() - 1)
+        .map(|i| {
+            let from = if i == 0 { splits[0] } else { splits[i] - blend * (splits[i] - splits[i - 1]) };
+            let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
+            match c.cascade_fit {
+                CascadeFit::Tight => {
+                    let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice);
+                    match samples.and_then(|s| s.get(i).copied().flatten()) {
+                        Some(window) => cascades::fit_cascade_to_samples(
+                            &tight,
+                            window,
+                            filter_margin_texels(settings, &tight),
+                            resolution,
+                        ),
+                        None => tight,
+                    }
+                }
+                CascadeFit::Stable => {
+                    cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
+                }
+            }
+        })
+        .collect();
+    let near_plane = fitted.iter().map(|p| p.near).fold(f32::INFINITY, f32::min);
+    let far_plane = fitted.iter().map(|p| p.far).fold(f32::NEG_INFINITY, f32::max);
+    ShadowLayout {
+        projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
+        splits,
+    }
+}
+
+/// The view depths bounding a sun's cascades: the range where the view frustum meets
+/// the scene's bounds, or `sampled` (SDSM), cut at the shadow distance, quantized for
+/// stable cascades, and split by the scheme. None when the camera sees none of the
+/// scene.
+fn cascade_splits(
+    scene: &Scene,
+    camera: &Camera,
+    aspect: f32,
+    settings: &Settings,
+    sampled: Option<(f32, f32)>,
+) -> Option<Vec<f32>> {
+    let c = &settings.shadow.cascades;
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
     // The view depths that hold any of the scene: beyond them a cascade would cover
     // nothing.
-    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
-    let Some((near, far)) = seen_depth_range(camera, &receivers) else {
-        return single();
-    };
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&scene.bounds()));
+    let (near, far) = seen_depth_range(camera, &receivers)?;
     let (near, far) = match sampled {
         Some((lo, hi)) => (lo.max(camera.near), hi.min(camera.far).max(lo.max(camera.near) * 1.001)),
         None => (near, far),
@@ -819,26 +932,26 @@ pub fn shadow_layout(
         SplitScheme::Log => cascades::SplitScheme::Logarithmic,
         SplitScheme::Practical => cascades::SplitScheme::Practical { lambda: c.split_lambda },
     };
-    let splits = cascades::split_distances(scheme, c.count as usize, near, far);
-    let resolution = settings.shadow.map.resolution;
-    let fitted: Vec<LightProjection> = splits
-        .windows(2)
-        .map(|w| {
-            let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, w[0], w[1]);
-            match c.cascade_fit {
-                CascadeFit::Tight => cascades::fit_cascade_tight(sun.direction, &bounds, &slice),
-                CascadeFit::Stable => {
-                    cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
-                }
-            }
-        })
-        .collect();
-    let near_plane = fitted.iter().map(|p| p.near).fold(f32::INFINITY, f32::min);
-    let far_plane = fitted.iter().map(|p| p.far).fold(f32::NEG_INFINITY, f32::max);
-    ShadowLayout {
-        projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
-        splits,
-    }
+    Some(cascades::split_distances(scheme, c.count as usize, near, far))
+}
+
+/// Texels a sample-fitted cascade keeps around its samples: the technique's filter
+/// reach and the normal offset, plus two for the bilinear footprint and the pixel's
+/// own extent.
+fn filter_margin_texels(settings: &Settings, tight: &LightProjection) -> f32 {
+    let f = &settings.shadow.filter;
+    let texel = tight.texel_world_size(settings.shadow.map.resolution, 0.0).max(1e-9);
+    let kernel = match f.kernel_unit {
+        KernelUnit::Texels => f.pcf_kernel,
+        KernelUnit::World => f.pcf_kernel / texel,
+    };
+    let reach = match f.technique {
+        Technique::Hard | Technique::Pcf2x2 => 0.0,
+        Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => 0.5 * kernel,
+        Technique::Pcss => f.pcss.max_radius,
+        _ => f.moments.blur_radius as f32,
+    };
+    2.0 + reach + settings.shadow.bias.normal_offset
 }
 
 fn warp_of(kind: WarpKind) -> Option<Warp> {

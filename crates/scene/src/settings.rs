@@ -614,6 +614,11 @@ pub struct CascadeSettings {
     /// bounds. Costs a prepass and a read back of two numbers before the shadow pass.
     #[arg(long, help_heading = "Cascades")]
     pub sdsm: bool,
+    /// With --sdsm, also fit each tight cascade in x and y to the light-space bounds of
+    /// the samples it serves (a second reduction of the same depth buffer), instead of
+    /// to its whole slice of the view frustum.
+    #[arg(long, help_heading = "Cascades")]
+    pub sdsm_bounds: bool,
 }
 
 impl Default for CascadeSettings {
@@ -628,6 +633,7 @@ impl Default for CascadeSettings {
             cascade_blend: 0.1,
             freeze: false,
             sdsm: false,
+            sdsm_bounds: false,
         }
     }
 }
@@ -856,6 +862,15 @@ impl Settings {
             "0 to 0.5",
         )?;
         check_opt(c.shadow_distance, "--shadow-distance", |x| x > 0.0, "a distance > 0")?;
+        if c.sdsm_bounds {
+            check(c.sdsm, "--sdsm-bounds", "set", "only with --sdsm, whose depth prepass it reduces")?;
+            check(
+                c.cascade_fit == CascadeFit::Tight,
+                "--sdsm-bounds",
+                "set",
+                "only with --cascade-fit tight: bounds that follow every pixel cannot keep a stable cascade still",
+            )?;
+        }
         let b = &s.bias;
         check(
             b.slope_bias.is_finite() && b.slope_bias >= 0.0,
@@ -1096,6 +1111,20 @@ mod tests {
         s.validate().unwrap();
         s.shadow.filter.kernel_unit = KernelUnit::World;
         assert!(s.validate().unwrap_err().to_string().contains("--kernel-unit world"));
+    }
+
+    #[test]
+    fn sdsm_bounds_need_sdsm_and_tight_cascades() {
+        let mut s = Settings::default();
+        s.shadow.partition = Partition::Cascades;
+        s.shadow.cascades.sdsm_bounds = true;
+        let e = s.validate().unwrap_err();
+        assert!(e.flag == "--sdsm-bounds" && e.to_string().contains("only with --sdsm"), "{e}");
+        s.shadow.cascades.sdsm = true;
+        s.shadow.cascades.cascade_fit = CascadeFit::Stable;
+        assert!(s.validate().unwrap_err().to_string().contains("--cascade-fit tight"));
+        s.shadow.cascades.cascade_fit = CascadeFit::Tight;
+        s.validate().unwrap();
     }
 
     #[test]

@@ -1,14 +1,47 @@
-//! The sample-distribution pass of SDSM: a depth-only prepass from the camera and a
-//! compute reduction of its depth buffer to the view depths actually seen, which the
-//! cascades then split instead of the frustum's intersection with the scene bounds.
+//! The sample-distribution passes of SDSM: a compute reduction of the camera's depth
+//! buffer to the view depths actually seen, which the cascades then split instead of
+//! the frustum's intersection with the scene bounds; and, optionally, a second one to
+//! each cascade's light-space x and y bounds of the samples it serves, which the
+//! cascades are then fitted to.
 
 use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
 use wgpu::util::DeviceExt;
 
-/// The reduction pipeline and its bind group layout.
+/// The reduction pipelines and their bind group layout (both read the depth buffer,
+/// fold into a storage buffer and take a uniform).
 pub(crate) struct DepthReducePass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    bounds_pipeline: wgpu::ComputePipeline,
+}
+
+/// The per-cascade bounds readback, waiting on the submission.
+pub(crate) struct PendingSampleBounds {
+    buffer: wgpu::Buffer,
+    count: usize,
+}
+
+/// The bounds pass's uniform: see `sample_bounds.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct BoundsParams {
+    world_from_clip: Mat4,
+    light_from_world: Mat4,
+    splits: [f32; 12],
+    planes: Vec4,
+}
+
+/// What the bounds pass needs to know of the camera and the cascades.
+pub(crate) struct BoundsRequest<'a> {
+    pub world_from_clip: Mat4,
+    pub light_from_world: Mat4,
+    pub near: f32,
+    pub far: f32,
+    /// The cascades' view-depth splits, count + 1 of them.
+    pub splits: &'a [f32],
+    /// The lighting pass's blend band, as a fraction of a cascade's depth range.
+    pub blend: f32,
 }
 
 /// The depth-range readback, waiting on the submission.
@@ -78,7 +111,92 @@ impl DepthReducePass {
             compilation_options: Default::default(),
             cache: None,
         });
-        Self { layout, pipeline }
+        let bounds_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sample_bounds.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("sample_bounds.wgsl").into()),
+        });
+        let bounds_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("sample bounds"),
+            layout: Some(&pipeline_layout),
+            module: &bounds_module,
+            entry_point: Some("bounds_of_samples"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { layout, pipeline, bounds_pipeline }
+    }
+
+    /// Records the per-cascade light-space bounds of `depth`'s samples and the copy of
+    /// the result out.
+    pub fn record_bounds(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::Texture,
+        request: &BoundsRequest,
+    ) -> PendingSampleBounds {
+        let count = request.splits.len().saturating_sub(1).min(MAX_BOUNDS);
+        // Minima start at the largest encoding, maxima at the smallest.
+        let initial: Vec<u32> = (0..4 * MAX_BOUNDS).map(|i| if i % 4 < 2 { u32::MAX } else { 0 }).collect();
+        let bounds = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sample bounds"),
+            contents: bytemuck::cast_slice(&initial),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        });
+        let mut splits = [0.0f32; 12];
+        for (slot, z) in splits.iter_mut().zip(request.splits) {
+            *slot = z.min(f32::MAX);
+        }
+        let params = BoundsParams {
+            world_from_clip: request.world_from_clip,
+            light_from_world: request.light_from_world,
+            splits,
+            planes: Vec4::new(request.near, request.far, count as f32, request.blend),
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sample bounds parameters"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        self.dispatch(device, encoder, &self.bounds_pipeline, depth, &bounds, &params, "sample bounds");
+        let size = (16 * MAX_BOUNDS) as u64;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sample bounds readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_buffer_to_buffer(&bounds, 0, &buffer, 0, size);
+        PendingSampleBounds { buffer, count }
+    }
+
+    /// Binds `depth`, `output` and `params` and runs `pipeline` over 16×16 tiles.
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        depth: &wgpu::Texture,
+        output: &wgpu::Buffer,
+        params: &wgpu::Buffer,
+        label: &str,
+    ) {
+        let view = depth.create_view(&Default::default());
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
+            ],
+        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(depth.width().div_ceil(16), depth.height().div_ceil(16), 1);
     }
 
     /// Records the reduction of `depth` (a camera depth buffer with planes `near`,
@@ -101,25 +219,7 @@ impl DepthReducePass {
             contents: bytemuck::bytes_of(&Planes { near, far, _pad: [0.0; 2] }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let view = depth.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("depth reduction"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: range.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: planes.as_entire_binding() },
-            ],
-        });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("depth reduction"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(depth.width().div_ceil(16), depth.height().div_ceil(16), 1);
-        }
+        self.dispatch(device, encoder, &self.pipeline, depth, &range, &planes, "depth reduction");
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("depth range readback"),
             size: 8,
@@ -138,5 +238,51 @@ impl PendingDepthRange {
         let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer)?;
         let (near, far) = (f32::from_bits(bits[0]), f32::from_bits(bits[1]));
         Ok((bits[0] != u32::MAX && near <= far).then_some((near, far)))
+    }
+}
+
+/// Cascades the bounds pass serves, as the lighting pass's uniform allows.
+const MAX_BOUNDS: usize = 8;
+
+/// Inverts the shader's order-preserving encoding.
+fn decode(bits: u32) -> f32 {
+    f32::from_bits(if bits & 0x8000_0000 != 0 { bits & 0x7fff_ffff } else { !bits })
+}
+
+impl PendingSampleBounds {
+    /// Each cascade's (min x, min y, max x, max y) in light view space, after the
+    /// submission; None for a cascade that serves no sample.
+    pub fn read(self, gpu: &crate::Gpu) -> Result<Vec<Option<[f32; 4]>>, crate::RenderError> {
+        let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer)?;
+        Ok(bits
+            .chunks_exact(4)
+            .take(self.count)
+            .map(|b| {
+                let bounds = [decode(b[0]), decode(b[1]), decode(b[2]), decode(b[3])];
+                (b[0] != u32::MAX && bounds[0] <= bounds[2] && bounds[1] <= bounds[3]).then_some(bounds)
+            })
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::decode;
+
+    /// The shader's encoding, mirrored: it must order like the floats.
+    fn encode(f: f32) -> u32 {
+        let bits = f.to_bits();
+        if bits & 0x8000_0000 != 0 { !bits } else { bits | 0x8000_0000 }
+    }
+
+    #[test]
+    fn the_bounds_encoding_orders_like_the_floats_and_round_trips() {
+        let values = [-1e30f32, -3.5, -1.0, -1e-20, -0.0, 0.0, 1e-20, 0.25, 1.0, 7.0, 1e30];
+        for w in values.windows(2) {
+            assert!(encode(w[0]) <= encode(w[1]), "{} then {}", w[0], w[1]);
+        }
+        for v in values {
+            assert_eq!(decode(encode(v)).to_bits(), v.to_bits());
+        }
     }
 }
