@@ -10,6 +10,10 @@ use gnomon_reference::{ReferenceImage, ReferenceOptions};
 use gnomon_scene::{Camera, Light, Scene};
 
 const MAGIC: &[u8; 8] = b"GNOMREF1";
+/// Part of every key: bump it whenever the tracer's results change, so that caches
+/// written by an older tracer are not served. 2: hit points from the barycentrics and
+/// the t error bound (false self-shadowing on large, distant triangles).
+const TRACER_REVISION: u32 = 2;
 
 pub fn cache_dir() -> Option<PathBuf> {
     if let Some(d) = std::env::var_os("GNOMON_CACHE_DIR") {
@@ -25,6 +29,7 @@ pub fn cache_dir() -> Option<PathBuf> {
 pub fn key(scene: &Scene, camera: &Camera, light: &Light, options: &ReferenceOptions) -> String {
     let mut h = xxhash_rust::xxh3::Xxh3::new();
     h.update(MAGIC);
+    h.update(&TRACER_REVISION.to_le_bytes());
     for mesh in &scene.meshes {
         h.update(bytemuck::cast_slice(&mesh.positions.iter().map(|p| p.to_array()).collect::<Vec<_>>()));
         h.update(bytemuck::cast_slice(&mesh.indices));

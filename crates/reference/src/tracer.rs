@@ -141,9 +141,16 @@ impl TracedScene {
             normal = -normal;
         }
         let (instance, triangle) = self.owners[id];
+        // The point from the triangle's own barycentrics: origin + t·direction is off
+        // the plane by about t·ε, which the shadow ray's offset cannot absorb far from
+        // the camera (Wächter & Binder assume an accurate hit point).
+        let position = match sheared.intersect(tri, hit.t, hit.t) {
+            Some((_, w)) => Vec3::from(tri.v0 * w.x + tri.v1 * w.y + tri.v2 * w.z),
+            None => origin + direction * hit.t,
+        };
         Some(Hit {
             t: hit.t,
-            position: origin + direction * hit.t,
+            position,
             normal,
             object_id: instance + 1,
             triangle,
@@ -225,9 +232,23 @@ impl ShearedRay {
         if det == 0.0 {
             return None;
         }
-        let t = (u * s.z * a[kz] + v * s.z * b[kz] + w * s.z * c[kz]) / det;
+        let (az, bz, cz) = (s.z * a[kz], s.z * b[kz], s.z * c[kz]);
+        let t = (u * az + v * bz + w * cz) / det;
+        // A hit closer than the rounding error of t may be the surface the ray leaves
+        // from: a bound on that error (Pharr, Jakob & Humphreys, PBRT 3rd ed., §3.9.6)
+        // keeps such a hit out. A triangle far larger than the offset of the ray's
+        // origin (a city's ground seen from above) otherwise shadows itself.
+        let gamma = |n: f32| n * 0.5 * f32::EPSILON / (1.0 - n * 0.5 * f32::EPSILON);
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let (delta_x, delta_y, delta_z) =
+            (gamma(5.0) * (max_x + max_z), gamma(5.0) * (max_y + max_z), gamma(3.0) * max_z);
+        let delta_e = 2.0 * (gamma(2.0) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t = 3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
         // U weighs the vertex opposite edge BC (A), V the one opposite CA (B), W C.
-        (t >= t_min && t <= t_max).then(|| (t, Vec3::new(u, v, w) / det))
+        (t > delta_t && t >= t_min && t <= t_max).then(|| (t, Vec3::new(u, v, w) / det))
     }
 }
 
@@ -255,6 +276,38 @@ mod tests {
     use super::*;
     use glam::Mat4;
     use gnomon_scene::{Instance, builtin, geometry};
+
+    /// Florence's open ground (y = 0, seen from 400 units away) came out speckled with
+    /// false shadow: a hit point taken as origin + t·direction is off the plane by
+    /// about t·ε, more than the offset near y = 0, so the shadow ray started below the
+    /// ground and hit it. Hits come from the barycentrics, on the plane to its own
+    /// rounding.
+    #[test]
+    fn distant_ground_does_not_shadow_itself() {
+        let mut scene = builtin::spheres();
+        scene.meshes = vec![geometry::plane(1000.0, 1000.0)];
+        scene.instances = vec![Instance {
+            name: "ground".into(),
+            mesh: 0,
+            material: 0,
+            world_from_object: Mat4::IDENTITY,
+            casts_shadow: true,
+        }];
+        let traced = TracedScene::build(&scene);
+        let eye = Vec3::new(150.0, 220.0, 380.0);
+        let to_sun = Vec3::new(0.5, 0.5, -0.4).normalize();
+        let mut self_shadowed = 0;
+        for i in 0..100 {
+            for j in 0..100 {
+                let target = Vec3::new(-300.0 + 6.0 * i as f32 + 0.37, 0.0, -300.0 + 6.0 * j as f32 + 0.61);
+                let direction = (target - eye).normalize();
+                let hit = traced.intersect(eye, direction, 0.0, 1e4).unwrap();
+                let origin = offset_ray_origin(hit.position, hit.normal);
+                self_shadowed += traced.occluded(origin, to_sun, 1e4) as u32;
+            }
+        }
+        assert_eq!(self_shadowed, 0, "of 10000 ground points");
+    }
 
     #[test]
     fn hits_the_ground_and_respects_casts_shadow() {
