@@ -92,6 +92,24 @@ impl LightProjection {
         }
     }
 
+    /// The same orthographic projection with its near plane moved up to the nearest of
+    /// `receivers` (world points), for a map drawn with depth clamping: casters in
+    /// front of the plane are clamped onto it ("pancaking") and still shadow every
+    /// receiver behind them, and the depth range spans only the receivers. Returned
+    /// unchanged when that would not move the plane forward, and for other kinds.
+    pub fn pancaked(&self, receivers: &[Vec3]) -> LightProjection {
+        if !matches!(self.kind, ProjectionKind::Orthographic { .. }) || receivers.is_empty() {
+            return *self;
+        }
+        let nearest = receivers
+            .iter()
+            .map(|p| -self.light_from_world.transform_point3(*p).z)
+            .fold(f32::INFINITY, f32::min);
+        let margin = 1e-3 * (self.far - self.near).abs().max(1e-6);
+        let near = nearest - margin;
+        if near > self.near && near < self.far { self.with_depth_range(near, self.far) } else { *self }
+    }
+
     /// For a perspective map, the factor k such that a texel at view distance d spans
     /// k·d world units; for an orthographic map, the constant texel size. The shader
     /// uses `texel = k_ortho + k_persp · d`.
@@ -225,5 +243,35 @@ mod tests {
         assert!(k0 == 0.0 && (k1 - 0.002).abs() < 1e-8);
         // Behind the light: w < 0.
         assert!((m * Vec4::new(0.0, 11.0, 0.0, 1.0)).w < 0.0);
+    }
+
+    #[test]
+    fn pancaking_moves_the_near_plane_to_the_receivers_and_clamps_casters_onto_it() {
+        let scene = Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 20.0, 10.0));
+        let direction = Vec3::new(0.2, -1.0, 0.1).normalize();
+        let full = directional_light_projection(direction, &scene);
+        // Receivers on the ground; a caster high above them.
+        let receivers = [Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, 5.0), Vec3::new(5.0, 1.0, -5.0)];
+        let pancaked = full.pancaked(&receivers);
+        assert!(pancaked.near > full.near + 10.0, "near {} against {}", pancaked.near, full.near);
+        assert_eq!(pancaked.far, full.far);
+        let depth = |p: &LightProjection, w: Vec3| project(p.clip_from_world(), w).z;
+        for r in receivers {
+            let z = depth(&pancaked, r);
+            assert!((0.0..=1.0).contains(&z), "receiver depth {z}");
+        }
+        // The caster lies before the near plane: a clamping rasterizer stores 0 there,
+        // still in front of the receiver below it, which keeps its shadow.
+        let caster = Vec3::new(0.0, 15.0, 0.0);
+        let below = caster + direction * (15.0 / -direction.y);
+        assert!(depth(&pancaked, caster) < 0.0);
+        assert!(depth(&pancaked, below) > 0.0);
+        // Depth resolution over the receivers improves by the ratio of the ranges.
+        let gain = (depth(&pancaked, receivers[2]) - depth(&pancaked, receivers[0]))
+            / (depth(&full, receivers[2]) - depth(&full, receivers[0]));
+        assert!(gain > 3.0, "gain {gain}");
+        // Perspective projections are left alone.
+        let spot = spot_light_projection(Vec3::Y * 10.0, Vec3::NEG_Y, 0.5, 0.1, 30.0);
+        assert_eq!(spot.pancaked(&receivers), spot);
     }
 }

@@ -148,13 +148,7 @@ impl TracedScene {
             Some((_, w)) => Vec3::from(tri.v0 * w.x + tri.v1 * w.y + tri.v2 * w.z),
             None => origin + direction * hit.t,
         };
-        Some(Hit {
-            t: hit.t,
-            position,
-            normal,
-            object_id: instance + 1,
-            triangle,
-        })
+        Some(Hit { t: hit.t, position, normal, object_id: instance + 1, triangle })
     }
 
     /// True when a shadow caster blocks the segment from `origin` along `direction`

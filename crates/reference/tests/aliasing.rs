@@ -16,8 +16,9 @@ use gnomon_reference::{
 };
 use gnomon_render::{Frame, OutputRequest, Renderer};
 use gnomon_scene::{
-    Scene, Settings, builtin,
+    Instance, Scene, Settings, builtin,
     camera_path::{CameraPathKind, camera_on_path},
+    geometry,
     settings::{
         CameraSettings, CascadeFit, CascadeSelection, Fit, Partition, SplitScheme, Technique, WarpKind,
     },
@@ -343,4 +344,66 @@ fn sdsm_bounds_fit_each_cascade_to_its_samples() {
     assert!(area_b < 0.8 * area_a, "windows {area_b} against {area_a}");
     assert!(m_b < 0.9 * m_a, "mean m {m_b} against {m_a}");
     assert!(e_b < 0.001, "mismatch {e_b} (without bounds {e_a})");
+}
+
+/// Depth clamping ("pancaking", issue 6's fitting): with `--fit receivers` the map's
+/// near plane moves up to the nearest receiver, and a caster before it, clamped onto
+/// that plane, still casts its shadow. Here a box floats 7 units above a ground that
+/// the camera sees from 1.5 units up, out to 12 units: every receiver is far below the
+/// box, which lies wholly before the near plane (without clamping it would be clipped
+/// away, and its shadow with it).
+#[test]
+fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
+    let mut scene = builtin::spheres();
+    scene.meshes = vec![geometry::plane(60.0, 60.0), geometry::cuboid(Vec3::splat(1.0))];
+    let instance = |name: &str, mesh, at: Vec3| Instance {
+        name: name.into(),
+        mesh,
+        material: 0,
+        world_from_object: glam::Mat4::from_translation(at),
+        casts_shadow: true,
+    };
+    scene.instances = vec![instance("ground", 0, Vec3::ZERO), instance("box", 1, Vec3::new(0.0, 8.0, 0.0))];
+    scene.sun.direction = Vec3::new(0.3, -1.0, 0.2).normalize();
+    scene.camera.eye = Vec3::new(2.4, 1.5, 6.0);
+    scene.camera.target = Vec3::new(2.4, 0.0, 1.6);
+    scene.camera.far = 12.0;
+    let mut clamped_settings = single_map(WarpKind::None);
+    clamped_settings.shadow.map.fit = Fit::Receivers;
+    let mut full_settings = clamped_settings.clone();
+    full_settings.shadow.map.depth_clamp = false;
+    let clamped = render(&scene, &clamped_settings);
+    let full = render(&scene, &full_settings);
+    if !clamped.shadow_depth_clamp {
+        eprintln!("skipped: this device cannot draw with unclipped depth (DEPTH_CLIP_CONTROL)");
+        return;
+    }
+    assert!(!full.shadow_depth_clamp);
+    // The whole box is nearer the sun than the clamped map's near plane.
+    let light_depth = |p: Vec3| -clamped.light_projection.light_from_world.transform_point3(p).z;
+    let box_far = [Vec3::new(0.0, 7.0, 0.0), Vec3::new(1.0, 7.0, 1.0), Vec3::new(-1.0, 7.0, -1.0)]
+        .map(light_depth)
+        .into_iter()
+        .fold(f32::NEG_INFINITY, f32::max);
+    assert!(
+        box_far < clamped.light_projection.near,
+        "box to {box_far}, near plane {}",
+        clamped.light_projection.near
+    );
+    let range = |f: &Frame| f.light_projection.far - f.light_projection.near;
+    let truth = common::reference(&scene, &clamped_settings);
+    let (e_clamped, e_full) =
+        (common::compare(&clamped, &truth).mismatch_rate, common::compare(&full, &truth).mismatch_rate);
+    let shadowed = truth.visibility.iter().filter(|&&v| v < 0.5).count();
+    eprintln!(
+        "depth range {:.2} → {:.2}; mismatch {:.3}% → {:.3}%; {shadowed} shadowed pixels",
+        range(&full),
+        range(&clamped),
+        100.0 * e_full,
+        100.0 * e_clamped
+    );
+    assert!(shadowed > clamped.pixel_count() / 20, "the box's shadow is in view: {shadowed}");
+    assert!(range(&clamped) < 0.7 * range(&full), "{} against {}", range(&clamped), range(&full));
+    assert!(e_clamped <= e_full + 2e-4, "mismatch {e_clamped} clamped against {e_full}");
+    assert!(e_clamped < 0.005, "the box's shadow is kept: mismatch {e_clamped}");
 }

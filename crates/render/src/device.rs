@@ -63,9 +63,13 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gnomon"),
             // Timestamps time each pass where the adapter has them (lavapipe does);
-            // 32-bit float filtering lets moment maps keep full precision.
+            // 32-bit float filtering lets moment maps keep full precision; unclipped
+            // depth lets a sun's map clamp casters in front of its near plane onto it
+            // ("pancaking"), so the depth range need only span the receivers.
             required_features: adapter.features()
-                & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE),
+                & (wgpu::Features::TIMESTAMP_QUERY
+                    | wgpu::Features::FLOAT32_FILTERABLE
+                    | wgpu::Features::DEPTH_CLIP_CONTROL),
             required_limits: limits.clone(),
             ..Default::default()
         }))

@@ -74,6 +74,9 @@ pub struct Frame {
     pub cascades: Vec<LightProjection>,
     /// The view depths bounding the cascades (one more than there are cascades).
     pub cascade_splits: Vec<f32>,
+    /// The shadow map was drawn with depth clamping: its near plane sits at the nearest
+    /// receiver, and casters before it are clamped onto it.
+    pub shadow_depth_clamp: bool,
     pub shadow_resolution: u32,
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
@@ -135,7 +138,11 @@ impl Frame {
     /// The shadow layout this frame was drawn with, to draw others with it
     /// ([`OutputRequest::fixed_layout`]).
     pub fn shadow_layout(&self) -> ShadowLayout {
-        ShadowLayout { projections: self.cascades.clone(), splits: self.cascade_splits.clone() }
+        ShadowLayout {
+            projections: self.cascades.clone(),
+            splits: self.cascade_splits.clone(),
+            depth_clamp: self.shadow_depth_clamp,
+        }
     }
 
     /// World size of one shadow texel at `world` (which must be in front of the light).
@@ -328,7 +335,8 @@ impl<'g> Renderer<'g> {
                     }
                     _ => None,
                 };
-                shadow_layout(scene, &light, &camera, aspect, settings, sampled.as_ref())
+                let depth_clamp = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+                shadow_layout(scene, &light, &camera, aspect, settings, sampled.as_ref(), depth_clamp)
             }
         };
         let layers = layout.projections.len() as u32;
@@ -425,6 +433,7 @@ impl<'g> Renderer<'g> {
                     &layer_group,
                     &layer_view,
                     Draws::Casters,
+                    layout.depth_clamp,
                     timestamps,
                     &mut stats,
                 );
@@ -617,6 +626,7 @@ impl<'g> Renderer<'g> {
             light_projection: layout.projections[0],
             cascades: layout.projections,
             cascade_splits: layout.splits,
+            shadow_depth_clamp: layout.depth_clamp,
             shadow_resolution: resolution,
             shadow_map,
             timings,
@@ -667,6 +677,7 @@ impl<'g> Renderer<'g> {
                 &group,
                 &depth.create_view(&Default::default()),
                 Draws::Everything,
+                false,
                 None,
                 &mut DrawStats::default(),
             );
@@ -719,7 +730,8 @@ impl<'g> Renderer<'g> {
     }
 
     /// Records a depth-only pass through `scene_group`'s projection with the shadow
-    /// pipelines: the shadow pass (every caster, from the light) or SDSM's prepass.
+    /// pipelines: the shadow pass (every caster, from the light) or SDSM's prepass;
+    /// `unclipped` clamps depth instead of clipping it.
     #[allow(clippy::too_many_arguments)]
     fn record_depth_pass(
         &mut self,
@@ -729,6 +741,7 @@ impl<'g> Renderer<'g> {
         scene_group: &wgpu::BindGroup,
         shadow_view: &wgpu::TextureView,
         draws: Draws,
+        unclipped: bool,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
         stats: &mut DrawStats,
     ) {
@@ -769,6 +782,7 @@ impl<'g> Renderer<'g> {
                             &shadow.bias,
                             d.double_sided,
                             masked,
+                            unclipped,
                         ));
                         pipeline = Some((d.double_sided, masked));
                         stats.pipeline_changes += 1;
@@ -820,6 +834,9 @@ pub struct ShadowLayout {
     /// One more than the projections: cascade i covers view depths splits[i] to
     /// splits[i + 1]. A single map covers 0 to infinity.
     pub splits: Vec<f32>,
+    /// Draw with depth clamping ("pancaking"): the projections' near planes sit at the
+    /// nearest receiver, and casters before them are clamped onto them.
+    pub depth_clamp: bool,
 }
 
 /// The shadow layout of `light` under `settings`: one map, or for a sun with
@@ -830,6 +847,13 @@ pub struct ShadowLayout {
 /// samples: the cascades split the range of view depths it saw instead of the range
 /// where the view frustum meets the scene's bounds, and with --sdsm-bounds each tight
 /// cascade narrows to the light-space bounds of its own samples.
+///
+/// `depth_clamp` says the device can draw with unclipped depth; with it, and
+/// `--depth-clamp true` (the default), where a sun's map
+/// follows the receivers (--fit receivers, tight cascades) its near plane then moves up
+/// to the nearest receiver ([`LightProjection::pancaked`]). Not for PCSS, whose blocker
+/// search reads the true distance to each blocker, nor for stable cascades, whose depth
+/// range must not follow the camera, nor for warps, which rely on clipping.
 pub fn shadow_layout(
     scene: &Scene,
     light: &Light,
@@ -837,10 +861,27 @@ pub fn shadow_layout(
     aspect: f32,
     settings: &Settings,
     sampled: Option<&SampleDistribution>,
+    depth_clamp: bool,
 ) -> ShadowLayout {
-    let single = || ShadowLayout {
-        projections: vec![light_projection(scene, light, camera, aspect, settings.shadow.map.fit)],
-        splits: vec![0.0, f32::INFINITY],
+    let pancake =
+        depth_clamp && settings.shadow.map.depth_clamp && settings.shadow.filter.technique != Technique::Pcss;
+    let single = || {
+        let projection = light_projection(scene, light, camera, aspect, settings.shadow.map.fit);
+        let pancaked = match light {
+            Light::Directional(_) if pancake && settings.shadow.map.fit == Fit::Receivers => {
+                let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+                Some(
+                    projection
+                        .pancaked(&intersection_vertices(&frustum, &Hexahedron::from_aabb(&scene.bounds()))),
+                )
+            }
+            _ => None,
+        };
+        ShadowLayout {
+            projections: vec![pancaked.unwrap_or(projection)],
+            splits: vec![0.0, f32::INFINITY],
+            depth_clamp: pancaked.is_some(),
+        }
     };
     if let (Light::Directional(sun), Partition::Single, Some(warp)) =
         (light, settings.shadow.partition, warp_of(settings.shadow.map.warp))
@@ -871,8 +912,9 @@ pub fn shadow_layout(
             let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
             match c.cascade_fit {
                 CascadeFit::Tight => {
-                    let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice);
-                    match samples.and_then(|s| s.get(i).copied().flatten()) {
+                    let receivers = intersection_vertices(&slice, &Hexahedron::from_aabb(&bounds));
+                    let tight = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
+                    let fitted = match samples.and_then(|s| s.get(i).copied().flatten()) {
                         Some(window) => cascades::fit_cascade_to_samples(
                             &tight,
                             window,
@@ -880,7 +922,8 @@ pub fn shadow_layout(
                             resolution,
                         ),
                         None => tight,
-                    }
+                    };
+                    if pancake { fitted.pancaked(&receivers) } else { fitted }
                 }
                 CascadeFit::Stable => {
                     cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
@@ -893,6 +936,7 @@ pub fn shadow_layout(
     ShadowLayout {
         projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
         splits,
+        depth_clamp: pancake && c.cascade_fit == CascadeFit::Tight,
     }
 }
 
@@ -980,6 +1024,7 @@ fn warped_layout(
     Some(ShadowLayout {
         projections: vec![fit_warped(warp, direction, &bounds, &receivers, &view)],
         splits: vec![0.0, f32::INFINITY],
+        depth_clamp: false,
     })
 }
 

@@ -497,6 +497,13 @@ pub struct MapSettings {
     /// texels; a spot's map is perspective already and ignores this.
     #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
     pub warp: WarpKind,
+    /// Depth clamping ("pancaking") where the device supports it (unclipped depth): a
+    /// sun's map fitted to the receivers (--fit receivers, tight cascades) starts its
+    /// depth range at the nearest receiver, and casters nearer the sun are clamped onto
+    /// that plane, so the range, and the depth error, shrink. Never for PCSS, stable
+    /// cascades or warps.
+    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set, help_heading = "Shadow map")]
+    pub depth_clamp: bool,
 }
 
 impl Default for MapSettings {
@@ -506,6 +513,7 @@ impl Default for MapSettings {
             format: MapFormat::default(),
             fit: Fit::default(),
             warp: WarpKind::default(),
+            depth_clamp: true,
         }
     }
 }

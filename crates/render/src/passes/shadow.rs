@@ -15,6 +15,7 @@ struct ShadowPipelineKey {
     depth_bias: i32,
     slope_bias_bits: u32,
     masked: bool,
+    unclipped: bool,
 }
 
 /// Shadow-pass pipelines, built on first use for each bias, cull and alpha-test
@@ -48,19 +49,22 @@ impl ShadowPass {
     }
 
     /// The pipeline for casters with these bias settings; `double_sided` casters are
-    /// never culled, and `masked` ones run the alpha test.
+    /// never culled, `masked` ones run the alpha test, and `unclipped` clamps depth
+    /// instead of clipping it (pancaking; needs `Features::DEPTH_CLIP_CONTROL`).
     pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
         bias: &BiasSettings,
         double_sided: bool,
         masked: bool,
+        unclipped: bool,
     ) -> &wgpu::RenderPipeline {
         let key = ShadowPipelineKey {
             cull: if double_sided { CullMode::None } else { bias.cull },
             depth_bias: bias.depth_bias,
             slope_bias_bits: bias.slope_bias.to_bits(),
             masked,
+            unclipped,
         };
         let module = &self.module;
         let layout = if masked { &self.masked_layout } else { &self.layout };
@@ -80,6 +84,7 @@ impl ShadowPass {
                         CullMode::Front => Some(wgpu::Face::Front),
                         CullMode::None => None,
                     },
+                    unclipped_depth: key.unclipped,
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
