@@ -1,7 +1,8 @@
 //! Pure shadow-mapping math, with no GPU: bounding boxes, camera and light
 //! projections, and the mapping from normalized device coordinates to shadow-map
 //! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
-//! [`warping`]); and the filter kernels the shaders use ([`kernels`]).
+//! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
+//! kernels the shaders use ([`kernels`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -16,6 +17,7 @@ pub mod cascades;
 pub mod fitting;
 pub mod kernels;
 mod light;
+pub mod omni;
 mod projection;
 #[cfg(test)]
 mod test_rng;
