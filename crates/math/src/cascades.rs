@@ -54,10 +54,17 @@ pub fn frustum_slice(view_frustum: &Hexahedron, near: f32, far: f32, from: f32, 
 }
 
 /// A cascade's projection fitted tightly: the light's map covers exactly the slice's
-/// potential receivers (the slice ∩ the scene).
-pub fn fit_cascade_tight(direction: Vec3, scene: &Aabb, slice: &Hexahedron) -> LightProjection {
+/// potential receivers (the slice ∩ the scene). With `depth_clamp` its depth range
+/// starts at the nearest of them ([`LightProjection::pancaked`]).
+pub fn fit_cascade_tight(
+    direction: Vec3,
+    scene: &Aabb,
+    slice: &Hexahedron,
+    depth_clamp: bool,
+) -> LightProjection {
     let receivers = intersection_vertices(slice, &Hexahedron::from_aabb(scene));
-    fit_directional_to_receivers(direction, scene, &receivers)
+    let fitted = fit_directional_to_receivers(direction, scene, &receivers);
+    if depth_clamp { fitted.pancaked(&receivers) } else { fitted }
 }
 
 /// A cascade's projection fitted stably: a square window of the slice's bounding
@@ -219,11 +226,12 @@ mod tests {
             let splits = split_distances(SplitScheme::Practical { lambda: 0.8 }, 4, near, far);
             for w in splits.windows(2) {
                 let slice = frustum_slice(&frustum, near, far, w[0], w[1]);
-                for stable in [false, true] {
-                    let p = if stable {
-                        fit_cascade_stable(direction, &scene, &slice, 1024)
-                    } else {
-                        fit_cascade_tight(direction, &scene, &slice)
+                // Tight, tight with its depth range pancaked onto the receivers, stable.
+                for fit in 0..3 {
+                    let p = match fit {
+                        0 => fit_cascade_tight(direction, &scene, &slice, false),
+                        1 => fit_cascade_tight(direction, &scene, &slice, true),
+                        _ => fit_cascade_stable(direction, &scene, &slice, 1024),
                     };
                     let m = p.clip_from_world();
                     for _ in 0..200 {
@@ -246,7 +254,7 @@ mod tests {
                             ndc.x.abs() <= 1.0001
                                 && ndc.y.abs() <= 1.0001
                                 && (-1e-4..=1.0001).contains(&ndc.z),
-                            "stable {stable}: receiver {p_world} of slice {w:?} maps to {ndc}"
+                            "fit {fit}: receiver {p_world} of slice {w:?} maps to {ndc}"
                         );
                     }
                 }

@@ -866,21 +866,12 @@ pub fn shadow_layout(
     let pancake =
         depth_clamp && settings.shadow.map.depth_clamp && settings.shadow.filter.technique != Technique::Pcss;
     let single = || {
-        let projection = light_projection(scene, light, camera, aspect, settings.shadow.map.fit);
-        let pancaked = match light {
-            Light::Directional(_) if pancake && settings.shadow.map.fit == Fit::Receivers => {
-                let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
-                Some(
-                    projection
-                        .pancaked(&intersection_vertices(&frustum, &Hexahedron::from_aabb(&scene.bounds()))),
-                )
-            }
-            _ => None,
-        };
+        let fit = settings.shadow.map.fit;
+        let clamped = pancake && fit == Fit::Receivers && matches!(light, Light::Directional(_));
         ShadowLayout {
-            projections: vec![pancaked.unwrap_or(projection)],
+            projections: vec![light_projection(scene, light, camera, aspect, fit, clamped)],
             splits: vec![0.0, f32::INFINITY],
-            depth_clamp: pancaked.is_some(),
+            depth_clamp: clamped,
         }
     };
     if let (Light::Directional(sun), Partition::Single, Some(warp)) =
@@ -912,9 +903,8 @@ pub fn shadow_layout(
             let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
             match c.cascade_fit {
                 CascadeFit::Tight => {
-                    let receivers = intersection_vertices(&slice, &Hexahedron::from_aabb(&bounds));
-                    let tight = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
-                    let fitted = match samples.and_then(|s| s.get(i).copied().flatten()) {
+                    let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice, pancake);
+                    match samples.and_then(|s| s.get(i).copied().flatten()) {
                         Some(window) => cascades::fit_cascade_to_samples(
                             &tight,
                             window,
@@ -922,8 +912,7 @@ pub fn shadow_layout(
                             resolution,
                         ),
                         None => tight,
-                    };
-                    if pancake { fitted.pancaked(&receivers) } else { fitted }
+                    }
                 }
                 CascadeFit::Stable => {
                     cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
@@ -1060,20 +1049,23 @@ fn render_target(
 
 /// The shadow projection of `light`: for a sun, an orthographic box fitted to the
 /// scene's bounds or to the receivers `camera` can see ([`Fit`]); for a spot, the
-/// perspective frustum of its cone out to its range.
+/// perspective frustum of its cone out to its range. `depth_clamp` pancakes a
+/// receiver-fitted sun map ([`LightProjection::pancaked`]).
 pub fn light_projection(
     scene: &Scene,
     light: &Light,
     camera: &Camera,
     aspect: f32,
     fit: Fit,
+    depth_clamp: bool,
 ) -> LightProjection {
     match light {
         Light::Directional(sun) if fit == Fit::Receivers => {
             let bounds = scene.bounds();
             let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
             let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
-            fit_directional_to_receivers(sun.direction, &bounds, &receivers)
+            let fitted = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
+            if depth_clamp { fitted.pancaked(&receivers) } else { fitted }
         }
         Light::Directional(sun) => directional_light_projection(sun.direction, &scene.bounds()),
         Light::Spot(spot) => spot_light_projection(

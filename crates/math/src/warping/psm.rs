@@ -142,7 +142,11 @@ fn potential_casters(light_from_world: Mat4, scene: &Aabb, receivers: &[DVec3]) 
         .collect()
 }
 
-/// Two unit vectors completing `axis` to an orthonormal frame.
+/// Two unit vectors completing `axis` to an orthonormal frame, square to
+/// post-perspective x (the screen's horizontal) unless the axis lies along it. The
+/// window is a rectangle in this frame, so keeping it aligned with the screen's axes
+/// keeps it tight around the receivers, which fill the screen: an arbitrary rotation
+/// (glam's `any_orthonormal_pair`) measured mean m 2.72 instead of 0.66 on `columns`.
 fn frame_around(axis: DVec3) -> (DVec3, DVec3) {
     let helper = if axis.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
     let across = axis.cross(helper).normalize();
