@@ -64,7 +64,7 @@ pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
         let (scene, extras) = gnomon_scene::gltf_loader::load(path)?;
         if extras.ignored_lights > 0 {
             eprintln!(
-                "gnomon: {name}: {} point light(s) ignored (point lights come with cube maps)",
+                "gnomon: {name}: {} light(s) ignored (a directional or spot light without a direction)",
                 extras.ignored_lights
             );
         }

@@ -14,6 +14,7 @@
 
 mod aabb;
 pub mod cascades;
+pub mod culling;
 pub mod fitting;
 pub mod kernels;
 mod light;

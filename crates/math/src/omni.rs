@@ -13,6 +13,8 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use crate::{LightProjection, ProjectionKind};
+
 /// The six faces in WebGPU's layer order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CubeFace {
@@ -92,6 +94,29 @@ pub fn cube_face_projection(near: f32, far: f32) -> Mat4 {
     glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, near, far)
 }
 
+/// The six face projections of a point light's cube map at `position`, from `near`
+/// to `far`, in layer order. Each is a 90° perspective [`LightProjection`], so the
+/// renderer draws and culls a face like any other layer.
+pub fn cube_face_projections(position: Vec3, near: f32, far: f32) -> [LightProjection; 6] {
+    CubeFace::ALL.map(|face| LightProjection {
+        light_from_world: cube_face_view(face, position),
+        clip_from_light: cube_face_projection(near, far),
+        kind: ProjectionKind::Perspective { fov: std::f32::consts::FRAC_PI_2 },
+        near,
+        far,
+    })
+}
+
+/// World size of one cube-map texel across the ray to a receiver `offset` from the
+/// light, for faces of `resolution`² texels. A face texel at major-axis distance m is
+/// 2m / resolution wide in the face's plane; seen across a ray at angle θ to the
+/// major axis it is cos θ = m / |offset| as wide, the smallest it gets (the shader's
+/// `cube_texel_world_size`).
+pub fn cube_texel_world_size(offset: Vec3, resolution: u32) -> f32 {
+    let major = offset.abs().max_element();
+    2.0 * major * major / (resolution as f32 * offset.length().max(f32::MIN_POSITIVE))
+}
+
 /// A dual-paraboloid map's coordinates of light-space direction `d` (unit length):
 /// the front hemisphere (z ≥ 0) maps to (x, y) / (1 + z), the back one mirrors z. The
 /// result lies in the unit disk; the flag says which hemisphere.
@@ -142,6 +167,33 @@ mod tests {
             let drawn = ndc_to_texture(ndc).truncate();
             assert!((drawn - uv).length() < 1e-4, "{d}: drawn at {drawn}, looked up at {uv} on {face:?}");
         }
+    }
+
+    #[test]
+    fn face_projections_draw_the_cube_layers_in_order() {
+        let light = Vec3::new(-2.0, 1.0, 0.5);
+        let faces = cube_face_projections(light, 0.02, 10.0);
+        for (layer, projection) in faces.iter().enumerate() {
+            let face = CubeFace::ALL[layer];
+            assert_eq!(face.layer(), layer as u32);
+            // The face's own axis lands at the centre of its layer, in front of the light.
+            let (_, _, major) = face.axes();
+            let ndc = projection.clip_from_world().project_point3(light + major * 3.0);
+            assert!(ndc.truncate().length() < 1e-5 && (0.0..1.0).contains(&ndc.z), "{face:?}: {ndc}");
+            assert_eq!(projection.near, 0.02);
+            assert_eq!(projection.far, 10.0);
+        }
+    }
+
+    #[test]
+    fn cube_texels_shrink_toward_face_corners() {
+        // On the axis, a texel spans 2d / resolution; toward a corner it is seen at
+        // an angle, and spans less across the ray.
+        let on_axis = cube_texel_world_size(Vec3::new(0.0, 0.0, -4.0), 512);
+        assert!((on_axis - 8.0 / 512.0).abs() < 1e-7);
+        let corner = Vec3::new(1.0, 1.0, 1.0) * (4.0 / 3f32.sqrt());
+        let at_corner = cube_texel_world_size(corner, 512);
+        assert!((at_corner - on_axis / 3.0).abs() < 1e-6, "{at_corner}");
     }
 
     #[test]

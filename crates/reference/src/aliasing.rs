@@ -57,8 +57,12 @@ pub struct AliasingImage {
 }
 
 /// The layer that shades a point, chosen as the lighting pass does (see
-/// `select_cascade` in the renderer's `lighting.wgsl`; the normal offset is ignored).
+/// `select_cascade` in the renderer's `map_visibility.wgsl`; the normal offset is
+/// ignored): for a point light, the cube face its direction falls on.
 pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usize {
+    if let Light::Point(point) = input.light {
+        return gnomon_math::omni::CubeFace::of_direction(world - point.position).layer() as usize;
+    }
     let count = input.layers.len();
     if !input.select_by_projection {
         return (1..count).rfind(|&i| view_depth > input.splits[i]).unwrap_or(0);
@@ -123,6 +127,7 @@ pub fn measure(input: &AliasingInput) -> AliasingImage {
             let travel = match input.light {
                 Light::Directional(sun) => sun.direction.normalize(),
                 Light::Spot(spot) => (p - spot.position).normalize(),
+                Light::Point(point) => (p - point.position).normalize(),
             };
             let (across_u, across_v) = travel.any_orthonormal_pair();
             let layer = input.layers[shading_layer(input, p, input.depth[i])];

@@ -62,6 +62,8 @@ enum Emitter {
     Sun { to_light: Vec3, half_angle: f32 },
     /// A disk at `center` of `radius` facing along `axis`; 0 is a point.
     Disk { center: Vec3, axis: Vec3, radius: f32, cos_outer: f32, range: f32 },
+    /// A sphere at `center` of `radius` emitting in every direction; 0 is a point.
+    Sphere { center: Vec3, radius: f32, range: f32 },
 }
 
 impl Emitter {
@@ -78,13 +80,16 @@ impl Emitter {
                 cos_outer: spot.outer_angle_degrees.to_radians().cos(),
                 range: spot.range,
             },
+            Light::Point(point) => {
+                Emitter::Sphere { center: point.position, radius: point.radius, range: point.range }
+            }
         }
     }
 
     fn is_point(&self) -> bool {
         match self {
             Emitter::Sun { half_angle, .. } => *half_angle <= 0.0,
-            Emitter::Disk { radius, .. } => *radius <= 0.0,
+            Emitter::Disk { radius, .. } | Emitter::Sphere { radius, .. } => *radius <= 0.0,
         }
     }
 
@@ -98,6 +103,11 @@ impl Emitter {
                 let dist = to.length();
                 let l = to / dist;
                 (l, (-l).dot(axis) >= cos_outer && dist <= range)
+            }
+            Emitter::Sphere { center, range, .. } => {
+                let to = center - p;
+                let dist = to.length();
+                (to / dist, dist <= range)
             }
         }
     }
@@ -120,6 +130,21 @@ impl Emitter {
                 let to = target - p;
                 let len = to.length();
                 (to / len, len)
+            }
+            Emitter::Sphere { center, radius, .. } => {
+                let to = center - p;
+                let dist = to.length();
+                let axis = to / dist;
+                if radius <= 0.0 || radius >= dist {
+                    return (axis, dist);
+                }
+                // Uniform over the cone the sphere subtends, which is uniform over its
+                // visible area as the receiver sees it (a sphere of uniform radiance);
+                // the ray ends where it enters the sphere.
+                let d = cone_direction(u, axis, (radius / dist).asin());
+                let along = d.dot(to);
+                let entry = along - (radius * radius - (dist * dist - along * along)).max(0.0).sqrt();
+                (d, entry.max(0.0))
             }
         }
     }

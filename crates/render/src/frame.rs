@@ -3,16 +3,19 @@
 
 use glam::{Vec3, Vec4};
 use gnomon_math::{
-    LightProjection, ProjectionKind, cascades, directional_light_projection,
+    LightProjection, ProjectionKind, cascades,
+    culling::Frustum,
+    directional_light_projection,
     fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
+    omni::{cube_face_projections, cube_texel_world_size},
     spot_light_projection,
     warping::{Warp, WarpView, fit_warped},
 };
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
     settings::{
-        BiasSettings, CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, MomentFormat, Partition,
-        SplitScheme, Technique, WarpKind,
+        BiasSettings, CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, LightKind, MomentFormat,
+        Partition, SplitScheme, Technique, WarpKind,
     },
 };
 use wgpu::util::DeviceExt;
@@ -23,7 +26,7 @@ use crate::{
     passes::{
         Layouts, SHADOW_FORMAT,
         depth_reduce::{BoundsRequest, DepthReducePass},
-        lighting::{self, LightingPass},
+        lighting::{self, LightingKey, LightingPass, LightingRole},
         moments::MomentPass,
         shadow::ShadowPass,
     },
@@ -67,6 +70,8 @@ pub struct Frame {
     /// Instance index + 1 of the visible surface; 0 for background.
     pub object_id: Vec<u32>,
     pub camera: Camera,
+    /// The light whose visibility the frame reports: the one light, or with
+    /// `--light all` the one at `--light-index`. The shadow-map fields below are its.
     pub light: Light,
     /// The shadow map's projection (the first cascade's, with cascades).
     pub light_projection: LightProjection,
@@ -81,19 +86,62 @@ pub struct Frame {
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
     pub timings: Option<PassTimings>,
-    /// Draw calls and state changes.
+    /// Draw calls and state changes, every light together.
     pub stats: DrawStats,
+    /// What each light drew and cost, in the order they were drawn.
+    pub lights: Vec<LightStats>,
     /// The moment map's texel format, for the filterable techniques.
     pub moment_format: Option<wgpu::TextureFormat>,
 }
 
 /// Which draws a depth-only pass takes.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Draws {
-    /// The shadow casters: the shadow pass.
-    Casters,
+#[derive(Clone, Copy)]
+enum Draws<'f> {
+    /// The shadow casters: the shadow pass. With `inside`, only the instances whose
+    /// bounds may reach into that frustum (the bool says whether its near plane
+    /// counts). `cube_face` draws a point light's face.
+    Casters { inside: Option<(&'f Frustum, bool)>, cube_face: bool },
     /// Every surface the camera can see: SDSM's prepass.
     Everything,
+}
+
+/// What one light of a frame drew and cost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightStats {
+    /// The light's name in the scene's list, or its type for a single light.
+    pub name: String,
+    /// "sun", "spot" or "point".
+    pub kind: &'static str,
+    pub technique: Technique,
+    /// Texels per side of each of its layers.
+    pub resolution: u32,
+    /// Draw calls into each layer of its map (one per cascade, six for a cube): the
+    /// casters that survived culling against that layer's frustum.
+    pub layer_draws: Vec<u32>,
+    /// GPU time of its shadow passes, moment pass and lighting pass, where the device
+    /// has timestamp queries.
+    pub shadow_ms: Option<f64>,
+    pub filter_ms: Option<f64>,
+    pub lighting_ms: Option<f64>,
+}
+
+impl LightStats {
+    /// Draw calls into its map, every layer together.
+    pub fn shadow_draws(&self) -> u32 {
+        self.layer_draws.iter().sum()
+    }
+}
+
+/// One light of a frame, as decided before recording.
+struct LightPlan {
+    name: String,
+    light: Light,
+    /// The render's settings with this light's shadow settings.
+    settings: Settings,
+    layout: ShadowLayout,
+    filterable_map: Option<techniques::FilterableMap>,
+    moment_format: wgpu::TextureFormat,
+    light_gpu: LightGpu,
 }
 
 /// What SDSM measured of the camera's samples (Lauritzen, Salvi & Lefohn 2011).
@@ -121,13 +169,17 @@ pub struct DrawStats {
     pub bind_group_changes: u32,
 }
 
-/// GPU time per pass, in milliseconds, from timestamp queries.
+/// GPU time per pass, in milliseconds, from timestamp queries; with many lights,
+/// each kind of pass summed over the lights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassTimings {
     pub shadow_ms: f64,
     /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
     pub filter_ms: Option<f64>,
     pub lighting_ms: f64,
+    /// The whole frame on the GPU, from the first shadow pass's start to the last
+    /// lighting pass's end (SDSM's prepass not included).
+    pub frame_ms: f64,
 }
 
 impl Frame {
@@ -147,6 +199,9 @@ impl Frame {
 
     /// World size of one shadow texel at `world` (which must be in front of the light).
     pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
+        if let Light::Point(point) = self.light {
+            return cube_texel_world_size(world - point.position, self.shadow_resolution);
+        }
         let distance = -self.light_projection.light_from_world.transform_point3(world).z;
         self.light_projection.texel_world_size(self.shadow_resolution, distance)
     }
@@ -161,9 +216,13 @@ pub struct Renderer<'g> {
     moment_pass: MomentPass,
     depth_reduce: DepthReducePass,
     compare_sampler: wgpu::Sampler,
+    compare_nearest_sampler: wgpu::Sampler,
+    gather_sampler: wgpu::Sampler,
     moment_sampler: wgpu::Sampler,
     /// Bound in place of a moment map for the depth-comparison techniques.
     placeholder_moments: wgpu::TextureView,
+    /// Bound in place of a cube map for the lights that are not point lights.
+    placeholder_cube: wgpu::TextureView,
 }
 
 impl<'g> Renderer<'g> {
@@ -184,6 +243,30 @@ impl<'g> Renderer<'g> {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
+        let compare_nearest_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow compare, nearest"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let gather_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow gather"),
+            ..Default::default()
+        });
+        let placeholder_cube = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("no cube map"),
+                size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 6 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: SHADOW_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::Cube),
+                ..Default::default()
+            });
         let moment_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("moment map"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -216,8 +299,11 @@ impl<'g> Renderer<'g> {
             depth_reduce: DepthReducePass::new(device),
             layouts,
             compare_sampler,
+            compare_nearest_sampler,
+            gather_sampler,
             moment_sampler,
             placeholder_moments,
+            placeholder_cube,
         }
     }
 
@@ -307,8 +393,9 @@ impl<'g> Renderer<'g> {
         Ok((submitted.timings, submitted.stats))
     }
 
-    /// Records and submits the shadow and lighting passes, copying the render targets
-    /// (and the shadow map) out when asked, and reads the pass timestamps.
+    /// Records and submits every light's shadow and lighting passes, copying the
+    /// render targets (and the reported light's shadow map) out when asked, and reads
+    /// the pass timestamps.
     fn submit(
         &mut self,
         uploaded: &GpuScene,
@@ -321,40 +408,64 @@ impl<'g> Renderer<'g> {
         settings.validate()?;
         self.check_limits(settings)?;
         let camera = settings.resolve_camera(scene)?;
-        let light = settings.resolve_light(scene)?;
-        let shadow = &settings.shadow;
-        let resolution = shadow.map.resolution;
+        let resolved = settings.resolve_lights(scene)?;
+        let shown = if settings.light.kind == LightKind::All { settings.light.light_index } else { 0 };
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
-        let layout = match fixed_layout {
-            Some(layout) => layout.clone(),
-            None => {
-                let sampled = match (&light, shadow.partition, shadow.cascades.sdsm) {
-                    (Light::Directional(sun), Partition::Cascades, true) => {
-                        self.sample_distribution(uploaded, scene, sun.direction, settings, &camera, aspect)?
-                    }
-                    _ => None,
-                };
-                let depth_clamp = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-                shadow_layout(scene, &light, &camera, aspect, settings, sampled.as_ref(), depth_clamp)
+        let depth_clamp = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+
+        // Everything about each light that is decided before recording.
+        let mut plans = Vec::with_capacity(resolved.len());
+        for (index, r) in resolved.into_iter().enumerate() {
+            let light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
+            self.check_limits(&light_settings)?;
+            let shadow = &light_settings.shadow;
+            let layout = match fixed_layout {
+                Some(layout) if index == shown => layout.clone(),
+                _ => {
+                    let sampled = match (&r.light, shadow.partition, shadow.cascades.sdsm) {
+                        (Light::Directional(sun), Partition::Cascades, true) => self.sample_distribution(
+                            uploaded,
+                            scene,
+                            sun.direction,
+                            &light_settings,
+                            &camera,
+                            aspect,
+                        )?,
+                        _ => None,
+                    };
+                    shadow_layout(scene, &r.light, &camera, aspect, &light_settings, sampled.as_ref(), depth_clamp)
+                }
+            };
+            let technique = techniques::lookup(shadow.filter.technique);
+            let filterable_map = technique.filterable_map(&shadow.filter);
+            let moment_format = self.moment_format(&light_settings)?;
+            let precision = match moment_format {
+                wgpu::TextureFormat::Rgba16Float => techniques::MapPrecision::Half,
+                _ => techniques::MapPrecision::Single,
+            };
+            let mut light_gpu = light_uniform(
+                scene,
+                &r.light,
+                &layout,
+                &light_settings,
+                technique.params(&shadow.filter, precision),
+                filterable_map,
+            );
+            if index > 0 {
+                // Ambient light is added once, by the first light's pass.
+                light_gpu.ambient = Vec4::ZERO;
             }
-        };
-        let layers = layout.projections.len() as u32;
-        let technique = techniques::lookup(shadow.filter.technique);
-        let filterable_map = technique.filterable_map(&shadow.filter);
-        let moment_format = self.moment_format(settings)?;
-        let precision = match moment_format {
-            wgpu::TextureFormat::Rgba16Float => techniques::MapPrecision::Half,
-            _ => techniques::MapPrecision::Single,
-        };
-        let light_gpu = light_uniform(
-            scene,
-            &light,
-            &layout,
-            settings,
-            technique.params(&shadow.filter, precision),
-            filterable_map,
-        );
+            plans.push(LightPlan {
+                name: r.name,
+                light: r.light,
+                settings: light_settings,
+                layout,
+                filterable_map,
+                moment_format,
+                light_gpu,
+            });
+        }
         let camera_gpu = CameraGpu {
             clip_from_world: camera.clip_from_world(aspect),
             view_from_world: camera.view_from_world(),
@@ -364,122 +475,111 @@ impl<'g> Renderer<'g> {
 
         let gpu = self.gpu;
         let device = &gpu.device;
-        let (pending, shadow_pending, timestamps, stats) = gpu.checked("rendering the frame", || {
-            let (light_buffer, scene_group) = self.scene_group(uploaded, &light_gpu);
+        let timestamp_count = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
+        let (pending, shadow_pending, timestamps, stats, layer_draws) = gpu.checked("rendering the frame", || {
             let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
             let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("camera"),
                 layout: &self.layouts.camera,
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: camera_buffer.as_entire_binding() }],
             });
-            let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("shadow map"),
-                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: SHADOW_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            });
-            let shadow_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
             let queries = gpu.timestamp_period_ns.map(|_| {
                 device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("pass timestamps"),
                     ty: wgpu::QueryType::Timestamp,
-                    count: TIMESTAMPS,
+                    count: timestamp_count,
                 })
             });
-            let pass_timestamps = |first: u32| {
-                queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(first),
-                    end_of_pass_write_index: Some(first + 1),
-                })
-            };
             let mut encoder = device.create_command_encoder(&Default::default());
             let mut stats = DrawStats::default();
-            // One depth pass per layer, each with the light uniform of its cascade; the
-            // timestamps bracket them all.
-            for layer in 0..layers {
-                let layer_light = LightGpu {
-                    clip_from_world: light_gpu.cascade_clip_from_world[layer as usize],
-                    ..light_gpu
-                };
-                let (_, layer_group) = self.scene_group(uploaded, &layer_light);
-                let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
+            let mut layer_draws = Vec::with_capacity(plans.len());
+            let mut shadow_pending = None;
+            // Each light's shadow map(s), then its bind groups for the lighting pass.
+            let mut lit = Vec::with_capacity(plans.len());
+            for (index, plan) in plans.iter().enumerate() {
+                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
+                let (shadow_map, draws) =
+                    self.record_shadow_maps(&mut encoder, uploaded, plan, queries.as_ref(), slot, &mut stats);
+                layer_draws.push(draws);
+                if read_shadow_map && index == shown {
+                    shadow_pending = Some(readback::record(
+                        device,
+                        &mut encoder,
+                        &shadow_map,
+                        wgpu::TextureAspect::DepthOnly,
+                    ));
+                }
+                let (light_buffer, scene_group) = self.scene_group(uploaded, &plan.light_gpu);
+                let shadow_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
                     ..Default::default()
                 });
-                let (first, last) = (layer == 0, layer + 1 == layers);
-                let timestamps = queries.as_ref().filter(|_| first || last).map(|query_set| {
-                    wgpu::RenderPassTimestampWrites {
-                        query_set,
-                        beginning_of_pass_write_index: first.then_some(0),
-                        end_of_pass_write_index: last.then_some(1),
-                    }
+                let shadow = &plan.settings.shadow;
+                let moment_map = plan.filterable_map.map(|map| {
+                    self.moment_pass.record(
+                        device,
+                        &mut encoder,
+                        shadow.filter.technique,
+                        map,
+                        &shadow.filter.moments,
+                        plan.moment_format,
+                        shadow.map.resolution,
+                        plan.layout.projections.len() as u32,
+                        &shadow_view,
+                        &light_buffer,
+                        queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
+                            query_set,
+                            beginning_of_pass_write_index: Some(slot + 4),
+                            end_of_pass_write_index: Some(slot + 5),
+                        }),
+                    )
                 });
-                self.record_depth_pass(
-                    &mut encoder,
-                    uploaded,
-                    settings,
-                    &layer_group,
-                    &layer_view,
-                    Draws::Casters,
-                    layout.depth_clamp,
-                    timestamps,
-                    &mut stats,
-                );
+                let cube_view = matches!(plan.light, Light::Point(_)).then(|| {
+                    shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::Cube),
+                        ..Default::default()
+                    })
+                });
+                let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
+                let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow map"),
+                    layout: &self.layouts.shadow,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&shadow_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::TextureView(moment_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: wgpu::BindingResource::TextureView(
+                                cube_view.as_ref().unwrap_or(&self.placeholder_cube),
+                            ),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: wgpu::BindingResource::Sampler(&self.compare_nearest_sampler),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 6,
+                            resource: wgpu::BindingResource::Sampler(&self.gather_sampler),
+                        },
+                    ],
+                });
+                lit.push((scene_group, shadow_group));
             }
-            let moment_map = filterable_map.map(|map| {
-                self.moment_pass.record(
-                    device,
-                    &mut encoder,
-                    shadow.filter.technique,
-                    map,
-                    &shadow.filter.moments,
-                    moment_format,
-                    resolution,
-                    layers,
-                    &shadow_view,
-                    &light_buffer,
-                    queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
-                        query_set,
-                        beginning_of_pass_write_index: Some(4),
-                        end_of_pass_write_index: Some(5),
-                    }),
-                )
-            });
-            let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
-            let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadow map"),
-                layout: &self.layouts.shadow,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&shadow_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(moment_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
-                    },
-                ],
-            });
+
             let targets: Vec<wgpu::Texture> = lighting::TARGETS
                 .iter()
                 .map(|&format| render_target(device, width, height, format))
@@ -488,45 +588,60 @@ impl<'g> Renderer<'g> {
                 targets.iter().map(|t| t.create_view(&Default::default())).collect();
             let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
             let depth_view = depth.create_view(&Default::default());
-
-            {
+            for (index, (plan, (scene_group, shadow_group))) in plans.iter().zip(&lit).enumerate() {
+                let first = index == 0;
+                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
                 let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
                     .iter()
                     .enumerate()
                     .map(|(i, view)| {
                         // The colour image gets an opaque sky; the data targets zero
-                        // (object id 0 marks background).
+                        // (object id 0 marks background). Later lights add to them.
                         let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
                         Some(wgpu::RenderPassColorAttachment {
                             view,
                             depth_slice: None,
                             resolve_target: None,
                             ops: wgpu::Operations {
-                                load: wgpu::LoadOp::Clear(clear),
+                                load: if first { wgpu::LoadOp::Clear(clear) } else { wgpu::LoadOp::Load },
                                 store: wgpu::StoreOp::Store,
                             },
                         })
                     })
                     .collect();
+                let last = index + 1 == plans.len();
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("lighting"),
                     color_attachments: &attachments,
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: &depth_view,
                         depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Discard,
+                            load: if first { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                            store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
                         }),
                         stencil_ops: None,
                     }),
-                    timestamp_writes: pass_timestamps(2),
+                    timestamp_writes: queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: Some(slot + 2),
+                        end_of_pass_write_index: Some(slot + 3),
+                    }),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(self.lighting_pass.pipeline(device, shadow.filter.technique));
-                pass.set_bind_group(0, &scene_group, &[]);
+                let key = LightingKey {
+                    technique: plan.settings.shadow.filter.technique,
+                    cube: matches!(plan.light, Light::Point(_)),
+                    role: if first {
+                        LightingRole::First
+                    } else {
+                        LightingRole::Added { visibility: index == shown }
+                    },
+                };
+                pass.set_pipeline(self.lighting_pass.pipeline(device, key));
+                pass.set_bind_group(0, scene_group, &[]);
                 pass.set_bind_group(1, &camera_group, &[]);
-                pass.set_bind_group(2, &shadow_group, &[]);
+                pass.set_bind_group(2, shadow_group, &[]);
                 stats.pipeline_changes += 1;
                 stats.bind_group_changes += 3;
                 uploaded.bind_geometry(&mut pass);
@@ -549,38 +664,146 @@ impl<'g> Renderer<'g> {
             } else {
                 Vec::new()
             };
-            let shadow_pending = read_shadow_map
-                .then(|| readback::record(device, &mut encoder, &shadow_map, wgpu::TextureAspect::DepthOnly));
             let timestamps = queries
                 .as_ref()
-                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, TIMESTAMPS));
+                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, timestamp_count));
             gpu.queue.submit([encoder.finish()]);
-            (pending, shadow_pending, timestamps, stats)
+            (pending, shadow_pending, timestamps, stats, layer_draws)
         })?;
 
-        let timings = match (timestamps, gpu.timestamp_period_ns) {
-            (Some(t), Some(period)) => {
-                let ticks = t.read(gpu)?;
-                let ms = |a: usize, b: usize| ticks[b].saturating_sub(ticks[a]) as f64 * period as f64 * 1e-6;
-                Some(PassTimings {
-                    shadow_ms: ms(0, 1),
-                    filter_ms: filterable_map.is_some().then(|| ms(4, 5)),
-                    lighting_ms: ms(2, 3),
-                })
-            }
-            _ => None,
+        let ticks = match timestamps {
+            Some(t) => Some(t.read(gpu)?),
+            None => None,
         };
-        let moment_format = filterable_map.is_some().then_some(moment_format);
-        Ok(Submitted { pending, shadow_pending, timings, stats, camera, light, layout, moment_format })
+        let ms = |a: u32, b: u32| -> Option<f64> {
+            let (ticks, period) = (ticks.as_ref()?, gpu.timestamp_period_ns?);
+            Some(ticks[b as usize].saturating_sub(ticks[a as usize]) as f64 * period as f64 * 1e-6)
+        };
+        let lights: Vec<LightStats> = plans
+            .iter()
+            .zip(layer_draws)
+            .enumerate()
+            .map(|(index, (plan, layer_draws))| {
+                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
+                LightStats {
+                    name: plan.name.clone(),
+                    kind: plan.light.type_name(),
+                    technique: plan.settings.shadow.filter.technique,
+                    resolution: plan.settings.shadow.map.resolution,
+                    layer_draws,
+                    shadow_ms: ms(slot, slot + 1),
+                    filter_ms: plan.filterable_map.and_then(|_| ms(slot + 4, slot + 5)),
+                    lighting_ms: ms(slot + 2, slot + 3),
+                }
+            })
+            .collect();
+        let timings = ticks.as_ref().map(|_| {
+            let sum = |f: fn(&LightStats) -> Option<f64>| lights.iter().filter_map(f).sum::<f64>();
+            let filtered = lights.iter().any(|l| l.filter_ms.is_some());
+            PassTimings {
+                shadow_ms: sum(|l| l.shadow_ms),
+                filter_ms: filtered.then(|| sum(|l| l.filter_ms)),
+                lighting_ms: sum(|l| l.lighting_ms),
+                // From the first shadow pass's start to the last lighting pass's end.
+                frame_ms: ms(0, timestamp_count - TIMESTAMPS_PER_LIGHT + 3).unwrap_or(0.0),
+            }
+        });
+        let plan = plans.swap_remove(shown);
+        Ok(Submitted {
+            pending,
+            shadow_pending,
+            timings,
+            stats,
+            lights,
+            camera,
+            light: plan.light,
+            resolution: plan.settings.shadow.map.resolution,
+            layout: plan.layout,
+            moment_format: plan.filterable_map.is_some().then_some(plan.moment_format),
+        })
+    }
+
+    /// Draws a light's shadow map, one depth pass per layer (cascade or cube face),
+    /// each drawing only the casters inside that layer's frustum. Returns the map and
+    /// the draws of each layer; the timestamps bracket all the layers.
+    fn record_shadow_maps(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        plan: &LightPlan,
+        queries: Option<&wgpu::QuerySet>,
+        slot: u32,
+        stats: &mut DrawStats,
+    ) -> (wgpu::Texture, Vec<u32>) {
+        let device = &self.gpu.device;
+        let resolution = plan.settings.shadow.map.resolution;
+        let layers = plan.layout.projections.len() as u32;
+        let cube_face = matches!(plan.light, Light::Point(_));
+        let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow map"),
+            size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: SHADOW_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut draws = Vec::with_capacity(layers as usize);
+        for layer in 0..layers {
+            let projection = &plan.layout.projections[layer as usize];
+            let layer_light =
+                LightGpu { clip_from_world: plan.light_gpu.cascade_clip_from_world[layer as usize], ..plan.light_gpu };
+            let (_, layer_group) = self.scene_group(uploaded, &layer_light);
+            let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let (first, last) = (layer == 0, layer + 1 == layers);
+            let timestamps = queries.filter(|_| first || last).map(|query_set| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: first.then_some(slot),
+                end_of_pass_write_index: last.then_some(slot + 1),
+            });
+            // A pass that clamps depth draws the casters before its near plane too.
+            let frustum = Frustum::from_clip_from_world(projection.clip_from_world());
+            let before = stats.shadow_draws;
+            self.record_depth_pass(
+                encoder,
+                uploaded,
+                &plan.settings,
+                &layer_group,
+                &layer_view,
+                Draws::Casters { inside: Some((&frustum, !plan.layout.depth_clamp)), cube_face },
+                plan.layout.depth_clamp,
+                timestamps,
+                stats,
+            );
+            draws.push(stats.shadow_draws - before);
+        }
+        (shadow_map, draws)
     }
 
     /// Reads a submitted frame's images back and assembles the [`Frame`].
     fn read_frame(&self, submitted: Submitted, settings: &Settings) -> Result<Frame, RenderError> {
         let gpu = self.gpu;
-        let Submitted { pending, shadow_pending, timings, stats, camera, light, layout, moment_format } =
-            submitted;
+        let Submitted {
+            pending,
+            shadow_pending,
+            timings,
+            stats,
+            lights,
+            camera,
+            light,
+            resolution,
+            layout,
+            moment_format,
+        } = submitted;
         let (width, height) = (settings.image.width, settings.image.height);
-        let resolution = settings.shadow.map.resolution;
         let mut pending = pending.into_iter();
         let mut next = || pending.next().expect("one readback per target");
         let color: Vec<u8> = next().read(gpu)?;
@@ -631,6 +854,7 @@ impl<'g> Renderer<'g> {
             shadow_map,
             timings,
             stats,
+            lights,
             moment_format,
         })
     }
@@ -768,40 +992,66 @@ impl<'g> Renderer<'g> {
             uploaded.bind_geometry(&mut pass);
             // Opaque casters first (no bind group changes at all), then the
             // alpha-masked ones, texture by texture.
+            let (inside, cube_face) = match draws {
+                Draws::Casters { inside, cube_face } => (inside, cube_face),
+                Draws::Everything => (None, false),
+            };
+            let visible = |instance: u32| {
+                inside.is_none_or(|(frustum, near)| {
+                    frustum.intersects(&uploaded.instance_bounds[instance as usize], near)
+                })
+            };
             let mut pipeline = None;
             for masked in [false, true] {
                 let mut bound = None;
                 let drawn = |d: &&crate::gpu_scene::Draw| match draws {
-                    Draws::Casters => d.casts_shadow,
+                    Draws::Casters { .. } => d.casts_shadow,
                     Draws::Everything => true,
                 };
                 for d in uploaded.draws.iter().filter(drawn).filter(|d| d.masked == masked) {
-                    if pipeline != Some((d.double_sided, masked)) {
-                        pass.set_pipeline(self.shadow_pass.pipeline(
-                            device,
-                            &shadow.bias,
-                            d.double_sided,
-                            masked,
-                            unclipped,
-                        ));
-                        pipeline = Some((d.double_sided, masked));
-                        stats.pipeline_changes += 1;
+                    // The runs of consecutive instances that survive culling.
+                    let end = d.instance + d.instance_count;
+                    let mut start = d.instance;
+                    while start < end {
+                        if !visible(start) {
+                            start += 1;
+                            continue;
+                        }
+                        let mut stop = start + 1;
+                        while stop < end && visible(stop) {
+                            stop += 1;
+                        }
+                        if pipeline != Some((d.double_sided, masked)) {
+                            pass.set_pipeline(self.shadow_pass.pipeline(
+                                device,
+                                &shadow.bias,
+                                d.double_sided,
+                                masked,
+                                unclipped,
+                                cube_face,
+                            ));
+                            pipeline = Some((d.double_sided, masked));
+                            stats.pipeline_changes += 1;
+                        }
+                        if masked && bound != Some(d.material_group) {
+                            pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
+                            bound = Some(d.material_group);
+                            stats.bind_group_changes += 1;
+                        }
+                        let run = crate::gpu_scene::Draw { instance: start, instance_count: stop - start, ..*d };
+                        GpuScene::draw_one(&mut pass, &run);
+                        stats.shadow_draws += 1;
+                        start = stop;
                     }
-                    if masked && bound != Some(d.material_group) {
-                        pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
-                        bound = Some(d.material_group);
-                        stats.bind_group_changes += 1;
-                    }
-                    GpuScene::draw_one(&mut pass, d);
-                    stats.shadow_draws += 1;
                 }
             }
         }
     }
 }
 
-/// Timestamp queries per frame: begin and end of the shadow, lighting and moment passes.
-const TIMESTAMPS: u32 = 6;
+/// Timestamp queries per light: begin and end of its shadow, lighting and moment
+/// passes, in that order.
+const TIMESTAMPS_PER_LIGHT: u32 = 6;
 
 fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, contents: &T) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -820,8 +1070,11 @@ struct Submitted {
     shadow_pending: Option<readback::PendingReadback>,
     timings: Option<PassTimings>,
     stats: DrawStats,
+    lights: Vec<LightStats>,
     camera: Camera,
+    /// The reported light, its map's resolution, layout and moment format.
     light: Light,
+    resolution: u32,
     layout: ShadowLayout,
     moment_format: Option<wgpu::TextureFormat>,
 }
@@ -841,7 +1094,8 @@ pub struct ShadowLayout {
 
 /// The shadow layout of `light` under `settings`: one map, or for a sun with
 /// `--partition cascades`, one per slice of the view frustum, all sharing one depth
-/// range so that every layer stores depth the same way.
+/// range so that every layer stores depth the same way; for a point light, the six
+/// faces of its cube.
 ///
 /// `sampled`, for SDSM, is what [`Renderer`]'s reductions measured of the camera's
 /// samples: the cascades split the range of view depths it saw instead of the range
@@ -863,6 +1117,14 @@ pub fn shadow_layout(
     sampled: Option<&SampleDistribution>,
     depth_clamp: bool,
 ) -> ShadowLayout {
+    if let Light::Point(point) = light {
+        // Six 90° faces from the light's position, near and far from its range.
+        return ShadowLayout {
+            projections: cube_face_projections(point.position, point.shadow_near(), point.range).to_vec(),
+            splits: vec![0.0, f32::INFINITY],
+            depth_clamp: false,
+        };
+    }
     let pancake =
         depth_clamp && settings.shadow.map.depth_clamp && settings.shadow.filter.technique != Technique::Pcss;
     let single = || {
@@ -1049,7 +1311,8 @@ fn render_target(
 
 /// The shadow projection of `light`: for a sun, an orthographic box fitted to the
 /// scene's bounds or to the receivers `camera` can see ([`Fit`]); for a spot, the
-/// perspective frustum of its cone out to its range. `depth_clamp` pancakes a
+/// perspective frustum of its cone out to its range; for a point light, its cube's
+/// first face (+x; [`shadow_layout`] has all six). `depth_clamp` pancakes a
 /// receiver-fitted sun map ([`LightProjection::pancaked`]).
 pub fn light_projection(
     scene: &Scene,
@@ -1075,6 +1338,7 @@ pub fn light_projection(
             spot.shadow_near(),
             spot.range,
         ),
+        Light::Point(point) => cube_face_projections(point.position, point.shadow_near(), point.range)[0],
     }
 }
 
@@ -1109,6 +1373,7 @@ fn light_uniform(
     let light_size = match light {
         Light::Directional(sun) => (0.5 * sun.angular_diameter_degrees.to_radians()).tan(),
         Light::Spot(spot) => spot.radius,
+        Light::Point(point) => point.radius,
     };
     let common = LightGpu {
         clip_from_world: projection.clip_from_world(),
@@ -1147,6 +1412,12 @@ fn light_uniform(
             filterable_map.map_or(1, |m| m.layers) as f32,
         ),
         cone: Vec4::new(1.0, -1.0, projection.near, projection.far),
+        raster_bias: Vec4::new(
+            settings.shadow.bias.depth_bias as f32,
+            settings.shadow.bias.slope_bias,
+            0.0,
+            0.0,
+        ),
         ..Default::default()
     };
     match light {
@@ -1165,6 +1436,12 @@ fn light_uniform(
                 projection.near,
                 projection.far,
             ),
+            ..common
+        },
+        Light::Point(point) => LightGpu {
+            radiance: (point.color * point.intensity).extend(0.0),
+            direction: Vec4::new(0.0, 0.0, 0.0, 2.0),
+            position: point.position.extend(point.range),
             ..common
         },
     }

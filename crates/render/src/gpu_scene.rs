@@ -3,6 +3,7 @@
 //! vertex buffer, only the index range and the instance index.
 
 use glam::{Mat3, Mat4, Vec4};
+use gnomon_math::Aabb;
 use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
 use wgpu::util::DeviceExt;
 
@@ -47,6 +48,8 @@ pub struct GpuScene {
     pub(crate) draws: Vec<Draw>,
     /// One bind group per texture, plus a 1×1 white one (index 0) for untextured draws.
     pub(crate) material_groups: Vec<wgpu::BindGroup>,
+    /// Each instance's world-space bounds, for culling casters per light.
+    pub(crate) instance_bounds: Vec<Aabb>,
 }
 
 impl GpuScene {
@@ -136,6 +139,11 @@ impl GpuScene {
             }),
             draws,
             material_groups: material_groups(gpu, scene, layouts),
+            instance_bounds: scene
+                .instances
+                .iter()
+                .map(|i| scene.meshes[i.mesh].bounds().transformed(i.world_from_object))
+                .collect(),
         })
     }
 

@@ -26,9 +26,10 @@ pub struct LightGpu {
     pub light_from_world: Mat4,
     /// rgb: colour × intensity.
     pub radiance: Vec4,
-    /// xyz: the sun's travel direction or the spot's axis; w: 0 for a sun, 1 for a spot.
+    /// xyz: the sun's travel direction or the spot's axis; w: 0 for a sun, 1 for a
+    /// spot, 2 for a point light.
     pub direction: Vec4,
-    /// xyz: spot position; w: spot range.
+    /// xyz: spot or point light position; w: its range.
     pub position: Vec4,
     /// x: cos(inner angle), y: cos(outer angle), z: map near plane, w: map far plane.
     pub cone: Vec4,
@@ -57,6 +58,10 @@ pub struct LightGpu {
     /// x: layer count, y: 1 to select cascades by projection, z: blend band as a
     /// fraction of a cascade's depth range, w: moment-map layers per cascade.
     pub cascades: Vec4,
+    /// The rasterizer's depth bias, for the passes that write their own depth (a
+    /// point light's distance cube): x: constant bias in units of the depth's last
+    /// mantissa bit, y: slope-scaled bias.
+    pub raster_bias: Vec4,
 }
 
 /// The most cascades a light may have (the size of the uniform arrays).

@@ -3,7 +3,10 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::{Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, geometry, sun_direction};
+use crate::{
+    Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight, SpotLight, geometry,
+    sun_direction,
+};
 
 /// A built-in scene: its name, what it shows, and how to build it.
 pub struct Builtin {
@@ -33,6 +36,11 @@ pub const BUILTINS: &[Builtin] = &[
         name: "columns",
         description: "a long ground with rows of columns far from the camera: a large depth range",
         build: columns,
+    },
+    Builtin {
+        name: "lamps",
+        description: "a courtyard lit by eight shadowed lights at once: a sun, three spots and four point lights",
+        build: lamps,
     },
 ];
 
@@ -78,7 +86,14 @@ impl SceneBuilder {
         });
     }
 
-    fn finish(self, name: &str, camera: Camera, sun: DirectionalLight, spot: SpotLight) -> Scene {
+    fn finish(
+        self,
+        name: &str,
+        camera: Camera,
+        sun: DirectionalLight,
+        spot: SpotLight,
+        point: PointLight,
+    ) -> Scene {
         Scene {
             name: name.into(),
             meshes: self.meshes,
@@ -87,6 +102,8 @@ impl SceneBuilder {
             camera,
             sun,
             spot,
+            point,
+            lights: Vec::new(),
             ambient: Vec3::splat(0.12),
             textures: Vec::new(),
             has_ground: true,
@@ -114,6 +131,10 @@ fn spot(position: Vec3, target: Vec3, outer_degrees: f32, range: f32) -> SpotLig
         intensity: 1.0,
         radius: 0.0,
     }
+}
+
+fn point(position: Vec3, range: f32) -> PointLight {
+    PointLight { position, range, color: Vec3::new(1.0, 0.93, 0.8), intensity: 1.0, radius: 0.0 }
 }
 
 fn at(p: Vec3) -> Mat4 {
@@ -150,7 +171,15 @@ pub fn spheres() -> Scene {
         near: 0.1,
         far: 100.0,
     };
-    b.finish("spheres", camera, sun(48.0, 35.0), spot(Vec3::new(4.0, 9.0, 5.0), Vec3::ZERO, 40.0, 30.0))
+    // The point light hangs among the spheres, between the centre one and its
+    // neighbours, so that its shadows fall in every direction.
+    b.finish(
+        "spheres",
+        camera,
+        sun(48.0, 35.0),
+        spot(Vec3::new(4.0, 9.0, 5.0), Vec3::ZERO, 40.0, 30.0),
+        point(Vec3::new(1.5, 2.2, 1.5), 30.0),
+    )
 }
 
 /// Objects resting exactly on the ground (y = 0): a 2 × 1 × 2 box, a unit sphere, a
@@ -187,6 +216,7 @@ pub fn contact() -> Scene {
         camera,
         sun(35.0, 200.0),
         spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0),
+        point(Vec3::new(0.5, 2.5, 0.0), 20.0),
     )
 }
 
@@ -216,6 +246,7 @@ pub fn grazing() -> Scene {
         camera,
         sun(6.0, 250.0),
         spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0),
+        point(Vec3::new(-3.0, 1.0, 1.0), 40.0),
     )
 }
 
@@ -246,7 +277,106 @@ pub fn columns() -> Scene {
         camera,
         sun(40.0, 60.0),
         spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0),
+        point(Vec3::new(0.0, 4.0, -20.0), 30.0),
     )
+}
+
+/// A 30 × 30 courtyard with a ring of 3 m pillars, crates and spheres, lit by eight
+/// shadowed lights of every type at once, each with its own shadow settings: a low
+/// sun with cascades, three spot lights and four coloured point lights (lamps) among
+/// the objects. The scene for many lights: `--light all`.
+pub fn lamps() -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(30.0, 30.0));
+    let grey = b.material("ground", GROUND);
+    let stone = b.material("stone", Vec3::new(0.78, 0.74, 0.66));
+    let wood = b.material("wood", Vec3::new(0.7, 0.5, 0.3));
+    let blue = b.material("blue", Vec3::new(0.3, 0.45, 0.8));
+    b.place("ground", ground, grey, Mat4::IDENTITY);
+    let pillar = b.mesh(geometry::cuboid(Vec3::new(0.35, 1.5, 0.35)));
+    for i in 0..8 {
+        let angle = i as f32 * std::f32::consts::FRAC_PI_4;
+        let p = Vec3::new(7.0 * angle.cos(), 1.5, 7.0 * angle.sin());
+        b.place(&format!("pillar {i}"), pillar, stone, at(p));
+    }
+    let crate_mesh = b.mesh(geometry::cuboid(Vec3::splat(0.6)));
+    for (i, p) in [Vec3::new(-2.5, 0.6, 1.0), Vec3::new(2.0, 0.6, -2.5), Vec3::new(3.0, 0.6, 3.0)]
+        .into_iter()
+        .enumerate()
+    {
+        b.place(&format!("crate {i}"), crate_mesh, wood, at(p) * Mat4::from_rotation_y(0.4 * i as f32));
+    }
+    let ball = b.mesh(geometry::uv_sphere(0.8, 40, 20));
+    b.place("sphere 0", ball, blue, at(Vec3::new(0.0, 0.8, 0.0)));
+    b.place("sphere 1", ball, blue, at(Vec3::new(-4.0, 0.8, -3.0)));
+    let camera = Camera {
+        eye: Vec3::new(0.0, 11.0, 16.0),
+        target: Vec3::new(0.0, 0.5, 0.0),
+        up: Vec3::Y,
+        fov_y_degrees: 50.0,
+        near: 0.1,
+        far: 80.0,
+    };
+    let dim = |mut l: PointLight, color: Vec3| {
+        l.color = color;
+        l.intensity = 0.35;
+        l
+    };
+    let settings = |text: &str| Some(text.parse::<toml::Table>().expect("built-in light settings parse"));
+    let mut sun_light = sun(25.0, 140.0);
+    sun_light.intensity = 0.35;
+    let spots = [
+        (Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), Vec3::new(1.0, 0.6, 0.6)),
+        (Vec3::new(8.0, 6.0, 8.0), Vec3::new(2.0, 0.0, -1.0), Vec3::new(0.6, 1.0, 0.6)),
+        (Vec3::new(0.0, 7.0, -9.0), Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.6, 0.7, 1.0)),
+    ];
+    let points = [
+        (Vec3::new(-3.0, 2.2, 3.5), Vec3::new(1.0, 0.75, 0.4)),
+        (Vec3::new(3.5, 2.0, 0.5), Vec3::new(0.5, 0.8, 1.0)),
+        (Vec3::new(0.5, 2.5, -4.0), Vec3::new(1.0, 0.5, 0.8)),
+        (Vec3::new(-5.0, 1.8, -0.5), Vec3::new(0.7, 1.0, 0.5)),
+    ];
+    let mut lights = vec![SceneLight {
+        name: "sun".into(),
+        light: Light::Directional(sun_light),
+        shadow: settings("partition = \"cascades\"\n[filter]\ntechnique = \"pcf-poisson\""),
+    }];
+    for (i, (position, target, color)) in spots.into_iter().enumerate() {
+        let mut s = spot(position, target, 38.0, 25.0);
+        s.color = color;
+        s.intensity = 0.5;
+        let technique = ["pcf", "pcss", "hard"][i];
+        let shadow = match technique {
+            "pcss" => format!("[filter]\ntechnique = \"pcss\"\n"),
+            _ => format!("[filter]\ntechnique = \"{technique}\"\n[map]\nresolution = 1024"),
+        };
+        if technique == "pcss" {
+            s.radius = 0.3;
+        }
+        lights.push(SceneLight { name: format!("spot {i}"), light: Light::Spot(s), shadow: settings(&shadow) });
+    }
+    for (i, (position, color)) in points.into_iter().enumerate() {
+        let technique = ["pcf2x2", "pcf-poisson", "pcf", "pcss"][i];
+        let mut p = dim(point(position, 14.0), color);
+        if technique == "pcss" {
+            p.radius = 0.15;
+        }
+        lights.push(SceneLight {
+            name: format!("lamp {i}"),
+            light: Light::Point(p),
+            shadow: settings(&format!("[filter]\ntechnique = \"{technique}\"\n[map]\nresolution = 512")),
+        });
+    }
+    let mut scene = b.finish(
+        "lamps",
+        camera,
+        sun_light,
+        spot(Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), 38.0, 25.0),
+        dim(point(points[0].0, 14.0), points[0].1),
+    );
+    scene.ambient = Vec3::splat(0.06);
+    scene.lights = lights;
+    scene
 }
 
 #[cfg(test)]

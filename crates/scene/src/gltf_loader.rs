@@ -13,8 +13,8 @@ use glam::{Mat4, Vec2, Vec3};
 use gltf::image::Format;
 
 use crate::{
-    AlphaMode, Camera, DirectionalLight, Instance, Material, Mesh, Scene, SpotLight, Texture, Wrap,
-    sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight,
+    SpotLight, Texture, Wrap, sun_direction,
 };
 
 /// A glTF file that could not be loaded.
@@ -34,7 +34,10 @@ pub struct FileExtras {
     pub has_sun: bool,
     /// Whether the file had a spot light (else a default spot was placed).
     pub has_spot: bool,
-    /// Lights the file has that Gnomon does not draw yet (point lights).
+    /// Whether the file had a point light (else a default point light was placed).
+    pub has_point: bool,
+    /// Lights the file has that Gnomon cannot use (a directional or spot light with
+    /// a degenerate transform).
     pub ignored_lights: usize,
 }
 
@@ -277,7 +280,8 @@ fn build(
     };
     let mut instances = Vec::new();
     let mut camera = None;
-    let (mut sun, mut spot) = (None, None);
+    let (mut sun, mut spot, mut point) = (None, None, None);
+    let mut lights: Vec<SceneLight> = Vec::new();
     let mut extras = FileExtras::default();
     let mut stack: Vec<(gltf::Node, Mat4, usize)> =
         roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
@@ -330,19 +334,21 @@ fn build(
             let color = Vec3::from_array(light.color());
             let position = world.transform_point3(Vec3::ZERO);
             let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-            match light.kind() {
-                gltf::khr_lights_punctual::Kind::Directional if sun.is_none() && direction != Vec3::ZERO => {
-                    sun = Some(DirectionalLight {
+            // glTF intensities are photometric (lux, candela); Gnomon's lights are
+            // relative, so every file light gets intensity 1 and its colour.
+            let parsed = match light.kind() {
+                gltf::khr_lights_punctual::Kind::Directional if direction != Vec3::ZERO => {
+                    Some(Light::Directional(DirectionalLight {
                         direction,
                         color,
                         intensity: 1.0,
                         angular_diameter_degrees: 0.0,
-                    });
+                    }))
                 }
                 gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle }
-                    if spot.is_none() && direction != Vec3::ZERO =>
+                    if direction != Vec3::ZERO =>
                 {
-                    spot = Some(SpotLight {
+                    Some(Light::Spot(SpotLight {
                         position,
                         direction,
                         inner_angle_degrees: inner_cone_angle.to_degrees(),
@@ -351,9 +357,29 @@ fn build(
                         color,
                         intensity: 1.0,
                         radius: 0.0,
-                    });
+                    }))
                 }
-                _ => extras.ignored_lights += 1,
+                gltf::khr_lights_punctual::Kind::Point => Some(Light::Point(PointLight {
+                    position,
+                    range: light.range().unwrap_or(f32::INFINITY),
+                    color,
+                    intensity: 1.0,
+                    radius: 0.0,
+                })),
+                _ => None,
+            };
+            match parsed {
+                Some(l) => {
+                    match l {
+                        Light::Directional(d) if sun.is_none() => sun = Some(d),
+                        Light::Spot(s) if spot.is_none() => spot = Some(s),
+                        Light::Point(p) if point.is_none() => point = Some(p),
+                        _ => {}
+                    }
+                    let name = light.name().map_or_else(|| format!("light {}", light.index()), str::to_owned);
+                    lights.push(SceneLight { name, light: l, shadow: None });
+                }
+                None => extras.ignored_lights += 1,
             }
         }
         for child in node.children() {
@@ -393,6 +419,14 @@ fn build(
             intensity: 1.0,
             radius: 0.0,
         },
+        point: PointLight {
+            position: Vec3::ONE,
+            range: 10.0,
+            color: Vec3::new(1.0, 0.93, 0.8),
+            intensity: 1.0,
+            radius: 0.0,
+        },
+        lights: Vec::new(),
         ambient: Vec3::splat(0.12),
         textures,
         has_ground: false,
@@ -403,6 +437,7 @@ fn build(
     extras.has_camera = camera.is_some();
     extras.has_sun = sun.is_some();
     extras.has_spot = spot.is_some();
+    extras.has_point = point.is_some();
     scene.camera = camera.unwrap_or_else(|| fitted_camera(center, radius));
     if let Some(s) = sun {
         scene.sun = s;
@@ -416,6 +451,27 @@ fn build(
     if !scene.spot.range.is_finite() {
         scene.spot.range = 4.0 * radius + scene.spot.position.distance(center);
     }
+    // A point light without a file's: above the centre, reaching past the bounds.
+    scene.point = point.unwrap_or(PointLight {
+        position: center + Vec3::new(0.2, 0.9, 0.3) * radius,
+        range: 4.0 * radius,
+        ..scene.point
+    });
+    // A light without a range reaches past everything the file holds.
+    for l in lights.iter_mut().map(|l| &mut l.light) {
+        let (range, position) = match l {
+            Light::Spot(s) => (&mut s.range, s.position),
+            Light::Point(p) => (&mut p.range, p.position),
+            Light::Directional(_) => continue,
+        };
+        if !range.is_finite() {
+            *range = 4.0 * radius + position.distance(center);
+        }
+    }
+    if !scene.point.range.is_finite() {
+        scene.point.range = 4.0 * radius + scene.point.position.distance(center);
+    }
+    scene.lights = lights;
     Ok((scene, extras))
 }
 

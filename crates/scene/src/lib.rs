@@ -10,7 +10,7 @@ pub mod scene_file;
 pub mod settings;
 
 pub use model::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SceneError, SpotLight,
-    Texture, Wrap, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneError,
+    SceneLight, SpotLight, Texture, Wrap, sun_direction,
 };
 pub use settings::Settings;

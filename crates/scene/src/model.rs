@@ -170,11 +170,55 @@ impl SpotLight {
     }
 }
 
+/// A light emitting in every direction from a point, or from a sphere for soft shadows.
+/// Its shadow map is a cube: six 90° views.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    pub position: Vec3,
+    /// Distance in world units beyond which no light arrives; also the far plane of the
+    /// cube's faces.
+    pub range: f32,
+    pub color: Vec3,
+    pub intensity: f32,
+    /// Radius in world units of the emitting sphere; 0 is a point (hard shadows). The
+    /// reference samples the sphere's solid angle for soft shadows.
+    pub radius: f32,
+}
+
+impl PointLight {
+    /// The cube faces' near plane: a fixed fraction of the range, as for a spot.
+    pub fn shadow_near(&self) -> f32 {
+        (self.range * 2e-3).max(1e-3)
+    }
+}
+
 /// The light a render uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
     Directional(DirectionalLight),
     Spot(SpotLight),
+    Point(PointLight),
+}
+
+impl Light {
+    /// The light's type, as the command line and scene files name it.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Light::Directional(_) => "sun",
+            Light::Spot(_) => "spot",
+            Light::Point(_) => "point",
+        }
+    }
+}
+
+/// One light of a scene's light list (`--light all`): the light, and the shadow
+/// settings it changes from the render's (a table in the shape of
+/// [`crate::settings::ShadowSettings`], laid over them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneLight {
+    pub name: String,
+    pub light: Light,
+    pub shadow: Option<toml::Table>,
 }
 
 /// Direction *toward* the sun for an elevation above the horizon and an azimuth
@@ -196,6 +240,11 @@ pub struct Scene {
     pub sun: DirectionalLight,
     /// The scene's default spot light, used with `--light spot`.
     pub spot: SpotLight,
+    /// The scene's default point light, used with `--light point`.
+    pub point: PointLight,
+    /// Every light the scene defines, each with its own shadow settings: rendered
+    /// together with `--light all`. Empty for a scene that defines none.
+    pub lights: Vec<SceneLight>,
     /// Linear RGB ambient light, added unshadowed.
     pub ambient: Vec3,
     /// Textures referred to by materials.

@@ -22,6 +22,21 @@
 //! range = 30.0
 //! radius = 0.1
 //!
+//! [point]                              # the default point light (--light point)
+//! position = [0.0, 2.5, 0.0]
+//! range = 20.0
+//! radius = 0.05                          # 0 for hard shadows
+//!
+//! [[light]]                              # the light list, rendered with --light all
+//! name = "lamp"
+//! type = "point"                         # sun, spot or point; the fields as above
+//! position = [1.0, 2.0, 0.0]
+//! range = 12.0
+//! color = [1.0, 0.8, 0.6]
+//! [light.shadow]                         # this light's shadow settings, over the render's
+//! filter.technique = "pcss"
+//! map.resolution = 512
+//!
 //! [[view]]
 //! name = "front"
 //! eye = [0.0, 3.0, 9.0]
@@ -37,7 +52,10 @@ use std::path::{Path, PathBuf};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use serde::Deserialize;
 
-use crate::{Camera, Scene, Settings, SpotLight, gltf_loader, sun_direction};
+use crate::{
+    Camera, DirectionalLight, Light, PointLight, Scene, SceneLight, Settings, SpotLight, gltf_loader,
+    settings::ShadowSettings, sun_direction,
+};
 
 /// A scene file that could not be used.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +74,9 @@ struct SceneFile {
     model: Vec<ModelEntry>,
     sun: Option<SunEntry>,
     spot: Option<SpotEntry>,
+    point: Option<PointEntry>,
+    #[serde(default)]
+    light: Vec<LightEntry>,
     #[serde(default)]
     view: Vec<ViewEntry>,
     settings: Option<toml::Value>,
@@ -100,6 +121,110 @@ struct SpotEntry {
     radius: f32,
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PointEntry {
+    position: [f32; 3],
+    range: f32,
+    #[serde(default)]
+    radius: f32,
+    color: Option<[f32; 3]>,
+    intensity: Option<f32>,
+}
+
+/// One `[[light]]`: a sun, spot or point light with the fields of `[sun]`, `[spot]`
+/// or `[point]`, and its own shadow settings.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightEntry {
+    name: Option<String>,
+    #[serde(rename = "type")]
+    kind: String,
+    elevation: Option<f32>,
+    azimuth: Option<f32>,
+    angular_diameter: Option<f32>,
+    position: Option<[f32; 3]>,
+    target: Option<[f32; 3]>,
+    outer_angle: Option<f32>,
+    inner_angle: Option<f32>,
+    range: Option<f32>,
+    radius: Option<f32>,
+    color: Option<[f32; 3]>,
+    intensity: Option<f32>,
+    shadow: Option<toml::Table>,
+}
+
+impl LightEntry {
+    /// The light this entry describes, or what is wrong with it.
+    fn to_light(&self, defaults: &Scene) -> Result<Light, String> {
+        let need = |v: Option<f32>, field: &str| v.ok_or_else(|| format!("needs `{field}`"));
+        let need3 = |v: Option<[f32; 3]>, field: &str| {
+            v.map(Vec3::from_array).ok_or_else(|| format!("needs `{field}` = [x, y, z]"))
+        };
+        let color = |fallback: Vec3| self.color.map_or(fallback, Vec3::from_array);
+        let positive = |v: f32, field: &str, valid: &str| {
+            if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("`{field}` = {v} is invalid: {valid}")) }
+        };
+        let radius = self.radius.unwrap_or(0.0);
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(format!("`radius` = {radius} is invalid: a distance ≥ 0"));
+        }
+        match self.kind.as_str() {
+            "sun" => {
+                let elevation = need(self.elevation, "elevation")?;
+                if !(elevation > 0.0 && elevation <= 90.0) {
+                    return Err(format!("`elevation` = {elevation} is invalid: in (0, 90] degrees"));
+                }
+                Ok(Light::Directional(DirectionalLight {
+                    direction: -sun_direction(elevation, need(self.azimuth, "azimuth")?),
+                    color: color(defaults.sun.color),
+                    intensity: self.intensity.unwrap_or(1.0),
+                    angular_diameter_degrees: self.angular_diameter.unwrap_or(0.0),
+                }))
+            }
+            "spot" => {
+                let position = need3(self.position, "position")?;
+                let outer = need(self.outer_angle, "outer_angle")?;
+                if !(outer > 0.0 && outer <= 89.0) {
+                    return Err(format!("`outer_angle` = {outer} is invalid: in (0, 89] degrees"));
+                }
+                let aim = need3(self.target, "target")? - position;
+                if aim.length() < 1e-6 {
+                    return Err("`target` equals `position`: a spot must aim somewhere".into());
+                }
+                Ok(Light::Spot(SpotLight {
+                    position,
+                    direction: aim.normalize(),
+                    inner_angle_degrees: self.inner_angle.unwrap_or(0.8 * outer).min(outer),
+                    outer_angle_degrees: outer,
+                    range: positive(need(self.range, "range")?, "range", "a distance > 0")?,
+                    color: color(defaults.spot.color),
+                    intensity: self.intensity.unwrap_or(1.0),
+                    radius,
+                }))
+            }
+            "point" => Ok(Light::Point(PointLight {
+                position: need3(self.position, "position")?,
+                range: positive(need(self.range, "range")?, "range", "a distance > 0")?,
+                color: color(defaults.point.color),
+                intensity: self.intensity.unwrap_or(1.0),
+                radius,
+            })),
+            other => Err(format!("`type` = \"{other}\" is invalid: sun, spot or point")),
+        }
+    }
+}
+
+/// Checks that a light's `[light.shadow]` table lays over the render's shadow
+/// settings as valid shadow settings.
+pub fn check_light_shadow(table: &toml::Table) -> Result<ShadowSettings, String> {
+    let mut merged = toml::Value::try_from(ShadowSettings::default()).map_err(|e| e.to_string())?;
+    overlay(&mut merged, &toml::Value::Table(table.clone()));
+    let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
+    shadow.validate().map_err(|e| e.to_string())?;
+    Ok(shadow)
 }
 
 #[derive(Deserialize)]
@@ -187,6 +312,26 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
             radius: spot.radius,
         };
     }
+    if let Some(point) = &file.point {
+        scene.point = PointLight {
+            position: Vec3::from_array(point.position),
+            range: point.range,
+            color: point.color.map(Vec3::from_array).unwrap_or(scene.point.color),
+            intensity: point.intensity.unwrap_or(scene.point.intensity),
+            radius: point.radius,
+        };
+    }
+    if !file.light.is_empty() {
+        scene.lights.clear();
+    }
+    for (i, entry) in file.light.iter().enumerate() {
+        let name = entry.name.clone().unwrap_or_else(|| format!("light {i}"));
+        let light = entry.to_light(&scene).map_err(|e| fail(format!("[[light]] `{name}`: {e}")))?;
+        if let Some(table) = &entry.shadow {
+            check_light_shadow(table).map_err(|e| fail(format!("[[light]] `{name}` shadow: {e}")))?;
+        }
+        scene.lights.push(SceneLight { name, light, shadow: entry.shadow.clone() });
+    }
     let view_names: Vec<String> = file.view.iter().map(|v| v.name.clone()).collect();
     let chosen = match view {
         Some(name) => Some(file.view.iter().find(|v| v.name == name).ok_or_else(|| {
@@ -227,7 +372,7 @@ pub fn merge_settings(file: &toml::Value, command_line: &Settings) -> Result<Set
 }
 
 /// Copies every value of `from` into `into`, recursing into tables.
-fn overlay(into: &mut toml::Value, from: &toml::Value) {
+pub(crate) fn overlay(into: &mut toml::Value, from: &toml::Value) {
     match (into, from) {
         (toml::Value::Table(a), toml::Value::Table(b)) => {
             for (k, v) in b {

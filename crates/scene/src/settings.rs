@@ -120,6 +120,12 @@ pub enum LightKind {
     Sun,
     /// The scene's spot light, with a perspective shadow map covering its cone.
     Spot,
+    /// The scene's point light, with a cube shadow map (six 90° faces).
+    Point,
+    /// Every light of the scene's light list at once (scene files' [[light]],
+    /// glTF KHR_lights_punctual, the built-in `lamps`), each with its own shadow map
+    /// and shadow settings.
+    All,
 }
 
 /// The light, and overrides of the scene's light parameters.
@@ -158,6 +164,30 @@ pub struct LightSettings {
     /// shadows, the real sun is about 0.53 [default: the scene's, 0 for the built-ins].
     #[arg(long, value_name = "DEGREES", help_heading = "Light")]
     pub sun_angular_diameter: Option<f32>,
+    /// Point light position, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub point_position: Option<Vec3>,
+    /// Point light range in world units, > 0; also the cube faces' far plane [default: the scene's].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub point_range: Option<f32>,
+    /// Radius of the point light's emitting sphere in world units, ≥ 0; 0 gives hard
+    /// shadows [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub point_radius: Option<f32>,
+    /// With --light all: the light whose visibility the frame outputs and the
+    /// reference traces, as an index into the scene's light list.
+    #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Light")]
+    pub light_index: usize,
+}
+
+/// One light of a render, with the shadow settings it is drawn with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResolvedLight {
+    /// The light's name in the scene's list, or its type for a single light.
+    pub name: String,
+    pub light: Light,
+    /// The render's shadow settings with the light's own laid over them.
+    pub shadow: ShadowSettings,
 }
 
 /// How the shadow map is sampled and filtered.
@@ -222,6 +252,20 @@ impl Technique {
 
     pub fn all() -> &'static [Technique] {
         Technique::value_variants()
+    }
+
+    /// Whether the technique can shadow a point light, from its cube map: the
+    /// depth-comparison techniques, which sample the cube by direction.
+    pub fn supports_point_lights(self) -> bool {
+        matches!(
+            self,
+            Technique::Hard
+                | Technique::Pcf2x2
+                | Technique::Pcf
+                | Technique::PcfTent
+                | Technique::PcfPoisson
+                | Technique::Pcss
+        )
     }
 
     /// Whether the technique filters a map of moments (or other functions of depth)
@@ -744,57 +788,10 @@ impl MomentSettings {
     }
 }
 
-fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
-    match v {
-        Some(p) => check(p.is_finite(), flag, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
-        None => Ok(()),
-    }
-}
-
-/// The largest shadow map Gnomon allows, whatever the device.
-pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
-/// The smallest shadow map Gnomon allows.
-pub const MIN_SHADOW_RESOLUTION: u32 = 256;
-
-impl Settings {
-    /// Checks every value against its documented range. Device-dependent limits (the
-    /// largest texture) are checked by the renderer, which knows the device.
+impl ShadowSettings {
+    /// Checks every shadow value against its documented range.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let i = &self.image;
-        check((1..=16384).contains(&i.width), "--width", i.width, "1 to 16384 pixels")?;
-        check((1..=16384).contains(&i.height), "--height", i.height, "1 to 16384 pixels")?;
-        let c = &self.camera;
-        check_vec(c.eye, "--camera-eye")?;
-        check_vec(c.target, "--camera-target")?;
-        check_opt(
-            c.fov_y_degrees,
-            "--fov",
-            |x| x > 0.0 && x < 180.0,
-            "between 0 and 180 degrees, exclusive",
-        )?;
-        check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
-        check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
-        let l = &self.light;
-        check_opt(l.sun_elevation, "--sun-elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
-        check_opt(l.sun_azimuth, "--sun-azimuth", |_| true, "a finite angle in degrees")?;
-        check_vec(l.spot_position, "--spot-position")?;
-        check_vec(l.spot_target, "--spot-target")?;
-        check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
-        check_opt(
-            l.spot_inner_angle,
-            "--spot-inner-angle",
-            |x| (0.0..=89.0).contains(&x),
-            "in [0, outer angle] degrees",
-        )?;
-        check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
-        check_opt(l.spot_radius, "--spot-radius", |x| x >= 0.0, "a distance ≥ 0")?;
-        check_opt(
-            l.sun_angular_diameter,
-            "--sun-angular-diameter",
-            |x| (0.0..=30.0).contains(&x),
-            "in [0, 30] degrees",
-        )?;
-        let s = &self.shadow;
+        let s = self;
         let f = &s.filter;
         match f.kernel_unit {
             KernelUnit::Texels => check(
@@ -892,8 +889,6 @@ impl Settings {
             b.normal_offset,
             "a finite number of texels ≥ 0",
         )?;
-        let n = self.reference.samples;
-        check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
         let r = s.map.resolution;
         check(
             (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
@@ -901,6 +896,66 @@ impl Settings {
             r,
             format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
         )?;
+        Ok(())
+    }
+}
+
+fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
+    match v {
+        Some(p) => check(p.is_finite(), flag, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
+        None => Ok(()),
+    }
+}
+
+/// The largest shadow map Gnomon allows, whatever the device.
+pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
+/// The smallest shadow map Gnomon allows.
+pub const MIN_SHADOW_RESOLUTION: u32 = 256;
+
+impl Settings {
+    /// Checks every value against its documented range. Device-dependent limits (the
+    /// largest texture) are checked by the renderer, which knows the device.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let i = &self.image;
+        check((1..=16384).contains(&i.width), "--width", i.width, "1 to 16384 pixels")?;
+        check((1..=16384).contains(&i.height), "--height", i.height, "1 to 16384 pixels")?;
+        let c = &self.camera;
+        check_vec(c.eye, "--camera-eye")?;
+        check_vec(c.target, "--camera-target")?;
+        check_opt(
+            c.fov_y_degrees,
+            "--fov",
+            |x| x > 0.0 && x < 180.0,
+            "between 0 and 180 degrees, exclusive",
+        )?;
+        check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
+        check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
+        let l = &self.light;
+        check_opt(l.sun_elevation, "--sun-elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
+        check_opt(l.sun_azimuth, "--sun-azimuth", |_| true, "a finite angle in degrees")?;
+        check_vec(l.spot_position, "--spot-position")?;
+        check_vec(l.spot_target, "--spot-target")?;
+        check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
+        check_opt(
+            l.spot_inner_angle,
+            "--spot-inner-angle",
+            |x| (0.0..=89.0).contains(&x),
+            "in [0, outer angle] degrees",
+        )?;
+        check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.spot_radius, "--spot-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_vec(l.point_position, "--point-position")?;
+        check_opt(l.point_range, "--point-range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.point_radius, "--point-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_opt(
+            l.sun_angular_diameter,
+            "--sun-angular-diameter",
+            |x| (0.0..=30.0).contains(&x),
+            "in [0, 30] degrees",
+        )?;
+        self.shadow.validate()?;
+        let n = self.reference.samples;
+        check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
         Ok(())
     }
 
@@ -937,10 +992,29 @@ impl Settings {
         Ok(cam)
     }
 
-    /// The light: the scene's light of the chosen kind, with these settings' overrides.
+    /// The light whose visibility a frame outputs and the reference traces: the
+    /// scene's light of the chosen kind with these settings' overrides, or with
+    /// --light all the one at --light-index.
     pub fn resolve_light(&self, scene: &Scene) -> Result<Light, SettingsError> {
         let l = &self.light;
         Ok(match l.kind {
+            LightKind::All => {
+                let lights = self.scene_light_list(scene)?;
+                check(
+                    l.light_index < lights.len(),
+                    "--light-index",
+                    l.light_index,
+                    format!("below {}, the number of lights scene `{}` lists", lights.len(), scene.name),
+                )?;
+                lights[l.light_index].light
+            }
+            LightKind::Point => {
+                let mut point = scene.point;
+                point.position = l.point_position.unwrap_or(point.position);
+                point.range = l.point_range.unwrap_or(point.range);
+                point.radius = l.point_radius.unwrap_or(point.radius);
+                Light::Point(point)
+            }
             LightKind::Sun => {
                 let mut sun = scene.sun;
                 if l.sun_elevation.is_some() || l.sun_azimuth.is_some() {
@@ -988,6 +1062,84 @@ impl Settings {
             }
         })
     }
+
+    /// Every light of the render, each with its shadow settings: the one light of
+    /// --light sun, spot or point with these shadow settings, or with --light all the
+    /// scene's list, each light's own settings laid over these.
+    pub fn resolve_lights(&self, scene: &Scene) -> Result<Vec<ResolvedLight>, SettingsError> {
+        if self.light.kind != LightKind::All {
+            let light = self.resolve_light(scene)?;
+            check_light_type(&light, &self.shadow, light.type_name())?;
+            return Ok(vec![ResolvedLight {
+                name: light.type_name().into(),
+                light,
+                shadow: self.shadow.clone(),
+            }]);
+        }
+        self.resolve_light(scene)?;
+        self.scene_light_list(scene)?
+            .iter()
+            .map(|entry| {
+                let shadow = match &entry.shadow {
+                    None => self.shadow.clone(),
+                    Some(table) => self.shadow_with(table).map_err(|problem| SettingsError {
+                        flag: "[light.shadow]",
+                        value: entry.name.clone(),
+                        valid: problem,
+                    })?,
+                };
+                check_light_type(&entry.light, &shadow, &entry.name)?;
+                Ok(ResolvedLight { name: entry.name.clone(), light: entry.light, shadow })
+            })
+            .collect()
+    }
+
+    /// These shadow settings with `table` laid over them.
+    fn shadow_with(&self, table: &toml::Table) -> Result<ShadowSettings, String> {
+        let mut merged = toml::Value::try_from(&self.shadow).map_err(|e| e.to_string())?;
+        crate::scene_file::overlay(&mut merged, &toml::Value::Table(table.clone()));
+        let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
+        shadow.validate().map_err(|e| e.to_string())?;
+        Ok(shadow)
+    }
+
+    fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<&'s [crate::SceneLight], SettingsError> {
+        check(
+            !scene.lights.is_empty(),
+            "--light",
+            "all",
+            format!(
+                "a scene with a light list; `{}` has none (scene files list [[light]], glTF files KHR_lights_punctual lights, and the built-in `lamps` has eight)",
+                scene.name
+            ),
+        )?;
+        check(
+            scene.lights.len() <= MAX_LIGHTS,
+            "--light",
+            "all",
+            format!("at most {MAX_LIGHTS} lights; `{}` lists {}", scene.name, scene.lights.len()),
+        )?;
+        Ok(&scene.lights)
+    }
+}
+
+/// The most lights one render draws.
+pub const MAX_LIGHTS: usize = 32;
+
+/// Checks that a light's type and its shadow settings go together: a point light's
+/// cube map takes the depth-comparison techniques and a single map.
+fn check_light_type(light: &Light, shadow: &ShadowSettings, name: &str) -> Result<(), SettingsError> {
+    if let Light::Point(_) = light {
+        check(
+            shadow.filter.technique.supports_point_lights(),
+            "--technique",
+            shadow.filter.technique.name(),
+            format!(
+                "for point light `{name}` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
+            ),
+        )?;
+    }
+    Ok(())
 }
 
 /// Parses `X,Y,Z` into a vector.

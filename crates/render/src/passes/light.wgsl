@@ -6,8 +6,8 @@ struct Light {
     clip_from_world: mat4x4<f32>,
     light_from_world: mat4x4<f32>,
     radiance: vec4<f32>,     // rgb: colour × intensity
-    direction: vec4<f32>,    // xyz: travel direction (sun) or cone axis (spot); w: 0 sun, 1 spot
-    position: vec4<f32>,     // xyz: spot position; w: range
+    direction: vec4<f32>,    // xyz: travel direction (sun) or cone axis (spot); w: 0 sun, 1 spot, 2 point
+    position: vec4<f32>,     // xyz: spot or point light position; w: range
     cone: vec4<f32>,         // x: cos inner, y: cos outer, z: map near, w: map far
     texel: vec4<f32>,        // x: ortho texel size, y: texel size per unit distance, z: normal offset (texels), w: map size
     kernel: vec4<f32>,       // x: kernel width, y: 1 when in world units, z: Poisson taps, w: 1 for receiver-plane bias
@@ -19,6 +19,7 @@ struct Light {
     cascade_texel: array<vec4<f32>, 8>,  // x: orthographic texel world size; y: 1 when warped; z: warped difference step
     cascade_splits: array<vec4<f32>, 3>, // view depth where cascade i starts (i) and ends (i + 1)
     cascades: vec4<f32>,     // x: count, y: 1 to select by projection, z: blend band, w: moment layers per cascade
+    raster_bias: vec4<f32>,  // x: constant depth bias (units), y: slope-scaled bias, for passes that write their own depth
 };
 
 // The view depth where cascade `i` starts; `i + 1` where it ends.

@@ -1,5 +1,7 @@
 //! The lighting pass: every instance shaded from the camera with the selected
 //! technique's shadow lookup, writing the colour image and the per-pixel outputs.
+//! With many lights, one pass per light: the first writes every target, the others
+//! add their light to the colour on the same depths, each with its own technique.
 
 use std::collections::HashMap;
 
@@ -24,10 +26,29 @@ pub(crate) fn target_bytes_per_pixel() -> u32 {
     TARGETS.iter().map(|f| f.block_copy_size(None).unwrap_or(16)).sum()
 }
 
-/// Lighting pipelines, one per technique, built on first use.
+/// What a light's lighting pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum LightingRole {
+    /// The first light: clears and writes every target and the depth.
+    First,
+    /// A later light: adds its light to the colour where the depth is equal, and
+    /// replaces the visibility target when `visibility` (the light the frame reports).
+    Added { visibility: bool },
+}
+
+/// What makes two lighting pipelines differ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct LightingKey {
+    pub technique: Technique,
+    /// A point light: the cube lookup instead of the 2D layers.
+    pub cube: bool,
+    pub role: LightingRole,
+}
+
+/// Lighting pipelines, one per technique, lookup and role, built on first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
-    pipelines: HashMap<Technique, wgpu::RenderPipeline>,
+    pipelines: HashMap<LightingKey, wgpu::RenderPipeline>,
 }
 
 impl LightingPass {
@@ -45,20 +66,56 @@ impl LightingPass {
         Self { layout, pipelines: HashMap::new() }
     }
 
-    pub fn pipeline(&mut self, device: &wgpu::Device, technique: Technique) -> &wgpu::RenderPipeline {
+    pub fn pipeline(&mut self, device: &wgpu::Device, key: LightingKey) -> &wgpu::RenderPipeline {
         let layout = &self.layout;
-        self.pipelines.entry(technique).or_insert_with(|| {
+        self.pipelines.entry(key).or_insert_with(|| {
+            let technique = techniques::lookup(key.technique);
             let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned(), SCENE_COMMON_WGSL.to_owned()];
             parts.extend(techniques::shared_wgsl());
-            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            if key.cube {
+                parts.push(techniques::CUBE_WGSL.to_owned());
+                let cube = technique.cube_wgsl().unwrap_or_else(|| {
+                    unreachable!("{:?} has no cube lookup; settings refuse it for point lights", key.technique)
+                });
+                parts.extend(cube.iter().map(|s| s.to_string()));
+                parts.push(include_str!("cube_visibility.wgsl").to_owned());
+            } else {
+                parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
+                parts.push(include_str!("map_visibility.wgsl").to_owned());
+            }
             parts.push(include_str!("lighting.wgsl").to_owned());
             let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let source = compose_wgsl(&refs);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(technique.name()),
+                label: Some(key.technique.name()),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             });
-            let targets = TARGETS.map(|format| Some(wgpu::ColorTargetState::from(format)));
+            let targets: Vec<Option<wgpu::ColorTargetState>> = TARGETS
+                .iter()
+                .enumerate()
+                .map(|(i, &format)| {
+                    let mut target = wgpu::ColorTargetState::from(format);
+                    if let LightingRole::Added { visibility } = key.role {
+                        match i {
+                            // Light adds up in linear space (the sRGB target blends linearly).
+                            0 => {
+                                target.blend = Some(wgpu::BlendState {
+                                    color: wgpu::BlendComponent {
+                                        src_factor: wgpu::BlendFactor::One,
+                                        dst_factor: wgpu::BlendFactor::One,
+                                        operation: wgpu::BlendOperation::Add,
+                                    },
+                                    alpha: wgpu::BlendComponent::REPLACE,
+                                })
+                            }
+                            1 if visibility => {}
+                            _ => target.write_mask = wgpu::ColorWrites::empty(),
+                        }
+                    }
+                    Some(target)
+                })
+                .collect();
+            let first = key.role == LightingRole::First;
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("lighting"),
                 layout: Some(layout),
@@ -71,10 +128,16 @@ impl LightingPass {
                 // Both sides are drawn, as a ray tracer sees them; the shader flips the
                 // normal of back faces.
                 primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                // Later lights shade exactly the surfaces the first one found: the
+                // same vertex stage (its position is invariant) gives the same depths.
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    depth_write_enabled: Some(first),
+                    depth_compare: Some(if first {
+                        wgpu::CompareFunction::Less
+                    } else {
+                        wgpu::CompareFunction::Equal
+                    }),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),

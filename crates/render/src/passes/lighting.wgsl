@@ -2,7 +2,10 @@
 // factor of the selected technique multiplying only the direct term. Also writes the
 // per-pixel visibility, world position, normal, view depth and object id.
 //
-// A technique provides `fn sample_shadow(q: ShadowQuery) -> f32` (techniques/common.wgsl).
+// A technique provides `fn sample_shadow(q: ShadowQuery) -> f32` (techniques/common.wgsl),
+// or for a point light `fn sample_shadow_cube(q: CubeQuery) -> f32` (techniques/cube.wgsl).
+// The shadow lookup itself, `shadow_visibility`, comes from map_visibility.wgsl (a
+// light's 2D layers: one map or cascades) or cube_visibility.wgsl (a point light).
 
 struct Camera {
     clip_from_world: mat4x4<f32>,
@@ -22,7 +25,8 @@ const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
 @group(3) @binding(1) var base_color_sampler: sampler;
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: every light's pass must rasterize the same depths, to test Equal.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) instance: u32,
@@ -50,62 +54,13 @@ struct FragmentOut {
     @location(4) object_id: u32,
 };
 
-// Shadow-map coordinates of a receiver at `world` with unit normal `n`, lit from `l`:
-// the point is first pushed along its normal by the normal-offset bias (in texels of
-// the map at the receiver, times 1 − N·L: a surface facing the light needs no offset,
-// and offsetting it only shifts its shadows sideways), then projected: clip → NDC →
-// texture space with v flipped.
-// Returns (u, v, depth, inside) where inside is 1 when the point projects into the
-// map's frustum.
 // A surface facing the light keeps this fraction of the offset, against the depth
 // quantisation that the slope bias (zero for it) cannot cover.
 const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 
-// Texture coordinates of `world` in layer `layer`, before any bias.
-fn project_to_map(layer: u32, world: vec3<f32>) -> vec2<f32> {
-    let clip = light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0);
-    return clip.xy / clip.w * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5, 0.5);
-}
-
-// World size of a texel of layer `layer` at `world`. Orthographic and spot maps have a
-// closed form; a warped map (LiSPSM, TSM) is measured: the largest extent of a texel
-// across the light's rays, 1 / σ_min of the Jacobian of texel coordinates along the
-// light's x and y axes, by differences `cascade_texel.z` world units apart.
-fn local_texel_world_size(layer: u32, world: vec3<f32>, distance: f32) -> f32 {
-    if light.cascade_texel[layer].y < 0.5 {
-        return texel_world_size_at(layer, distance);
-    }
-    let step = light.cascade_texel[layer].z;
-    // The light's x and y axes in world space: the first two rows of light_from_world.
-    let m = light.light_from_world;
-    let axis_x = vec3<f32>(m[0].x, m[1].x, m[2].x);
-    let axis_y = vec3<f32>(m[0].y, m[1].y, m[2].y);
-    let t = project_to_map(layer, world);
-    let dx = (project_to_map(layer, world + axis_x * step) - t) * light.texel.w / step;
-    let dy = (project_to_map(layer, world + axis_y * step) - t) * light.texel.w / step;
-    let squares = dot(dx, dx) + dot(dy, dy);
-    let det = abs(dx.x * dy.y - dy.x * dx.y);
-    let sigma_max = sqrt(0.5 * (squares + sqrt(max(squares * squares - 4.0 * det * det, 0.0))));
-    return sigma_max / max(det, 1e-20);
-}
-
-fn shadow_coords(layer: u32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
-    let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    let texel_world = local_texel_world_size(layer, world, distance);
-    let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let p = world + n * (light.texel.z * texel_world * slope);
-    let clip = light.cascade_clip_from_world[layer] * vec4<f32>(p, 1.0);
-    if clip.w <= 0.0 {
-        return vec4<f32>(0.0, 0.0, 0.0, 0.0);
-    }
-    let ndc = clip.xyz / clip.w;
-    let uv = ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5, 0.5);
-    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && ndc.z >= 0.0 && ndc.z <= 1.0;
-    return vec4<f32>(uv, ndc.z, select(0.0, 1.0, inside));
-}
-
 // Fraction of the light arriving at `world` before shadowing: 1 for the sun, the
-// cone and range test for a spot (0 outside the outer cone or beyond the range).
+// cone and range test for a spot (0 outside the outer cone or beyond the range), the
+// range test for a point light.
 // Returns (unit direction to the light, cone factor in [0, 1]).
 fn light_geometry(world: vec3<f32>) -> vec4<f32> {
     if light.direction.w < 0.5 {
@@ -114,59 +69,13 @@ fn light_geometry(world: vec3<f32>) -> vec4<f32> {
     let to_light = light.position.xyz - world;
     let dist = length(to_light);
     let l = to_light / dist;
+    if light.direction.w > 1.5 {
+        return vec4<f32>(l, select(0.0, 1.0, dist <= light.position.w));
+    }
     let cos_angle = dot(-l, light.direction.xyz);
     let inside = cos_angle >= light.cone.y && dist <= light.position.w;
     let falloff = smoothstep(light.cone.y, light.cone.x, cos_angle);
     return vec4<f32>(l, select(0.0, falloff, inside));
-}
-
-// The cascade that shades a point at `view_depth`: by depth, the one whose split
-// range holds it; by projection, the first whose map holds its lookup.
-fn select_cascade(view_depth: f32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> u32 {
-    let count = u32(light.cascades.x);
-    if light.cascades.y < 0.5 {
-        var layer = 0u;
-        for (var i = 1u; i < count; i++) {
-            if view_depth > cascade_split(i) {
-                layer = i;
-            }
-        }
-        return layer;
-    }
-    for (var i = 0u; i + 1u < count; i++) {
-        let c = shadow_coords(i, world, n, l);
-        // A margin of a few texels keeps the filter's footprint inside the map.
-        let margin = 4.0 / light.texel.w;
-        if c.w > 0.5 && all(c.xy > vec2<f32>(margin)) && all(c.xy < vec2<f32>(1.0 - margin)) {
-            return i;
-        }
-    }
-    return count - 1u;
-}
-
-// The shadow lookup in layer `layer`: 1 (lit) outside the map.
-fn shadow_lookup(
-    layer: u32,
-    world: vec3<f32>,
-    n: vec3<f32>,
-    l: vec3<f32>,
-    world_dx: vec3<f32>,
-    world_dy: vec3<f32>,
-    pixel: vec2<f32>,
-) -> f32 {
-    let coords = shadow_coords(layer, world, n, l);
-    if coords.w < 0.5 {
-        return 1.0;
-    }
-    var query: ShadowQuery;
-    query.coords = coords.xyz;
-    // Screen derivatives of the lookup, for receiver-plane bias and mip selection.
-    query.coords_dx = shadow_coords(layer, world + world_dx, n, l).xyz - coords.xyz;
-    query.coords_dy = shadow_coords(layer, world + world_dy, n, l).xyz - coords.xyz;
-    query.pixel = pixel;
-    query.distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    query.layer = layer;
-    return sample_shadow(query);
 }
 
 @fragment
@@ -194,21 +103,12 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let world_dx = dpdx(in.world);
     let world_dy = dpdy(in.world);
     let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
-    let layer = select_cascade(view_depth, in.world, n, l);
-    var visibility = shadow_lookup(layer, in.world, n, l, world_dx, world_dy, in.clip.xy);
-    // Blend into the next cascade over the last `cascades.z` of this one's depth range.
-    let count = u32(light.cascades.x);
-    if light.cascades.y < 0.5 && layer + 1u < count && light.cascades.z > 0.0 {
-        let start = cascade_split(layer);
-        let end = cascade_split(layer + 1u);
-        let band = light.cascades.z * (end - start);
-        if view_depth > end - band {
-            let next = shadow_lookup(layer + 1u, in.world, n, l, world_dx, world_dy, in.clip.xy);
-            visibility = mix(visibility, next, clamp((view_depth - (end - band)) / band, 0.0, 1.0));
-        }
-    }
+    let shadow = shadow_visibility(in.world, n, l, world_dx, world_dy, in.clip.xy, view_depth);
+    var visibility = shadow.x;
+    let layer = u32(shadow.y);
     if light.direction.w > 0.5 && cone <= 0.0 {
-        // Outside a spot's cone or range no light arrives: visibility 0 by definition.
+        // Outside a spot's cone or a light's range no light arrives: visibility 0 by
+        // definition.
         visibility = 0.0;
     }
     if dot(geometric_n, l) <= 0.0 {

@@ -27,8 +27,9 @@ pub(crate) struct Layouts {
     pub scene: wgpu::BindGroupLayout,
     /// Group 1 of the lighting pass: the camera.
     pub camera: wgpu::BindGroupLayout,
-    /// Group 2 of the lighting pass: the shadow map and its comparison sampler, and
-    /// the filterable techniques' moment map and its sampler.
+    /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the
+    /// filterable techniques' moment map and its sampler, and a point light's cube
+    /// with its nearest comparison and gathering samplers.
     pub shadow: wgpu::BindGroupLayout,
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
@@ -91,6 +92,28 @@ impl Layouts {
                     binding: 3,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::Cube,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
                     count: None,
                 },
             ],

@@ -1,5 +1,8 @@
 //! The shadow pass: casters drawn depth-only from the light into a Depth32Float map,
 //! with the rasterizer's constant and slope-scaled depth bias and a chosen cull mode.
+//! A point light's cube faces write distance over range instead, with the same bias
+//! applied in the fragment stage (`shadow_depth.wgsl`), and flip their winding: the
+//! face views are mirrored (`gnomon_math::omni`).
 
 use std::collections::HashMap;
 
@@ -16,6 +19,7 @@ struct ShadowPipelineKey {
     slope_bias_bits: u32,
     masked: bool,
     unclipped: bool,
+    cube_face: bool,
 }
 
 /// Shadow-pass pipelines, built on first use for each bias, cull and alpha-test
@@ -50,7 +54,8 @@ impl ShadowPass {
 
     /// The pipeline for casters with these bias settings; `double_sided` casters are
     /// never culled, `masked` ones run the alpha test, and `unclipped` clamps depth
-    /// instead of clipping it (pancaking; needs `Features::DEPTH_CLIP_CONTROL`).
+    /// instead of clipping it (pancaking; needs `Features::DEPTH_CLIP_CONTROL`), and
+    /// `cube_face` draws a point light's face (distance, mirrored winding).
     pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
@@ -58,6 +63,7 @@ impl ShadowPass {
         double_sided: bool,
         masked: bool,
         unclipped: bool,
+        cube_face: bool,
     ) -> &wgpu::RenderPipeline {
         let key = ShadowPipelineKey {
             cull: if double_sided { CullMode::None } else { bias.cull },
@@ -65,16 +71,25 @@ impl ShadowPass {
             slope_bias_bits: bias.slope_bias.to_bits(),
             masked,
             unclipped,
+            cube_face,
         };
         let module = &self.module;
         let layout = if masked { &self.masked_layout } else { &self.layout };
         self.pipelines.entry(key).or_insert_with(|| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(if masked { "shadow depth, alpha-masked" } else { "shadow depth" }),
+                label: Some(match (cube_face, masked) {
+                    (true, _) => "shadow distance (cube face)",
+                    (false, true) => "shadow depth, alpha-masked",
+                    (false, false) => "shadow depth",
+                }),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module,
-                    entry_point: Some(if masked { "vs_shadow_masked" } else { "vs_shadow" }),
+                    entry_point: Some(match (cube_face, masked) {
+                        (true, _) => "vs_shadow_distance",
+                        (false, true) => "vs_shadow_masked",
+                        (false, false) => "vs_shadow",
+                    }),
                     compilation_options: Default::default(),
                     buffers: &[Some(VertexGpu::layout())],
                 },
@@ -85,6 +100,7 @@ impl ShadowPass {
                         CullMode::None => None,
                     },
                     unclipped_depth: key.unclipped,
+                    front_face: if cube_face { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -93,17 +109,27 @@ impl ShadowPass {
                     depth_compare: Some(wgpu::CompareFunction::LessEqual),
                     stencil: Default::default(),
                     // The clamp stays 0: wgpu 30 does not enable the Vulkan feature
-                    // (depthBiasClamp) that a non-zero clamp needs.
-                    bias: wgpu::DepthBiasState {
-                        constant: key.depth_bias,
-                        slope_scale: f32::from_bits(key.slope_bias_bits),
-                        clamp: 0.0,
+                    // (depthBiasClamp) that a non-zero clamp needs. A cube face biases
+                    // the depth it writes itself (the rasterizer's bias does not reach
+                    // a written depth).
+                    bias: if cube_face {
+                        wgpu::DepthBiasState::default()
+                    } else {
+                        wgpu::DepthBiasState {
+                            constant: key.depth_bias,
+                            slope_scale: f32::from_bits(key.slope_bias_bits),
+                            clamp: 0.0,
+                        }
                     },
                 }),
                 multisample: Default::default(),
-                fragment: masked.then_some(wgpu::FragmentState {
+                fragment: (masked || cube_face).then_some(wgpu::FragmentState {
                     module,
-                    entry_point: Some("fs_shadow_masked"),
+                    entry_point: Some(match (cube_face, masked) {
+                        (true, true) => "fs_shadow_distance_masked",
+                        (true, false) => "fs_shadow_distance",
+                        _ => "fs_shadow_masked",
+                    }),
                     compilation_options: Default::default(),
                     targets: &[],
                 }),

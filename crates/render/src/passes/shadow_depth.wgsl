@@ -35,3 +35,50 @@ fn fs_shadow_masked(in: MaskedOut) {
         discard;
     }
 }
+
+// A point light's cube faces store distance from the light over its range, not the
+// face's projected depth, so that a filter tap compares the same quantity on every
+// face (and across seams). The fragment stage writes it, with the bias the rasterizer
+// would have applied to projected depth: a constant in units of the last mantissa
+// bit of a 32-bit float at that depth, and a slope-scaled term of the depth's
+// screen derivatives (Vulkan spec, "Depth Bias").
+struct DistanceOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    @location(2) @interpolate(flat) instance: u32,
+};
+
+@vertex
+fn vs_shadow_distance(v: VertexIn, @builtin(instance_index) instance_index: u32) -> DistanceOut {
+    let inst = instances[instance_index];
+    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+    var out: DistanceOut;
+    out.clip = light.clip_from_world * world;
+    out.world = world.xyz;
+    out.uv = v.uv;
+    out.instance = instance_index;
+    return out;
+}
+
+fn biased_distance(world: vec3<f32>) -> f32 {
+    let d = length(world - light.position.xyz) / light.position.w;
+    let slope = max(abs(dpdx(d)), abs(dpdy(d)));
+    let unit = exp2(floor(log2(max(d, 1e-30))) - 23.0);
+    return d + light.raster_bias.x * unit + light.raster_bias.y * slope;
+}
+
+@fragment
+fn fs_shadow_distance(in: DistanceOut) -> @builtin(frag_depth) f32 {
+    return biased_distance(in.world);
+}
+
+@fragment
+fn fs_shadow_distance_masked(in: DistanceOut) -> @builtin(frag_depth) f32 {
+    // Derivatives first, in uniform control flow.
+    let depth = biased_distance(in.world);
+    if alpha_cut(instances[in.instance], in.uv) {
+        discard;
+    }
+    return depth;
+}

@@ -50,6 +50,12 @@ pub trait ShadowTechnique: Sync {
     fn params(&self, _settings: &FilterSettings, _precision: MapPrecision) -> [Vec4; 2] {
         [Vec4::ZERO; 2]
     }
+    /// WGSL sources defining `fn sample_shadow_cube(q: CubeQuery) -> f32`, the lookup
+    /// in a point light's cube map (see `cube.wgsl`), for the techniques that have one
+    /// ([`Technique::supports_point_lights`]).
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        None
+    }
     /// The filterable map the technique samples, if any.
     fn filterable_map(&self, _settings: &FilterSettings) -> Option<FilterableMap> {
         None
@@ -79,6 +85,9 @@ pub fn lookup(technique: Technique) -> &'static dyn ShadowTechnique {
         unreachable!("technique {technique:?} is not registered; see `every_technique_is_registered_once`")
     })
 }
+
+/// The helpers every cube lookup shares, composed before a technique's cube WGSL.
+pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
 
 /// Taps in the shared Poisson disk, the most any technique may ask for.
 pub const POISSON_DISK_SIZE: usize = 64;
@@ -115,6 +124,17 @@ mod tests {
             assert_eq!(n, 1, "{t:?} is registered {n} times");
         }
         assert_eq!(REGISTRY.len(), Technique::all().len());
+    }
+
+    #[test]
+    fn point_light_techniques_have_a_cube_lookup() {
+        for t in REGISTRY {
+            let cube = t.cube_wgsl();
+            assert_eq!(cube.is_some(), t.technique().supports_point_lights(), "{:?}", t.technique());
+            if let Some(sources) = cube {
+                assert!(sources.concat().contains("fn sample_shadow_cube(q: CubeQuery) -> f32"));
+            }
+        }
     }
 
     #[test]

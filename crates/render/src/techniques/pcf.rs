@@ -28,6 +28,10 @@ impl ShadowTechnique for Pcf2x2 {
         &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
            return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.layer, q.coords.z);\n}\n"]
     }
+
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_compare_tap(q, vec2<f32>(0.0));\n}\n"])
+    }
 }
 
 impl ShadowTechnique for PcfBox {
@@ -40,6 +44,12 @@ impl ShadowTechnique for PcfBox {
             PCF_WGSL,
             "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), false);\n}\n",
         ]
+    }
+
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[
+            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_pcf_grid(q, cube_kernel_width_texels(q), false);\n}\n",
+        ])
     }
 }
 
@@ -54,6 +64,12 @@ impl ShadowTechnique for PcfTent {
             "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), true);\n}\n",
         ]
     }
+
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[
+            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_pcf_grid(q, cube_kernel_width_texels(q), true);\n}\n",
+        ])
+    }
 }
 
 impl ShadowTechnique for PcfPoisson {
@@ -64,5 +80,10 @@ impl ShadowTechnique for PcfPoisson {
     fn wgsl(&self) -> &'static [&'static str] {
         &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
            return pcf_poisson(q, 0.5 * kernel_width_texels(q), u32(light.kernel.z));\n}\n"]
+    }
+
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    \
+                return cube_pcf_poisson(q, 0.5 * cube_kernel_width_texels(q), u32(light.kernel.z));\n}\n"])
     }
 }

@@ -1,5 +1,5 @@
 //! `pcss`: percentage-closer soft shadows (Fernando 2005). The light's size is the
-//! light's own (spot disk radius or sun angular diameter), the same parameter the
+//! light's own (spot disk radius, point light sphere radius or sun angular diameter), the same parameter the
 //! reference's area light uses; the search settings are carried in `light.pcss`.
 
 use gnomon_scene::settings::Technique;
@@ -15,5 +15,9 @@ impl ShadowTechnique for Pcss {
 
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("pcss.wgsl")]
+    }
+
+    fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcss_cube.wgsl")])
     }
 }

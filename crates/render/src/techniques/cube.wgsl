@@ -1,0 +1,93 @@
+// What every technique's `sample_shadow_cube` receives, and the helpers they share:
+// a point light's cube map is sampled by direction, and the hardware picks the face
+// and filters across face seams (Vulkan always filters cube maps seamlessly), so
+// kernels are laid out in the plane across the ray and never meet a face edge.
+
+// One cube lookup.
+struct CubeQuery {
+    // From the light to the (biased) receiver, in world units.
+    offset: vec3<f32>,
+    // |offset| / range: the receiver's depth as the cube stores it.
+    depth: f32,
+    // World size of one texel across the ray at the receiver.
+    texel_world: f32,
+    // Fragment position in pixels, for per-pixel noise.
+    pixel: vec2<f32>,
+    // Orthonormal axes across the ray, for kernel offsets.
+    tangent: vec3<f32>,
+    bitangent: vec3<f32>,
+};
+
+// An orthonormal pair perpendicular to unit `n` (Duff et al., "Building an
+// orthonormal basis, revisited", JCGT 2017).
+fn orthonormal_pair(n: vec3<f32>) -> mat2x3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(
+        vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        vec3<f32>(b, sign + n.y * n.y * a, -n.y),
+    );
+}
+
+// World size of one cube texel across the ray to `offset`: a face texel at
+// major-axis distance m is 2m / resolution wide in the face plane, and m / |offset|
+// of that across the ray (gnomon_math::omni::cube_texel_world_size).
+fn cube_texel_world_size(offset: vec3<f32>) -> f32 {
+    let m = max(abs(offset.x), max(abs(offset.y), abs(offset.z)));
+    return 2.0 * m * m / (light.texel.w * max(length(offset), 1e-20));
+}
+
+// The lookup direction `texels` (across the ray) from the receiver's.
+fn cube_direction(q: CubeQuery, texels: vec2<f32>) -> vec3<f32> {
+    return q.offset + (q.tangent * texels.x + q.bitangent * texels.y) * q.texel_world;
+}
+
+// One bilinear comparison tap `texels` from the lookup.
+fn cube_compare_tap(q: CubeQuery, texels: vec2<f32>) -> f32 {
+    return textureSampleCompareLevel(shadow_cube, shadow_compare, cube_direction(q, texels), q.depth);
+}
+
+// A rotated Poisson disk of `count` bilinear taps, `radius` texels wide.
+fn cube_pcf_poisson(q: CubeQuery, radius: f32, count: u32) -> f32 {
+    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
+    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    var sum = 0.0;
+    for (var i = 0u; i < count; i++) {
+        sum += cube_compare_tap(q, rotation * POISSON_DISK[i] * radius);
+    }
+    return sum / f32(count);
+}
+
+// A box or tent kernel `width` texels wide: a regular grid of bilinear taps one
+// texel apart or closer, weighted by the kernel. Texel centres on the cube do not
+// line up with a grid across the ray, so the exact-weight pairing of the 2D maps
+// (pcf.wgsl) does not apply; the bilinear taps smooth the grid instead.
+fn cube_pcf_grid(q: CubeQuery, width: f32, tent: bool) -> f32 {
+    let n = i32(ceil(max(width, 1.0)));
+    let step = width / f32(n);
+    let h = 0.5 * width;
+    var sum = 0.0;
+    var total = 0.0;
+    for (var j = 0; j < n; j++) {
+        let y = (f32(j) + 0.5) * step - h;
+        for (var i = 0; i < n; i++) {
+            let x = (f32(i) + 0.5) * step - h;
+            var w = 1.0;
+            if tent {
+                w = max(1.0 - abs(x) / h, 0.0) * max(1.0 - abs(y) / h, 0.0);
+            }
+            sum += w * cube_compare_tap(q, vec2<f32>(x, y));
+            total += w;
+        }
+    }
+    return sum / max(total, 1e-12);
+}
+
+// The kernel width in texels at this receiver (kernel_width_texels for the cube).
+fn cube_kernel_width_texels(q: CubeQuery) -> f32 {
+    if light.kernel.y > 0.5 {
+        return clamp(light.kernel.x / q.texel_world, 1.0, 32.0);
+    }
+    return light.kernel.x;
+}

@@ -1,0 +1,35 @@
+// PCSS on a point light's cube map (Fernando 2005, as pcss.wgsl), for a sphere of
+// radius w_light (light.pcss.x). Distances are from the light's centre; every
+// offset is across the ray, in texels at the receiver.
+
+fn sample_shadow_cube(q: CubeQuery) -> f32 {
+    let size = light.pcss.x;
+    let max_radius = light.pcss.z;
+    let range = light.position.w;
+    let near = light.cone.z;
+    let d_receiver = q.depth * range;
+
+    // 1. The search region: a blocker at distance t hides the light from the receiver
+    // within size·(d − t)/t across the ray at the receiver, the most at the near plane.
+    let search = clamp(size * (d_receiver - near) / near / q.texel_world, 1.0, max_radius);
+    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
+    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let taps = u32(light.pcss.y);
+    var blocker_sum = 0.0;
+    var blockers = 0.0;
+    for (var i = 0u; i < taps; i++) {
+        let stored = textureGather(shadow_cube, shadow_gather, cube_direction(q, rotation * POISSON_DISK[i] * search));
+        let nearer = vec4<f32>(stored < vec4<f32>(q.depth));
+        blocker_sum += dot(nearer, stored);
+        blockers += dot(nearer, vec4<f32>(1.0));
+    }
+    if blockers == 0.0 {
+        return 1.0;
+    }
+    let d_blocker = max(blocker_sum / blockers * range, near);
+
+    // 2. The penumbra's radius at the receiver, by similar triangles.
+    let penumbra = size * max(d_receiver - d_blocker, 0.0) / d_blocker / q.texel_world;
+    // 3. At least the bilinear tap's own half-texel footprint.
+    return cube_pcf_poisson(q, clamp(penumbra, 0.5, max_radius), u32(light.kernel.z));
+}
