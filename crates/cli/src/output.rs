@@ -201,10 +201,16 @@ pub fn visibility_rgba(visibility: &[f32]) -> Vec<u8> {
         .collect()
 }
 
-/// The shadow map as 16-bit gray: depth linearized for perspective maps, then
-/// stretched over the range the casters cover. Empty texels (depth 1) are white.
-pub fn shadow_map_to_gray16(map: &ShadowMapImage, projection: &LightProjection) -> Vec<u16> {
+/// The shadow map as 16-bit gray: depth linearized for perspective maps (a point
+/// light's cube, `stores_distance`, holds linear distance already), then stretched
+/// over the range the casters cover. Empty texels (depth 1) are white.
+pub fn shadow_map_to_gray16(
+    map: &ShadowMapImage,
+    projection: &LightProjection,
+    stores_distance: bool,
+) -> Vec<u16> {
     let linear = |d: f32| match projection.kind {
+        _ if stores_distance => d,
         ProjectionKind::Perspective { .. } => {
             let z = linearize_perspective_depth(d, projection.near, projection.far);
             (z - projection.near) / (projection.far - projection.near)

@@ -85,15 +85,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let render_started = std::time::Instant::now();
     let frame = renderer.render(&scene, settings, &request)?;
     if args.verbose {
+        let shadows = match frame.lights.as_slice() {
+            [one] => format!("technique {}, shadow map {}²", one.technique.name(), one.resolution),
+            many => format!("{} shadowed lights", many.len()),
+        };
         eprintln!(
-            "gnomon: scene `{}` ({} triangles, {} instances), {}×{}, technique {}, shadow map {}², rendered in {:.1} ms",
+            "gnomon: scene `{}` ({} triangles, {} instances), {}×{}, {shadows}, rendered in {:.1} ms",
             scene.name,
             scene.triangle_count(),
             scene.instances.len(),
             frame.width,
             frame.height,
-            settings.shadow.filter.technique.name(),
-            frame.shadow_resolution,
             render_started.elapsed().as_secs_f64() * 1e3
         );
         let st = frame.stats;
@@ -115,9 +117,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         if let Some(t) = frame.timings {
             let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
             eprintln!(
-                "gnomon: GPU time: shadow pass {:.2} ms{filter}, lighting pass {:.2} ms",
-                t.shadow_ms, t.lighting_ms
+                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}, lighting pass {:.2} ms",
+                t.frame_ms, t.shadow_ms, t.lighting_ms
             );
+        }
+        for (i, light) in frame.lights.iter().enumerate() {
+            eprintln!("gnomon: {}", light_line(i, light));
         }
     }
 
@@ -125,7 +130,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let mut staged = Staged::default();
     staged.png_rgba(&args.out, frame.width, frame.height, &frame.color)?;
     if let (Some(path), Some(map)) = (&args.shadow_map_out, &frame.shadow_map) {
-        let linear = output::shadow_map_to_gray16(map, &frame.light_projection);
+        let linear = output::shadow_map_to_gray16(
+            map,
+            &frame.light_projection,
+            matches!(frame.light, gnomon_scene::Light::Point(_)),
+        );
         staged.png_gray16(path, map.resolution, map.resolution, &linear)?;
     }
     if let Some(path) = &args.visibility_out {
@@ -150,4 +159,28 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         eprintln!("gnomon: done in {:.1} ms", started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(())
+}
+
+/// One light's line of `--verbose`: what it is, what its map holds, the draws into
+/// each layer and its GPU time.
+fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
+    let layers = light.layer_draws.len();
+    let map = if layers > 1 {
+        format!("{layers} × {}²", light.resolution)
+    } else {
+        format!("{}²", light.resolution)
+    };
+    let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
+    let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
+    format!(
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}",
+        light.name,
+        light.kind,
+        light.technique.name(),
+        light.shadow_draws(),
+        per_layer.join(" "),
+        ms("shadow", light.shadow_ms),
+        ms("moments", light.filter_ms),
+        ms("lighting", light.lighting_ms),
+    )
 }

@@ -345,3 +345,50 @@ fn no_adapter_says_how_to_get_one() {
     assert!(e.contains("no GPU adapter found") && e.contains("apt-get install mesa-vulkan-drivers"), "{e}");
     assert!(files_in(&dir).is_empty());
 }
+
+#[test]
+fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
+    let dir = temp_dir("many-lights");
+    let out = gnomon(
+        &dir,
+        &[
+            "render",
+            "lamps",
+            "--light",
+            "all",
+            "--width",
+            "320",
+            "--height",
+            "180",
+            "--verbose",
+            "-o",
+            "lamps.png",
+        ],
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(dir.join("lamps.png").is_file());
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("gnomon: light ")).collect();
+    assert_eq!(lines.len(), 8, "{err}");
+    assert!(lines[0].contains("`sun` (sun, pcf-poisson, map 4 × 2048²)"), "{}", lines[0]);
+    assert!(
+        lines[4].contains("(point, pcf2x2, map 6 × 512²)") && lines[4].contains("shadow draws ["),
+        "{}",
+        lines[4]
+    );
+    assert!(err.contains("rendered in"), "{err}");
+    // The GPU's frame time where the device has timestamp queries (lavapipe does).
+    if err.contains("GPU time") {
+        assert!(err.contains("GPU time: frame "), "{err}");
+    }
+
+    // A technique a cube map cannot take is refused, naming the light.
+    let out = gnomon(&dir, &["render", "--light", "point", "--technique", "vsm", "-o", "vsm.png"]);
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("--technique") && err.contains("point light"), "{err}");
+    assert!(!dir.join("vsm.png").exists());
+    // --light all needs a light list.
+    let out = gnomon(&dir, &["render", "columns", "--light", "all", "-o", "none.png"]);
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("light list") && err.contains("lamps"), "{err}");
+}

@@ -248,10 +248,8 @@ impl<'g> Renderer<'g> {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        let gather_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("shadow gather"),
-            ..Default::default()
-        });
+        let gather_sampler = device
+            .create_sampler(&wgpu::SamplerDescriptor { label: Some("shadow gather"), ..Default::default() });
         let placeholder_cube = device
             .create_texture(&wgpu::TextureDescriptor {
                 label: Some("no cube map"),
@@ -434,7 +432,15 @@ impl<'g> Renderer<'g> {
                         )?,
                         _ => None,
                     };
-                    shadow_layout(scene, &r.light, &camera, aspect, &light_settings, sampled.as_ref(), depth_clamp)
+                    shadow_layout(
+                        scene,
+                        &r.light,
+                        &camera,
+                        aspect,
+                        &light_settings,
+                        sampled.as_ref(),
+                        depth_clamp,
+                    )
                 }
             };
             let technique = techniques::lookup(shadow.filter.technique);
@@ -476,200 +482,210 @@ impl<'g> Renderer<'g> {
         let gpu = self.gpu;
         let device = &gpu.device;
         let timestamp_count = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
-        let (pending, shadow_pending, timestamps, stats, layer_draws) = gpu.checked("rendering the frame", || {
-            let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
-            let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("camera"),
-                layout: &self.layouts.camera,
-                entries: &[wgpu::BindGroupEntry { binding: 0, resource: camera_buffer.as_entire_binding() }],
-            });
-            let queries = gpu.timestamp_period_ns.map(|_| {
-                device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: timestamp_count,
-                })
-            });
-            let mut encoder = device.create_command_encoder(&Default::default());
-            let mut stats = DrawStats::default();
-            let mut layer_draws = Vec::with_capacity(plans.len());
-            let mut shadow_pending = None;
-            // Each light's shadow map(s), then its bind groups for the lighting pass.
-            let mut lit = Vec::with_capacity(plans.len());
-            for (index, plan) in plans.iter().enumerate() {
-                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
-                let (shadow_map, draws) =
-                    self.record_shadow_maps(&mut encoder, uploaded, plan, queries.as_ref(), slot, &mut stats);
-                layer_draws.push(draws);
-                if read_shadow_map && index == shown {
-                    shadow_pending = Some(readback::record(
-                        device,
-                        &mut encoder,
-                        &shadow_map,
-                        wgpu::TextureAspect::DepthOnly,
-                    ));
-                }
-                let (light_buffer, scene_group) = self.scene_group(uploaded, &plan.light_gpu);
-                let shadow_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    ..Default::default()
+        let (pending, shadow_pending, timestamps, stats, layer_draws) =
+            gpu.checked("rendering the frame", || {
+                let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
+                let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("camera"),
+                    layout: &self.layouts.camera,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: camera_buffer.as_entire_binding(),
+                    }],
                 });
-                let shadow = &plan.settings.shadow;
-                let moment_map = plan.filterable_map.map(|map| {
-                    self.moment_pass.record(
-                        device,
-                        &mut encoder,
-                        shadow.filter.technique,
-                        map,
-                        &shadow.filter.moments,
-                        plan.moment_format,
-                        shadow.map.resolution,
-                        plan.layout.projections.len() as u32,
-                        &shadow_view,
-                        &light_buffer,
-                        queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
-                            query_set,
-                            beginning_of_pass_write_index: Some(slot + 4),
-                            end_of_pass_write_index: Some(slot + 5),
-                        }),
-                    )
-                });
-                let cube_view = matches!(plan.light, Light::Point(_)).then(|| {
-                    shadow_map.create_view(&wgpu::TextureViewDescriptor {
-                        dimension: Some(wgpu::TextureViewDimension::Cube),
-                        ..Default::default()
+                let queries = gpu.timestamp_period_ns.map(|_| {
+                    device.create_query_set(&wgpu::QuerySetDescriptor {
+                        label: Some("pass timestamps"),
+                        ty: wgpu::QueryType::Timestamp,
+                        count: timestamp_count,
                     })
                 });
-                let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
-                let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shadow map"),
-                    layout: &self.layouts.shadow,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&shadow_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::TextureView(moment_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: wgpu::BindingResource::TextureView(
-                                cube_view.as_ref().unwrap_or(&self.placeholder_cube),
-                            ),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 5,
-                            resource: wgpu::BindingResource::Sampler(&self.compare_nearest_sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 6,
-                            resource: wgpu::BindingResource::Sampler(&self.gather_sampler),
-                        },
-                    ],
-                });
-                lit.push((scene_group, shadow_group));
-            }
-
-            let targets: Vec<wgpu::Texture> = lighting::TARGETS
-                .iter()
-                .map(|&format| render_target(device, width, height, format))
-                .collect();
-            let target_views: Vec<wgpu::TextureView> =
-                targets.iter().map(|t| t.create_view(&Default::default())).collect();
-            let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
-            let depth_view = depth.create_view(&Default::default());
-            for (index, (plan, (scene_group, shadow_group))) in plans.iter().zip(&lit).enumerate() {
-                let first = index == 0;
-                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
-                let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
-                    .iter()
-                    .enumerate()
-                    .map(|(i, view)| {
-                        // The colour image gets an opaque sky; the data targets zero
-                        // (object id 0 marks background). Later lights add to them.
-                        let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
-                        Some(wgpu::RenderPassColorAttachment {
-                            view,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: if first { wgpu::LoadOp::Clear(clear) } else { wgpu::LoadOp::Load },
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })
-                    })
-                    .collect();
-                let last = index + 1 == plans.len();
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("lighting"),
-                    color_attachments: &attachments,
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth_view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: if first { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
-                            store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
-                        query_set,
-                        beginning_of_pass_write_index: Some(slot + 2),
-                        end_of_pass_write_index: Some(slot + 3),
-                    }),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                let key = LightingKey {
-                    technique: plan.settings.shadow.filter.technique,
-                    cube: matches!(plan.light, Light::Point(_)),
-                    role: if first {
-                        LightingRole::First
-                    } else {
-                        LightingRole::Added { visibility: index == shown }
-                    },
-                };
-                pass.set_pipeline(self.lighting_pass.pipeline(device, key));
-                pass.set_bind_group(0, scene_group, &[]);
-                pass.set_bind_group(1, &camera_group, &[]);
-                pass.set_bind_group(2, shadow_group, &[]);
-                stats.pipeline_changes += 1;
-                stats.bind_group_changes += 3;
-                uploaded.bind_geometry(&mut pass);
-                let mut bound = None;
-                for d in &uploaded.draws {
-                    if bound != Some(d.material_group) {
-                        pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
-                        bound = Some(d.material_group);
-                        stats.bind_group_changes += 1;
+                let mut encoder = device.create_command_encoder(&Default::default());
+                let mut stats = DrawStats::default();
+                let mut layer_draws = Vec::with_capacity(plans.len());
+                let mut shadow_pending = None;
+                // Each light's shadow map(s), then its bind groups for the lighting pass.
+                let mut lit = Vec::with_capacity(plans.len());
+                for (index, plan) in plans.iter().enumerate() {
+                    let slot = TIMESTAMPS_PER_LIGHT * index as u32;
+                    let (shadow_map, draws) = self.record_shadow_maps(
+                        &mut encoder,
+                        uploaded,
+                        plan,
+                        queries.as_ref(),
+                        slot,
+                        &mut stats,
+                    );
+                    layer_draws.push(draws);
+                    if read_shadow_map && index == shown {
+                        shadow_pending = Some(readback::record(
+                            device,
+                            &mut encoder,
+                            &shadow_map,
+                            wgpu::TextureAspect::DepthOnly,
+                        ));
                     }
-                    GpuScene::draw_one(&mut pass, d);
-                    stats.lighting_draws += 1;
+                    let (light_buffer, scene_group) = self.scene_group(uploaded, &plan.light_gpu);
+                    let shadow_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        ..Default::default()
+                    });
+                    let shadow = &plan.settings.shadow;
+                    let moment_map = plan.filterable_map.map(|map| {
+                        self.moment_pass.record(
+                            device,
+                            &mut encoder,
+                            shadow.filter.technique,
+                            map,
+                            &shadow.filter.moments,
+                            plan.moment_format,
+                            shadow.map.resolution,
+                            plan.layout.projections.len() as u32,
+                            &shadow_view,
+                            &light_buffer,
+                            queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
+                                query_set,
+                                beginning_of_pass_write_index: Some(slot + 4),
+                                end_of_pass_write_index: Some(slot + 5),
+                            }),
+                        )
+                    });
+                    let cube_view = matches!(plan.light, Light::Point(_)).then(|| {
+                        shadow_map.create_view(&wgpu::TextureViewDescriptor {
+                            dimension: Some(wgpu::TextureViewDimension::Cube),
+                            ..Default::default()
+                        })
+                    });
+                    let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
+                    let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("shadow map"),
+                        layout: &self.layouts.shadow,
+                        entries: &[
+                            wgpu::BindGroupEntry {
+                                binding: 0,
+                                resource: wgpu::BindingResource::TextureView(&shadow_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 2,
+                                resource: wgpu::BindingResource::TextureView(moment_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 3,
+                                resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 4,
+                                resource: wgpu::BindingResource::TextureView(
+                                    cube_view.as_ref().unwrap_or(&self.placeholder_cube),
+                                ),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 5,
+                                resource: wgpu::BindingResource::Sampler(&self.compare_nearest_sampler),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 6,
+                                resource: wgpu::BindingResource::Sampler(&self.gather_sampler),
+                            },
+                        ],
+                    });
+                    lit.push((scene_group, shadow_group));
                 }
-            }
-            let pending: Vec<_> = if read_images {
-                targets
+
+                let targets: Vec<wgpu::Texture> = lighting::TARGETS
                     .iter()
-                    .map(|t| readback::record(device, &mut encoder, t, wgpu::TextureAspect::All))
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            let timestamps = queries
-                .as_ref()
-                .map(|query_set| readback::record_timestamps(device, &mut encoder, query_set, timestamp_count));
-            gpu.queue.submit([encoder.finish()]);
-            (pending, shadow_pending, timestamps, stats, layer_draws)
-        })?;
+                    .map(|&format| render_target(device, width, height, format))
+                    .collect();
+                let target_views: Vec<wgpu::TextureView> =
+                    targets.iter().map(|t| t.create_view(&Default::default())).collect();
+                let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
+                let depth_view = depth.create_view(&Default::default());
+                for (index, (plan, (scene_group, shadow_group))) in plans.iter().zip(&lit).enumerate() {
+                    let first = index == 0;
+                    let slot = TIMESTAMPS_PER_LIGHT * index as u32;
+                    let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
+                        .iter()
+                        .enumerate()
+                        .map(|(i, view)| {
+                            // The colour image gets an opaque sky; the data targets zero
+                            // (object id 0 marks background). Later lights add to them.
+                            let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
+                            Some(wgpu::RenderPassColorAttachment {
+                                view,
+                                depth_slice: None,
+                                resolve_target: None,
+                                ops: wgpu::Operations {
+                                    load: if first { wgpu::LoadOp::Clear(clear) } else { wgpu::LoadOp::Load },
+                                    store: wgpu::StoreOp::Store,
+                                },
+                            })
+                        })
+                        .collect();
+                    let last = index + 1 == plans.len();
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("lighting"),
+                        color_attachments: &attachments,
+                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                            view: &depth_view,
+                            depth_ops: Some(wgpu::Operations {
+                                load: if first { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                                store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+                            }),
+                            stencil_ops: None,
+                        }),
+                        timestamp_writes: queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
+                            query_set,
+                            beginning_of_pass_write_index: Some(slot + 2),
+                            end_of_pass_write_index: Some(slot + 3),
+                        }),
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    let key = LightingKey {
+                        technique: plan.settings.shadow.filter.technique,
+                        cube: matches!(plan.light, Light::Point(_)),
+                        role: if first {
+                            LightingRole::First
+                        } else {
+                            LightingRole::Added { visibility: index == shown }
+                        },
+                    };
+                    pass.set_pipeline(self.lighting_pass.pipeline(device, key));
+                    pass.set_bind_group(0, scene_group, &[]);
+                    pass.set_bind_group(1, &camera_group, &[]);
+                    pass.set_bind_group(2, shadow_group, &[]);
+                    stats.pipeline_changes += 1;
+                    stats.bind_group_changes += 3;
+                    uploaded.bind_geometry(&mut pass);
+                    let mut bound = None;
+                    for d in &uploaded.draws {
+                        if bound != Some(d.material_group) {
+                            pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
+                            bound = Some(d.material_group);
+                            stats.bind_group_changes += 1;
+                        }
+                        GpuScene::draw_one(&mut pass, d);
+                        stats.lighting_draws += 1;
+                    }
+                }
+                let pending: Vec<_> = if read_images {
+                    targets
+                        .iter()
+                        .map(|t| readback::record(device, &mut encoder, t, wgpu::TextureAspect::All))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                let timestamps = queries.as_ref().map(|query_set| {
+                    readback::record_timestamps(device, &mut encoder, query_set, timestamp_count)
+                });
+                gpu.queue.submit([encoder.finish()]);
+                (pending, shadow_pending, timestamps, stats, layer_draws)
+            })?;
 
         let ticks = match timestamps {
             Some(t) => Some(t.read(gpu)?),
@@ -754,8 +770,10 @@ impl<'g> Renderer<'g> {
         let mut draws = Vec::with_capacity(layers as usize);
         for layer in 0..layers {
             let projection = &plan.layout.projections[layer as usize];
-            let layer_light =
-                LightGpu { clip_from_world: plan.light_gpu.cascade_clip_from_world[layer as usize], ..plan.light_gpu };
+            let layer_light = LightGpu {
+                clip_from_world: plan.light_gpu.cascade_clip_from_world[layer as usize],
+                ..plan.light_gpu
+            };
             let (_, layer_group) = self.scene_group(uploaded, &layer_light);
             let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -764,11 +782,12 @@ impl<'g> Renderer<'g> {
                 ..Default::default()
             });
             let (first, last) = (layer == 0, layer + 1 == layers);
-            let timestamps = queries.filter(|_| first || last).map(|query_set| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: first.then_some(slot),
-                end_of_pass_write_index: last.then_some(slot + 1),
-            });
+            let timestamps =
+                queries.filter(|_| first || last).map(|query_set| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: first.then_some(slot),
+                    end_of_pass_write_index: last.then_some(slot + 1),
+                });
             // A pass that clamps depth draws the casters before its near plane too.
             let frustum = Frustum::from_clip_from_world(projection.clip_from_world());
             let before = stats.shadow_draws;
@@ -1038,7 +1057,8 @@ impl<'g> Renderer<'g> {
                             bound = Some(d.material_group);
                             stats.bind_group_changes += 1;
                         }
-                        let run = crate::gpu_scene::Draw { instance: start, instance_count: stop - start, ..*d };
+                        let run =
+                            crate::gpu_scene::Draw { instance: start, instance_count: stop - start, ..*d };
                         GpuScene::draw_one(&mut pass, &run);
                         stats.shadow_draws += 1;
                         start = stop;

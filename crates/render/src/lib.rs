@@ -21,7 +21,9 @@ mod readback;
 pub mod techniques;
 
 pub use device::{Gpu, GpuInfo};
-pub use frame::{DrawStats, Frame, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection};
+pub use frame::{
+    DrawStats, Frame, LightStats, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection,
+};
 pub use gpu_scene::GpuScene;
 pub use wgpu;
 

@@ -4,8 +4,8 @@
 use glam::{Mat4, Vec3};
 
 use crate::{
-    Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight, SpotLight, geometry,
-    sun_direction,
+    Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight, SpotLight,
+    geometry, sun_direction,
 };
 
 /// A built-in scene: its name, what it shows, and how to build it.
@@ -347,17 +347,21 @@ pub fn lamps() -> Scene {
         s.intensity = 0.5;
         let technique = ["pcf", "pcss", "hard"][i];
         let shadow = match technique {
-            "pcss" => format!("[filter]\ntechnique = \"pcss\"\n"),
+            "pcss" => "[filter]\ntechnique = \"pcss\"\n".to_string(),
             _ => format!("[filter]\ntechnique = \"{technique}\"\n[map]\nresolution = 1024"),
         };
         if technique == "pcss" {
             s.radius = 0.3;
         }
-        lights.push(SceneLight { name: format!("spot {i}"), light: Light::Spot(s), shadow: settings(&shadow) });
+        lights.push(SceneLight {
+            name: format!("spot {i}"),
+            light: Light::Spot(s),
+            shadow: settings(&shadow),
+        });
     }
     for (i, (position, color)) in points.into_iter().enumerate() {
         let technique = ["pcf2x2", "pcf-poisson", "pcf", "pcss"][i];
-        let mut p = dim(point(position, 14.0), color);
+        let mut p = dim(point(position, 22.0), color);
         if technique == "pcss" {
             p.radius = 0.15;
         }
@@ -372,7 +376,7 @@ pub fn lamps() -> Scene {
         camera,
         sun_light,
         spot(Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), 38.0, 25.0),
-        dim(point(points[0].0, 14.0), points[0].1),
+        dim(point(points[0].0, 22.0), points[0].1),
     );
     scene.ambient = Vec3::splat(0.06);
     scene.lights = lights;

@@ -280,8 +280,8 @@ fn build(
     };
     let mut instances = Vec::new();
     let mut camera = None;
-    let (mut sun, mut spot, mut point) = (None, None, None);
-    let mut lights: Vec<SceneLight> = Vec::new();
+    // Lights as the nodes place them, with the index of the file's light each is.
+    let mut found: Vec<(usize, SceneLight)> = Vec::new();
     let mut extras = FileExtras::default();
     let mut stack: Vec<(gltf::Node, Mat4, usize)> =
         roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
@@ -370,14 +370,8 @@ fn build(
             };
             match parsed {
                 Some(l) => {
-                    match l {
-                        Light::Directional(d) if sun.is_none() => sun = Some(d),
-                        Light::Spot(s) if spot.is_none() => spot = Some(s),
-                        Light::Point(p) if point.is_none() => point = Some(p),
-                        _ => {}
-                    }
                     let name = light.name().map_or_else(|| format!("light {}", light.index()), str::to_owned);
-                    lights.push(SceneLight { name, light: l, shadow: None });
+                    found.push((light.index(), SceneLight { name, light: l, shadow: None }));
                 }
                 None => extras.ignored_lights += 1,
             }
@@ -388,6 +382,18 @@ fn build(
     }
     if instances.is_empty() {
         return Err("has no triangle meshes in its scene".into());
+    }
+    // The light list in the file's order; the first of each type is the default.
+    found.sort_by_key(|(index, _)| *index);
+    let mut lights: Vec<SceneLight> = found.into_iter().map(|(_, l)| l).collect();
+    let (mut sun, mut spot, mut point) = (None, None, None);
+    for l in &lights {
+        match l.light {
+            Light::Directional(d) if sun.is_none() => sun = Some(d),
+            Light::Spot(s) if spot.is_none() => spot = Some(s),
+            Light::Point(p) if point.is_none() => point = Some(p),
+            _ => {}
+        }
     }
 
     let mut scene = Scene {

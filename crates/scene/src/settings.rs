@@ -1327,4 +1327,65 @@ mod tests {
             (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
         assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
     }
+
+    #[test]
+    fn point_light_flags_override_the_scenes_and_are_checked() {
+        let scene = crate::builtin::spheres();
+        let parsed = Cli::try_parse_from([
+            "gnomon",
+            "--light",
+            "point",
+            "--point-position",
+            "1,2,3",
+            "--point-range",
+            "7",
+            "--point-radius",
+            "0.2",
+        ])
+        .unwrap()
+        .settings;
+        parsed.validate().unwrap();
+        let Light::Point(p) = parsed.resolve_light(&scene).unwrap() else { panic!("a point light") };
+        assert_eq!((p.position, p.range, p.radius), (Vec3::new(1.0, 2.0, 3.0), 7.0, 0.2));
+        assert_eq!(p.color, scene.point.color, "what no flag names stays the scene's");
+        let lights = parsed.resolve_lights(&scene).unwrap();
+        assert_eq!((lights.len(), lights[0].name.as_str()), (1, "point"));
+
+        let mut bad = parsed.clone();
+        bad.light.point_range = Some(0.0);
+        assert_eq!(bad.validate().unwrap_err().flag, "--point-range");
+        bad.light.point_range = None;
+        bad.light.point_radius = Some(-1.0);
+        assert_eq!(bad.validate().unwrap_err().flag, "--point-radius");
+        // A cube map is compared by direction: the moment techniques are refused.
+        let mut vsm = parsed;
+        vsm.shadow.filter.technique = Technique::Vsm;
+        let e = vsm.resolve_lights(&scene).unwrap_err();
+        assert_eq!(e.flag, "--technique");
+        assert!(e.valid.contains("pcf-poisson or pcss"), "{e}");
+    }
+
+    #[test]
+    fn light_all_takes_each_lights_own_shadow_settings() {
+        let scene = crate::builtin::lamps();
+        let mut s = Settings::default();
+        s.light.kind = LightKind::All;
+        s.shadow.bias.slope_bias = 2.5;
+        let lights = s.resolve_lights(&scene).unwrap();
+        assert_eq!(lights.len(), 8);
+        assert_eq!(lights[0].shadow.partition, Partition::Cascades);
+        assert_eq!(lights[2].shadow.filter.technique, Technique::Pcss);
+        assert!(
+            lights.iter().all(|l| l.shadow.bias.slope_bias == 2.5),
+            "the render's, where a light says nothing"
+        );
+        // A light whose own table is invalid over these settings is named.
+        let mut broken = scene.clone();
+        broken.lights[3].shadow = Some("[map]\nresolution = 100".parse().unwrap());
+        let e = s.resolve_lights(&broken).unwrap_err();
+        assert!(e.to_string().contains("spot 2") && e.to_string().contains("--shadow-res"), "{e}");
+        // No list: a clear error naming where lists come from.
+        let e = s.resolve_lights(&crate::builtin::spheres()).unwrap_err();
+        assert!(e.valid.contains("[[light]]") && e.valid.contains("lamps"), "{e}");
+    }
 }

@@ -101,3 +101,42 @@ fn truncated_and_garbage_files_do_not_panic() {
         .unwrap();
     assert!(gltf_loader::load(&path).is_err());
 }
+
+#[test]
+fn every_punctual_light_joins_the_light_list() {
+    use gnomon_scene::Light;
+    let dir = temp_dir("lights");
+    let json = hierarchy_json(None).replacen(
+        r#""asset": {"version": "2.0"},"#,
+        r#""asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {"KHR_lights_punctual": {"lights": [
+    {"type": "point", "name": "bulb", "color": [1, 0.5, 0.5], "range": 6},
+    {"type": "spot", "spot": {"outerConeAngle": 0.5}},
+    {"type": "point"}
+  ]}},"#,
+        1,
+    );
+    // Three light nodes beside the hierarchy.
+    let json = json
+        .replacen(r#""scenes": [{"nodes": [0]}],"#, r#""scenes": [{"nodes": [0, 2, 3, 4]}],"#, 1)
+        .replacen(
+            r#"{"name": "child", "translation": [1, 0, 0], "mesh": 0}"#,
+            r#"{"name": "child", "translation": [1, 0, 0], "mesh": 0},
+    {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+    {"translation": [0, 5, 0], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+    {"translation": [2, 1, 0], "extensions": {"KHR_lights_punctual": {"light": 2}}}"#,
+            1,
+        );
+    std::fs::write(dir.join("lights.glb"), glb(&json, &triangle_bytes())).unwrap();
+    let (scene, extras) = gltf_loader::load(&dir.join("lights.glb")).unwrap();
+    assert!(extras.has_point && extras.has_spot && !extras.has_sun);
+    assert_eq!(scene.lights.len(), 3);
+    assert_eq!(scene.lights[0].name, "bulb");
+    let Light::Point(bulb) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
+    assert_eq!((bulb.position, bulb.range), (Vec3::new(0.0, 3.0, 0.0), 6.0));
+    assert_eq!(scene.point, bulb, "the first point light is the default");
+    // A light without a range reaches past the scene.
+    let Light::Point(unranged) = scene.lights[2].light else { panic!() };
+    assert!(unranged.range.is_finite() && unranged.range > 2.0);
+}

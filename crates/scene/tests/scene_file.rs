@@ -96,3 +96,88 @@ fn bad_scene_files_name_the_file_and_the_problem() {
     let e = scene_file::load(&path, Some("side")).err().unwrap().to_string();
     assert!(e.contains("no view `side`") && e.contains("front, top"), "{e}");
 }
+
+const LIGHTS: &str = r#"
+[[model]]
+file = "tri.glb"
+
+[point]
+position = [0.0, 3.0, 0.0]
+range = 12.0
+radius = 0.1
+
+[[light]]
+name = "key"
+type = "sun"
+elevation = 40.0
+azimuth = 10.0
+
+[[light]]
+name = "lamp"
+type = "point"
+position = [1.0, 2.0, 0.0]
+range = 8.0
+color = [1.0, 0.5, 0.25]
+[light.shadow]
+filter.technique = "pcss"
+map.resolution = 512
+
+[[light]]
+type = "spot"
+position = [0.0, 5.0, 5.0]
+target = [0.0, 0.0, 0.0]
+outer_angle = 30.0
+range = 20.0
+"#;
+
+#[test]
+fn point_lights_and_the_light_list_come_from_the_file() {
+    use gnomon_scene::{Light, settings::LightKind};
+    let dir = temp_dir("scene-file-lights");
+    let scene = scene_file::load(&write_scene(&dir, LIGHTS), None).unwrap().scene;
+    assert_eq!(
+        (scene.point.position, scene.point.range, scene.point.radius),
+        (Vec3::new(0.0, 3.0, 0.0), 12.0, 0.1)
+    );
+    let names: Vec<&str> = scene.lights.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["key", "lamp", "light 2"]);
+    let Light::Point(lamp) = scene.lights[1].light else { panic!("{:?}", scene.lights[1]) };
+    assert_eq!((lamp.range, lamp.color), (8.0, Vec3::new(1.0, 0.5, 0.25)));
+
+    // --light all resolves every light with its own shadow settings over the render's.
+    let mut s = Settings::default();
+    s.light.kind = LightKind::All;
+    s.shadow.bias.normal_offset = 1.25;
+    let lights = s.resolve_lights(&scene).unwrap();
+    assert_eq!(lights.len(), 3);
+    assert_eq!(lights[0].shadow, s.shadow, "no table: the render's settings");
+    assert_eq!((lights[1].shadow.filter.technique, lights[1].shadow.map.resolution), (Technique::Pcss, 512));
+    assert_eq!(lights[1].shadow.bias.normal_offset, 1.25, "the rest stays the render's");
+    s.light.light_index = 2;
+    assert!(matches!(s.resolve_light(&scene).unwrap(), Light::Spot(_)));
+    s.light.light_index = 3;
+    let e = s.resolve_light(&scene).unwrap_err().to_string();
+    assert!(e.contains("--light-index") && e.contains("below 3"), "{e}");
+}
+
+#[test]
+fn bad_light_entries_name_the_light_and_the_field() {
+    let dir = temp_dir("scene-file-bad-lights");
+    let check = |light: &str, expected: &str| {
+        let text = format!("[[model]]\nfile = \"tri.glb\"\n[[light]]\nname = \"lamp\"\n{light}");
+        let path = write_scene(&dir, &text);
+        let e = scene_file::load(&path, None).err().expect(expected).to_string();
+        assert!(e.contains("scene.toml") && e.contains("`lamp`") && e.contains(expected), "{e}");
+    };
+    check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\n", "needs `range`");
+    check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance > 0");
+    check("type = \"area\"\n", "sun, spot or point");
+    check(
+        "type = \"spot\"\nposition = [0.0, 1.0, 0.0]\ntarget = [0.0, 1.0, 0.0]\nouter_angle = 30.0\nrange = 5.0\n",
+        "a spot must aim",
+    );
+    check(
+        "type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = 5.0\n[light.shadow]\nmap.resolution = 3\n",
+        "--shadow-res",
+    );
+}

@@ -5,8 +5,8 @@
 // is the same whichever face a filter tap lands on.
 
 // The lit fraction at `world` and the cube face its direction falls on, as
-// (visibility, face). The screen derivatives are unused: the cube lookup has no
-// receiver-plane bias.
+// (visibility, face). The screen derivatives give the receiver's plane, for
+// receiver-plane depth bias (when it is on).
 fn shadow_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
@@ -26,6 +26,10 @@ fn shadow_visibility(
     let frame = orthonormal_pair(normalize(q.offset));
     q.tangent = frame[0];
     q.bitangent = frame[1];
+    let plane = cross(world_dx, world_dy);
+    if light.kernel.w > 0.5 && dot(plane, plane) > 0.0 {
+        q.plane_normal = normalize(plane);
+    }
     return vec2<f32>(sample_shadow_cube(q), f32(cube_face(q.offset)));
 }
 

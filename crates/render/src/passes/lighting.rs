@@ -75,7 +75,10 @@ impl LightingPass {
             if key.cube {
                 parts.push(techniques::CUBE_WGSL.to_owned());
                 let cube = technique.cube_wgsl().unwrap_or_else(|| {
-                    unreachable!("{:?} has no cube lookup; settings refuse it for point lights", key.technique)
+                    unreachable!(
+                        "{:?} has no cube lookup; settings refuse it for point lights",
+                        key.technique
+                    )
                 });
                 parts.extend(cube.iter().map(|s| s.to_string()));
                 parts.push(include_str!("cube_visibility.wgsl").to_owned());

@@ -16,7 +16,35 @@ struct CubeQuery {
     // Orthonormal axes across the ray, for kernel offsets.
     tangent: vec3<f32>,
     bitangent: vec3<f32>,
+    // Unit normal of the receiver's plane, for receiver-plane depth bias; zero
+    // without it.
+    plane_normal: vec3<f32>,
 };
+
+// The steepest receiver plane a tap follows, as depth change per unit of offset
+// across the ray (tan 76°): steeper planes come from silhouettes and slivers, and
+// following them across a kernel would open leaks.
+const MAX_CUBE_RECEIVER_SLOPE: f32 = 4.0;
+
+// The depth the receiver's plane has along `direction` (from the light): where the
+// ray meets the plane through the receiver, n · (s·direction − offset) = 0. A kernel
+// tap compares with it instead of the receiver's own depth, so that a plane tilted
+// away from the light does not shadow itself across a wide kernel (receiver-plane
+// depth bias, exact for a planar receiver; the 2D maps' version is
+// `receiver_depth_gradient`).
+fn cube_tap_depth(q: CubeQuery, direction: vec3<f32>) -> f32 {
+    let along = dot(q.plane_normal, direction);
+    if abs(along) < 1e-6 * length(direction) {
+        return q.depth;
+    }
+    let s = dot(q.plane_normal, q.offset) / along;
+    if s <= 0.0 {
+        return q.depth;
+    }
+    let depth = s * length(direction) / light.position.w;
+    let reach = MAX_CUBE_RECEIVER_SLOPE * length(direction - q.offset) / light.position.w;
+    return clamp(depth, q.depth - reach, q.depth + reach);
+}
 
 // An orthonormal pair perpendicular to unit `n` (Duff et al., "Building an
 // orthonormal basis, revisited", JCGT 2017).
@@ -45,7 +73,8 @@ fn cube_direction(q: CubeQuery, texels: vec2<f32>) -> vec3<f32> {
 
 // One bilinear comparison tap `texels` from the lookup.
 fn cube_compare_tap(q: CubeQuery, texels: vec2<f32>) -> f32 {
-    return textureSampleCompareLevel(shadow_cube, shadow_compare, cube_direction(q, texels), q.depth);
+    let direction = cube_direction(q, texels);
+    return textureSampleCompareLevel(shadow_cube, shadow_compare, direction, cube_tap_depth(q, direction));
 }
 
 // A rotated Poisson disk of `count` bilinear taps, `radius` texels wide.

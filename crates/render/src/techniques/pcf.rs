@@ -30,7 +30,9 @@ impl ShadowTechnique for Pcf2x2 {
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_compare_tap(q, vec2<f32>(0.0));\n}\n"])
+        Some(&[
+            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_compare_tap(q, vec2<f32>(0.0));\n}\n",
+        ])
     }
 }
 

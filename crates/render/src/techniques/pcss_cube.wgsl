@@ -18,8 +18,9 @@ fn sample_shadow_cube(q: CubeQuery) -> f32 {
     var blocker_sum = 0.0;
     var blockers = 0.0;
     for (var i = 0u; i < taps; i++) {
-        let stored = textureGather(shadow_cube, shadow_gather, cube_direction(q, rotation * POISSON_DISK[i] * search));
-        let nearer = vec4<f32>(stored < vec4<f32>(q.depth));
+        let direction = cube_direction(q, rotation * POISSON_DISK[i] * search);
+        let stored = textureGather(shadow_cube, shadow_gather, direction);
+        let nearer = vec4<f32>(stored < vec4<f32>(cube_tap_depth(q, direction)));
         blocker_sum += dot(nearer, stored);
         blockers += dot(nearer, vec4<f32>(1.0));
     }

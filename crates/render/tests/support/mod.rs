@@ -98,6 +98,10 @@ pub fn ray_traced_lit(scene: &Scene, light: &Light, point: Vec3, normal: Vec3) -
             let to = spot.position - origin;
             (to.normalize(), to.length())
         }
+        Light::Point(point) => {
+            let to = point.position - origin;
+            (to.normalize(), to.length())
+        }
     };
     let inv_dir = dir.recip();
     for inst in scene.instances.iter().filter(|i| i.casts_shadow) {
