@@ -117,6 +117,31 @@ pub fn cube_texel_world_size(offset: Vec3, resolution: u32) -> f32 {
     2.0 * major * major / (resolution as f32 * offset.length().max(f32::MIN_POSITIVE))
 }
 
+/// The two hemispheres of a point light's dual-paraboloid map at `position`, as
+/// layers: each `light_from_world` is the hemisphere's frame (its axis along +z:
+/// world −y for layer 0, +y for layer 1, so the lower hemisphere, where most
+/// receivers are, is whole), and each `clip_from_light` an orthographic box over the
+/// hemisphere out to `far`, a conservative volume for culling casters. The shader
+/// maps directions with [`paraboloid_coords`], not with the box.
+pub fn paraboloid_projections(position: Vec3, near: f32, far: f32) -> [LightProjection; 2] {
+    // Rotations taking world −y, then +y, to +z; both keep world x as x.
+    let lower = Mat3::from_cols(Vec3::X, Vec3::Z, -Vec3::Y).transpose();
+    let upper = Mat3::from_cols(Vec3::X, -Vec3::Z, Vec3::Y).transpose();
+    [lower, upper].map(|rotation| {
+        let light_from_world = Mat4::from_mat3(rotation) * Mat4::from_translation(-position);
+        // The box looks down its −z: flip z so the hemisphere (z ≥ 0) lies in front.
+        let flip = Mat4::from_scale(Vec3::new(1.0, 1.0, -1.0));
+        LightProjection {
+            light_from_world,
+            clip_from_light: glam::camera::rh::proj::directx::orthographic(-far, far, -far, far, 0.0, far)
+                * flip,
+            kind: ProjectionKind::Orthographic { width: 2.0 * far, height: 2.0 * far },
+            near,
+            far,
+        }
+    })
+}
+
 /// A dual-paraboloid map's coordinates of light-space direction `d` (unit length):
 /// the front hemisphere (z ≥ 0) maps to (x, y) / (1 + z), the back one mirrors z. The
 /// result lies in the unit disk; the flag says which hemisphere.
@@ -182,6 +207,29 @@ mod tests {
             assert!(ndc.truncate().length() < 1e-5 && (0.0..1.0).contains(&ndc.z), "{face:?}: {ndc}");
             assert_eq!(projection.near, 0.02);
             assert_eq!(projection.far, 10.0);
+        }
+    }
+
+    #[test]
+    fn paraboloid_layers_split_the_sphere_at_the_horizon() {
+        let light = Vec3::new(1.0, 2.0, -1.0);
+        let [lower, upper] = paraboloid_projections(light, 0.01, 10.0);
+        let down = lower.light_from_world.transform_point3(light - Vec3::Y);
+        let up = upper.light_from_world.transform_point3(light + Vec3::Y);
+        assert!(down.abs_diff_eq(Vec3::Z, 1e-6) && up.abs_diff_eq(Vec3::Z, 1e-6), "{down} {up}");
+        let mut rng = Lcg(5);
+        for _ in 0..500 {
+            let d = random_direction(&mut rng);
+            let p = light + d * rng.range(0.1, 9.0);
+            // Every point within range is in exactly the hemisphere its y says, and that
+            // layer's culling box holds it.
+            let layer = if d.y <= 0.0 { &lower } else { &upper };
+            let z = layer.light_from_world.transform_point3(p).z;
+            assert!(z >= -1e-5, "{d}: z {z}");
+            let ndc = layer.clip_from_world().project_point3(p);
+            assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && (-1e-6..=1.0).contains(&ndc.z), "{d}: {ndc}");
+            let (front, xy) = paraboloid_coords(layer.light_from_world.transform_vector3(d));
+            assert!(front && xy.length() <= 1.0 + 1e-5);
         }
     }
 

@@ -61,7 +61,12 @@ pub struct AliasingImage {
 /// ignored): for a point light, the cube face its direction falls on.
 pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usize {
     if let Light::Point(point) = input.light {
-        return gnomon_math::omni::CubeFace::of_direction(world - point.position).layer() as usize;
+        let d = world - point.position;
+        return match input.layers.len() {
+            // Dual paraboloids: the lower hemisphere is layer 0.
+            2 => usize::from(d.y > 0.0),
+            _ => gnomon_math::omni::CubeFace::of_direction(d).layer() as usize,
+        };
     }
     let count = input.layers.len();
     if !input.select_by_projection {

@@ -7,7 +7,7 @@ use gnomon_math::{
     culling::Frustum,
     directional_light_projection,
     fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
-    omni::{cube_face_projections, cube_texel_world_size},
+    omni::{cube_face_projections, cube_texel_world_size, paraboloid_projections},
     spot_light_projection,
     warping::{Warp, WarpView, fit_warped},
 };
@@ -15,7 +15,7 @@ use gnomon_scene::{
     Camera, Light, Scene, Settings,
     settings::{
         BiasSettings, CascadeFit, CascadeSelection, DebugView, Fit, KernelUnit, LightKind, MomentFormat,
-        Partition, SplitScheme, Technique, WarpKind,
+        OmniMap, Partition, SplitScheme, Technique, WarpKind,
     },
 };
 use wgpu::util::DeviceExt;
@@ -26,9 +26,9 @@ use crate::{
     passes::{
         Layouts, SHADOW_FORMAT,
         depth_reduce::{BoundsRequest, DepthReducePass},
-        lighting::{self, LightingKey, LightingPass, LightingRole},
+        lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
         moments::MomentPass,
-        shadow::ShadowPass,
+        shadow::{DepthTarget, ShadowPass},
     },
     readback, techniques,
 };
@@ -99,8 +99,8 @@ pub struct Frame {
 enum Draws<'f> {
     /// The shadow casters: the shadow pass. With `inside`, only the instances whose
     /// bounds may reach into that frustum (the bool says whether its near plane
-    /// counts). `cube_face` draws a point light's face.
-    Casters { inside: Option<(&'f Frustum, bool)>, cube_face: bool },
+    /// counts). `target` says what the map stores.
+    Casters { inside: Option<(&'f Frustum, bool)>, target: DepthTarget },
     /// Every surface the camera can see: SDSM's prepass.
     Everything,
 }
@@ -550,7 +550,8 @@ impl<'g> Renderer<'g> {
                             }),
                         )
                     });
-                    let cube_view = matches!(plan.light, Light::Point(_)).then(|| {
+                    let lookup = lookup_of(plan);
+                    let cube_view = (lookup == Lookup::Cube).then(|| {
                         shadow_map.create_view(&wgpu::TextureViewDescriptor {
                             dimension: Some(wgpu::TextureViewDimension::Cube),
                             ..Default::default()
@@ -593,7 +594,7 @@ impl<'g> Renderer<'g> {
                             },
                         ],
                     });
-                    lit.push((scene_group, shadow_group));
+                    lit.push((scene_group, shadow_group, lookup));
                 }
 
                 let targets: Vec<wgpu::Texture> = lighting::TARGETS
@@ -604,7 +605,8 @@ impl<'g> Renderer<'g> {
                     targets.iter().map(|t| t.create_view(&Default::default())).collect();
                 let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
                 let depth_view = depth.create_view(&Default::default());
-                for (index, (plan, (scene_group, shadow_group))) in plans.iter().zip(&lit).enumerate() {
+                for (index, (plan, (scene_group, shadow_group, lookup))) in plans.iter().zip(&lit).enumerate()
+                {
                     let first = index == 0;
                     let slot = TIMESTAMPS_PER_LIGHT * index as u32;
                     let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
@@ -647,7 +649,7 @@ impl<'g> Renderer<'g> {
                     });
                     let key = LightingKey {
                         technique: plan.settings.shadow.filter.technique,
-                        cube: matches!(plan.light, Light::Point(_)),
+                        lookup: *lookup,
                         role: if first {
                             LightingRole::First
                         } else {
@@ -754,7 +756,11 @@ impl<'g> Renderer<'g> {
         let device = &self.gpu.device;
         let resolution = plan.settings.shadow.map.resolution;
         let layers = plan.layout.projections.len() as u32;
-        let cube_face = matches!(plan.light, Light::Point(_));
+        let target = match (plan.light, plan.settings.shadow.map.omni) {
+            (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
+            (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
+            _ => DepthTarget::Projected,
+        };
         let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow map"),
             size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
@@ -797,7 +803,7 @@ impl<'g> Renderer<'g> {
                 &plan.settings,
                 &layer_group,
                 &layer_view,
-                Draws::Casters { inside: Some((&frustum, !plan.layout.depth_clamp)), cube_face },
+                Draws::Casters { inside: Some((&frustum, !plan.layout.depth_clamp)), target },
                 plan.layout.depth_clamp,
                 timestamps,
                 stats,
@@ -1011,9 +1017,9 @@ impl<'g> Renderer<'g> {
             uploaded.bind_geometry(&mut pass);
             // Opaque casters first (no bind group changes at all), then the
             // alpha-masked ones, texture by texture.
-            let (inside, cube_face) = match draws {
-                Draws::Casters { inside, cube_face } => (inside, cube_face),
-                Draws::Everything => (None, false),
+            let (inside, target) = match draws {
+                Draws::Casters { inside, target } => (inside, target),
+                Draws::Everything => (None, DepthTarget::Projected),
             };
             let visible = |instance: u32| {
                 inside.is_none_or(|(frustum, near)| {
@@ -1047,7 +1053,7 @@ impl<'g> Renderer<'g> {
                                 d.double_sided,
                                 masked,
                                 unclipped,
-                                cube_face,
+                                target,
                             ));
                             pipeline = Some((d.double_sided, masked));
                             stats.pipeline_changes += 1;
@@ -1138,9 +1144,14 @@ pub fn shadow_layout(
     depth_clamp: bool,
 ) -> ShadowLayout {
     if let Light::Point(point) = light {
-        // Six 90° faces from the light's position, near and far from its range.
+        // Six 90° faces from the light's position, or two paraboloids; near and far
+        // from its range.
+        let (near, far) = (point.shadow_near(), point.range);
         return ShadowLayout {
-            projections: cube_face_projections(point.position, point.shadow_near(), point.range).to_vec(),
+            projections: match settings.shadow.map.omni {
+                OmniMap::Cube => cube_face_projections(point.position, near, far).to_vec(),
+                OmniMap::Paraboloid => paraboloid_projections(point.position, near, far).to_vec(),
+            },
             splits: vec![0.0, f32::INFINITY],
             depth_clamp: false,
         };
@@ -1362,6 +1373,15 @@ pub fn light_projection(
     }
 }
 
+/// How the lighting pass looks a light's map up.
+fn lookup_of(plan: &LightPlan) -> Lookup {
+    match (plan.light, plan.settings.shadow.map.omni) {
+        (Light::Point(_), OmniMap::Cube) => Lookup::Cube,
+        (Light::Point(_), OmniMap::Paraboloid) => Lookup::Paraboloid,
+        _ => Lookup::Map,
+    }
+}
+
 fn light_uniform(
     scene: &Scene,
     light: &Light,
@@ -1458,6 +1478,29 @@ fn light_uniform(
             ),
             ..common
         },
+        Light::Point(point) if settings.shadow.map.omni == OmniMap::Paraboloid => {
+            // The paraboloid passes read each hemisphere's frame, not a projection;
+            // its texels are 4 / resolution radians wide on the axis, the largest.
+            let mut frames = common.cascade_clip_from_world;
+            for (frame, p) in frames.iter_mut().zip(&layout.projections) {
+                *frame = p.light_from_world;
+            }
+            let texel_per_distance = 4.0 / resolution as f32;
+            LightGpu {
+                radiance: (point.color * point.intensity).extend(0.0),
+                direction: Vec4::new(0.0, 0.0, 0.0, 2.0),
+                position: point.position.extend(point.range),
+                cascade_clip_from_world: frames,
+                cascade_texel: [Vec4::ZERO; MAX_CASCADES],
+                texel: Vec4::new(
+                    0.0,
+                    texel_per_distance,
+                    settings.shadow.bias.normal_offset,
+                    resolution as f32,
+                ),
+                ..common
+            }
+        }
         Light::Point(point) => LightGpu {
             radiance: (point.color * point.intensity).extend(0.0),
             direction: Vec4::new(0.0, 0.0, 0.0, 2.0),

@@ -548,6 +548,9 @@ pub struct MapSettings {
     /// cascades or warps.
     #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set, help_heading = "Shadow map")]
     pub depth_clamp: bool,
+    /// How a point light's map covers every direction.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub omni: OmniMap,
 }
 
 impl Default for MapSettings {
@@ -558,8 +561,24 @@ impl Default for MapSettings {
             fit: Fit::default(),
             warp: WarpKind::default(),
             depth_clamp: true,
+            omni: OmniMap::default(),
         }
     }
+}
+
+/// The parametrization of a point light's map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum OmniMap {
+    /// A cube: six 90° faces, sampled by direction; uniform texels within a factor
+    /// of 3 in solid angle, six passes.
+    #[default]
+    Cube,
+    /// Dual paraboloids (Brabec, Annen & Seidel 2002): two hemispheres, the lower
+    /// one around the light's −y axis, in two passes. Cheaper to draw, but the
+    /// parabolic mapping bends straight edges that the rasterizer draws straight,
+    /// and texels grow 4× from the axis to the rim. Hard and PCF lookups only.
+    Paraboloid,
 }
 
 /// Perspective warps of a sun's map.
@@ -1129,6 +1148,16 @@ pub const MAX_LIGHTS: usize = 32;
 /// Checks that a light's type and its shadow settings go together: a point light's
 /// cube map takes the depth-comparison techniques and a single map.
 fn check_light_type(light: &Light, shadow: &ShadowSettings, name: &str) -> Result<(), SettingsError> {
+    if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
+        check(
+            shadow.filter.technique.supports_point_lights() && shadow.filter.technique != Technique::Pcss,
+            "--technique",
+            shadow.filter.technique.name(),
+            format!(
+                "for point light `{name}` with --omni paraboloid: hard, pcf2x2, pcf, pcf-tent or pcf-poisson"
+            ),
+        )?;
+    }
     if let Light::Point(_) = light {
         check(
             shadow.filter.technique.supports_point_lights(),
@@ -1363,6 +1392,14 @@ mod tests {
         let e = vsm.resolve_lights(&scene).unwrap_err();
         assert_eq!(e.flag, "--technique");
         assert!(e.valid.contains("pcf-poisson or pcss"), "{e}");
+        // Dual paraboloids take the 2D lookups, without PCSS.
+        let mut paraboloid = vsm;
+        paraboloid.shadow.map.omni = OmniMap::Paraboloid;
+        paraboloid.shadow.filter.technique = Technique::Pcss;
+        let e = paraboloid.resolve_lights(&scene).unwrap_err();
+        assert!(e.valid.contains("--omni paraboloid"), "{e}");
+        paraboloid.shadow.filter.technique = Technique::PcfPoisson;
+        paraboloid.resolve_lights(&scene).unwrap();
     }
 
     #[test]

@@ -40,9 +40,19 @@ pub(crate) enum LightingRole {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct LightingKey {
     pub technique: Technique,
-    /// A point light: the cube lookup instead of the 2D layers.
-    pub cube: bool,
+    pub lookup: Lookup,
     pub role: LightingRole,
+}
+
+/// How the lighting pass finds a receiver in its light's map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Lookup {
+    /// Projected into 2D layers: a sun's map or cascades, a spot's map.
+    Map,
+    /// By direction in a point light's cube.
+    Cube,
+    /// Through a point light's dual paraboloids, into two 2D layers.
+    Paraboloid,
 }
 
 /// Lighting pipelines, one per technique, lookup and role, built on first use.
@@ -72,20 +82,28 @@ impl LightingPass {
             let technique = techniques::lookup(key.technique);
             let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned(), SCENE_COMMON_WGSL.to_owned()];
             parts.extend(techniques::shared_wgsl());
-            if key.cube {
-                parts.push(techniques::CUBE_WGSL.to_owned());
-                let cube = technique.cube_wgsl().unwrap_or_else(|| {
-                    unreachable!(
-                        "{:?} has no cube lookup; settings refuse it for point lights",
-                        key.technique
-                    )
-                });
-                parts.extend(cube.iter().map(|s| s.to_string()));
-                parts.push(include_str!("cube_visibility.wgsl").to_owned());
-            } else {
-                parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
-                parts.push(include_str!("map_visibility.wgsl").to_owned());
-            }
+            let visibility = match key.lookup {
+                Lookup::Cube => {
+                    parts.push(techniques::CUBE_WGSL.to_owned());
+                    let cube = technique.cube_wgsl().unwrap_or_else(|| {
+                        unreachable!(
+                            "{:?} has no cube lookup; settings refuse it for point lights",
+                            key.technique
+                        )
+                    });
+                    parts.extend(cube.iter().map(|s| s.to_string()));
+                    include_str!("cube_visibility.wgsl")
+                }
+                Lookup::Map => {
+                    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
+                    include_str!("map_visibility.wgsl")
+                }
+                Lookup::Paraboloid => {
+                    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
+                    include_str!("paraboloid_visibility.wgsl")
+                }
+            };
+            parts.push(visibility.to_owned());
             parts.push(include_str!("lighting.wgsl").to_owned());
             let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let source = compose_wgsl(&refs);

@@ -19,7 +19,18 @@ struct ShadowPipelineKey {
     slope_bias_bits: u32,
     masked: bool,
     unclipped: bool,
-    cube_face: bool,
+    target: DepthTarget,
+}
+
+/// What a shadow pass stores in its depth attachment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum DepthTarget {
+    /// The projection's own depth, biased by the rasterizer: suns and spots.
+    Projected,
+    /// Distance over range, through a cube face's mirrored view.
+    CubeFace,
+    /// Distance over range, through a dual-paraboloid hemisphere (mirrored too).
+    Paraboloid,
 }
 
 /// Shadow-pass pipelines, built on first use for each bias, cull and alpha-test
@@ -55,7 +66,7 @@ impl ShadowPass {
     /// The pipeline for casters with these bias settings; `double_sided` casters are
     /// never culled, `masked` ones run the alpha test, and `unclipped` clamps depth
     /// instead of clipping it (pancaking; needs `Features::DEPTH_CLIP_CONTROL`), and
-    /// `cube_face` draws a point light's face (distance, mirrored winding).
+    /// `target` says what the pass stores.
     pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
@@ -63,7 +74,7 @@ impl ShadowPass {
         double_sided: bool,
         masked: bool,
         unclipped: bool,
-        cube_face: bool,
+        target: DepthTarget,
     ) -> &wgpu::RenderPipeline {
         let key = ShadowPipelineKey {
             cull: if double_sided { CullMode::None } else { bias.cull },
@@ -71,24 +82,27 @@ impl ShadowPass {
             slope_bias_bits: bias.slope_bias.to_bits(),
             masked,
             unclipped,
-            cube_face,
+            target,
         };
+        let writes_distance = target != DepthTarget::Projected;
         let module = &self.module;
         let layout = if masked { &self.masked_layout } else { &self.layout };
         self.pipelines.entry(key).or_insert_with(|| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(match (cube_face, masked) {
-                    (true, _) => "shadow distance (cube face)",
-                    (false, true) => "shadow depth, alpha-masked",
-                    (false, false) => "shadow depth",
+                label: Some(match (target, masked) {
+                    (DepthTarget::CubeFace, _) => "shadow distance (cube face)",
+                    (DepthTarget::Paraboloid, _) => "shadow distance (paraboloid)",
+                    (DepthTarget::Projected, true) => "shadow depth, alpha-masked",
+                    (DepthTarget::Projected, false) => "shadow depth",
                 }),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module,
-                    entry_point: Some(match (cube_face, masked) {
-                        (true, _) => "vs_shadow_distance",
-                        (false, true) => "vs_shadow_masked",
-                        (false, false) => "vs_shadow",
+                    entry_point: Some(match (target, masked) {
+                        (DepthTarget::CubeFace, _) => "vs_shadow_distance",
+                        (DepthTarget::Paraboloid, _) => "vs_shadow_paraboloid",
+                        (DepthTarget::Projected, true) => "vs_shadow_masked",
+                        (DepthTarget::Projected, false) => "vs_shadow",
                     }),
                     compilation_options: Default::default(),
                     buffers: &[Some(VertexGpu::layout())],
@@ -100,7 +114,7 @@ impl ShadowPass {
                         CullMode::None => None,
                     },
                     unclipped_depth: key.unclipped,
-                    front_face: if cube_face { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+                    front_face: if writes_distance { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -112,7 +126,7 @@ impl ShadowPass {
                     // (depthBiasClamp) that a non-zero clamp needs. A cube face biases
                     // the depth it writes itself (the rasterizer's bias does not reach
                     // a written depth).
-                    bias: if cube_face {
+                    bias: if writes_distance {
                         wgpu::DepthBiasState::default()
                     } else {
                         wgpu::DepthBiasState {
@@ -123,12 +137,14 @@ impl ShadowPass {
                     },
                 }),
                 multisample: Default::default(),
-                fragment: (masked || cube_face).then_some(wgpu::FragmentState {
+                fragment: (masked || writes_distance).then_some(wgpu::FragmentState {
                     module,
-                    entry_point: Some(match (cube_face, masked) {
-                        (true, true) => "fs_shadow_distance_masked",
-                        (true, false) => "fs_shadow_distance",
-                        _ => "fs_shadow_masked",
+                    entry_point: Some(match (target, masked) {
+                        (DepthTarget::CubeFace, true) => "fs_shadow_distance_masked",
+                        (DepthTarget::CubeFace, false) => "fs_shadow_distance",
+                        (DepthTarget::Paraboloid, true) => "fs_shadow_paraboloid_masked",
+                        (DepthTarget::Paraboloid, false) => "fs_shadow_paraboloid",
+                        (DepthTarget::Projected, _) => "fs_shadow_masked",
                     }),
                     compilation_options: Default::default(),
                     targets: &[],

@@ -82,3 +82,42 @@ fn fs_shadow_distance_masked(in: DistanceOut) -> @builtin(frag_depth) f32 {
     }
     return depth;
 }
+
+// A point light's dual-paraboloid hemisphere (Brabec, Annen & Seidel 2002): here
+// `light.clip_from_world` holds the hemisphere's frame (light_from_world, its axis
+// along +z), and a vertex lands at (x, y) / (1 + z) of its unit direction. Depth is
+// distance over range, as for the cube. The rasterizer interpolates linearly between
+// vertices where the true image of an edge is curved: the method's known error, which
+// finer tessellation would reduce. Fragments of the other hemisphere are discarded.
+@vertex
+fn vs_shadow_paraboloid(v: VertexIn, @builtin(instance_index) instance_index: u32) -> DistanceOut {
+    let inst = instances[instance_index];
+    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+    let d = (light.clip_from_world * world).xyz;
+    let n = d / max(length(d), 1e-20);
+    var out: DistanceOut;
+    // Directions far behind the hemisphere go far outside the disk, not to infinity.
+    out.clip = vec4<f32>(n.xy / max(1.0 + n.z, 1e-3), clamp(length(d) / light.position.w, 0.0, 1.0), 1.0);
+    out.world = world.xyz;
+    out.uv = v.uv;
+    out.instance = instance_index;
+    return out;
+}
+
+@fragment
+fn fs_shadow_paraboloid(in: DistanceOut) -> @builtin(frag_depth) f32 {
+    let depth = biased_distance(in.world);
+    if (light.clip_from_world * vec4<f32>(in.world, 1.0)).z < 0.0 {
+        discard;
+    }
+    return depth;
+}
+
+@fragment
+fn fs_shadow_paraboloid_masked(in: DistanceOut) -> @builtin(frag_depth) f32 {
+    let depth = biased_distance(in.world);
+    if (light.clip_from_world * vec4<f32>(in.world, 1.0)).z < 0.0 || alpha_cut(instances[in.instance], in.uv) {
+        discard;
+    }
+    return depth;
+}
