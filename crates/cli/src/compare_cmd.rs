@@ -12,6 +12,7 @@ use gnomon_reference::{
     metrics::{self, Metrics, PixelClass, RasterView},
 };
 use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_scene::settings::LightKind;
 use gnomon_scene::{
     Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
@@ -144,7 +145,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         "--path-travel = {} is invalid: a fraction in (0, 1]",
         args.path_travel
     );
-    let (scene, settings) = lab::load(&args.scene, &args.settings)?;
+    let (mut scene, mut settings) = lab::load(&args.scene, &args.settings)?;
+    if settings.light.kind == LightKind::All {
+        single_out_light(&mut scene, &mut settings)?;
+    }
     let settings = &settings;
     output::check_dir(&args.out, "--out")?;
 
@@ -468,4 +472,28 @@ fn markdown_table(report: &Report, soft: bool) -> String {
         }
     }
     s
+}
+
+/// With `--light all`, a comparison measures one light, the one at `--light-index`,
+/// as the scene's only light: the reference traces that light alone, the timings are
+/// its passes', and each compared technique replaces the technique its own shadow
+/// settings name (its other settings, such as its resolution, stay).
+fn single_out_light(
+    scene: &mut gnomon_scene::Scene,
+    settings: &mut gnomon_scene::Settings,
+) -> anyhow::Result<()> {
+    settings.resolve_light(scene)?;
+    let mut light = scene.lights.swap_remove(settings.light.light_index);
+    if let Some(toml::Value::Table(filter)) = light.shadow.as_mut().and_then(|t| t.get_mut("filter")) {
+        filter.remove("technique");
+    }
+    eprintln!(
+        "gnomon: comparing light {} `{}` ({})",
+        settings.light.light_index,
+        light.name,
+        light.light.type_name()
+    );
+    scene.lights = vec![light];
+    settings.light.light_index = 0;
+    Ok(())
 }
