@@ -156,15 +156,18 @@ fn seam_band_mismatch(
 }
 
 /// The must-show: where the ground crosses a cube-face boundary there is no
-/// band of mismatch along it, for the point-sampled, bilinear and filtered lookups
-/// alike (their taps cross the seam). A seam drawn or looked up wrong (a face rotated
+/// band of mismatch along it, for the point-sampled, bilinear, filtered and PCSS
+/// lookups alike (their taps cross the seam; PCSS's blocker search too, here for a
+/// point light, whose penumbra is its smallest kernel). A seam drawn or looked up wrong (a face rotated
 /// or mirrored, a field of view short of 90°, taps clamped at a face's edge) shows
 /// as a line of error along it: the planted line below is caught.
 #[test]
 fn no_band_of_mismatch_along_cube_face_seams() {
     let scene = seam_scene();
     let band = 3.0;
-    for technique in [Technique::Hard, Technique::Pcf2x2, Technique::PcfPoisson] {
+    for technique in
+        [Technique::Hard, Technique::Pcf2x2, Technique::Pcf, Technique::PcfPoisson, Technique::Pcss]
+    {
         let mut s = point_settings(technique, 512, 960, 640);
         s.shadow.filter.pcf_kernel = 3.0;
         let truth = reference(&scene, &s);

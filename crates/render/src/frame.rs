@@ -200,6 +200,13 @@ impl Frame {
     /// World size of one shadow texel at `world` (which must be in front of the light).
     pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
         if let Light::Point(point) = self.light {
+            if let [lower, upper] = self.cascades.as_slice() {
+                // Dual paraboloids: (1 + cos θ)·2/resolution radians at distance |d|
+                // (see `paraboloid_visibility.wgsl`).
+                let hemisphere = if world.y <= point.position.y { lower } else { upper };
+                let d = hemisphere.light_from_world.transform_point3(world);
+                return (d.length() + d.z) * 2.0 / self.shadow_resolution as f32;
+            }
             return cube_texel_world_size(world - point.position, self.shadow_resolution);
         }
         let distance = -self.light_projection.light_from_world.transform_point3(world).z;
