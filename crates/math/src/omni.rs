@@ -142,6 +142,15 @@ pub fn paraboloid_projections(position: Vec3, near: f32, far: f32) -> [LightProj
     })
 }
 
+/// World size of one dual-paraboloid texel across the ray to a receiver at `offset`
+/// in its hemisphere's frame (axis +z), for `resolution`² layers: the map's xy =
+/// tan(θ/2) has dxy/dθ = 1 / (1 + cos θ), so a texel (2 / resolution in xy) spans
+/// (1 + cos θ)·2/resolution radians, 4/resolution on the axis and half that at the
+/// rim (the shader's `paraboloid_texel_world_size`).
+pub fn paraboloid_texel_world_size(offset: Vec3, resolution: u32) -> f32 {
+    (offset.length() + offset.z) * 2.0 / resolution as f32
+}
+
 /// A dual-paraboloid map's coordinates of light-space direction `d` (unit length):
 /// the front hemisphere (z ≥ 0) maps to (x, y) / (1 + z), the back one mirrors z. The
 /// result lies in the unit disk; the flag says which hemisphere.
@@ -230,6 +239,21 @@ mod tests {
             assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && (-1e-6..=1.0).contains(&ndc.z), "{d}: {ndc}");
             let (front, xy) = paraboloid_coords(layer.light_from_world.transform_vector3(d));
             assert!(front && xy.length() <= 1.0 + 1e-5);
+        }
+    }
+
+    #[test]
+    fn paraboloid_texels_halve_from_axis_to_rim() {
+        // Measured against the mapping itself: one texel step in xy at the axis and at
+        // the rim, turned into an angle by paraboloid_direction.
+        let res = 256;
+        let step = 2.0 / res as f32;
+        for (xy, offset) in [(0.0f32, Vec3::Z * 5.0), (1.0 - step, Vec3::X * 5.0)] {
+            let a = paraboloid_direction(true, Vec2::new(xy - 0.5 * step, 0.0));
+            let b = paraboloid_direction(true, Vec2::new(xy + 0.5 * step, 0.0));
+            let measured = 5.0 * a.angle_between(b);
+            let size = paraboloid_texel_world_size(offset, res);
+            assert!((measured - size).abs() < 0.02 * size, "at xy {xy}: {measured} against {size}");
         }
     }
 

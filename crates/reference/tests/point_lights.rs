@@ -165,9 +165,14 @@ fn seam_band_mismatch(
 fn no_band_of_mismatch_along_cube_face_seams() {
     let scene = seam_scene();
     let band = 3.0;
-    for technique in
-        [Technique::Hard, Technique::Pcf2x2, Technique::Pcf, Technique::PcfPoisson, Technique::Pcss]
-    {
+    for technique in [
+        Technique::Hard,
+        Technique::Pcf2x2,
+        Technique::Pcf,
+        Technique::PcfTent,
+        Technique::PcfPoisson,
+        Technique::Pcss,
+    ] {
         let mut s = point_settings(technique, 512, 960, 640);
         s.shadow.filter.pcf_kernel = 3.0;
         let truth = reference(&scene, &s);

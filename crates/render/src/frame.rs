@@ -7,7 +7,9 @@ use gnomon_math::{
     culling::Frustum,
     directional_light_projection,
     fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
-    omni::{cube_face_projections, cube_texel_world_size, paraboloid_projections},
+    omni::{
+        cube_face_projections, cube_texel_world_size, paraboloid_projections, paraboloid_texel_world_size,
+    },
     spot_light_projection,
     warping::{Warp, WarpView, fit_warped},
 };
@@ -201,11 +203,10 @@ impl Frame {
     pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
         if let Light::Point(point) = self.light {
             if let [lower, upper] = self.cascades.as_slice() {
-                // Dual paraboloids: (1 + cos θ)·2/resolution radians at distance |d|
-                // (see `paraboloid_visibility.wgsl`).
+                // Dual paraboloids: the lower hemisphere holds y at or below the light.
                 let hemisphere = if world.y <= point.position.y { lower } else { upper };
-                let d = hemisphere.light_from_world.transform_point3(world);
-                return (d.length() + d.z) * 2.0 / self.shadow_resolution as f32;
+                let offset = hemisphere.light_from_world.transform_point3(world);
+                return paraboloid_texel_world_size(offset, self.shadow_resolution);
             }
             return cube_texel_world_size(world - point.position, self.shadow_resolution);
         }
@@ -1485,34 +1486,28 @@ fn light_uniform(
             ),
             ..common
         },
-        Light::Point(point) if settings.shadow.map.omni == OmniMap::Paraboloid => {
-            // The paraboloid passes read each hemisphere's frame, not a projection;
-            // its texels are 4 / resolution radians wide on the axis, the largest.
-            let mut frames = common.cascade_clip_from_world;
-            for (frame, p) in frames.iter_mut().zip(&layout.projections) {
-                *frame = p.light_from_world;
-            }
-            let texel_per_distance = 4.0 / resolution as f32;
-            LightGpu {
+        Light::Point(point) => {
+            let lit = LightGpu {
                 radiance: (point.color * point.intensity).extend(0.0),
                 direction: Vec4::new(0.0, 0.0, 0.0, 2.0),
                 position: point.position.extend(point.range),
+                ..common
+            };
+            if settings.shadow.map.omni == OmniMap::Cube {
+                return lit;
+            }
+            // The paraboloid passes read each hemisphere's frame, not a projection;
+            // its texels are 4 / resolution radians wide on the axis, the largest.
+            let mut frames = lit.cascade_clip_from_world;
+            for (frame, p) in frames.iter_mut().zip(&layout.projections) {
+                *frame = p.light_from_world;
+            }
+            LightGpu {
                 cascade_clip_from_world: frames,
                 cascade_texel: [Vec4::ZERO; MAX_CASCADES],
-                texel: Vec4::new(
-                    0.0,
-                    texel_per_distance,
-                    settings.shadow.bias.normal_offset,
-                    resolution as f32,
-                ),
-                ..common
+                texel: Vec4::new(0.0, 4.0 / resolution as f32, lit.texel.z, lit.texel.w),
+                ..lit
             }
         }
-        Light::Point(point) => LightGpu {
-            radiance: (point.color * point.intensity).extend(0.0),
-            direction: Vec4::new(0.0, 0.0, 0.0, 2.0),
-            position: point.position.extend(point.range),
-            ..common
-        },
     }
 }

@@ -313,13 +313,27 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
         };
     }
     if let Some(point) = &file.point {
-        scene.point = PointLight {
-            position: Vec3::from_array(point.position),
-            range: point.range,
-            color: point.color.map(Vec3::from_array).unwrap_or(scene.point.color),
-            intensity: point.intensity.unwrap_or(scene.point.intensity),
-            radius: point.radius,
+        // Built and checked as a [[light]] of type point is.
+        let entry = LightEntry {
+            name: None,
+            kind: "point".into(),
+            position: Some(point.position),
+            range: Some(point.range),
+            radius: Some(point.radius),
+            color: point.color,
+            intensity: point.intensity,
+            elevation: None,
+            azimuth: None,
+            angular_diameter: None,
+            target: None,
+            outer_angle: None,
+            inner_angle: None,
+            shadow: None,
         };
+        let Light::Point(light) = entry.to_light(&scene).map_err(|e| fail(format!("[point]: {e}")))? else {
+            unreachable!("a point entry builds a point light")
+        };
+        scene.point = light;
     }
     if !file.light.is_empty() {
         scene.lights.clear();

@@ -172,6 +172,13 @@ fn bad_light_entries_name_the_light_and_the_field() {
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\n", "needs `range`");
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance > 0");
     check("type = \"area\"\n", "sun, spot or point");
+    // The [point] table is checked the same way.
+    let path = write_scene(
+        &dir,
+        "[[model]]\nfile = \"tri.glb\"\n[point]\nposition = [0.0, 1.0, 0.0]\nrange = 0.0\n",
+    );
+    let e = scene_file::load(&path, None).err().unwrap().to_string();
+    assert!(e.contains("[point]") && e.contains("a distance > 0"), "{e}");
     check(
         "type = \"spot\"\nposition = [0.0, 1.0, 0.0]\ntarget = [0.0, 1.0, 0.0]\nouter_angle = 30.0\nrange = 5.0\n",
         "a spot must aim",

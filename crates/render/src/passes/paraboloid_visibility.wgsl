@@ -13,7 +13,8 @@ fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {
 
 // World size of a texel across the ray at `world`: xy = tan(θ/2) has dxy/dθ =
 // 1 / (1 + cos θ), so a texel (2 / resolution in xy) spans (1 + cos θ)·2/resolution
-// radians: 4/resolution on the axis, half that at the rim.
+// radians: 4/resolution on the axis, half that at the rim
+// (gnomon_math::omni::paraboloid_texel_world_size).
 fn paraboloid_texel_world_size(layer: u32, world: vec3<f32>) -> f32 {
     let d = (light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0)).xyz;
     let len = max(length(d), 1e-20);
