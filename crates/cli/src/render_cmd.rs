@@ -99,8 +99,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             render_started.elapsed().as_secs_f64() * 1e3
         );
         let st = frame.stats;
+        let prepass = if frame.shadow_mask {
+            format!(", {} in the prepass (shadows resolved in a screen-space mask)", st.prepass_draws)
+        } else {
+            String::new()
+        };
         eprintln!(
-            "gnomon: draws: {} in the shadow pass, {} in the lighting pass; {} pipeline and {} bind group changes",
+            "gnomon: draws: {} in the shadow pass, {} in the lighting pass{prepass}; {} pipeline and {} bind group changes",
             st.shadow_draws, st.lighting_draws, st.pipeline_changes, st.bind_group_changes
         );
         if let Some(format) = frame.moment_format {
@@ -116,8 +121,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         if let Some(t) = frame.timings {
             let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
+            let prepass = t.prepass_ms.map(|p| format!(", prepass {p:.2} ms")).unwrap_or_default();
+            let mask = t.mask_ms.map(|m| format!(", shadow mask {m:.2} ms")).unwrap_or_default();
             eprintln!(
-                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}, lighting pass {:.2} ms",
+                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}{prepass}{mask}, lighting pass {:.2} ms",
                 t.frame_ms, t.shadow_ms, t.lighting_ms
             );
         }
@@ -173,7 +180,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
     let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
     let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
     format!(
-        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}",
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}{}",
         light.name,
         light.kind,
         light.technique.name(),
@@ -181,6 +188,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         per_layer.join(" "),
         ms("shadow", light.shadow_ms),
         ms("moments", light.filter_ms),
+        ms("mask", light.mask_ms),
         ms("lighting", light.lighting_ms),
     )
 }

@@ -392,3 +392,23 @@ fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("light list") && err.contains("lamps"), "{err}");
 }
+
+#[test]
+fn contact_shadows_render_through_the_mask_and_forward_refuses_them() {
+    let dir = temp_dir("contact-shadows");
+    let args = ["render", "contact", "--width", "320", "--height", "180", "--contact-shadows", "--verbose"];
+    let out = gnomon(&dir, &[&args[..], &["-o", "contact.png"]].concat());
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(dir.join("contact.png").is_file());
+    assert!(err.contains("in the prepass (shadows resolved in a screen-space mask)"), "{err}");
+    // Contact shadows march through the prepass's depth: the forward path has none.
+    let out = gnomon(&dir, &[&args[..], &["--shadow-path", "forward", "-o", "forward.png"]].concat());
+    let err = stderr(&out);
+    assert!(!out.status.success() && !dir.join("forward.png").exists());
+    assert!(err.contains("--contact-shadows") && err.contains("--shadow-path auto or mask"), "{err}");
+    // An impossible parameter names its flag and range.
+    let out = gnomon(&dir, &[&args[..], &["--contact-steps", "0", "-o", "zero.png"]].concat());
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("--contact-steps") && err.contains("1 to 64"), "{err}");
+}

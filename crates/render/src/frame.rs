@@ -30,6 +30,7 @@ use crate::{
         depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
         moments::MomentPass,
+        screen_space::{self, MaskKey, ScreenSpacePass},
         shadow::{DepthTarget, ShadowPass},
     },
     readback, techniques,
@@ -94,6 +95,9 @@ pub struct Frame {
     pub lights: Vec<LightStats>,
     /// The moment map's texel format, for the filterable techniques.
     pub moment_format: Option<wgpu::TextureFormat>,
+    /// Shadows were resolved in a screen-space mask (a prepass, then one mask pass
+    /// per light), not per fragment in the lighting passes.
+    pub shadow_mask: bool,
 }
 
 /// Which draws a depth-only pass takes.
@@ -125,6 +129,8 @@ pub struct LightStats {
     pub shadow_ms: Option<f64>,
     pub filter_ms: Option<f64>,
     pub lighting_ms: Option<f64>,
+    /// GPU time of its shadow-mask pass, on the mask path.
+    pub mask_ms: Option<f64>,
 }
 
 impl LightStats {
@@ -165,9 +171,11 @@ pub struct DrawStats {
     pub shadow_draws: u32,
     /// Draw calls in the lighting pass.
     pub lighting_draws: u32,
-    /// Pipeline changes, both passes together.
+    /// Draw calls in the mask path's prepass.
+    pub prepass_draws: u32,
+    /// Pipeline changes, every pass together.
     pub pipeline_changes: u32,
-    /// Bind group changes, both passes together.
+    /// Bind group changes, every pass together.
     pub bind_group_changes: u32,
 }
 
@@ -179,6 +187,9 @@ pub struct PassTimings {
     /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
     pub filter_ms: Option<f64>,
     pub lighting_ms: f64,
+    /// On the mask path: the depth-and-normal prepass, and the mask passes.
+    pub prepass_ms: Option<f64>,
+    pub mask_ms: Option<f64>,
     /// The whole frame on the GPU, from the first shadow pass's start to the last
     /// lighting pass's end (SDSM's prepass not included).
     pub frame_ms: f64,
@@ -221,6 +232,7 @@ pub struct Renderer<'g> {
     layouts: Layouts,
     shadow_pass: ShadowPass,
     lighting_pass: LightingPass,
+    screen_space: ScreenSpacePass,
     moment_pass: MomentPass,
     depth_reduce: DepthReducePass,
     compare_sampler: wgpu::Sampler,
@@ -231,6 +243,8 @@ pub struct Renderer<'g> {
     placeholder_moments: wgpu::TextureView,
     /// Bound in place of a cube map for the lights that are not point lights.
     placeholder_cube: wgpu::TextureView,
+    /// Bound in place of the shadow mask on the forward path and in the mask pass.
+    placeholder_mask: wgpu::TextureView,
 }
 
 impl<'g> Renderer<'g> {
@@ -297,10 +311,23 @@ impl<'g> Renderer<'g> {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
             });
+        let placeholder_mask = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("no shadow mask"),
+                size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: screen_space::MASK_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
         Self {
             gpu,
             shadow_pass: ShadowPass::new(device, &layouts),
             lighting_pass: LightingPass::new(device, &layouts),
+            screen_space: ScreenSpacePass::new(device, &layouts),
             moment_pass: MomentPass::new(device),
             depth_reduce: DepthReducePass::new(device),
             layouts,
@@ -310,6 +337,7 @@ impl<'g> Renderer<'g> {
             moment_sampler,
             placeholder_moments,
             placeholder_cube,
+            placeholder_mask,
         }
     }
 
@@ -415,6 +443,7 @@ impl<'g> Renderer<'g> {
         self.check_limits(settings)?;
         let camera = settings.resolve_camera(scene)?;
         let resolved = settings.resolve_lights(scene)?;
+        let mask_path = settings.uses_shadow_mask(&resolved)?;
         let shown = if settings.light.kind == LightKind::All { settings.light.light_index } else { 0 };
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
@@ -480,16 +509,22 @@ impl<'g> Renderer<'g> {
                 light_gpu,
             });
         }
+        let clip_from_view = camera.clip_from_view(aspect);
         let camera_gpu = CameraGpu {
             clip_from_world: camera.clip_from_world(aspect),
             view_from_world: camera.view_from_world(),
+            world_from_view: camera.view_from_world().inverse(),
             eye: camera.eye.extend(1.0),
             debug: Vec4::new((settings.image.debug_view == DebugView::Cascades) as u8 as f32, 0.0, 0.0, 0.0),
+            projection: Vec4::new(clip_from_view.x_axis.x, clip_from_view.y_axis.y, camera.near, camera.far),
+            viewport: Vec4::new(width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32),
         };
 
         let gpu = self.gpu;
         let device = &gpu.device;
-        let timestamp_count = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
+        // Each light's passes, then the prepass's two.
+        let prepass_slot = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
+        let timestamp_count = prepass_slot + 2;
         let (pending, shadow_pending, timestamps, stats, layer_draws) =
             gpu.checked("rendering the frame", || {
                 let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
@@ -512,7 +547,33 @@ impl<'g> Renderer<'g> {
                 let mut stats = DrawStats::default();
                 let mut layer_draws = Vec::with_capacity(plans.len());
                 let mut shadow_pending = None;
-                // Each light's shadow map(s), then its bind groups for the lighting pass.
+                // On the mask path, one layer of the mask per light.
+                let mask_layers: Vec<wgpu::TextureView> = if mask_path {
+                    let mask = device.create_texture(&wgpu::TextureDescriptor {
+                        label: Some("shadow mask"),
+                        size: wgpu::Extent3d { width, height, depth_or_array_layers: plans.len() as u32 },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: screen_space::MASK_FORMAT,
+                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    });
+                    (0..plans.len() as u32)
+                        .map(|layer| {
+                            mask.create_view(&wgpu::TextureViewDescriptor {
+                                dimension: Some(wgpu::TextureViewDimension::D2),
+                                base_array_layer: layer,
+                                array_layer_count: Some(1),
+                                ..Default::default()
+                            })
+                        })
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                // Each light's shadow map(s), then its bind groups for the lighting pass
+                // (and on the mask path, for its mask pass).
                 let mut lit = Vec::with_capacity(plans.len());
                 for (index, plan) in plans.iter().enumerate() {
                     let slot = TIMESTAMPS_PER_LIGHT * index as u32;
@@ -566,43 +627,54 @@ impl<'g> Renderer<'g> {
                         })
                     });
                     let moment_view = moment_map.as_ref().map_or(&self.placeholder_moments, |m| &m.view);
-                    let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("shadow map"),
-                        layout: &self.layouts.shadow,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: wgpu::BindingResource::TextureView(&shadow_view),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 2,
-                                resource: wgpu::BindingResource::TextureView(moment_view),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 3,
-                                resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 4,
-                                resource: wgpu::BindingResource::TextureView(
-                                    cube_view.as_ref().unwrap_or(&self.placeholder_cube),
-                                ),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 5,
-                                resource: wgpu::BindingResource::Sampler(&self.compare_nearest_sampler),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 6,
-                                resource: wgpu::BindingResource::Sampler(&self.gather_sampler),
-                            },
-                        ],
-                    });
-                    lit.push((scene_group, shadow_group, lookup));
+                    let shadow_group = |mask: &wgpu::TextureView| {
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("shadow map"),
+                            layout: &self.layouts.shadow,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: wgpu::BindingResource::TextureView(&shadow_view),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 1,
+                                    resource: wgpu::BindingResource::Sampler(&self.compare_sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 2,
+                                    resource: wgpu::BindingResource::TextureView(moment_view),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 3,
+                                    resource: wgpu::BindingResource::Sampler(&self.moment_sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 4,
+                                    resource: wgpu::BindingResource::TextureView(
+                                        cube_view.as_ref().unwrap_or(&self.placeholder_cube),
+                                    ),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 5,
+                                    resource: wgpu::BindingResource::Sampler(&self.compare_nearest_sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 6,
+                                    resource: wgpu::BindingResource::Sampler(&self.gather_sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 7,
+                                    resource: wgpu::BindingResource::TextureView(mask),
+                                },
+                            ],
+                        })
+                    };
+                    // The mask pass writes the layer its light's lighting pass reads.
+                    let (lighting_group, mask_group) = match mask_layers.get(index) {
+                        Some(layer) => (shadow_group(layer), Some(shadow_group(&self.placeholder_mask))),
+                        None => (shadow_group(&self.placeholder_mask), None),
+                    };
+                    lit.push((scene_group, lighting_group, mask_group, lookup));
                 }
 
                 let targets: Vec<wgpu::Texture> = lighting::TARGETS
@@ -613,7 +685,23 @@ impl<'g> Renderer<'g> {
                     targets.iter().map(|t| t.create_view(&Default::default())).collect();
                 let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
                 let depth_view = depth.create_view(&Default::default());
-                for (index, (plan, (scene_group, shadow_group, lookup))) in plans.iter().zip(&lit).enumerate()
+                if mask_path {
+                    self.record_screen_space(
+                        &mut encoder,
+                        uploaded,
+                        &plans,
+                        &lit,
+                        &camera_buffer,
+                        &camera_group,
+                        &depth_view,
+                        &mask_layers,
+                        queries.as_ref(),
+                        prepass_slot,
+                        &mut stats,
+                    );
+                }
+                for (index, (plan, (scene_group, shadow_group, _, lookup))) in
+                    plans.iter().zip(&lit).enumerate()
                 {
                     let first = index == 0;
                     let slot = TIMESTAMPS_PER_LIGHT * index as u32;
@@ -642,7 +730,11 @@ impl<'g> Renderer<'g> {
                         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                             view: &depth_view,
                             depth_ops: Some(wgpu::Operations {
-                                load: if first { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                                load: if first && !mask_path {
+                                    wgpu::LoadOp::Clear(1.0)
+                                } else {
+                                    wgpu::LoadOp::Load
+                                },
                                 store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
                             }),
                             stencil_ops: None,
@@ -657,7 +749,7 @@ impl<'g> Renderer<'g> {
                     });
                     let key = LightingKey {
                         technique: plan.settings.shadow.filter.technique,
-                        lookup: *lookup,
+                        lookup: if mask_path { Lookup::Mask } else { *lookup },
                         role: if first {
                             LightingRole::First
                         } else {
@@ -720,6 +812,7 @@ impl<'g> Renderer<'g> {
                     shadow_ms: ms(slot, slot + 1),
                     filter_ms: plan.filterable_map.and_then(|_| ms(slot + 4, slot + 5)),
                     lighting_ms: ms(slot + 2, slot + 3),
+                    mask_ms: if mask_path { ms(slot + 6, slot + 7) } else { None },
                 }
             })
             .collect();
@@ -730,8 +823,10 @@ impl<'g> Renderer<'g> {
                 shadow_ms: sum(|l| l.shadow_ms),
                 filter_ms: filtered.then(|| sum(|l| l.filter_ms)),
                 lighting_ms: sum(|l| l.lighting_ms),
+                prepass_ms: if mask_path { ms(prepass_slot, prepass_slot + 1) } else { None },
+                mask_ms: mask_path.then(|| sum(|l| l.mask_ms)),
                 // From the first shadow pass's start to the last lighting pass's end.
-                frame_ms: ms(0, timestamp_count - TIMESTAMPS_PER_LIGHT + 3).unwrap_or(0.0),
+                frame_ms: ms(0, prepass_slot - TIMESTAMPS_PER_LIGHT + 3).unwrap_or(0.0),
             }
         });
         let plan = plans.swap_remove(shown);
@@ -746,6 +841,7 @@ impl<'g> Renderer<'g> {
             resolution: plan.settings.shadow.map.resolution,
             layout: plan.layout,
             moment_format: plan.filterable_map.is_some().then_some(plan.moment_format),
+            shadow_mask: mask_path,
         })
     }
 
@@ -821,6 +917,138 @@ impl<'g> Renderer<'g> {
         (shadow_map, draws)
     }
 
+    /// The mask path's screen-space passes: the depth-and-normal prepass into `depth`,
+    /// then each light's mask pass into its layer of the mask.
+    #[allow(clippy::too_many_arguments)]
+    fn record_screen_space(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        plans: &[LightPlan],
+        lit: &[LitGroups],
+        camera_buffer: &wgpu::Buffer,
+        camera_group: &wgpu::BindGroup,
+        depth: &wgpu::TextureView,
+        mask_layers: &[wgpu::TextureView],
+        queries: Option<&wgpu::QuerySet>,
+        prepass_slot: u32,
+        stats: &mut DrawStats,
+    ) {
+        let device = &self.gpu.device;
+        let (width, height) = (depth.texture().width(), depth.texture().height());
+        let prepass_target = |format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("prepass target"),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let normals = prepass_target(screen_space::NORMALS_FORMAT).create_view(&Default::default());
+        let view_depth = prepass_target(screen_space::VIEW_DEPTH_FORMAT).create_view(&Default::default());
+        {
+            let cleared = |view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    // View depth 0 marks the background.
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("prepass"),
+                color_attachments: &[cleared(&normals), cleared(&view_depth)],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: queries.map(|query_set| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(prepass_slot),
+                    end_of_pass_write_index: Some(prepass_slot + 1),
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(self.screen_space.prepass());
+            // The light plays no part in the prepass; any light's group carries the
+            // instances.
+            pass.set_bind_group(0, &lit[0].0, &[]);
+            pass.set_bind_group(1, camera_group, &[]);
+            stats.pipeline_changes += 1;
+            stats.bind_group_changes += 2;
+            uploaded.bind_geometry(&mut pass);
+            let mut bound = None;
+            for d in &uploaded.draws {
+                if bound != Some(d.material_group) {
+                    pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
+                    bound = Some(d.material_group);
+                    stats.bind_group_changes += 1;
+                }
+                GpuScene::draw_one(&mut pass, d);
+                stats.prepass_draws += 1;
+            }
+        }
+        let screen_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("screen"),
+            layout: &self.layouts.screen,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: camera_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view_depth),
+                },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normals) },
+            ],
+        });
+        for (index, ((plan, (scene_group, _, mask_group, lookup)), layer)) in
+            plans.iter().zip(lit).zip(mask_layers).enumerate()
+        {
+            let slot = TIMESTAMPS_PER_LIGHT * index as u32;
+            let mask_group = mask_group.as_ref().expect("a mask pass group on the mask path");
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow mask"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: layer,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: queries.map(|query_set| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(slot + 6),
+                    end_of_pass_write_index: Some(slot + 7),
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            let key = MaskKey { technique: plan.settings.shadow.filter.technique, lookup: *lookup };
+            pass.set_pipeline(self.screen_space.mask(device, key));
+            pass.set_bind_group(0, scene_group, &[]);
+            pass.set_bind_group(1, &screen_group, &[]);
+            pass.set_bind_group(2, mask_group, &[]);
+            stats.pipeline_changes += 1;
+            stats.bind_group_changes += 3;
+            pass.draw(0..3, 0..1);
+        }
+    }
+
     /// Reads a submitted frame's images back and assembles the [`Frame`].
     fn read_frame(&self, submitted: Submitted, settings: &Settings) -> Result<Frame, RenderError> {
         let gpu = self.gpu;
@@ -835,6 +1063,7 @@ impl<'g> Renderer<'g> {
             resolution,
             layout,
             moment_format,
+            shadow_mask,
         } = submitted;
         let (width, height) = (settings.image.width, settings.image.height);
         let mut pending = pending.into_iter();
@@ -889,6 +1118,7 @@ impl<'g> Renderer<'g> {
             stats,
             lights,
             moment_format,
+            shadow_mask,
         })
     }
 
@@ -1083,9 +1313,9 @@ impl<'g> Renderer<'g> {
     }
 }
 
-/// Timestamp queries per light: begin and end of its shadow, lighting and moment
-/// passes, in that order.
-const TIMESTAMPS_PER_LIGHT: u32 = 6;
+/// Timestamp queries per light: begin and end of its shadow, lighting, moment and
+/// shadow-mask passes, in that order.
+const TIMESTAMPS_PER_LIGHT: u32 = 8;
 
 fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, contents: &T) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -1097,6 +1327,11 @@ fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, contents
 
 /// Background colour of the image, linear RGB.
 const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
+
+/// A light's bind groups for its passes from the camera: the scene (with its light),
+/// the lighting pass's shadow group, the mask pass's (on the mask path), and how its
+/// map is looked up.
+type LitGroups = (wgpu::BindGroup, wgpu::BindGroup, Option<wgpu::BindGroup>, Lookup);
 
 /// A frame submitted to the GPU, waiting to be read back.
 struct Submitted {
@@ -1111,6 +1346,7 @@ struct Submitted {
     resolution: u32,
     layout: ShadowLayout,
     moment_format: Option<wgpu::TextureFormat>,
+    shadow_mask: bool,
 }
 
 /// The layers of a light's shadow map: their projections, and the view depths
@@ -1417,6 +1653,7 @@ fn light_uniform(
     let c = &settings.shadow.cascades;
     let (texel_ortho, texel_per_distance) = projection.texel_size_coefficients(resolution);
     let f = &settings.shadow.filter;
+    let contact = &settings.shadow.contact;
     // PCSS's light size, the same quantity the reference's area light uses.
     let light_size = match light {
         Light::Directional(sun) => (0.5 * sun.angular_diameter_degrees.to_radians()).tan(),
@@ -1466,6 +1703,17 @@ fn light_uniform(
             0.0,
             0.0,
         ),
+        contact: if contact.contact_shadows {
+            Vec4::new(
+                contact.contact_length,
+                contact.contact_steps as f32,
+                contact.contact_thickness,
+                contact.contact_bias,
+            )
+        } else {
+            Vec4::ZERO
+        },
+        contact_range: Vec4::new(contact.contact_distance, 0.0, 0.0, 0.0),
         ..Default::default()
     };
     match light {

@@ -62,20 +62,32 @@ pub struct LightGpu {
     /// point light's distance cube): x: constant bias in units of the depth's last
     /// mantissa bit, y: slope-scaled bias.
     pub raster_bias: Vec4,
+    /// Contact shadows: x: ray length in world units, y: steps (0 when off), z:
+    /// thickness as a fraction of view depth, w: the ray's start offset along the
+    /// normal in world units.
+    pub contact: Vec4,
+    /// x: the view depth where contact shadows end.
+    pub contact_range: Vec4,
 }
 
 /// The most cascades a light may have (the size of the uniform arrays).
 pub const MAX_CASCADES: usize = 8;
 
-/// The camera uniform (`Camera` in `lighting.wgsl`).
+/// The camera uniform (`Camera` in `camera.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct CameraGpu {
     pub clip_from_world: Mat4,
     pub view_from_world: Mat4,
+    pub world_from_view: Mat4,
     pub eye: Vec4,
     /// x: 1 to tint pixels by their cascade.
     pub debug: Vec4,
+    /// x: clip_from_view's x scale, y: its y scale (a symmetric perspective), z: the
+    /// near plane, w: the far plane.
+    pub projection: Vec4,
+    /// x, y: the image's width and height in pixels; z, w: their inverses.
+    pub viewport: Vec4,
 }
 
 /// One vertex: position, normal, texture coordinate (locations 0, 1, 2).

@@ -27,7 +27,114 @@ pub struct Settings {
     #[command(flatten)]
     pub shadow: ShadowSettings,
     #[command(flatten)]
+    pub screen: ScreenSpaceSettings,
+    #[command(flatten)]
     pub reference: ReferenceSettings,
+}
+
+/// Where each pixel's shadow is resolved.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowPath {
+    /// The mask when any light has contact shadows (which march through its depth),
+    /// forward otherwise.
+    #[default]
+    Auto,
+    /// In the lighting pass, once per fragment drawn.
+    Forward,
+    /// Screen-space shadows, as in Unity URP: a depth-and-normal prepass, then one
+    /// full-screen pass per light that reconstructs each pixel's position from depth,
+    /// looks its shadow up once and stores it in a mask the lighting pass reads.
+    Mask,
+}
+
+/// How shadows are resolved on screen: the frame-wide choice of path (contact
+/// shadows, per light, are in the shadow settings).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScreenSpaceSettings {
+    /// Where each pixel's shadow lookup runs: forward, in the lighting pass, or once
+    /// per pixel into a screen-space shadow mask.
+    #[arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")]
+    pub shadow_path: ShadowPath,
+}
+
+/// Contact shadows: a short ray marched in screen space from each pixel toward the
+/// light through the depth prepass, to restore the shadows that a shadow map's bias
+/// and resolution lose where objects meet (after Sousa, Kasyan & Schulz, "Secrets of
+/// CryENGINE 3 graphics technology", 2011, and Unreal's screen-space shadows). The
+/// result multiplies in as min(map, contact).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ContactSettings {
+    /// March contact shadows for this light (needs --shadow-path auto or mask).
+    #[arg(long, help_heading = "Contact shadows")]
+    pub contact_shadows: bool,
+    /// Length of the ray toward the light, in world units (> 0, at most 10).
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_length, help_heading = "Contact shadows")]
+    pub contact_length: f32,
+    /// Depth-buffer samples along the ray, 1 to 64; the start is jittered per pixel by
+    /// interleaved gradient noise.
+    #[arg(long, value_name = "N", default_value_t = ContactSettings::default().contact_steps, help_heading = "Contact shadows")]
+    pub contact_steps: u32,
+    /// Assumed thickness of what the depth buffer holds, as a fraction of its view
+    /// depth: a sample behind the depth buffer by less than this occludes the ray,
+    /// one farther behind passes behind the surface. 0 to 1.
+    #[arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows")]
+    pub contact_thickness: f32,
+    /// The ray starts this far along the surface's normal, in world units, so that its
+    /// first samples clear the receiver's own depth. ≥ 0.
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_bias, help_heading = "Contact shadows")]
+    pub contact_bias: f32,
+    /// View depth beyond which contact shadows are off; they fade out over its last
+    /// quarter. > 0.
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_distance, help_heading = "Contact shadows")]
+    pub contact_distance: f32,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            contact_shadows: false,
+            contact_length: 0.3,
+            contact_steps: 16,
+            contact_thickness: 0.02,
+            contact_bias: 0.02,
+            contact_distance: 50.0,
+        }
+    }
+}
+
+impl ContactSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let finite = |x: f32| x.is_finite();
+        check(
+            finite(self.contact_length) && self.contact_length > 0.0 && self.contact_length <= 10.0,
+            "--contact-length",
+            self.contact_length,
+            "a distance in (0, 10]",
+        )?;
+        check((1..=64).contains(&self.contact_steps), "--contact-steps", self.contact_steps, "1 to 64")?;
+        check(
+            finite(self.contact_thickness) && self.contact_thickness > 0.0 && self.contact_thickness <= 1.0,
+            "--contact-thickness",
+            self.contact_thickness,
+            "a fraction of the view depth in (0, 1]",
+        )?;
+        check(
+            finite(self.contact_bias) && self.contact_bias >= 0.0,
+            "--contact-bias",
+            self.contact_bias,
+            "a distance ≥ 0",
+        )?;
+        check(
+            finite(self.contact_distance) && self.contact_distance > 0.0,
+            "--contact-distance",
+            self.contact_distance,
+            "a distance > 0",
+        )?;
+        Ok(())
+    }
 }
 
 /// Changes to the scene itself.
@@ -724,6 +831,8 @@ pub struct ShadowSettings {
     pub partition: Partition,
     #[command(flatten)]
     pub cascades: CascadeSettings,
+    #[command(flatten)]
+    pub contact: ContactSettings,
 }
 
 /// A setting outside its valid range. The message names the flag and what is valid.
@@ -915,6 +1024,7 @@ impl ShadowSettings {
             r,
             format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
         )?;
+        s.contact.validate()?;
         Ok(())
     }
 }
@@ -976,6 +1086,24 @@ impl Settings {
         let n = self.reference.samples;
         check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
         Ok(())
+    }
+
+    /// Whether a frame with these lights resolves its shadows in a screen-space mask:
+    /// as --shadow-path says, and with `auto` when any light marches contact shadows.
+    /// Contact shadows with --shadow-path forward are refused: they need the prepass.
+    pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
+        let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
+        match (self.screen.shadow_path, contact) {
+            (ShadowPath::Forward, Some(light)) => Err(SettingsError {
+                flag: "--contact-shadows",
+                value: format!("on for light `{}`", light.name),
+                valid: "only with --shadow-path auto or mask: contact shadows march through the mask path's depth prepass"
+                    .into(),
+            }),
+            (ShadowPath::Forward, None) => Ok(false),
+            (ShadowPath::Mask, _) => Ok(true),
+            (ShadowPath::Auto, contact) => Ok(contact.is_some()),
+        }
     }
 
     /// The camera: the scene's, with these settings' overrides applied.
@@ -1234,6 +1362,13 @@ mod tests {
             "rgba16float",
             "--csm-terms",
             "12",
+            "--shadow-path",
+            "mask",
+            "--contact-shadows",
+            "--contact-length",
+            "0.5",
+            "--contact-steps",
+            "24",
         ])
         .unwrap()
         .settings;
@@ -1257,6 +1392,12 @@ mod tests {
             cull = "front"
             [shadow.map]
             resolution = 1024
+            [shadow.contact]
+            contact_shadows = true
+            contact_length = 0.5
+            contact_steps = 24
+            [screen]
+            shadow_path = "mask"
         "#;
         let from_file: Settings = toml::from_str(text).unwrap();
         assert_eq!(parsed, from_file);
@@ -1424,5 +1565,43 @@ mod tests {
         // No list: a clear error naming where lists come from.
         let e = s.resolve_lights(&crate::builtin::spheres()).unwrap_err();
         assert!(e.valid.contains("[[light]]") && e.valid.contains("lamps"), "{e}");
+    }
+
+    #[test]
+    fn contact_shadows_choose_the_mask_path_and_are_checked() {
+        let scene = crate::builtin::lamps();
+        let mut s = Settings::default();
+        let lights = s.resolve_lights(&scene).unwrap();
+        assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto without contact shadows is forward");
+        s.screen.shadow_path = ShadowPath::Mask;
+        assert!(s.uses_shadow_mask(&lights).unwrap());
+        // One light with contact shadows is enough for auto to take the mask...
+        s.screen.shadow_path = ShadowPath::Auto;
+        s.light.kind = LightKind::All;
+        let mut lit = scene.clone();
+        lit.lights[5].shadow = Some("[contact]\ncontact_shadows = true".parse().unwrap());
+        let lights = s.resolve_lights(&lit).unwrap();
+        assert!(lights[5].shadow.contact.contact_shadows && !lights[4].shadow.contact.contact_shadows);
+        assert!(s.uses_shadow_mask(&lights).unwrap());
+        // ...and forward refuses it, naming the light.
+        s.screen.shadow_path = ShadowPath::Forward;
+        let e = s.uses_shadow_mask(&lights).unwrap_err();
+        assert!(e.flag == "--contact-shadows" && e.to_string().contains(&lit.lights[5].name), "{e}");
+        // Each parameter's range is checked, naming the flag.
+        for (flag, set) in [
+            (
+                "--contact-length",
+                (|c: &mut ContactSettings| c.contact_length = 0.0) as fn(&mut ContactSettings),
+            ),
+            ("--contact-steps", |c| c.contact_steps = 0),
+            ("--contact-steps", |c| c.contact_steps = 65),
+            ("--contact-thickness", |c| c.contact_thickness = f32::NAN),
+            ("--contact-bias", |c| c.contact_bias = -0.1),
+            ("--contact-distance", |c| c.contact_distance = 0.0),
+        ] {
+            let mut s = Settings::default();
+            set(&mut s.shadow.contact);
+            assert_eq!(s.validate().unwrap_err().flag, flag);
+        }
     }
 }

@@ -20,6 +20,8 @@ struct Light {
     cascade_splits: array<vec4<f32>, 3>, // view depth where cascade i starts (i) and ends (i + 1)
     cascades: vec4<f32>,     // x: count, y: 1 to select by projection, z: blend band, w: moment layers per cascade
     raster_bias: vec4<f32>,  // x: constant depth bias (units), y: slope-scaled bias, for passes that write their own depth
+    contact: vec4<f32>,      // contact shadows: x: ray length (world), y: steps (0: off), z: thickness (fraction of view depth), w: start offset (world)
+    contact_range: vec4<f32>, // x: view depth where contact shadows end
 };
 
 // The view depth where cascade `i` starts; `i + 1` where it ends.

@@ -2,12 +2,14 @@
 //! technique's shadow lookup, writing the colour image and the per-pixel outputs.
 //! With many lights, one pass per light: the first writes every target, the others
 //! add their light to the colour on the same depths, each with its own technique.
+//! On the mask path every pass tests the prepass's depths and reads its light's
+//! visibility from the shadow mask instead of looking it up.
 
 use std::collections::HashMap;
 
 use gnomon_scene::settings::Technique;
 
-use super::{LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, compose_wgsl};
+use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
 use crate::{gpu_types::VertexGpu, techniques};
 
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -53,6 +55,47 @@ pub(crate) enum Lookup {
     Cube,
     /// Through a point light's dual paraboloids, into two 2D layers.
     Paraboloid,
+    /// Not at all: the screen-space shadow mask holds it (the mask pass made the
+    /// lookup, with the light's own lookup kind).
+    Mask,
+}
+
+/// The WGSL that defines `pixel_visibility` for a technique and lookup: the
+/// technique's shadow lookup and the rules of resolve_visibility.wgsl, or on the
+/// mask path the read of the mask. Shared by the lighting and shadow-mask passes.
+pub(crate) fn visibility_wgsl(technique: Technique, lookup: Lookup) -> Vec<String> {
+    let mut parts: Vec<String> = Vec::new();
+    let visibility = match lookup {
+        Lookup::Mask => return vec![include_str!("mask_lookup.wgsl").to_owned()],
+        Lookup::Cube => {
+            parts.extend(techniques::shared_wgsl());
+            parts.push(techniques::CUBE_WGSL.to_owned());
+            let cube = techniques::lookup(technique).cube_wgsl().unwrap_or_else(|| {
+                unreachable!("{technique:?} has no cube lookup; settings refuse it for point lights")
+            });
+            parts.extend(cube.iter().map(|s| s.to_string()));
+            include_str!("cube_visibility.wgsl")
+        }
+        Lookup::Map => {
+            parts.extend(techniques::shared_wgsl());
+            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            include_str!("map_visibility.wgsl")
+        }
+        Lookup::Paraboloid => {
+            parts.extend(techniques::shared_wgsl());
+            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            include_str!("paraboloid_visibility.wgsl")
+        }
+    };
+    parts.push(visibility.to_owned());
+    parts.push(include_str!("resolve_visibility.wgsl").to_owned());
+    parts
+}
+
+/// The start of every module that shades from the camera: the light, the scene's
+/// declarations, the camera and the shared shading helpers.
+pub(crate) fn camera_shading_wgsl() -> Vec<String> {
+    [LIGHT_WGSL, SCENE_COMMON_WGSL, CAMERA_WGSL, SHADING_WGSL].map(str::to_owned).to_vec()
 }
 
 /// Lighting pipelines, one per technique, lookup and role, built on first use.
@@ -79,31 +122,8 @@ impl LightingPass {
     pub fn pipeline(&mut self, device: &wgpu::Device, key: LightingKey) -> &wgpu::RenderPipeline {
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
-            let technique = techniques::lookup(key.technique);
-            let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned(), SCENE_COMMON_WGSL.to_owned()];
-            parts.extend(techniques::shared_wgsl());
-            let visibility = match key.lookup {
-                Lookup::Cube => {
-                    parts.push(techniques::CUBE_WGSL.to_owned());
-                    let cube = technique.cube_wgsl().unwrap_or_else(|| {
-                        unreachable!(
-                            "{:?} has no cube lookup; settings refuse it for point lights",
-                            key.technique
-                        )
-                    });
-                    parts.extend(cube.iter().map(|s| s.to_string()));
-                    include_str!("cube_visibility.wgsl")
-                }
-                Lookup::Map => {
-                    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
-                    include_str!("map_visibility.wgsl")
-                }
-                Lookup::Paraboloid => {
-                    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
-                    include_str!("paraboloid_visibility.wgsl")
-                }
-            };
-            parts.push(visibility.to_owned());
+            let mut parts = camera_shading_wgsl();
+            parts.extend(visibility_wgsl(key.technique, key.lookup));
             parts.push(include_str!("lighting.wgsl").to_owned());
             let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let source = compose_wgsl(&refs);
@@ -136,7 +156,8 @@ impl LightingPass {
                     Some(target)
                 })
                 .collect();
-            let first = key.role == LightingRole::First;
+            // The first light's pass draws the depths, unless the prepass has.
+            let first = key.role == LightingRole::First && key.lookup != Lookup::Mask;
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("lighting"),
                 layout: Some(layout),
@@ -149,8 +170,9 @@ impl LightingPass {
                 // Both sides are drawn, as a ray tracer sees them; the shader flips the
                 // normal of back faces.
                 primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                // Later lights shade exactly the surfaces the first one found: the
-                // same vertex stage (its position is invariant) gives the same depths.
+                // Later lights shade exactly the surfaces the first one (or the
+                // prepass) found: the same vertex transform, its position invariant,
+                // gives the same depths.
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
                     depth_write_enabled: Some(first),

@@ -2,17 +2,10 @@
 // factor of the selected technique multiplying only the direct term. Also writes the
 // per-pixel visibility, world position, normal, view depth and object id.
 //
-// A technique provides `fn sample_shadow(q: ShadowQuery) -> f32` (techniques/common.wgsl),
-// or for a point light `fn sample_shadow_cube(q: CubeQuery) -> f32` (techniques/cube.wgsl).
-// The shadow lookup itself, `shadow_visibility`, comes from map_visibility.wgsl (a
-// light's 2D layers: one map or cascades) or cube_visibility.wgsl (a point light).
-
-struct Camera {
-    clip_from_world: mat4x4<f32>,
-    view_from_world: mat4x4<f32>,
-    eye: vec4<f32>,
-    debug: vec4<f32>,   // x: 1 to tint pixels by their cascade
-};
+// `pixel_visibility` comes from resolve_visibility.wgsl on the forward path (the
+// technique's lookup, per fragment) or from mask_lookup.wgsl on the mask path (what
+// the screen-space shadow mask stored for the pixel). Camera: camera.wgsl; the
+// light's direction and cone: shading.wgsl.
 
 // Cascade tints of the debug view.
 const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
@@ -20,7 +13,6 @@ const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
     vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
 );
 
-@group(1) @binding(0) var<uniform> camera: Camera;
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
 @group(3) @binding(1) var base_color_sampler: sampler;
 
@@ -54,30 +46,6 @@ struct FragmentOut {
     @location(4) object_id: u32,
 };
 
-// A surface facing the light keeps this fraction of the offset, against the depth
-// quantisation that the slope bias (zero for it) cannot cover.
-const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
-
-// Fraction of the light arriving at `world` before shadowing: 1 for the sun, the
-// cone and range test for a spot (0 outside the outer cone or beyond the range), the
-// range test for a point light.
-// Returns (unit direction to the light, cone factor in [0, 1]).
-fn light_geometry(world: vec3<f32>) -> vec4<f32> {
-    if light.direction.w < 0.5 {
-        return vec4<f32>(-light.direction.xyz, 1.0);
-    }
-    let to_light = light.position.xyz - world;
-    let dist = length(to_light);
-    let l = to_light / dist;
-    if light.direction.w > 1.5 {
-        return vec4<f32>(l, select(0.0, 1.0, dist <= light.position.w));
-    }
-    let cos_angle = dot(-l, light.direction.xyz);
-    let inside = cos_angle >= light.cone.y && dist <= light.position.w;
-    let falloff = smoothstep(light.cone.y, light.cone.x, cos_angle);
-    return vec4<f32>(l, select(0.0, falloff, inside));
-}
-
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
@@ -103,19 +71,9 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let world_dx = dpdx(in.world);
     let world_dy = dpdy(in.world);
     let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
-    let shadow = shadow_visibility(in.world, n, l, world_dx, world_dy, in.clip.xy, view_depth);
-    var visibility = shadow.x;
+    let shadow = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
+    let visibility = shadow.x;
     let layer = u32(shadow.y);
-    if light.direction.w > 0.5 && cone <= 0.0 {
-        // Outside a spot's cone or a light's range no light arrives: visibility 0 by
-        // definition.
-        visibility = 0.0;
-    }
-    if dot(geometric_n, l) <= 0.0 {
-        // A surface turned away from the light is shadowed by itself, whatever the map
-        // says (the reference ray tracer uses the same geometric test).
-        visibility = 0.0;
-    }
 
     if alpha_cut(inst, in.uv) {
         discard;

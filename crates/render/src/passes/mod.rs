@@ -4,6 +4,7 @@
 pub(crate) mod depth_reduce;
 pub(crate) mod lighting;
 pub(crate) mod moments;
+pub(crate) mod screen_space;
 pub(crate) mod shadow;
 
 /// The shadow map's texel format.
@@ -21,15 +22,25 @@ pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
 /// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
 
+/// The camera uniform of the passes that shade from the camera.
+pub(crate) const CAMERA_WGSL: &str = include_str!("camera.wgsl");
+
+/// What the lighting and shadow-mask passes share about a point and its light.
+pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
+
 /// Bind group layouts shared by the passes.
 pub(crate) struct Layouts {
     /// Group 0: instances (storage) and the light (uniform).
     pub scene: wgpu::BindGroupLayout,
-    /// Group 1 of the lighting pass: the camera.
+    /// Group 1 of the lighting pass and the prepass: the camera.
     pub camera: wgpu::BindGroupLayout,
+    /// Group 1 of the shadow-mask pass: the camera and the prepass's view depth and
+    /// normals.
+    pub screen: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the
-    /// filterable techniques' moment map and its sampler, and a point light's cube
-    /// with its nearest comparison and gathering samplers.
+    /// filterable techniques' moment map and its sampler, a point light's cube with
+    /// its nearest comparison and gathering samplers, and on the mask path the light's
+    /// layer of the shadow mask.
     pub shadow: wgpu::BindGroupLayout,
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
@@ -116,6 +127,15 @@ impl Layouts {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
                     count: None,
                 },
+                unfilterable_texture_entry(7),
+            ],
+        });
+        let screen = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("screen"),
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
+                unfilterable_texture_entry(1),
+                unfilterable_texture_entry(2),
             ],
         });
         let fragment = wgpu::ShaderStages::FRAGMENT;
@@ -140,7 +160,7 @@ impl Layouts {
                 },
             ],
         });
-        Self { scene, camera, shadow, material }
+        Self { scene, camera, screen, shadow, material }
     }
 }
 
@@ -152,6 +172,20 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: false,
             min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A 2D float texture read with `textureLoad` by a fragment stage.
+fn unfilterable_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
         },
         count: None,
     }

@@ -1,0 +1,32 @@
+// A pixel's visibility of its light, resolved from the shadow map: the lookup of
+// `shadow_visibility` (map_visibility.wgsl, cube_visibility.wgsl or
+// paraboloid_visibility.wgsl), then the rules that hold whatever the map says. The
+// forward lighting pass calls it per fragment; the shadow-mask pass once per pixel.
+
+// (visibility, layer that shaded it) of the surface at `world` with shading normal
+// `n` and camera-facing geometric normal `geometric_n`, lit from `l` with cone factor
+// `cone`. The world position's screen derivatives give the receiver's plane.
+fn pixel_visibility(
+    world: vec3<f32>,
+    n: vec3<f32>,
+    geometric_n: vec3<f32>,
+    l: vec3<f32>,
+    cone: f32,
+    world_dx: vec3<f32>,
+    world_dy: vec3<f32>,
+    pixel: vec2<f32>,
+    view_depth: f32,
+) -> vec2<f32> {
+    var shadow = shadow_visibility(world, n, l, world_dx, world_dy, pixel, view_depth);
+    if light.direction.w > 0.5 && cone <= 0.0 {
+        // Outside a spot's cone or a light's range no light arrives: visibility 0 by
+        // definition.
+        shadow.x = 0.0;
+    }
+    if dot(geometric_n, l) <= 0.0 {
+        // A surface turned away from the light is shadowed by itself, whatever the map
+        // says (the reference ray tracer uses the same geometric test).
+        shadow.x = 0.0;
+    }
+    return shadow;
+}

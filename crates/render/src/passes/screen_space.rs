@@ -1,0 +1,134 @@
+//! The mask path's screen-space passes (as in Unity URP's screen-space shadows): the
+//! depth-and-normal prepass, and one full-screen shadow-mask pass per light that
+//! resolves the light's shadow once per pixel (with contact shadows when the light
+//! has them) into that light's layer of the mask.
+
+use std::collections::HashMap;
+
+use gnomon_scene::settings::Technique;
+
+use super::{
+    Layouts, compose_wgsl,
+    lighting::{self, Lookup},
+};
+use crate::gpu_types::VertexGpu;
+
+/// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
+pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The prepass's linear view depth (0 where no surface is seen).
+pub(crate) const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The mask, one array layer per light: visibility + 2 × the shadow-map layer that
+/// shaded it, per pixel. A 32-bit float keeps the visibility exact, where half floats
+/// would round it by up to 2.4e-4; packing the layer in keeps it 4 bytes a pixel.
+pub(crate) const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// A mask pipeline per technique and lookup kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct MaskKey {
+    pub technique: Technique,
+    /// How the light's map is looked up (never [`Lookup::Mask`]).
+    pub lookup: Lookup,
+}
+
+pub(crate) struct ScreenSpacePass {
+    prepass: wgpu::RenderPipeline,
+    mask_layout: wgpu::PipelineLayout,
+    masks: HashMap<MaskKey, wgpu::RenderPipeline>,
+}
+
+impl ScreenSpacePass {
+    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        let prepass_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("prepass"),
+            bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.camera), None, Some(&layouts.material)],
+            immediate_size: 0,
+        });
+        let mut parts = lighting::camera_shading_wgsl();
+        parts.push(include_str!("octahedron.wgsl").to_owned());
+        parts.push(include_str!("prepass.wgsl").to_owned());
+        let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("prepass"),
+            source: wgpu::ShaderSource::Wgsl(compose_wgsl(&refs).into()),
+        });
+        let prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("prepass"),
+            layout: Some(&prepass_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_prepass"),
+                compilation_options: Default::default(),
+                buffers: &[Some(VertexGpu::layout())],
+            },
+            // Both sides, as the lighting pass draws them.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: lighting::DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_prepass"),
+                compilation_options: Default::default(),
+                targets: &[Some(NORMALS_FORMAT.into()), Some(VIEW_DEPTH_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let mask_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow mask"),
+            bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.screen), Some(&layouts.shadow)],
+            immediate_size: 0,
+        });
+        Self { prepass, mask_layout, masks: HashMap::new() }
+    }
+
+    /// The prepass pipeline: groups 0 (scene), 1 (camera) and 3 (material).
+    pub fn prepass(&self) -> &wgpu::RenderPipeline {
+        &self.prepass
+    }
+
+    /// The mask pipeline of a technique and lookup: groups 0 (scene and light), 1
+    /// (camera and prepass) and 2 (the light's shadow resources), drawn as one
+    /// full-screen triangle.
+    pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
+        let layout = &self.mask_layout;
+        self.masks.entry(key).or_insert_with(|| {
+            let mut parts = lighting::camera_shading_wgsl();
+            parts.extend(lighting::visibility_wgsl(key.technique, key.lookup));
+            parts.push(include_str!("octahedron.wgsl").to_owned());
+            parts.push(include_str!("contact.wgsl").to_owned());
+            parts.push(include_str!("shadow_mask.wgsl").to_owned());
+            let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("shadow mask"),
+                source: wgpu::ShaderSource::Wgsl(compose_wgsl(&refs).into()),
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow mask"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_fullscreen"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_mask"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(MASK_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+}

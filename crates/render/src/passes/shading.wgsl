@@ -1,0 +1,26 @@
+// What the lighting pass and the shadow-mask pass share about a surface point and its
+// light: the light's direction and cone at the point, and the normal-offset floor.
+
+// A surface facing the light keeps this fraction of the offset, against the depth
+// quantisation that the slope bias (zero for it) cannot cover.
+const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
+
+// Fraction of the light arriving at `world` before shadowing: 1 for the sun, the
+// cone and range test for a spot (0 outside the outer cone or beyond the range), the
+// range test for a point light.
+// Returns (unit direction to the light, cone factor in [0, 1]).
+fn light_geometry(world: vec3<f32>) -> vec4<f32> {
+    if light.direction.w < 0.5 {
+        return vec4<f32>(-light.direction.xyz, 1.0);
+    }
+    let to_light = light.position.xyz - world;
+    let dist = length(to_light);
+    let l = to_light / dist;
+    if light.direction.w > 1.5 {
+        return vec4<f32>(l, select(0.0, 1.0, dist <= light.position.w));
+    }
+    let cos_angle = dot(-l, light.direction.xyz);
+    let inside = cos_angle >= light.cone.y && dist <= light.position.w;
+    let falloff = smoothstep(light.cone.y, light.cone.x, cos_angle);
+    return vec4<f32>(l, select(0.0, falloff, inside));
+}

@@ -1,0 +1,71 @@
+// Screen-space shadow mask (as in Unity URP's screen-space shadows): one full-screen
+// pass per light over the prepass. It rebuilds each pixel's world position from its
+// linear view depth, resolves the light's shadow lookup there once, with the light's
+// own technique (`pixel_visibility`, resolve_visibility.wgsl), marches contact shadows
+// when the light has them (contact.wgsl), and stores the visibility in the light's
+// layer of the mask, for its lighting pass to read: one 32-bit float, visibility +
+// 2 × the shadow-map layer that shaded it (for the cascade debug view), so that the
+// mask path keeps the forward path's visibility exactly.
+
+// The prepass's outputs, with the camera (camera.wgsl) in group 1.
+@group(1) @binding(1) var prepass_view_depth: texture_2d<f32>;
+@group(1) @binding(2) var prepass_normals: texture_2d<f32>;
+
+// Declared for scene_common.wgsl's material helpers, which this pass never calls.
+@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
+@group(3) @binding(1) var base_color_sampler: sampler;
+
+// One triangle covering the screen.
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The world point that the ray through pixel position `pixel` (in pixels, centres at
+// .5) meets at view depth `view_depth`.
+fn world_at(pixel: vec2<f32>, view_depth: f32) -> vec3<f32> {
+    let ndc = vec2<f32>(pixel.x * camera.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * camera.viewport.w * 2.0);
+    let view = vec3<f32>(ndc * view_depth / camera.projection.xy, -view_depth);
+    return (camera.world_from_view * vec4<f32>(view, 1.0)).xyz;
+}
+
+// Where the ray through `pixel` meets the plane through `origin` with normal `n`.
+fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let direction = world_at(pixel, 1.0) - camera.eye.xyz;
+    let along = dot(direction, n);
+    if abs(along) < 1e-12 {
+        return origin;
+    }
+    return camera.eye.xyz + direction * (dot(origin - camera.eye.xyz, n) / along);
+}
+
+@fragment
+fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
+    let texel = vec2<i32>(frag.xy);
+    let view_depth = textureLoad(prepass_view_depth, texel, 0).x;
+    if view_depth <= 0.0 {
+        // Background: no surface, nothing to shade.
+        return 1.0;
+    }
+    let normals = textureLoad(prepass_normals, texel, 0);
+    let n = octahedron_decode(normals.xy);
+    let geometric_n = octahedron_decode(normals.zw);
+    let world = world_at(frag.xy, view_depth);
+    // The screen derivatives the forward pass's dpdx/dpdy give, rebuilt on the
+    // receiver's plane: differences across the pixel's 2×2 quad, as fine derivatives
+    // take them.
+    let quad = floor(frag.xy * 0.5) * 2.0 + vec2<f32>(0.5);
+    let world_dx = plane_point(vec2<f32>(quad.x + 1.0, frag.y), world, geometric_n)
+        - plane_point(vec2<f32>(quad.x, frag.y), world, geometric_n);
+    let world_dy = plane_point(vec2<f32>(frag.x, quad.y + 1.0), world, geometric_n)
+        - plane_point(vec2<f32>(frag.x, quad.y), world, geometric_n);
+
+    let geometry = light_geometry(world);
+    let l = geometry.xyz;
+    var shadow = pixel_visibility(world, n, geometric_n, l, geometry.w, world_dx, world_dy, frag.xy, view_depth);
+    if light.contact.y > 0.0 && shadow.x > 0.0 {
+        shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
+    }
+    return shadow.x + 2.0 * shadow.y;
+}
