@@ -335,3 +335,96 @@ fn an_over_thick_depth_buffer_is_caught_as_false_shadow() {
     );
     assert!(wrong.false_shadow_rate > right.false_shadow_rate + 0.002, "{right:?}\n{wrong:?}");
 }
+
+#[test]
+fn contact_shadows_fade_out_over_the_last_quarter_of_their_distance() {
+    let scene = builtin::contact();
+    let mut s = settings(1280, 720);
+    s.shadow.bias.slope_bias = PETER_PANNING_SLOPE_BIAS;
+    s.screen.shadow_path = ShadowPath::Mask;
+    let without = render(&scene, &s);
+    s.shadow.contact.contact_shadows = true;
+    let full = render(&scene, &s);
+    // The pixels contact shadows darken, and the view depths they span.
+    let darkened: Vec<usize> =
+        (0..full.pixel_count()).filter(|&i| full.visibility[i] < without.visibility[i] - 0.01).collect();
+    let mut depths: Vec<f32> = darkened.iter().map(|&i| full.depth[i]).collect();
+    depths.sort_by(f32::total_cmp);
+    assert!(darkened.len() > 1000, "{} pixels darkened", darkened.len());
+    // End the contact shadows where some of those pixels lie beyond the end and some
+    // before three quarters of it (they span 9 to 14 m): beyond, the shadows are
+    // gone, before, whole, and in between they fade.
+    let (nearest, farthest) = (depths[0], depths[depths.len() - 1]);
+    assert!(farthest > nearest / 0.75, "depths {nearest} to {farthest}");
+    let end = 0.5 * (nearest / 0.75 + farthest);
+    s.shadow.contact.contact_distance = end;
+    let faded = render(&scene, &s);
+    let (mut gone, mut whole, mut between) = (0, 0, 0);
+    for &i in &darkened {
+        let (v, lo, hi) = (faded.visibility[i], full.visibility[i], without.visibility[i]);
+        let z = full.depth[i];
+        if z >= end {
+            assert!((v - hi).abs() < 1e-6, "pixel {i} at depth {z}: {v} against {hi} without");
+            gone += 1;
+        } else if z <= 0.75 * end {
+            assert!((v - lo).abs() < 1e-6, "pixel {i} at depth {z}: {v} against {lo} in full");
+            whole += 1;
+        } else {
+            assert!(v >= lo - 1e-6 && v <= hi + 1e-6, "pixel {i} at depth {z}: {v} outside [{lo}, {hi}]");
+            between += (v > lo + 1e-3 && v < hi - 1e-3) as usize;
+        }
+    }
+    eprintln!("contact shadows ending at {end:.2} m: {gone} pixels gone, {whole} whole, {between} fading");
+    assert!(gone > 5 && whole > 100 && between > 10, "{gone} {whole} {between}");
+}
+
+#[test]
+fn contact_shadows_fade_at_the_screen_edges() {
+    // A 640-pixel-wide image with the same vertical field of view and height is the
+    // middle of a 1280-pixel one, pixel for pixel. Contact shadows found near the
+    // narrow image's left and right edges fade there; well inside, they darken as
+    // much in both (not pixel for pixel: the jitter follows pixel coordinates).
+    let scene = builtin::contact();
+    let mut s = settings(1280, 720);
+    s.shadow.bias.slope_bias = PETER_PANNING_SLOPE_BIAS;
+    // Fitted to the scene, the map does not change with the framing.
+    s.shadow.map.fit = gnomon_scene::settings::Fit::Scene;
+    s.screen.shadow_path = ShadowPath::Mask;
+    let frames = |s: &Settings| {
+        let mut on = s.clone();
+        on.shadow.contact.contact_shadows = true;
+        (render(&scene, s), render(&scene, &on))
+    };
+    let wide = frames(&s);
+    s.image.width = 640;
+    let narrow = frames(&s);
+    // Darkening by contact shadows alone (where the map lights the pixel), summed
+    // within 6 pixels of the narrow image's edges and beyond 64.
+    let (mut edge, mut inside) = ([0.0f64; 2], [0.0f64; 2]);
+    for y in 0..720usize {
+        for x in 0..640usize {
+            let (n, w) = (y * 640 + x, y * 1280 + x + 320);
+            assert_eq!(narrow.0.object_id[n], wide.0.object_id[w], "the same surface at ({x}, {y})");
+            for (k, (frame, i)) in [(&wide, w), (&narrow, n)].into_iter().enumerate() {
+                if frame.0.object_id[i] == 0 || frame.0.visibility[i] < 0.99 {
+                    continue;
+                }
+                let darkening = (frame.0.visibility[i] - frame.1.visibility[i]) as f64;
+                match x.min(639 - x) {
+                    0..6 => edge[k] += darkening,
+                    65.. => inside[k] += darkening,
+                    _ => {}
+                }
+            }
+        }
+    }
+    eprintln!(
+        "contact shadows' darkening near the screen edges: {:.1} wide, {:.1} narrow; inside: {:.1} wide, {:.1} narrow",
+        edge[0], edge[1], inside[0], inside[1]
+    );
+    assert!(edge[0] > 20.0 && inside[0] > 500.0, "{edge:?} {inside:?}");
+    // Within 1 % of an edge any hit is within 5 % of it (the rays span a few pixels
+    // here), where the fade takes most of it.
+    assert!(edge[1] <= 0.5 * edge[0], "{edge:?}");
+    assert!((inside[1] - inside[0]).abs() <= 0.1 * inside[0], "{inside:?}");
+}

@@ -188,3 +188,41 @@ fn bad_light_entries_name_the_light_and_the_field() {
         "--shadow-res",
     );
 }
+
+#[test]
+fn a_light_may_have_contact_shadows_and_the_file_a_shadow_path() {
+    let dir = temp_dir("contact-shadows");
+    let text = r#"
+ground = true
+[[model]]
+file = "tri.glb"
+[[light]]
+type = "sun"
+elevation = 40.0
+azimuth = 30.0
+[light.shadow.contact]
+contact_shadows = true
+contact_length = 0.5
+[[light]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+range = 10.0
+[settings.screen]
+shadow_path = "mask"
+"#;
+    let loaded = scene_file::load(&write_scene(&dir, text), None).unwrap();
+    let mut s: Settings = loaded.settings.clone().unwrap().try_into().unwrap();
+    assert_eq!(s.screen.shadow_path, gnomon_scene::settings::ShadowPath::Mask);
+    s.light.kind = gnomon_scene::settings::LightKind::All;
+    let lights = s.resolve_lights(&loaded.scene).unwrap();
+    assert!(lights[0].shadow.contact.contact_shadows && lights[0].shadow.contact.contact_length == 0.5);
+    assert!(!lights[1].shadow.contact.contact_shadows);
+    // A contact parameter out of range is named with its light.
+    let bad = text.replace("contact_length = 0.5", "contact_length = -1.0");
+    let mut scene = scene_file::load(&write_scene(&dir, &bad), None).map(|l| l.scene);
+    let e = match scene.as_mut() {
+        Ok(scene) => s.resolve_lights(scene).unwrap_err().to_string(),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("--contact-length"), "{e}");
+}
