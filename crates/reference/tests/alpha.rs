@@ -213,3 +213,28 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let close = measure(&scene, &s, "close view with ground");
     assert!(close.compared > 300_000, "{close:?}");
 }
+
+#[test]
+fn the_mask_paths_prepass_cuts_the_same_holes() {
+    // The prepass applies the alpha cut too: through the quad's holes the mask path
+    // sees, and shades, the same ground as the forward path.
+    let scene = checker_scene();
+    let mut s = settings(Technique::Pcf2x2);
+    s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Forward;
+    let forward = render(&scene, &s);
+    s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Mask;
+    let mask = render(&scene, &s);
+    let quad_id = scene.instances.iter().position(|i| i.name == "checker").unwrap() as u32 + 1;
+    let seen = forward.object_id.iter().filter(|&&id| id == quad_id).count();
+    let holes_differ =
+        (0..forward.pixel_count()).filter(|&i| forward.object_id[i] != mask.object_id[i]).count();
+    let far_apart = (0..forward.pixel_count())
+        .filter(|&i| forward.object_id[i] != 0 && (forward.visibility[i] - mask.visibility[i]).abs() > 1e-3)
+        .count();
+    eprintln!(
+        "checker: {seen} quad pixels; {holes_differ} pixels see another surface, {far_apart} differ by over 1e-3"
+    );
+    assert!(seen > 5000, "the camera sees the quad: {seen}");
+    assert_eq!(holes_differ, 0);
+    assert!(far_apart * 5000 <= forward.pixel_count(), "{far_apart}");
+}

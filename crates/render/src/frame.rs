@@ -762,17 +762,9 @@ impl<'g> Renderer<'g> {
                     pass.set_bind_group(2, shadow_group, &[]);
                     stats.pipeline_changes += 1;
                     stats.bind_group_changes += 3;
-                    uploaded.bind_geometry(&mut pass);
-                    let mut bound = None;
-                    for d in &uploaded.draws {
-                        if bound != Some(d.material_group) {
-                            pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
-                            bound = Some(d.material_group);
-                            stats.bind_group_changes += 1;
-                        }
-                        GpuScene::draw_one(&mut pass, d);
-                        stats.lighting_draws += 1;
-                    }
+                    let (draws, binds) = uploaded.draw_everything(&mut pass, 3);
+                    stats.lighting_draws += draws;
+                    stats.bind_group_changes += binds;
                 }
                 let pending: Vec<_> = if read_images {
                     targets
@@ -989,17 +981,9 @@ impl<'g> Renderer<'g> {
             pass.set_bind_group(1, camera_group, &[]);
             stats.pipeline_changes += 1;
             stats.bind_group_changes += 2;
-            uploaded.bind_geometry(&mut pass);
-            let mut bound = None;
-            for d in &uploaded.draws {
-                if bound != Some(d.material_group) {
-                    pass.set_bind_group(3, &uploaded.material_groups[d.material_group], &[]);
-                    bound = Some(d.material_group);
-                    stats.bind_group_changes += 1;
-                }
-                GpuScene::draw_one(&mut pass, d);
-                stats.prepass_draws += 1;
-            }
+            let (draws, binds) = uploaded.draw_everything(&mut pass, 3);
+            stats.prepass_draws += draws;
+            stats.bind_group_changes += binds;
         }
         let screen_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("screen"),

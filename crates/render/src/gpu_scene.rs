@@ -153,6 +153,25 @@ impl GpuScene {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
     }
 
+    /// Binds the geometry and draws every instance as seen from the camera, each
+    /// material's texture bound as group `material_group` when it changes. Returns
+    /// (draw calls, bind group changes).
+    pub(crate) fn draw_everything(&self, pass: &mut wgpu::RenderPass<'_>, material_group: u32) -> (u32, u32) {
+        self.bind_geometry(pass);
+        let (mut draws, mut binds) = (0, 0);
+        let mut bound = None;
+        for d in &self.draws {
+            if bound != Some(d.material_group) {
+                pass.set_bind_group(material_group, &self.material_groups[d.material_group], &[]);
+                bound = Some(d.material_group);
+                binds += 1;
+            }
+            Self::draw_one(pass, d);
+            draws += 1;
+        }
+        (draws, binds)
+    }
+
     /// Issues one draw.
     pub(crate) fn draw_one(pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
         pass.draw_indexed(

@@ -98,6 +98,10 @@ pub(crate) fn camera_shading_wgsl() -> Vec<String> {
     [LIGHT_WGSL, SCENE_COMMON_WGSL, CAMERA_WGSL, SHADING_WGSL].map(str::to_owned).to_vec()
 }
 
+/// The vertex stage (`vs_surface`) and normals of the passes that draw the scene
+/// from the camera: the lighting pass and the prepass.
+pub(crate) const SURFACE_WGSL: &str = include_str!("surface.wgsl");
+
 /// Lighting pipelines, one per technique, lookup and role, built on first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
@@ -124,6 +128,7 @@ impl LightingPass {
         self.pipelines.entry(key).or_insert_with(|| {
             let mut parts = camera_shading_wgsl();
             parts.extend(visibility_wgsl(key.technique, key.lookup));
+            parts.push(SURFACE_WGSL.to_owned());
             parts.push(include_str!("lighting.wgsl").to_owned());
             let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let source = compose_wgsl(&refs);
@@ -163,7 +168,7 @@ impl LightingPass {
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module: &module,
-                    entry_point: Some("vs_main"),
+                    entry_point: Some("vs_surface"),
                     compilation_options: Default::default(),
                     buffers: &[Some(VertexGpu::layout())],
                 },

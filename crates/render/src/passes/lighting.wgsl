@@ -5,38 +5,14 @@
 // `pixel_visibility` comes from resolve_visibility.wgsl on the forward path (the
 // technique's lookup, per fragment) or from mask_lookup.wgsl on the mask path (what
 // the screen-space shadow mask stored for the pixel). Camera: camera.wgsl; the
-// light's direction and cone: shading.wgsl.
+// vertex stage and normals: surface.wgsl; the light's direction and cone:
+// shading.wgsl.
 
 // Cascade tints of the debug view.
 const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
     vec3<f32>(1.0, 0.35, 0.35), vec3<f32>(0.35, 1.0, 0.35), vec3<f32>(0.4, 0.5, 1.0), vec3<f32>(1.0, 1.0, 0.3),
     vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
 );
-
-@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
-@group(3) @binding(1) var base_color_sampler: sampler;
-
-struct VertexOut {
-    // Invariant: every light's pass must rasterize the same depths, to test Equal.
-    @builtin(position) @invariant clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) @interpolate(flat) instance: u32,
-    @location(3) uv: vec2<f32>,
-};
-
-@vertex
-fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
-    let inst = instances[instance_index];
-    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
-    var out: VertexOut;
-    out.clip = camera.clip_from_world * world;
-    out.world = world.xyz;
-    out.normal = (inst.normal_from_object * vec4<f32>(v.normal, 0.0)).xyz;
-    out.instance = instance_index;
-    out.uv = v.uv;
-    return out;
-}
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
@@ -47,21 +23,11 @@ struct FragmentOut {
 };
 
 @fragment
-fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
+fn fs_main(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
-    // The triangle's geometric normal, facing the camera: the derivatives of the world
-    // position are constant across a triangle, so this is its plane's normal. Taken
-    // first, in uniform control flow.
-    var geometric_n = normalize(cross(dpdx(in.world), dpdy(in.world)));
-    if dot(geometric_n, camera.eye.xyz - in.world) < 0.0 {
-        geometric_n = -geometric_n;
-    }
-    // Two-sided shading: a back face seen by the camera is lit as its flipped side, as
-    // a ray tracer would see it.
-    var n = normalize(in.normal);
-    if !front {
-        n = -n;
-    }
+    let normals = surface_normals(in, front);
+    let n = normals.shading;
+    let geometric_n = normals.geometric;
     let geometry = light_geometry(in.world);
     let l = geometry.xyz;
     let cone = geometry.w;

@@ -44,6 +44,7 @@ impl ScreenSpacePass {
             immediate_size: 0,
         });
         let mut parts = lighting::camera_shading_wgsl();
+        parts.push(lighting::SURFACE_WGSL.to_owned());
         parts.push(include_str!("octahedron.wgsl").to_owned());
         parts.push(include_str!("prepass.wgsl").to_owned());
         let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
@@ -56,7 +57,7 @@ impl ScreenSpacePass {
             layout: Some(&prepass_layout),
             vertex: wgpu::VertexState {
                 module: &module,
-                entry_point: Some("vs_prepass"),
+                entry_point: Some("vs_surface"),
                 compilation_options: Default::default(),
                 buffers: &[Some(VertexGpu::layout())],
             },

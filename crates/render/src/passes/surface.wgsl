@@ -1,0 +1,52 @@
+// The camera's view of the scene's surfaces, shared by the lighting pass and the
+// mask path's prepass: one vertex stage, so that both rasterize the same depths
+// (the lighting passes test the prepass's for equality), and the normals both
+// derive per fragment. Also the material bindings (group 3) both read.
+
+@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
+@group(3) @binding(1) var base_color_sampler: sampler;
+
+struct SurfaceVertex {
+    // Invariant: every pass drawing from the camera must rasterize the same depths.
+    @builtin(position) @invariant clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) instance: u32,
+    @location(3) uv: vec2<f32>,
+};
+
+@vertex
+fn vs_surface(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertex {
+    let inst = instances[instance_index];
+    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+    var out: SurfaceVertex;
+    out.clip = camera.clip_from_world * world;
+    out.world = world.xyz;
+    out.normal = (inst.normal_from_object * vec4<f32>(v.normal, 0.0)).xyz;
+    out.instance = instance_index;
+    out.uv = v.uv;
+    return out;
+}
+
+struct SurfaceNormals {
+    // The interpolated normal, flipped on back faces: two-sided shading, so that a
+    // back face seen by the camera is lit as its flipped side, as a ray tracer sees it.
+    shading: vec3<f32>,
+    // The triangle's plane normal, facing the camera: the world position's
+    // derivatives are constant across a triangle.
+    geometric: vec3<f32>,
+};
+
+// Must be called in uniform control flow (it takes derivatives).
+fn surface_normals(in: SurfaceVertex, front: bool) -> SurfaceNormals {
+    var out: SurfaceNormals;
+    out.geometric = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    if dot(out.geometric, camera.eye.xyz - in.world) < 0.0 {
+        out.geometric = -out.geometric;
+    }
+    out.shading = normalize(in.normal);
+    if !front {
+        out.shading = -out.shading;
+    }
+    return out;
+}
