@@ -173,7 +173,8 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 /// pixel is foliage or trunk, so this is leaves shadowing leaves): 1.67 % measured on
 /// lavapipe. The errors are one-texel fringes around each leaf's shadow, so the figure
 /// depends on the sun and the framing; the README lists the other views measured,
-/// including those above 2 %. A close view with a ground is printed for the record.
+/// including those above 2 %. A close view with a ground, where 2 % is not met, is
+/// held to a regression bound.
 #[test]
 fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/tree/tree.glb");
@@ -202,7 +203,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     assert!(fitted.compared > 40_000, "{fitted:?}");
     assert!(fitted.mismatch_rate < 0.02, "{fitted:?}");
 
-    // For the record: close to the tree, with a ground three times its width.
+    // Close to the tree, with a ground three times its width.
     let b = scene.bounds();
     scene.add_ground_plane();
     let (c, r) = (b.center(), b.bounding_radius());
@@ -212,6 +213,9 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     scene.camera.far = 10.0 * r;
     let close = measure(&scene, &s, "close view with ground");
     assert!(close.compared > 300_000, "{close:?}");
+    // Issue 4's 2 % is not met on this view (2.09 % measured, README); this bound
+    // only guards it against getting worse.
+    assert!(close.mismatch_rate < 0.025, "{close:?}");
 }
 
 #[test]

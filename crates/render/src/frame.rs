@@ -679,11 +679,19 @@ impl<'g> Renderer<'g> {
 
                 let targets: Vec<wgpu::Texture> = lighting::TARGETS
                     .iter()
-                    .map(|&format| render_target(device, width, height, format))
+                    .map(|&format| {
+                        render_target(device, width, height, format, wgpu::TextureUsages::COPY_SRC)
+                    })
                     .collect();
                 let target_views: Vec<wgpu::TextureView> =
                     targets.iter().map(|t| t.create_view(&Default::default())).collect();
-                let depth = render_target(device, width, height, lighting::DEPTH_FORMAT);
+                let depth = render_target(
+                    device,
+                    width,
+                    height,
+                    lighting::DEPTH_FORMAT,
+                    wgpu::TextureUsages::empty(),
+                );
                 let depth_view = depth.create_view(&Default::default());
                 if mask_path {
                     self.record_screen_space(
@@ -928,18 +936,8 @@ impl<'g> Renderer<'g> {
     ) {
         let device = &self.gpu.device;
         let (width, height) = (depth.texture().width(), depth.texture().height());
-        let prepass_target = |format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("prepass target"),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-        };
+        let prepass_target =
+            |format| render_target(device, width, height, format, wgpu::TextureUsages::TEXTURE_BINDING);
         let normals = prepass_target(screen_space::NORMALS_FORMAT).create_view(&Default::default());
         let view_depth = prepass_target(screen_space::VIEW_DEPTH_FORMAT).create_view(&Default::default());
         {
@@ -1550,11 +1548,14 @@ fn seen_depth_range(camera: &Camera, receivers: &[Vec3]) -> Option<(f32, f32)> {
     Some((near, seen_far.min(camera.far).max(near * 1.001)))
 }
 
+/// A camera-sized attachment, with `usage` besides being rendered to (copied out for
+/// a readback, or sampled by a later pass).
 fn render_target(
     device: &wgpu::Device,
     width: u32,
     height: u32,
     format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some("render target"),
@@ -1563,7 +1564,7 @@ fn render_target(
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
         view_formats: &[],
     })
 }

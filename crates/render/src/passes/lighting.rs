@@ -124,6 +124,12 @@ impl LightingPass {
     }
 
     pub fn pipeline(&mut self, device: &wgpu::Device, key: LightingKey) -> &wgpu::RenderPipeline {
+        // Reading the mask is the same shader whatever technique filled it: one
+        // pipeline serves them all.
+        let key = match key.lookup {
+            Lookup::Mask => LightingKey { technique: Technique::default(), ..key },
+            _ => key,
+        };
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
             let mut parts = camera_shading_wgsl();
