@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use gnomon_reference::{
-    aliasing::{self, AliasingImage, AliasingInput},
+    aliasing,
     flicker::{Flicker, FlickerCounter, PathFrame},
     heatmap,
     metrics::{self, Metrics, PixelClass, RasterView},
@@ -16,7 +16,7 @@ use gnomon_scene::settings::LightKind;
 use gnomon_scene::{
     Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
-    settings::{CameraSettings, CascadeSelection, Technique},
+    settings::{CameraSettings, Technique},
 };
 use image::RgbaImage;
 use serde::Serialize;
@@ -184,7 +184,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         Some(kind) => measure_flicker(args, kind, &mut renderer, &uploaded, &scene, settings)?,
         None => vec![None; args.techniques.len()],
     };
-    let aliasing = measure_aliasing(&frames[0].frame, settings);
+    let aliasing = gnomon_viewer::measure_aliasing(&frames[0].frame, settings);
 
     let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
     let soft = reference.samples > 1;
@@ -295,24 +295,6 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     print!("{table}");
     eprintln!("gnomon: wrote {} files to {}", written.len(), args.out.display());
     Ok(())
-}
-
-/// Lloyd's m over `frame`, with the cascade selection of `settings`.
-fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
-    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
-    aliasing::measure(&AliasingInput {
-        width: frame.width,
-        height: frame.height,
-        position: &frame.position,
-        normal: &frame.normal,
-        depth: &frame.depth,
-        camera: &frame.camera,
-        light: &frame.light,
-        layers: &layers,
-        splits: &frame.cascade_splits,
-        select_by_projection: settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
-        resolution: frame.shadow_resolution,
-    })
 }
 
 /// Renders every technique and the reference along the camera path and counts, for

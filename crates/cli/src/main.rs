@@ -8,6 +8,7 @@ mod lab;
 mod output;
 mod reference_cmd;
 mod render_cmd;
+mod view_cmd;
 
 use std::process::ExitCode;
 
@@ -29,6 +30,8 @@ enum Command {
     Reference(Box<reference_cmd::ReferenceArgs>),
     /// Render techniques and the reference; write metrics, heat-maps and a grid.
     Compare(Box<compare_cmd::CompareArgs>),
+    /// Open the interactive viewer: every technique and setting live, with debug views.
+    View(Box<view_cmd::ViewArgs>),
     /// List the built-in scenes.
     Scenes,
     /// List the shadow techniques.
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Reference(args)) => reference_cmd::run(&args),
         Some(Command::Compare(args)) => compare_cmd::run(&args),
+        Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Scenes) => {
             for b in gnomon_scene::builtin::BUILTINS {
                 println!("{:<10} {}", b.name, b.description);

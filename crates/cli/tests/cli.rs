@@ -412,3 +412,43 @@ fn contact_shadows_render_through_the_mask_and_forward_refuses_them() {
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("--contact-steps") && err.contains("1 to 64"), "{err}");
 }
+
+/// `gnomon view --frames N --screenshot FILE` renders in a window (a virtual X server
+/// here) and saves it; bad viewer arguments and a missing display are refused with the
+/// input named, before any window opens and with nothing written.
+#[test]
+fn the_viewer_saves_a_screenshot_and_refuses_bad_input() {
+    let dir = temp_dir("view");
+    let refused = |args: &[&str], needle: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+            .current_dir(&dir)
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"), "{args:?}: {}", stderr(&out));
+    };
+    refused(&["view", "--screenshot", "shot.jpg", "--frames", "2"], "--screenshot");
+    refused(&["view", "--window", "10x10"], "WIDTHxHEIGHT");
+    refused(&["view", "--frames", "0"], "--frames");
+    refused(&["view", "nope"], "unknown scene `nope`");
+    refused(&["view", "--frames", "2"], "xvfb-run");
+    assert!(files_in(&dir).is_empty());
+
+    let out = Command::new("xvfb-run")
+        .current_dir(&dir)
+        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_gnomon")])
+        .args(["view", "contact", "--frames", "3", "--screenshot", "shot.png", "--window", "900x600"])
+        .output()
+        .expect("xvfb-run (Debian package xvfb; scripts/install-system-deps.sh --tests installs it)");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shot = image::open(dir.join("shot.png")).unwrap().to_rgba8();
+    // The window's size in physical pixels (Xvfb has a scale factor of 1).
+    assert_eq!(shot.dimensions(), (900, 600));
+    let distinct: std::collections::HashSet<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
+    assert!(distinct.len() > 500, "a near-blank screenshot: {} colours", distinct.len());
+    assert_eq!(files_in(&dir), ["shot.png"]);
+}

@@ -2,7 +2,7 @@
 //! projections, and the mapping from normalized device coordinates to shadow-map
 //! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
 //! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
-//! kernels the shaders use ([`kernels`]).
+//! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -20,6 +20,7 @@ pub mod kernels;
 mod light;
 pub mod omni;
 mod projection;
+pub mod solar;
 #[cfg(test)]
 mod test_rng;
 pub mod warping;

@@ -57,6 +57,15 @@ impl Gpu {
         };
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
             .map_err(|_| RenderError::NoAdapter { backends })?;
+        Self::with_adapter(&adapter, adjust)
+    }
+
+    /// Opens a device on `adapter` (one picked for a window's surface, say), with the
+    /// adapter's own limits lowered by `adjust` and the optional features Gnomon uses.
+    pub fn with_adapter(
+        adapter: &wgpu::Adapter,
+        adjust: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<Self, RenderError> {
         let adapter_info = adapter.get_info();
         let mut limits = adapter.limits();
         adjust(&mut limits);

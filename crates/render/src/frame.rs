@@ -29,6 +29,7 @@ use crate::{
         Layouts, SHADOW_FORMAT,
         depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
+        map_preview::MapPreviewPass,
         moments::MomentPass,
         screen_space::{self, MaskKey, ScreenSpacePass},
         shadow::{DepthTarget, ShadowPass},
@@ -97,6 +98,25 @@ pub struct Frame {
     pub moment_format: Option<wgpu::TextureFormat>,
     /// Shadows were resolved in a screen-space mask (a prepass, then one mask pass
     /// per light), not per fragment in the lighting passes.
+    pub shadow_mask: bool,
+}
+
+/// A frame left on the GPU for a window to show: nothing is read back but the pass
+/// timestamps, so it costs what the passes cost.
+#[derive(Clone, Debug)]
+pub struct LiveFrame {
+    /// The lit image, RGBA8 sRGB, bindable as a texture.
+    pub color: wgpu::Texture,
+    /// The reported light's shadow map: a Depth32Float 2D array, one layer per cascade
+    /// (six for a cube), bindable as a texture.
+    pub shadow_map: wgpu::Texture,
+    pub camera: Camera,
+    pub light: Light,
+    /// The reported light's layers and cascade splits.
+    pub layout: ShadowLayout,
+    pub timings: Option<PassTimings>,
+    pub stats: DrawStats,
+    pub lights: Vec<LightStats>,
     pub shadow_mask: bool,
 }
 
@@ -235,6 +255,7 @@ pub struct Renderer<'g> {
     screen_space: ScreenSpacePass,
     moment_pass: MomentPass,
     depth_reduce: DepthReducePass,
+    map_preview: MapPreviewPass,
     compare_sampler: wgpu::Sampler,
     compare_nearest_sampler: wgpu::Sampler,
     gather_sampler: wgpu::Sampler,
@@ -330,6 +351,7 @@ impl<'g> Renderer<'g> {
             screen_space: ScreenSpacePass::new(device, &layouts),
             moment_pass: MomentPass::new(device),
             depth_reduce: DepthReducePass::new(device),
+            map_preview: MapPreviewPass::new(device),
             layouts,
             compare_sampler,
             compare_nearest_sampler,
@@ -413,6 +435,44 @@ impl<'g> Renderer<'g> {
         let submitted =
             self.submit(uploaded, scene, settings, true, request.shadow_map, request.fixed_layout.as_ref())?;
         self.read_frame(submitted, settings)
+    }
+
+    /// Renders an uploaded scene and leaves the image and the shadow map on the GPU,
+    /// for a window to draw ([`LiveFrame`]).
+    pub fn render_live(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<LiveFrame, RenderError> {
+        let submitted = self.submit(uploaded, scene, settings, false, false, None)?;
+        Ok(LiveFrame {
+            color: submitted.color,
+            shadow_map: submitted.shadow_map,
+            camera: submitted.camera,
+            light: submitted.light,
+            layout: submitted.layout,
+            timings: submitted.timings,
+            stats: submitted.stats,
+            lights: submitted.lights,
+            shadow_mask: submitted.shadow_mask,
+        })
+    }
+
+    /// The shadow map of `frame`, every layer side by side in grayscale (near black,
+    /// far white; perspective layers linearized), each `tile` pixels square: an
+    /// `Rgba8Unorm` texture for a UI to show.
+    pub fn preview_shadow_map(&self, frame: &LiveFrame, tile: u32) -> Result<wgpu::Texture, RenderError> {
+        let gpu = self.gpu;
+        gpu.checked("drawing the shadow map preview", || {
+            self.map_preview.draw(
+                &gpu.device,
+                &gpu.queue,
+                &frame.shadow_map,
+                &frame.layout.projections,
+                tile.max(8),
+            )
+        })
     }
 
     /// Renders an uploaded scene for its pass times and draw counts alone: nothing is
@@ -525,7 +585,7 @@ impl<'g> Renderer<'g> {
         // Each light's passes, then the prepass's two.
         let prepass_slot = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
         let timestamp_count = prepass_slot + 2;
-        let (pending, shadow_pending, timestamps, stats, layer_draws) =
+        let (pending, shadow_pending, timestamps, stats, layer_draws, color, shown_map) =
             gpu.checked("rendering the frame", || {
                 let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
                 let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -547,6 +607,7 @@ impl<'g> Renderer<'g> {
                 let mut stats = DrawStats::default();
                 let mut layer_draws = Vec::with_capacity(plans.len());
                 let mut shadow_pending = None;
+                let mut shown_map = None;
                 // On the mask path, one layer of the mask per light.
                 let mask_layers: Vec<wgpu::TextureView> = if mask_path {
                     let mask = device.create_texture(&wgpu::TextureDescriptor {
@@ -586,6 +647,9 @@ impl<'g> Renderer<'g> {
                         &mut stats,
                     );
                     layer_draws.push(draws);
+                    if index == shown {
+                        shown_map = Some(shadow_map.clone());
+                    }
                     if read_shadow_map && index == shown {
                         shadow_pending = Some(readback::record(
                             device,
@@ -680,7 +744,13 @@ impl<'g> Renderer<'g> {
                 let targets: Vec<wgpu::Texture> = lighting::TARGETS
                     .iter()
                     .map(|&format| {
-                        render_target(device, width, height, format, wgpu::TextureUsages::COPY_SRC)
+                        render_target(
+                            device,
+                            width,
+                            height,
+                            format,
+                            wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
+                        )
                     })
                     .collect();
                 let target_views: Vec<wgpu::TextureView> =
@@ -786,7 +856,8 @@ impl<'g> Renderer<'g> {
                     readback::record_timestamps(device, &mut encoder, query_set, timestamp_count)
                 });
                 gpu.queue.submit([encoder.finish()]);
-                (pending, shadow_pending, timestamps, stats, layer_draws)
+                let shown_map = shown_map.expect("the reported light is one of the lights");
+                (pending, shadow_pending, timestamps, stats, layer_draws, targets[0].clone(), shown_map)
             })?;
 
         let ticks = match timestamps {
@@ -833,6 +904,8 @@ impl<'g> Renderer<'g> {
         Ok(Submitted {
             pending,
             shadow_pending,
+            color,
+            shadow_map: shown_map,
             timings,
             stats,
             lights,
@@ -1037,6 +1110,8 @@ impl<'g> Renderer<'g> {
         let Submitted {
             pending,
             shadow_pending,
+            color: _,
+            shadow_map: _,
             timings,
             stats,
             lights,
@@ -1319,6 +1394,9 @@ type LitGroups = (wgpu::BindGroup, wgpu::BindGroup, Option<wgpu::BindGroup>, Loo
 struct Submitted {
     pending: Vec<readback::PendingReadback>,
     shadow_pending: Option<readback::PendingReadback>,
+    /// The colour target and the reported light's shadow map, for [`LiveFrame`].
+    color: wgpu::Texture,
+    shadow_map: wgpu::Texture,
     timings: Option<PassTimings>,
     stats: DrawStats,
     lights: Vec<LightStats>,

@@ -22,9 +22,11 @@ pub mod techniques;
 
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
-    DrawStats, Frame, LightStats, OutputRequest, PassTimings, Renderer, ShadowMapImage, light_projection,
+    DrawStats, Frame, LightStats, LiveFrame, OutputRequest, PassTimings, Renderer, ShadowLayout,
+    ShadowMapImage, light_projection,
 };
 pub use gpu_scene::GpuScene;
+pub use readback::read_texture;
 pub use wgpu;
 
 use gnomon_scene::{SceneError, settings::SettingsError};

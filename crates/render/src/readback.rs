@@ -45,6 +45,15 @@ pub(crate) fn record(
     PendingReadback { buffer, width, height, bytes_per_texel, padded_bytes_per_row }
 }
 
+/// Copies mip 0 of a colour `texture` back to the CPU and waits for it: texels
+/// row-major, top row first, in the texture's own format.
+pub fn read_texture<T: bytemuck::Pod>(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<T>, RenderError> {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let pending = record(&gpu.device, &mut encoder, texture, wgpu::TextureAspect::All);
+    gpu.queue.submit([encoder.finish()]);
+    pending.read(gpu)
+}
+
 /// Maps `slice` for reading and waits until it is.
 fn map_blocking(gpu: &Gpu, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
     let (sender, receiver) = std::sync::mpsc::channel();

@@ -2,6 +2,7 @@
 //! and default render settings, in one human-edited file.
 //!
 //! ```toml
+//! builtin = "columns"                    # optional: start from a built-in scene
 //! ground = true                          # add a floor under the models
 //!
 //! [[model]]
@@ -68,6 +69,8 @@ pub struct SceneFileError {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SceneFile {
+    /// A built-in scene to start from; the models are added to it.
+    builtin: Option<String>,
     #[serde(default)]
     ground: bool,
     #[serde(default)]
@@ -251,15 +254,27 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
     let fail = |problem: String| SceneFileError { path: path.to_path_buf(), problem };
     let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read: {e}")))?;
     let file: SceneFile = toml::from_str(&text).map_err(|e| fail(e.to_string()))?;
-    if file.model.is_empty() {
-        return Err(fail("lists no models: add at least one [[model]] with a `file`".into()));
+    if file.model.is_empty() && file.builtin.is_none() {
+        return Err(fail(
+            "lists no models: add at least one [[model]] with a `file`, or start from a built-in \
+             scene with `builtin = \"NAME\"`"
+                .into(),
+        ));
     }
     if let Some(table) = &file.settings {
         // Check the settings now, so that a typo is reported against this file.
         table.clone().try_into::<Settings>().map_err(|e| fail(format!("[settings]: {e}")))?;
     }
     let base = path.parent().unwrap_or(Path::new("."));
-    let mut scene: Option<Scene> = None;
+    let mut scene: Option<Scene> = match &file.builtin {
+        Some(name) => Some(crate::builtin::build(name).ok_or_else(|| {
+            fail(format!(
+                "builtin = {name:?}: no such built-in scene; choose one of {}",
+                crate::builtin::names().join(", ")
+            ))
+        })?),
+        None => None,
+    };
     for model in &file.model {
         let model_path = base.join(&model.file);
         let (loaded, _) = gltf_loader::load(&model_path).map_err(|e| fail(format!("model: {e}")))?;
@@ -286,10 +301,13 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
             Some(s) => s.append(loaded, world_from_model),
         }
     }
-    let mut scene = scene.expect("at least one model");
+    let mut scene = scene.expect("a built-in scene or at least one model");
     scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let bounds = scene.bounds();
-    scene.camera = gltf_loader::fitted_camera(bounds.center(), bounds.bounding_radius().max(1e-3));
+    if file.builtin.is_none() {
+        // glTF models bring no camera: frame them all.
+        scene.camera = gltf_loader::fitted_camera(bounds.center(), bounds.bounding_radius().max(1e-3));
+    }
     if file.ground {
         scene.add_ground_plane();
     }

@@ -3,6 +3,7 @@
 
 pub(crate) mod depth_reduce;
 pub(crate) mod lighting;
+pub(crate) mod map_preview;
 pub(crate) mod moments;
 pub(crate) mod screen_space;
 pub(crate) mod shadow;

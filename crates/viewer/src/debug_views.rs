@@ -1,0 +1,193 @@
+//! The viewer's measured debug views: the texel-density (Lloyd's m) heat-map of the
+//! current view, and the error heat-map against the ray-traced reference, traced on
+//! a worker thread with its progress reported.
+
+use std::sync::{
+    Arc,
+    atomic::{AtomicU64, Ordering},
+    mpsc,
+};
+
+use gnomon_reference::{
+    ReferenceOptions, TracedScene, aliasing,
+    aliasing::{AliasingImage, AliasingInput},
+    heatmap, metrics,
+    metrics::RasterView,
+    reference_visibility,
+};
+use gnomon_render::Frame;
+use gnomon_scene::{Scene, Settings, settings::CascadeSelection};
+
+/// Lloyd's m over `frame`, with the cascade selection of `settings`.
+pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
+    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
+    aliasing::measure(&AliasingInput {
+        width: frame.width,
+        height: frame.height,
+        position: &frame.position,
+        normal: &frame.normal,
+        depth: &frame.depth,
+        camera: &frame.camera,
+        light: &frame.light,
+        layers: &layers,
+        splits: &frame.cascade_splits,
+        select_by_projection: settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
+        resolution: frame.shadow_resolution,
+    })
+}
+
+/// An RGBA8 picture with a one-line summary of what it shows.
+#[derive(Clone, Debug)]
+pub struct Picture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+    pub summary: String,
+    /// The settings it was made with, to tell when it no longer matches the view.
+    pub settings: Settings,
+}
+
+/// The texel-density heat-map of `frame`.
+pub fn texel_density(frame: &Frame, settings: &Settings) -> Picture {
+    let m = measure_aliasing(frame, settings);
+    Picture {
+        width: frame.width,
+        height: frame.height,
+        rgba: aliasing::heatmap(&m),
+        summary: format!(
+            "texel density m: mean {:.2}, max {:.1} pixels per texel (blue 1/16, green 1, red 16)",
+            m.mean, m.max
+        ),
+        settings: settings.clone(),
+    }
+}
+
+/// A reference being traced for one view.
+pub struct ErrorJob {
+    rows_done: Arc<AtomicU64>,
+    rows: u64,
+    result: mpsc::Receiver<Picture>,
+}
+
+impl ErrorJob {
+    /// Starts tracing the reference for the view of `frame` (rendered with `settings`).
+    pub fn start(scene: &Scene, frame: Frame, settings: Settings) -> Self {
+        let rows_done = Arc::new(AtomicU64::new(0));
+        let (sender, result) = mpsc::channel();
+        let rows = frame.height as u64;
+        let scene = scene.clone();
+        let counter = rows_done.clone();
+        std::thread::spawn(move || {
+            let traced = TracedScene::build(&scene);
+            let options = ReferenceOptions {
+                width: frame.width,
+                height: frame.height,
+                samples: settings.reference.samples,
+            };
+            let reference = reference_visibility(&traced, &frame.camera, &frame.light, &options, &|done| {
+                counter.store(done, Ordering::Relaxed)
+            });
+            let raster = RasterView {
+                visibility: &frame.visibility,
+                object_id: &frame.object_id,
+                depth: &frame.depth,
+            };
+            let classes = metrics::classify(raster, &reference);
+            let measured = metrics::measure(raster, &reference, &classes);
+            // An area light's reference is fractional: compare the penumbrae.
+            let (rgba, summary) = if reference.samples > 1 {
+                (
+                    heatmap::soft(&frame.visibility, &reference, &classes),
+                    format!(
+                        "error against a {}-sample reference: MAE {:.4}, p99 {:.3} (|V − R|, black 0 to red 1)",
+                        reference.samples, measured.mae, measured.p99
+                    ),
+                )
+            } else {
+                (
+                    heatmap::hard(&frame.visibility, &reference, &classes),
+                    format!(
+                        "error against the exact reference: {:.3} % wrong (red wrongly shadowed {:.3} %, \
+                         blue wrongly lit {:.3} %)",
+                        100.0 * measured.mismatch_rate,
+                        100.0 * measured.false_shadow_rate,
+                        100.0 * measured.false_lit_rate
+                    ),
+                )
+            };
+            let _ =
+                sender.send(Picture { width: frame.width, height: frame.height, rgba, summary, settings });
+        });
+        Self { rows_done, rows, result }
+    }
+
+    /// The fraction of rows traced.
+    pub fn progress(&self) -> f32 {
+        self.rows_done.load(Ordering::Relaxed) as f32 / self.rows.max(1) as f32
+    }
+
+    /// The heat-map, once it is ready; `Err` if the worker died.
+    pub fn poll(&self) -> Option<Result<Picture, String>> {
+        match self.result.try_recv() {
+            Ok(picture) => Some(Ok(picture)),
+            Err(mpsc::TryRecvError::Empty) => None,
+            Err(mpsc::TryRecvError::Disconnected) => Some(Err("the reference worker stopped".into())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use gnomon_render::{Gpu, OutputRequest, Renderer};
+    use gnomon_scene::builtin;
+
+    use super::*;
+
+    fn finish(job: ErrorJob) -> Picture {
+        let started = std::time::Instant::now();
+        loop {
+            if let Some(result) = job.poll() {
+                assert!((job.progress() - 1.0).abs() < 1e-6, "progress ended at {}", job.progress());
+                return result.unwrap();
+            }
+            assert!(started.elapsed().as_secs() < 300, "the reference took over 5 minutes");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    }
+
+    /// Pixels painted as wrongly shadowed or wrongly lit.
+    fn wrong(picture: &Picture) -> usize {
+        picture
+            .rgba
+            .chunks_exact(4)
+            .filter(|p| p[..3] == heatmap::FALSE_SHADOW || p[..3] == heatmap::FALSE_LIT)
+            .count()
+    }
+
+    /// The heat-map marks few pixels on a good render and most on a render whose
+    /// shadows were turned inside out.
+    #[test]
+    fn the_error_view_marks_where_the_shadows_are_wrong() {
+        let gpu = Gpu::new_headless().unwrap();
+        let mut renderer = Renderer::new(&gpu).unwrap();
+        let scene = builtin::spheres();
+        let mut settings = Settings::default();
+        (settings.image.width, settings.image.height) = (128, 72);
+        let frame = renderer.render(&scene, &settings, &OutputRequest::default()).unwrap();
+        let surface = frame.object_id.iter().filter(|&&id| id != 0).count();
+        let good = finish(ErrorJob::start(&scene, frame.clone(), settings.clone()));
+        assert_eq!(good.rgba.len(), 128 * 72 * 4);
+        assert!(good.summary.contains("% wrong"), "{}", good.summary);
+        let mut inverted = frame;
+        for v in inverted.visibility.iter_mut().filter(|v| !v.is_nan()) {
+            *v = 1.0 - *v;
+        }
+        let bad = finish(ErrorJob::start(&scene, inverted, settings));
+        let (good, bad) = (wrong(&good), wrong(&bad));
+        assert!(good * 50 < surface, "{good} of {surface} surface pixels marked wrong on a good render");
+        assert!(
+            bad * 10 > surface * 8,
+            "only {bad} of {surface} surface pixels marked on an inverted render"
+        );
+    }
+}

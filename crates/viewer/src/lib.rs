@@ -1,0 +1,113 @@
+//! `gnomon view`: an interactive window (winit + egui on wgpu) where every technique
+//! and setting is live. The settings panel is generated from the same [`Settings`]
+//! structure as the CLI's flags ([`settings_form`]); debug views show the shadow maps,
+//! cascades, texel density and the error against the ray-traced reference; any view
+//! can be copied out as a `gnomon render` command or saved as a scene file.
+//!
+//! The window runs headless under Xvfb on lavapipe too, which is how it is tested:
+//! [`ViewerOptions::script`] drives it through the same [`Action`]s the panel sends.
+
+pub mod camera_rig;
+mod debug_views;
+mod reproduce;
+pub mod settings_form;
+mod ui;
+mod window;
+
+use std::path::PathBuf;
+
+use gnomon_scene::{Scene, Settings};
+
+pub use debug_views::measure_aliasing;
+pub use reproduce::{SceneSource, scene_file_text};
+
+/// What the viewer opens and how it runs.
+pub struct ViewerOptions {
+    pub scene: Scene,
+    /// The settings to start from.
+    pub settings: Settings,
+    /// What the scene alone gives (its scene file's `[settings]`, or the defaults):
+    /// "copy as CLI command" writes the flags that differ from these.
+    pub baseline: Settings,
+    /// Where the scene came from, to name it in commands and scene files.
+    pub source: SceneSource,
+    /// Close after this many frames.
+    pub frames: Option<u32>,
+    /// Save the window as a PNG after the last frame (with `frames`) or on close.
+    pub screenshot: Option<PathBuf>,
+    /// Start with the settings panel hidden (F1 toggles it).
+    pub hide_panel: bool,
+    /// Start with the shadow-map preview open.
+    pub show_maps: bool,
+    /// Actions to take at given frames, as if sent by the panel: automation and tests.
+    pub script: Vec<(u32, Action)>,
+    /// The window's inner size in logical pixels.
+    pub window_size: [u32; 2],
+}
+
+impl ViewerOptions {
+    /// A viewer on `scene` with `settings`, interactive, with every option at rest.
+    pub fn new(scene: Scene, settings: Settings, source: SceneSource) -> Self {
+        Self {
+            scene,
+            baseline: Settings::default(),
+            settings,
+            source,
+            frames: None,
+            screenshot: None,
+            hide_panel: false,
+            show_maps: false,
+            script: Vec::new(),
+            window_size: [1400, 860],
+        }
+    }
+}
+
+/// Something the panel (or a script) asks of the viewer.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// Set the setting with clap id `id` to `value`, written as after its flag
+    /// (`None` gives an optional setting back to the scene).
+    Set { id: String, value: Option<String> },
+    /// Save the window as a PNG.
+    Screenshot(PathBuf),
+    /// Put the `gnomon render` command for this view on the clipboard.
+    CopyCommand,
+    /// Save the view as a scene file.
+    SaveSceneFile(PathBuf),
+    /// Trace the reference for this view and show the error heat-map.
+    CompareWithReference,
+    /// Choose what the central view shows.
+    Show(View),
+}
+
+/// What the central view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// The lit image (with `--debug-view cascades`, tinted by cascade).
+    Lit,
+    /// Lloyd's m: screen pixels per shadow texel.
+    TexelDensity,
+    /// The last comparison with the reference.
+    Error,
+}
+
+/// What a run did, for scripts and tests.
+#[derive(Debug, Default)]
+pub struct RunReport {
+    pub frames: u32,
+    /// Screenshots written, in order.
+    pub screenshots: Vec<PathBuf>,
+    /// The settings at the end.
+    pub settings: Settings,
+    /// Messages the viewer showed in its status line (errors included).
+    pub messages: Vec<String>,
+    /// Where the scene's view sat in the window at the end: x, y, width, height in
+    /// physical pixels (screenshots are the whole window).
+    pub view_rect: [u32; 4],
+}
+
+/// Opens the window and runs until it is closed (or `frames` have been drawn).
+pub fn run(options: ViewerOptions) -> anyhow::Result<RunReport> {
+    window::run(options)
+}

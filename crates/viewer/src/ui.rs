@@ -1,0 +1,625 @@
+//! The viewer's panels, drawn with egui: the settings panel generated from
+//! [`SettingsForm`], the light and time-of-day controls, the debug views, GPU timings
+//! and the buttons that reproduce a view. Everything they change is sent as an
+//! [`Action`]; nothing here touches the GPU.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use egui::{Color32, RichText};
+use glam::Vec3;
+use gnomon_math::solar;
+use gnomon_render::{LightStats, PassTimings};
+use gnomon_scene::{Light, Scene, Settings};
+
+use crate::{
+    Action, View,
+    camera_rig::{CameraMode, CameraRig},
+    debug_views::{ErrorJob, Picture},
+    reproduce::SceneSource,
+    settings_form::{FieldKind, SettingsForm},
+};
+
+/// Frames of GPU timings averaged in the timings table.
+const TIMING_WINDOW: usize = 30;
+
+/// The state behind the panels: the settings and everything the user chose.
+pub(crate) struct Model {
+    pub form: SettingsForm,
+    pub settings: Settings,
+    pub baseline: Settings,
+    pub source: SceneSource,
+    pub scene: Scene,
+    pub rig: CameraRig,
+    pub view: View,
+    pub show_panel: bool,
+    pub show_maps: bool,
+    /// Status lines, newest last.
+    pub messages: Vec<String>,
+    /// Text being typed into the text fields, by field id, until Enter.
+    drafts: BTreeMap<String, String>,
+    /// GPU timings of the last frames, and the last frame's lights.
+    pub timings: VecDeque<PassTimings>,
+    pub lights: Vec<LightStats>,
+    /// Size of the central view in physical pixels: the render's size.
+    pub view_size: [u32; 2],
+    /// Where the central view sits in the window: x, y, width, height in physical pixels.
+    pub view_rect: [u32; 4],
+    pub save_path: String,
+    pub time_of_day: TimeOfDay,
+    pub density: Option<Picture>,
+    pub error_job: Option<ErrorJob>,
+    pub error: Option<Picture>,
+    /// Actions the panels sent this frame, for the window to carry out.
+    pub pending: Vec<Action>,
+}
+
+/// The sun's clock: hour of local solar time, latitude and day of the year.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TimeOfDay {
+    pub hour: f32,
+    pub latitude: f32,
+    pub day: f32,
+}
+
+/// Textures the window made for this frame, as egui shows them.
+#[derive(Default)]
+pub(crate) struct Images {
+    pub view: Option<(egui::TextureId, [u32; 2])>,
+    pub maps: Option<(egui::TextureId, [u32; 2])>,
+    pub density: Option<egui::TextureHandle>,
+    pub error: Option<egui::TextureHandle>,
+}
+
+impl Model {
+    pub fn new(
+        scene: Scene,
+        settings: Settings,
+        baseline: Settings,
+        source: SceneSource,
+        show_panel: bool,
+    ) -> anyhow::Result<Self> {
+        let camera = settings.resolve_camera(&scene)?;
+        Ok(Self {
+            form: SettingsForm::new(),
+            rig: CameraRig::looking(camera.eye, camera.target),
+            settings,
+            baseline,
+            source,
+            scene,
+            view: View::Lit,
+            show_panel,
+            show_maps: false,
+            messages: Vec::new(),
+            drafts: BTreeMap::new(),
+            timings: VecDeque::new(),
+            lights: Vec::new(),
+            view_size: [960, 720],
+            view_rect: [0, 0, 960, 720],
+            save_path: "view.toml".into(),
+            time_of_day: TimeOfDay { hour: 15.0, latitude: 45.0, day: 172.0 },
+            density: None,
+            error_job: None,
+            error: None,
+            pending: Vec::new(),
+        })
+    }
+
+    /// The settings a frame is rendered with: the panel's, with the rig's camera and
+    /// the view's size.
+    pub fn frame_settings(&self) -> Settings {
+        let mut s = self.settings.clone();
+        s.camera.eye = Some(self.rig.eye());
+        s.camera.target = Some(self.rig.target);
+        s.image.width = self.view_size[0].max(16);
+        s.image.height = self.view_size[1].max(16);
+        s
+    }
+
+    pub fn say(&mut self, message: impl Into<String>) {
+        let message = message.into();
+        eprintln!("gnomon view: {message}");
+        self.messages.push(message);
+    }
+
+    /// Sets one setting through the form, as its flag would on the command line;
+    /// a refused value is reported and changes nothing.
+    pub fn set(&mut self, id: &str, value: Option<&str>) {
+        match self.form.set(&self.settings, id, value) {
+            Ok(settings) => {
+                if id == "eye" || id == "target" {
+                    let camera = settings.resolve_camera(&self.scene);
+                    if let Ok(camera) = camera {
+                        let mode = self.rig.mode;
+                        self.rig = CameraRig::looking(camera.eye, camera.target);
+                        self.rig.mode = mode;
+                    }
+                }
+                self.settings = settings;
+            }
+            Err(e) => self.say(e),
+        }
+    }
+
+    /// Turns or moves the light by a drag of (dx, dy) pixels: the sun's azimuth and
+    /// elevation, or a spot or point light across the view.
+    pub fn drag_light(&mut self, dx: f32, dy: f32) {
+        let light = match self.settings.resolve_light(&self.scene) {
+            Ok(light) => light,
+            Err(e) => return self.say(e.to_string()),
+        };
+        let (right, up) = self.rig.right_up();
+        let world_per_pixel = self.rig.distance() / self.view_size[1].max(1) as f32;
+        let moved = |p: Vec3| p + (right * dx - up * dy) * world_per_pixel;
+        let xyz = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
+        match light {
+            Light::Directional(sun) => {
+                let to_sun = -sun.direction;
+                let elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
+                let azimuth = to_sun.x.atan2(to_sun.z).to_degrees();
+                let azimuth = (azimuth + 0.4 * dx).rem_euclid(360.0);
+                let elevation = (elevation - 0.3 * dy).clamp(1.0, 90.0);
+                self.set("sun_azimuth", Some(&azimuth.to_string()));
+                self.set("sun_elevation", Some(&elevation.to_string()));
+            }
+            Light::Spot(spot) => self.set("spot_position", Some(&xyz(moved(spot.position)))),
+            Light::Point(point) => self.set("point_position", Some(&xyz(moved(point.position)))),
+        }
+    }
+
+    /// Puts the sun where the time-of-day control says.
+    fn place_sun(&mut self) {
+        let t = self.time_of_day;
+        let sun = solar::sun_position(t.hour, t.latitude, solar::declination_degrees(t.day));
+        if sun.elevation < 1.0 {
+            self.say(format!("at {:.1} h the sun is below the horizon; it stays at 1°", t.hour));
+        }
+        self.set("sun_elevation", Some(&sun.elevation.max(1.0).to_string()));
+        self.set("sun_azimuth", Some(&sun.azimuth.to_string()));
+    }
+
+    /// Draws every panel and the central view; returns the view's response, for the
+    /// camera and light drags.
+    pub fn ui(&mut self, ui: &mut egui::Ui, images: &Images) {
+        egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        if self.show_panel {
+            egui::Panel::left("settings").default_size(340.0).resizable(true).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.settings_panel(ui));
+            });
+            egui::Panel::right("inspect").default_size(300.0).resizable(true).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.inspect_panel(ui, images));
+            });
+        }
+        egui::CentralPanel::default().frame(egui::Frame::NONE).show(ui, |ui| self.central_view(ui, images));
+    }
+
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let mode = match self.rig.mode {
+                CameraMode::Orbit => "orbit",
+                CameraMode::Fly => "fly",
+            };
+            ui.label(format!(
+                "camera: {mode} (C switches) · left drag turns · right drag moves the light · middle drag pans · \
+                 scroll zooms{} · F1 panels · F12 screenshot",
+                if self.rig.mode == CameraMode::Fly { " · W A S D Q E fly" } else { "" }
+            ));
+        });
+        // Always two lines, so that a message does not resize the view.
+        let last = self.messages.last().map_or("", String::as_str);
+        ui.label(RichText::new(last).color(Color32::from_rgb(240, 200, 120)));
+    }
+
+    /// The settings panel: one widget per flag, grouped by `--help` heading.
+    fn settings_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Settings");
+        ui.label("Every control is a `gnomon render` flag; hover for its help.");
+        let values = self.form.values(&self.settings);
+        let mut edits: Vec<(String, Option<String>)> = Vec::new();
+        let mut headings: Vec<String> = Vec::new();
+        for field in self.form.fields() {
+            if !headings.contains(&field.heading) {
+                headings.push(field.heading.clone());
+            }
+        }
+        for heading in &headings {
+            let open = matches!(heading.as_str(), "Shadow filter" | "Shadow bias" | "Shadow map" | "Light");
+            egui::CollapsingHeader::new(heading).default_open(open).show(ui, |ui| {
+                egui::Grid::new(heading).num_columns(2).striped(true).show(ui, |ui| {
+                    for field in self.form.fields().iter().filter(|f| &f.heading == heading) {
+                        let label = ui.label(&field.long).on_hover_text(&field.help);
+                        let current = values.get(&field.id).cloned();
+                        // The window decides the image size and the camera (drag it).
+                        let driven = matches!(field.id.as_str(), "width" | "height");
+                        let response = ui.add_enabled_ui(!driven, |ui| {
+                            field_widget(ui, field, current.as_deref(), &mut self.drafts, &mut edits)
+                        });
+                        let help = if driven {
+                            format!("{}\n\nIn the viewer the window's size decides it.", field.help)
+                        } else {
+                            field.help.clone()
+                        };
+                        response.response.on_hover_text(help);
+                        let _ = label;
+                        ui.end_row();
+                    }
+                });
+            });
+        }
+        for (id, value) in edits {
+            self.pending.push(Action::Set { id, value });
+        }
+    }
+
+    /// The light, the debug views, the GPU timings and the reproduction buttons.
+    fn inspect_panel(&mut self, ui: &mut egui::Ui, images: &Images) {
+        ui.heading("Light");
+        let light = self.settings.resolve_light(&self.scene).ok();
+        self.light_sliders(ui, light);
+        if matches!(light, Some(Light::Directional(_))) {
+            let mut t = self.time_of_day;
+            let mut changed = false;
+            changed |= ui
+                .add(egui::Slider::new(&mut t.hour, 4.0..=20.0).text("time of day (h)"))
+                .on_hover_text("Local solar time; the sun follows its path across the sky.")
+                .changed();
+            changed |= ui
+                .add(egui::Slider::new(&mut t.latitude, -66.0..=66.0).text("latitude (°)"))
+                .on_hover_text("North positive. Scenes put north at +z and east at +x.")
+                .changed();
+            changed |= ui
+                .add(egui::Slider::new(&mut t.day, 1.0..=365.0).text("day of year"))
+                .on_hover_text("Sets the sun's declination: 172 is midsummer in the north.")
+                .changed();
+            self.time_of_day = t;
+            if changed {
+                self.place_sun();
+            }
+        }
+        ui.label(
+            "Right-drag in the view to move the light; the Light section of the settings sets it exactly.",
+        );
+
+        ui.separator();
+        ui.heading("Debug views");
+        let mut view = self.view;
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut view, View::Lit, "lit")
+                .on_hover_text("The lit image. Settings › Image › debug-view cascades tints it by cascade.");
+            ui.selectable_value(&mut view, View::TexelDensity, "texel density").on_hover_text(
+                "Lloyd's m: how many screen pixels one shadow texel spans, blue (1/16) to green (1) to red (16).",
+            );
+            ui.selectable_value(&mut view, View::Error, "error").on_hover_text(
+                "The shadow factor against the ray-traced reference for this view (Compare to compute it).",
+            );
+        });
+        if view != self.view {
+            self.pending.push(Action::Show(view));
+        }
+        let cascades = self.settings.image.debug_view == gnomon_scene::settings::DebugView::Cascades;
+        let mut tint = cascades;
+        if ui.checkbox(&mut tint, "cascade colours").on_hover_text("--debug-view cascades").changed() {
+            self.pending.push(Action::Set {
+                id: "debug_view".into(),
+                value: Some(if tint { "cascades" } else { "none" }.into()),
+            });
+        }
+        ui.checkbox(&mut self.show_maps, "shadow maps").on_hover_text(
+            "The reported light's depth map, every cascade (or cube face) side by side; near is black.",
+        );
+        if self.show_maps
+            && let Some((id, [w, h])) = images.maps
+        {
+            let width = ui.available_width();
+            ui.image((id, egui::vec2(width, width * h as f32 / w as f32)));
+        }
+        match &self.error_job {
+            Some(job) => {
+                ui.add(
+                    egui::ProgressBar::new(job.progress()).show_percentage().text("tracing the reference"),
+                );
+            }
+            None => {
+                if ui
+                    .button("Compare with the reference")
+                    .on_hover_text(
+                        "Ray-trace the ground truth for this view and show where the shadows are wrong.",
+                    )
+                    .clicked()
+                {
+                    self.pending.push(Action::CompareWithReference);
+                }
+            }
+        }
+        if let Some(error) = &self.error {
+            let stale = error.settings != self.frame_settings();
+            ui.label(&error.summary);
+            if stale {
+                ui.label(RichText::new("(for an earlier view)").weak());
+            }
+        }
+
+        ui.separator();
+        ui.heading("GPU time");
+        self.timings_table(ui);
+
+        ui.separator();
+        ui.heading("Reproduce");
+        if ui
+            .button("Copy as CLI command")
+            .on_hover_text("A `gnomon render` command for this view.")
+            .clicked()
+        {
+            self.pending.push(Action::CopyCommand);
+        }
+        ui.horizontal(|ui| {
+            ui.text_edit_singleline(&mut self.save_path);
+            if ui
+                .button("Save as scene file")
+                .on_hover_text("The scene, the camera and every setting.")
+                .clicked()
+            {
+                self.pending.push(Action::SaveSceneFile(self.save_path.clone().into()));
+            }
+        });
+    }
+
+    /// Sliders for the light: a sun's elevation and azimuth, or a spot or point
+    /// light's position; each sends its setting's flag.
+    fn light_sliders(&mut self, ui: &mut egui::Ui, light: Option<Light>) {
+        let xyz = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
+        match light {
+            Some(Light::Directional(sun)) => {
+                let to_sun = -sun.direction;
+                let mut elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
+                let mut azimuth = to_sun.x.atan2(to_sun.z).to_degrees().rem_euclid(360.0);
+                if ui.add(egui::Slider::new(&mut elevation, 1.0..=90.0).text("sun elevation (°)")).changed()
+                {
+                    self.pending
+                        .push(Action::Set { id: "sun_elevation".into(), value: Some(elevation.to_string()) });
+                }
+                if ui.add(egui::Slider::new(&mut azimuth, 0.0..=360.0).text("sun azimuth (°)")).changed() {
+                    self.pending
+                        .push(Action::Set { id: "sun_azimuth".into(), value: Some(azimuth.to_string()) });
+                }
+            }
+            Some(Light::Spot(spot)) => {
+                let mut p = spot.position;
+                if vec3_drag(ui, "spot position", &mut p, self.rig.distance()) {
+                    self.pending.push(Action::Set { id: "spot_position".into(), value: Some(xyz(p)) });
+                }
+            }
+            Some(Light::Point(point)) => {
+                let mut p = point.position;
+                if vec3_drag(ui, "point position", &mut p, self.rig.distance()) {
+                    self.pending.push(Action::Set { id: "point_position".into(), value: Some(xyz(p)) });
+                }
+            }
+            None => {}
+        }
+    }
+
+    fn timings_table(&self, ui: &mut egui::Ui) {
+        let Some(last) = self.timings.back() else {
+            ui.label("This device has no timestamp queries.");
+            return;
+        };
+        let n = self.timings.len() as f64;
+        let mean = |f: fn(&PassTimings) -> Option<f64>| -> Option<f64> {
+            let values: Vec<f64> = self.timings.iter().filter_map(f).collect();
+            (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+        };
+        egui::Grid::new("timings").num_columns(2).striped(true).show(ui, |ui| {
+            let rows: [(&str, Option<f64>); 6] = [
+                ("shadow maps", mean(|t| Some(t.shadow_ms))),
+                ("moment filtering", mean(|t| t.filter_ms)),
+                ("depth prepass", mean(|t| t.prepass_ms)),
+                ("shadow mask", mean(|t| t.mask_ms)),
+                ("lighting", mean(|t| Some(t.lighting_ms))),
+                ("frame", mean(|t| Some(t.frame_ms))),
+            ];
+            for (name, ms) in rows {
+                if let Some(ms) = ms {
+                    ui.label(name);
+                    ui.label(format!("{ms:.2} ms"));
+                    ui.end_row();
+                }
+            }
+        });
+        ui.label(
+            RichText::new(format!("mean of the last {n} frames; last frame {:.2} ms", last.frame_ms)).weak(),
+        );
+        if self.lights.len() > 1 {
+            for light in &self.lights {
+                ui.label(format!(
+                    "{} ({}, {}): shadow {:.2} ms, lighting {:.2} ms",
+                    light.name,
+                    light.kind,
+                    light.technique.name(),
+                    light.shadow_ms.unwrap_or(f64::NAN),
+                    light.lighting_ms.unwrap_or(f64::NAN)
+                ));
+            }
+        }
+    }
+
+    pub fn record_timings(&mut self, timings: Option<PassTimings>, lights: Vec<LightStats>) {
+        if let Some(t) = timings {
+            self.timings.push_back(t);
+            while self.timings.len() > TIMING_WINDOW {
+                self.timings.pop_front();
+            }
+        }
+        self.lights = lights;
+    }
+
+    /// The central view: the image, taking the camera and light drags.
+    fn central_view(&mut self, ui: &mut egui::Ui, images: &Images) {
+        let rect = ui.available_rect_before_wrap();
+        let ppp = ui.ctx().pixels_per_point();
+        self.view_size = [(rect.width() * ppp).round() as u32, (rect.height() * ppp).round() as u32];
+        let [x, y] = [(rect.left() * ppp).round() as u32, (rect.top() * ppp).round() as u32];
+        self.view_rect = [x, y, self.view_size[0], self.view_size[1]];
+        let picture = match self.view {
+            View::Lit => images.view.map(|(id, _)| id),
+            View::TexelDensity => images.density.as_ref().map(|t| t.id()),
+            View::Error => images.error.as_ref().map(|t| t.id()).or(images.view.map(|(id, _)| id)),
+        };
+        let response = match picture {
+            Some(id) => ui.add(egui::Image::new((id, rect.size())).sense(egui::Sense::click_and_drag())),
+            None => ui.allocate_rect(rect, egui::Sense::click_and_drag()),
+        };
+        let caption = match self.view {
+            View::Lit => None,
+            View::TexelDensity => self.density.as_ref().map(|p| p.summary.clone()),
+            View::Error if self.error.is_none() => {
+                Some("no comparison yet: press Compare with the reference".into())
+            }
+            View::Error => self.error.as_ref().map(|p| p.summary.clone()),
+        };
+        if let Some(caption) = caption {
+            ui.painter().text(
+                rect.left_top() + egui::vec2(8.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                caption,
+                egui::FontId::proportional(14.0),
+                Color32::WHITE,
+            );
+        }
+        let delta = response.drag_delta() * ppp;
+        if response.dragged_by(egui::PointerButton::Primary) {
+            self.rig.turn(delta.x, delta.y);
+        } else if response.dragged_by(egui::PointerButton::Secondary) {
+            self.drag_light(delta.x, delta.y);
+        } else if response.dragged_by(egui::PointerButton::Middle) {
+            let fov = self.settings.resolve_camera(&self.scene).map(|c| c.fov_y_degrees).unwrap_or(45.0);
+            self.rig.pan(delta.x, delta.y, fov.to_radians(), self.view_size[1] as f32);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                match self.rig.mode {
+                    CameraMode::Orbit => self.rig.zoom(scroll / 50.0),
+                    CameraMode::Fly => self.rig.fly(scroll / 50.0 * 0.1 * self.rig.distance(), 0.0, 0.0),
+                }
+            }
+        }
+        if !ui.ctx().egui_wants_keyboard_input() {
+            self.keys(ui);
+        }
+    }
+
+    fn keys(&mut self, ui: &mut egui::Ui) {
+        let (dt, pressed) = ui.input(|i| {
+            let held = |k| if i.key_down(k) { 1.0 } else { 0.0 };
+            let axes = [
+                held(egui::Key::W) - held(egui::Key::S),
+                held(egui::Key::D) - held(egui::Key::A),
+                held(egui::Key::E) - held(egui::Key::Q),
+            ];
+            (
+                (i.stable_dt.min(0.25), axes),
+                [i.key_pressed(egui::Key::C), i.key_pressed(egui::Key::F1), i.key_pressed(egui::Key::F12)],
+            )
+        });
+        let (dt, [forward, right, up]) = dt;
+        if self.rig.mode == CameraMode::Fly && (forward != 0.0 || right != 0.0 || up != 0.0) {
+            // Half the scene's size a second.
+            let speed = 0.5 * self.scene.bounds().bounding_radius().max(1e-3) * dt;
+            self.rig.fly(forward * speed, right * speed, up * speed);
+        }
+        let [camera, panel, screenshot] = pressed;
+        if camera {
+            self.rig.mode = match self.rig.mode {
+                CameraMode::Orbit => CameraMode::Fly,
+                CameraMode::Fly => CameraMode::Orbit,
+            };
+        }
+        if panel {
+            self.show_panel = !self.show_panel;
+        }
+        if screenshot {
+            let name = format!(
+                "gnomon-view-{}-{}.png",
+                self.settings.shadow.filter.technique.name(),
+                std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map(|d| d.as_secs())
+                    .unwrap_or_default()
+            );
+            self.pending.push(Action::Screenshot(name.into()));
+        }
+    }
+}
+
+/// Three drag values for a position; true when one changed.
+fn vec3_drag(ui: &mut egui::Ui, label: &str, p: &mut Vec3, scale: f32) -> bool {
+    let speed = (scale * 0.005).max(1e-3);
+    ui.horizontal(|ui| {
+        let mut changed = false;
+        for v in [&mut p.x, &mut p.y, &mut p.z] {
+            changed |= ui.add(egui::DragValue::new(v).speed(speed).max_decimals(3)).changed();
+        }
+        ui.label(label);
+        changed
+    })
+    .inner
+}
+
+/// One field's widget; an edit is pushed onto `edits` as flag text.
+fn field_widget(
+    ui: &mut egui::Ui,
+    field: &crate::settings_form::Field,
+    current: Option<&str>,
+    drafts: &mut BTreeMap<String, String>,
+    edits: &mut Vec<(String, Option<String>)>,
+) {
+    let id = field.id.clone();
+    match (&field.kind, current) {
+        (FieldKind::Choice(choices), Some(value)) => {
+            let mut chosen = value.to_string();
+            egui::ComboBox::from_id_salt(&id).selected_text(&chosen).show_ui(ui, |ui| {
+                for (name, help) in choices {
+                    ui.selectable_value(&mut chosen, name.clone(), name).on_hover_text(help);
+                }
+            });
+            if chosen != value {
+                edits.push((id, Some(chosen)));
+            }
+        }
+        (FieldKind::Flag | FieldKind::Bool, Some(value)) => {
+            let mut on = value == "true";
+            if ui.checkbox(&mut on, "").changed() {
+                edits.push((id, Some(on.to_string())));
+            }
+        }
+        (FieldKind::Integer, Some(value)) if !field.optional => {
+            let mut n: i64 = value.parse().unwrap_or_default();
+            let speed = (n.abs() as f64 * 0.02).max(0.05);
+            if ui.add(egui::DragValue::new(&mut n).speed(speed)).changed() {
+                edits.push((id, Some(n.to_string())));
+            }
+        }
+        (FieldKind::Float, Some(value)) if !field.optional => {
+            let mut x: f32 = value.parse().unwrap_or_default();
+            let speed = (x.abs() * 0.01).max(1e-3);
+            if ui.add(egui::DragValue::new(&mut x).speed(speed).max_decimals(4)).changed() {
+                edits.push((id, Some(x.to_string())));
+            }
+        }
+        _ => {
+            // Text: vectors, and the optional fields (empty gives them back to the scene).
+            let draft = drafts.entry(id.clone()).or_insert_with(|| current.unwrap_or_default().to_string());
+            let hint = if field.optional { "the scene's" } else { "" };
+            let response = ui.add(egui::TextEdit::singleline(draft).hint_text(hint).desired_width(140.0));
+            if response.lost_focus() {
+                let text = draft.trim().to_string();
+                if Some(text.as_str()) != current && !(text.is_empty() && current.is_none()) {
+                    edits.push((id.clone(), (!text.is_empty()).then_some(text)));
+                }
+                drafts.remove(&id);
+            } else if !response.has_focus() {
+                *draft = current.unwrap_or_default().to_string();
+            }
+        }
+    }
+}

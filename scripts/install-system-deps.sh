@@ -1,0 +1,44 @@
+#!/bin/sh
+# Installs the system packages Gnomon needs, where they are missing (Debian/Ubuntu):
+# - a Vulkan driver: on a machine without a GPU, Mesa's CPU driver lavapipe
+#   (mesa-vulkan-drivers);
+# - with --tests, an X server for the viewer's window test when there is no display
+#   (xvfb, whose xvfb-run the test starts itself).
+# Does nothing when everything is already there.
+set -eu
+
+want_tests=no
+[ "${1:-}" = "--tests" ] && want_tests=yes
+
+have_icd=no
+for f in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json; do
+    [ -e "$f" ] && have_icd=yes
+done
+have_loader=no
+for f in /usr/lib/*/libvulkan.so.1 /usr/lib/libvulkan.so.1 /usr/lib64/libvulkan.so.1; do
+    [ -e "$f" ] && have_loader=yes
+done
+
+packages=""
+if [ "$have_icd" = no ] || [ "$have_loader" = no ]; then
+    echo "install-system-deps: no Vulkan driver found; installing lavapipe (mesa-vulkan-drivers)" >&2
+    packages="mesa-vulkan-drivers libvulkan1"
+fi
+if [ "$want_tests" = yes ] && ! command -v xvfb-run >/dev/null 2>&1; then
+    echo "install-system-deps: no xvfb-run; installing xvfb for the viewer's window test" >&2
+    packages="$packages xvfb xauth"
+fi
+[ -z "$packages" ] && exit 0
+
+if ! command -v apt-get >/dev/null 2>&1; then
+    echo "install-system-deps: missing $packages and no apt-get; install your platform's Vulkan driver (on Mesa systems: lavapipe) and, for the tests, an X server such as Xvfb" >&2
+    exit 1
+fi
+
+SUDO=""
+if [ "$(id -u)" != "0" ]; then
+    SUDO="sudo"
+fi
+$SUDO apt-get update -qq
+# shellcheck disable=SC2086 # the package list is meant to split
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $packages >/dev/null
