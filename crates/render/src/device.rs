@@ -51,12 +51,8 @@ impl Gpu {
     /// Like [`Gpu::new_headless`], letting `adjust` lower the limits asked for.
     pub fn new_headless_with(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let backends = match std::env::var("WGPU_BACKEND") {
-            Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
-            Err(_) => String::new(),
-        };
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
-            .map_err(|_| RenderError::NoAdapter { backends })?;
+            .map_err(|_| RenderError::no_adapter())?;
         Self::with_adapter(&adapter, adjust)
     }
 
@@ -117,5 +113,16 @@ impl Gpu {
             Some(message) => Err(RenderError::Gpu { during, message }),
             None => Ok(value),
         }
+    }
+}
+
+impl RenderError {
+    /// No adapter could be found, naming the `WGPU_BACKEND` choice that limited the search.
+    pub fn no_adapter() -> Self {
+        let backends = match std::env::var("WGPU_BACKEND") {
+            Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
+            Err(_) => String::new(),
+        };
+        RenderError::NoAdapter { backends }
     }
 }

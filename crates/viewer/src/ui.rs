@@ -177,8 +177,7 @@ impl Model {
         self.set("sun_azimuth", Some(&sun.azimuth.to_string()));
     }
 
-    /// Draws every panel and the central view; returns the view's response, for the
-    /// camera and light drags.
+    /// Draws every panel and the central view, which takes the camera and light drags.
     pub fn ui(&mut self, ui: &mut egui::Ui, images: &Images) {
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
         if self.show_panel {
@@ -226,7 +225,7 @@ impl Model {
             egui::CollapsingHeader::new(heading).default_open(open).show(ui, |ui| {
                 egui::Grid::new(heading).num_columns(2).striped(true).show(ui, |ui| {
                     for field in self.form.fields().iter().filter(|f| &f.heading == heading) {
-                        let label = ui.label(&field.long).on_hover_text(&field.help);
+                        ui.label(&field.long).on_hover_text(&field.help);
                         let current = values.get(&field.id).cloned();
                         // The window decides the image size and the camera (drag it).
                         let driven = matches!(field.id.as_str(), "width" | "height");
@@ -239,7 +238,6 @@ impl Model {
                             field.help.clone()
                         };
                         response.response.on_hover_text(help);
-                        let _ = label;
                         ui.end_row();
                     }
                 });

@@ -120,13 +120,9 @@ impl App {
         ));
         let surface =
             instance.create_surface(window.clone()).context("cannot create a surface for the window")?;
-        let backends = match std::env::var("WGPU_BACKEND") {
-            Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
-            Err(_) => String::new(),
-        };
         let adapter =
             pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, Some(&surface)))
-                .map_err(|_| RenderError::NoAdapter { backends })?;
+                .map_err(|_| RenderError::no_adapter())?;
         // The renderer borrows the device for as long as it lives, and both live as long
         // as the window: to the end of the process.
         let gpu: &'static gnomon_render::Gpu =
@@ -226,8 +222,8 @@ impl App {
 
         // The panels.
         let ctx = live.egui.egui_ctx().clone();
-        refresh_picture(&ctx, "texel density", self.model.density.as_ref(), &mut live.images.density);
-        refresh_picture(&ctx, "error", self.model.error.as_ref(), &mut live.images.error);
+        refresh_picture(&ctx, self.model.density.as_ref(), &mut live.images.density);
+        refresh_picture(&ctx, self.model.error.as_ref(), &mut live.images.error);
         let input = live.egui.take_egui_input(&live.window);
         let model = &mut self.model;
         let images = &live.images;
@@ -416,7 +412,6 @@ fn show_live_frame(live: &mut Live, frame: &LiveFrame, show_maps: bool) {
 /// Uploads a CPU picture to egui when it changed.
 fn refresh_picture(
     ctx: &egui::Context,
-    name: &str,
     picture: Option<&debug_views::Picture>,
     handle: &mut Option<egui::TextureHandle>,
 ) {
@@ -431,7 +426,6 @@ fn refresh_picture(
         // The summary names the texture, so that a new picture of the same size replaces it.
         let mut options = egui::TextureOptions::LINEAR;
         options.magnification = egui::TextureFilter::Nearest;
-        let _ = name;
         *handle = Some(ctx.load_texture(picture.summary.clone(), image, options));
     }
 }
