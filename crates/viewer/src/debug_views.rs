@@ -45,21 +45,31 @@ pub struct Picture {
     pub summary: String,
     /// The settings it was made with, to tell when it no longer matches the view.
     pub settings: Settings,
+    /// Unique to this picture: a new one replaces the texture made from the old.
+    pub id: u64,
+}
+
+impl Picture {
+    fn new(width: u32, height: u32, rgba: Vec<u8>, summary: String, settings: Settings) -> Self {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let id = NEXT.fetch_add(1, Ordering::Relaxed);
+        Self { width, height, rgba, summary, settings, id }
+    }
 }
 
 /// The texel-density heat-map of `frame`.
 pub fn texel_density(frame: &Frame, settings: &Settings) -> Picture {
     let m = measure_aliasing(frame, settings);
-    Picture {
-        width: frame.width,
-        height: frame.height,
-        rgba: aliasing::heatmap(&m),
-        summary: format!(
+    Picture::new(
+        frame.width,
+        frame.height,
+        aliasing::heatmap(&m),
+        format!(
             "texel density m: mean {:.2}, max {:.1} pixels per texel (blue 1/16, green 1, red 16)",
             m.mean, m.max
         ),
-        settings: settings.clone(),
-    }
+        settings.clone(),
+    )
 }
 
 /// A reference being traced for one view.
@@ -115,8 +125,7 @@ impl ErrorJob {
                     ),
                 )
             };
-            let _ =
-                sender.send(Picture { width: frame.width, height: frame.height, rgba, summary, settings });
+            let _ = sender.send(Picture::new(frame.width, frame.height, rgba, summary, settings));
         });
         Self { rows_done, rows, result }
     }

@@ -607,7 +607,11 @@ fn field_widget(
         _ => {
             // Text: vectors, and the optional fields (empty gives them back to the scene).
             let draft = drafts.entry(id.clone()).or_insert_with(|| current.unwrap_or_default().to_string());
-            let hint = if field.optional { "the scene's" } else { "" };
+            let hint = match (field.optional, &field.value_name) {
+                (true, Some(v)) => format!("the scene's ({v})"),
+                (true, None) => "the scene's".to_string(),
+                (false, v) => v.clone().unwrap_or_default(),
+            };
             let response = ui.add(egui::TextEdit::singleline(draft).hint_text(hint).desired_width(140.0));
             if response.lost_focus() {
                 let text = draft.trim().to_string();

@@ -420,13 +420,15 @@ fn refresh_picture(
         return;
     };
     let size = [picture.width as usize, picture.height as usize];
-    let stale = handle.as_ref().is_none_or(|h| h.size() != size || h.name() != picture.summary);
+    let name = format!("picture {}", picture.id);
+    let stale = handle.as_ref().is_none_or(|h| h.name() != name);
     if stale {
         let image = egui::ColorImage::from_rgba_unmultiplied(size, &picture.rgba);
-        // The summary names the texture, so that a new picture of the same size replaces it.
+        // Named by the picture's id: a new picture replaces the texture even when its
+        // size and summary are those of the old one.
         let mut options = egui::TextureOptions::LINEAR;
         options.magnification = egui::TextureFilter::Nearest;
-        *handle = Some(ctx.load_texture(picture.summary.clone(), image, options));
+        *handle = Some(ctx.load_texture(name, image, options));
     }
 }
 
