@@ -11,7 +11,7 @@ use gnomon_reference::{
     heatmap,
     metrics::{self, Metrics, PixelClass, RasterView},
 };
-use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer, timing::ClockChoice};
 use gnomon_scene::settings::LightKind;
 use gnomon_scene::{
     Scene, Settings,
@@ -167,7 +167,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let frame = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
         let (mut shadow, mut filter, mut lighting) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.timing_frames {
-            if let (Some(t), _) = renderer.time_passes(&uploaded, &scene, &s)? {
+            if let Some(t) = renderer.time_passes(&uploaded, &scene, &s, ClockChoice::Auto)?.timings {
                 shadow.push(t.shadow_ms);
                 filter.extend(t.filter_ms);
                 lighting.push(t.lighting_ms);

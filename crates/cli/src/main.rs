@@ -1,6 +1,7 @@
 //! `gnomon`: the command-line front end. Parses flags (generated from the typed
 //! settings in `gnomon-scene`), runs the renderer, and writes images and float outputs.
 
+mod bench_cmd;
 mod cache;
 mod compare_cmd;
 mod grid;
@@ -30,6 +31,9 @@ enum Command {
     Reference(Box<reference_cmd::ReferenceArgs>),
     /// Render techniques and the reference; write metrics, heat-maps and a grid.
     Compare(Box<compare_cmd::CompareArgs>),
+    /// Time every pass (median and p95) per technique, with optional setting sweeps
+    /// and the depth-only baseline; write bench.json and bench.md.
+    Bench(Box<bench_cmd::BenchArgs>),
     /// Open the interactive viewer: every technique and setting live, with debug views.
     View(Box<view_cmd::ViewArgs>),
     /// List the built-in scenes.
@@ -46,6 +50,7 @@ fn main() -> ExitCode {
         Some(Command::Reference(args)) => reference_cmd::run(&args),
         Some(Command::Compare(args)) => compare_cmd::run(&args),
         Some(Command::View(args)) => view_cmd::run(&args),
+        Some(Command::Bench(args)) => bench_cmd::run(&args),
         Some(Command::Scenes) => {
             for b in gnomon_scene::builtin::BUILTINS {
                 println!("{:<10} {}", b.name, b.description);

@@ -452,3 +452,76 @@ fn the_viewer_saves_a_screenshot_and_refuses_bad_input() {
     assert!(distinct.len() > 500, "a near-blank screenshot: {} colours", distinct.len());
     assert_eq!(files_in(&dir), ["shot.png"]);
 }
+
+#[test]
+fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
+    let dir = temp_dir("bench");
+    let out = gnomon(
+        &dir,
+        &[
+            "bench",
+            "spheres",
+            "--techniques",
+            "hard,vsm",
+            "--sweep",
+            "shadow-res=256,512",
+            "--partition",
+            "cascades",
+            "--cascades",
+            "2",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--size",
+            "96x64",
+            "--depth-only",
+            "--out",
+            "b",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut written = files_in(&dir.join("b"));
+    written.sort();
+    assert_eq!(written, ["bench.json", "bench.md"]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("b/bench.json")).unwrap()).unwrap();
+    assert!(!report["adapter"].as_str().unwrap().is_empty() && report["driver"].is_string());
+    assert_eq!((report["width"].as_u64(), report["height"].as_u64()), (Some(96), Some(64)));
+    let configs = report["configs"].as_array().unwrap();
+    let labels: Vec<(String, String)> = configs
+        .iter()
+        .map(|c| (c["technique"].as_str().unwrap().into(), c["sweep_value"].as_str().unwrap().into()))
+        .collect();
+    assert_eq!(labels.len(), 4, "two techniques × two resolutions: {labels:?}");
+    assert_eq!(labels[1], ("hard".to_string(), "512".to_string()));
+    for config in configs {
+        let pass =
+            |name: &str| config["passes"].as_array().unwrap().iter().find(|p| p["name"] == name).cloned();
+        for name in ["shadow", "lighting", "GPU frame", "CPU submit", "wall frame"] {
+            let p = pass(name).unwrap_or_else(|| panic!("no {name} in {config}"));
+            let (median, p95) = (p["median_ms"].as_f64().unwrap(), p["p95_ms"].as_f64().unwrap());
+            assert!(median > 0.0 && p95 >= median && p["samples"] == 3, "{name}: {p}");
+        }
+        // The filterable technique has its moment pass timed; the other has none.
+        assert_eq!(pass("filter").is_some(), config["technique"] == "vsm", "{config}");
+        let layers = config["layers"].as_array().unwrap();
+        assert_eq!(layers.len(), 2, "one time per cascade: {config}");
+        assert!(config["shadow_over_depth_only"].as_f64().unwrap() > 0.0);
+    }
+    let md = std::fs::read_to_string(dir.join("b/bench.md")).unwrap();
+    assert!(md.contains("| technique | shadow-res |") && md.contains("L0 layer 1"), "{md}");
+
+    // Bad input: named, and nothing written.
+    for (args, expected) in [
+        (&["bench", "--sweep", "no-such-flag=1,2"][..], "no such setting"),
+        (&["bench", "--sweep", "shadow-res=100"][..], "--sweep shadow-res=100"),
+        (&["bench", "--size", "12"][..], "WIDTHxHEIGHT"),
+        (&["bench", "--frames", "0"][..], "--frames 0"),
+        (&["bench", "instances:5"][..], "unknown scene"),
+    ] {
+        let out = gnomon(&dir, args);
+        assert!(!out.status.success() && stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(files_in(&dir), ["b"]);
+}

@@ -1,6 +1,8 @@
-//! Frustum culling: the planes of a projection's clip volume, and a conservative test
-//! of a bounding box against them, so that a shadow pass skips the casters a light
-//! cannot see.
+//! Frustum culling: the planes of a projection's clip volume, a conservative test of a
+//! bounding box against them, and [`CullTree`], a bounding-volume hierarchy over many
+//! instances whose culling cost follows the frustum's boundary, not the instance count.
+
+use std::ops::Range;
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -28,18 +30,163 @@ impl Frustum {
     /// never false for a box inside). `near` includes the near plane; a pass that
     /// clamps depth (pancaking) draws casters in front of it and leaves it out.
     pub fn intersects(&self, bounds: &Aabb, near: bool) -> bool {
+        self.classify(bounds, near) != Containment::Outside
+    }
+
+    /// Where `bounds` lies: outside one plane, inside all of them, or straddling.
+    /// The same test as [`Frustum::intersects`] for `Outside`; `Inside` is exact (every
+    /// corner is inside every plane), so a whole subtree can be taken without testing
+    /// its boxes one by one.
+    pub fn classify(&self, bounds: &Aabb, near: bool) -> Containment {
         if bounds.is_empty() {
-            return false;
+            return Containment::Outside;
         }
-        self.planes.iter().enumerate().all(|(i, plane)| {
+        let mut inside = true;
+        for (i, plane) in self.planes.iter().enumerate() {
             if i == 4 && !near {
-                return true;
+                continue;
             }
-            // The box corner farthest along the plane's normal (the "p-vertex").
+            // The box corners farthest along the plane's normal and against it (the
+            // "p-vertex" and "n-vertex"; Greene, "Detecting intersection of a
+            // rectangular solid and a convex polyhedron", Graphics Gems IV, 1994).
             let n = plane.truncate();
-            let p = Vec3::select(n.cmpge(Vec3::ZERO), bounds.max, bounds.min);
-            n.dot(p) + plane.w >= 0.0
-        })
+            let positive = n.cmpge(Vec3::ZERO);
+            if n.dot(Vec3::select(positive, bounds.max, bounds.min)) + plane.w < 0.0 {
+                return Containment::Outside;
+            }
+            inside &= n.dot(Vec3::select(positive, bounds.min, bounds.max)) + plane.w >= 0.0;
+        }
+        if inside { Containment::Inside } else { Containment::Partial }
+    }
+}
+
+/// Where a box lies against a [`Frustum`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Containment {
+    Outside,
+    Partial,
+    Inside,
+}
+
+/// A bounding-volume hierarchy over instance bounds, for culling many instances
+/// against many frusta. [`CullTree::build`] reorders the instances so that every
+/// subtree holds a contiguous run of them; [`CullTree::cull`] then answers with runs
+/// (a subtree wholly inside the frustum is one run, found without visiting its
+/// leaves), which a renderer draws as instanced draws. Culling visits only the nodes
+/// that straddle the frustum's boundary and their children, so its cost grows with
+/// that boundary, not with the number of instances.
+#[derive(Clone, Debug, Default)]
+pub struct CullTree {
+    nodes: Vec<CullNode>,
+    /// Each instance's bounds, in the tree's order.
+    bounds: Vec<Aabb>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct CullNode {
+    bounds: Aabb,
+    /// The instances below this node: `first .. first + count` in the tree's order.
+    first: u32,
+    count: u32,
+    /// The index of the right child; the left child follows its parent. 0 for a leaf.
+    right: u32,
+}
+
+impl CullTree {
+    /// At most this many instances share a leaf, which is tested box by box.
+    pub const LEAF_SIZE: usize = 8;
+
+    /// Builds the tree over `bounds` by median splits along the widest axis of the
+    /// boxes' centres. Returns the tree and the order it keeps the instances in:
+    /// `order[i]` is the index into `bounds` of the tree's `i`-th instance.
+    pub fn build(bounds: &[Aabb]) -> (CullTree, Vec<u32>) {
+        let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * bounds.len() / Self::LEAF_SIZE + 1);
+        if !bounds.is_empty() {
+            Self::build_node(bounds, &mut order, 0, &mut nodes);
+        }
+        let sorted = order.iter().map(|&i| bounds[i as usize]).collect();
+        (CullTree { nodes, bounds: sorted }, order)
+    }
+
+    fn build_node(bounds: &[Aabb], order: &mut [u32], first: usize, nodes: &mut Vec<CullNode>) {
+        let node_bounds = order.iter().map(|&i| bounds[i as usize]).fold(Aabb::EMPTY, Aabb::union);
+        let index = nodes.len();
+        nodes.push(CullNode {
+            bounds: node_bounds,
+            first: first as u32,
+            count: order.len() as u32,
+            right: 0,
+        });
+        if order.len() <= Self::LEAF_SIZE {
+            return;
+        }
+        let centres = Aabb::from_points(order.iter().map(|&i| bounds[i as usize].center()));
+        let extent = centres.extent();
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
+        let half = order.len() / 2;
+        order.select_nth_unstable_by(half, |&a, &b| {
+            let (a, b) = (bounds[a as usize].center()[axis], bounds[b as usize].center()[axis]);
+            a.total_cmp(&b)
+        });
+        let (left, right) = order.split_at_mut(half);
+        Self::build_node(bounds, left, first, nodes);
+        nodes[index].right = nodes.len() as u32;
+        Self::build_node(bounds, right, first + half, nodes);
+    }
+
+    /// How many instances the tree holds.
+    pub fn len(&self) -> usize {
+        self.bounds.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bounds.is_empty()
+    }
+
+    /// The world bounds of every instance.
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds)
+    }
+
+    /// Appends to `runs` the runs of instances (in the tree's order) whose boxes
+    /// [`Frustum::intersects`] accepts, in increasing order, adjacent runs merged.
+    /// `near` as for [`Frustum::intersects`].
+    pub fn cull(&self, frustum: &Frustum, near: bool, runs: &mut Vec<Range<u32>>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut push = |run: Range<u32>| match runs.last_mut() {
+            Some(last) if last.end == run.start => last.end = run.end,
+            _ => runs.push(run),
+        };
+        let mut stack = vec![0u32];
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            match frustum.classify(&node.bounds, near) {
+                Containment::Outside => {}
+                Containment::Inside => push(node.first..node.first + node.count),
+                Containment::Partial if node.right == 0 => {
+                    for i in node.first..node.first + node.count {
+                        if frustum.intersects(&self.bounds[i as usize], near) {
+                            push(i..i + 1);
+                        }
+                    }
+                }
+                Containment::Partial => {
+                    // Right first, so the left subtree (lower instances) pops first and
+                    // the runs come out in order.
+                    stack.push(node.right);
+                    stack.push(index + 1);
+                }
+            }
+        }
     }
 }
 
@@ -82,6 +229,89 @@ mod tests {
                 assert!(frustum.intersects(&b, true) && frustum.intersects(&b, false));
             }
         }
+    }
+
+    /// Random boxes scattered over a wide area, most of them far outside `frustum`.
+    fn scattered_boxes(rng: &mut Lcg, count: usize) -> Vec<Aabb> {
+        (0..count)
+            .map(|_| {
+                let c = Vec3::new(rng.range(-200.0, 200.0), rng.range(-5.0, 5.0), rng.range(-200.0, 200.0));
+                let h = rng.vec(0.05, 1.5);
+                Aabb::new(c - h, c + h)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_tree_culls_exactly_what_the_box_test_culls() {
+        // Property: for random frusta, the runs hold every instance the per-box test
+        // accepts and no other, each once, in increasing order.
+        let mut rng = Lcg(7);
+        for count in [0, 1, 5, 8, 9, 100, 3000] {
+            let boxes = scattered_boxes(&mut rng, count);
+            let (tree, order) = CullTree::build(&boxes);
+            assert_eq!(tree.len(), count);
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert!(sorted.iter().enumerate().all(|(i, &o)| i as u32 == o), "order is a permutation");
+            for _ in 0..20 {
+                let eye = rng.vec(-150.0, 150.0);
+                let target = eye + rng.vec(-1.0, 1.0);
+                let view = crate::view_from_world_look_at(eye, target, Vec3::Y);
+                let projection =
+                    crate::camera_clip_from_view(rng.range(0.3, 1.5), 1.5, 0.5, rng.range(20.0, 300.0));
+                let frustum = Frustum::from_clip_from_world(projection * view);
+                let near = rng.next() < 0.5;
+                let mut runs = Vec::new();
+                tree.cull(&frustum, near, &mut runs);
+                let culled: Vec<u32> = runs.iter().flat_map(|r| r.clone()).collect();
+                assert!(culled.windows(2).all(|w| w[0] < w[1]), "runs are increasing and disjoint");
+                assert!(runs.windows(2).all(|w| w[0].end < w[1].start), "adjacent runs are merged");
+                let expected: Vec<u32> = (0..count as u32)
+                    .filter(|&i| frustum.intersects(&boxes[order[i as usize] as usize], near))
+                    .collect();
+                assert_eq!(culled, expected);
+            }
+        }
+    }
+
+    #[test]
+    fn a_wholly_visible_subtree_is_one_run() {
+        // 10 000 boxes in a 100 × 100 grid, a frustum seeing a corner of it: the
+        // visible boxes come out as far fewer runs than boxes, and culling visits far
+        // fewer nodes than there are boxes (the point of the tree).
+        let boxes: Vec<Aabb> = (0..10_000)
+            .map(|i| {
+                let c = Vec3::new((i % 100) as f32, 0.0, (i / 100) as f32);
+                Aabb::new(c - Vec3::splat(0.3), c + Vec3::splat(0.3))
+            })
+            .collect();
+        let (tree, _) = CullTree::build(&boxes);
+        let ortho = crate::LightProjection::orthographic(
+            crate::view_from_world_look_at(Vec3::new(0.0, 10.0, 0.0), Vec3::ZERO, Vec3::NEG_Z),
+            (-0.5, 30.5, -30.5, 0.5),
+            1.0,
+            20.0,
+        );
+        let frustum = Frustum::from_clip_from_world(ortho.clip_from_world());
+        let mut runs = Vec::new();
+        tree.cull(&frustum, true, &mut runs);
+        let visible: u32 = runs.iter().map(|r| r.end - r.start).sum();
+        assert_eq!(visible, 31 * 31);
+        assert!(runs.len() < 200, "{} runs for {visible} boxes", runs.len());
+    }
+
+    #[test]
+    fn classify_tells_inside_from_straddling() {
+        let ortho = crate::LightProjection::orthographic(Mat4::IDENTITY, (-1.0, 1.0, -1.0, 1.0), 1.0, 5.0);
+        let frustum = Frustum::from_clip_from_world(ortho.clip_from_world());
+        let at = |z: f32, h: f32| Aabb::new(Vec3::new(-h, -h, z - h), Vec3::new(h, h, z + h));
+        assert_eq!(frustum.classify(&at(-3.0, 0.5), true), Containment::Inside);
+        assert_eq!(frustum.classify(&at(-3.0, 1.5), true), Containment::Partial);
+        assert_eq!(frustum.classify(&at(-9.0, 0.5), true), Containment::Outside);
+        // Before the near plane: outside with it, inside without it.
+        assert_eq!(frustum.classify(&at(-0.3, 0.1), true), Containment::Outside);
+        assert_eq!(frustum.classify(&at(-0.3, 0.1), false), Containment::Inside);
     }
 
     #[test]

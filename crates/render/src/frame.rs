@@ -1,9 +1,11 @@
 //! One frame: resolve the camera and light, draw the shadow map, shade the image,
 //! and read every output back.
 
+use std::time::Instant;
+
 use glam::{Vec3, Vec4};
 use gnomon_math::{
-    LightProjection, ProjectionKind, cascades,
+    Aabb, LightProjection, ProjectionKind, cascades,
     culling::Frustum,
     directional_light_projection,
     fitting::{Hexahedron, directional_light_view, fit_directional_to_receivers, intersection_vertices},
@@ -24,9 +26,11 @@ use wgpu::util::DeviceExt;
 
 use crate::{
     Gpu, GpuScene, RenderError,
+    gpu_scene::{CullView, Visible},
     gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
         Layouts, SHADOW_FORMAT,
+        depth_baseline::{DepthBaselinePass, DepthBaselineScene},
         depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
         map_preview::MapPreviewPass,
@@ -35,6 +39,7 @@ use crate::{
         shadow::{DepthTarget, ShadowPass},
     },
     readback, techniques,
+    timing::{ClockChoice, PassClock, PassKind, PassTime, TimingSource},
 };
 
 /// Optional outputs of a frame.
@@ -120,17 +125,6 @@ pub struct LiveFrame {
     pub shadow_mask: bool,
 }
 
-/// Which draws a depth-only pass takes.
-#[derive(Clone, Copy)]
-enum Draws<'f> {
-    /// The shadow casters: the shadow pass. With `inside`, only the instances whose
-    /// bounds may reach into that frustum (the bool says whether its near plane
-    /// counts). `target` says what the map stores.
-    Casters { inside: Option<(&'f Frustum, bool)>, target: DepthTarget },
-    /// Every surface the camera can see: SDSM's prepass.
-    Everything,
-}
-
 /// What one light of a frame drew and cost.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightStats {
@@ -144,8 +138,12 @@ pub struct LightStats {
     /// Draw calls into each layer of its map (one per cascade, six for a cube): the
     /// casters that survived culling against that layer's frustum.
     pub layer_draws: Vec<u32>,
-    /// GPU time of its shadow passes, moment pass and lighting pass, where the device
-    /// has timestamp queries.
+    /// Instances drawn into each layer: those whose bounds reach into its frustum.
+    pub layer_instances: Vec<u32>,
+    /// The time of each layer's shadow pass, where the frame was timed.
+    pub layer_ms: Vec<f64>,
+    /// Time of its shadow passes (every layer), moment pass and lighting pass, where
+    /// the frame was timed.
     pub shadow_ms: Option<f64>,
     pub filter_ms: Option<f64>,
     pub lighting_ms: Option<f64>,
@@ -158,6 +156,17 @@ impl LightStats {
     pub fn shadow_draws(&self) -> u32 {
         self.layer_draws.iter().sum()
     }
+}
+
+/// A frame, as decided before recording.
+struct FramePlan {
+    camera: Camera,
+    aspect: f32,
+    /// Whether the lights' shadows go through the screen-space mask path.
+    mask_path: bool,
+    /// The reported light's index.
+    shown: usize,
+    plans: Vec<LightPlan>,
 }
 
 /// One light of a frame, as decided before recording.
@@ -197,6 +206,47 @@ pub struct DrawStats {
     pub pipeline_changes: u32,
     /// Bind group changes, every pass together.
     pub bind_group_changes: u32,
+    /// Instances drawn into shadow maps, every layer of every light together.
+    pub shadow_instances: u32,
+    /// Instances the camera sees, drawn by the lighting pass.
+    pub lighting_instances: u32,
+}
+
+impl DrawStats {
+    fn add(&mut self, other: &DrawStats) {
+        self.shadow_draws += other.shadow_draws;
+        self.lighting_draws += other.lighting_draws;
+        self.prepass_draws += other.prepass_draws;
+        self.pipeline_changes += other.pipeline_changes;
+        self.bind_group_changes += other.bind_group_changes;
+        self.shadow_instances += other.shadow_instances;
+        self.lighting_instances += other.lighting_instances;
+    }
+}
+
+/// What a frame cost the CPU, in milliseconds: fitting the lights' projections,
+/// culling (every layer and the camera, in parallel), and recording and submitting
+/// the commands. `submit_ms` is the whole, from the call to the queue's submit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CpuTimings {
+    pub plan_ms: f64,
+    pub cull_ms: f64,
+    pub record_ms: f64,
+    pub submit_ms: f64,
+}
+
+/// What timing one frame measured: the summary, each pass, the draws and the CPU
+/// cost ([`Renderer::time_passes`]).
+#[derive(Clone, Debug)]
+pub struct FrameCost {
+    /// None only when the frame was not timed.
+    pub timings: Option<PassTimings>,
+    /// Each pass's time: every layer of every light's map, filters, screen-space
+    /// passes and lighting.
+    pub passes: Vec<PassTime>,
+    pub stats: DrawStats,
+    pub lights: Vec<LightStats>,
+    pub cpu: CpuTimings,
 }
 
 /// GPU time per pass, in milliseconds, from timestamp queries; with many lights,
@@ -213,6 +263,8 @@ pub struct PassTimings {
     /// The whole frame on the GPU, from the first shadow pass's start to the last
     /// lighting pass's end (SDSM's prepass not included).
     pub frame_ms: f64,
+    /// GPU timestamps, or the CPU wall clock where the adapter has none.
+    pub source: TimingSource,
 }
 
 impl Frame {
@@ -256,6 +308,7 @@ pub struct Renderer<'g> {
     moment_pass: MomentPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
+    depth_baseline: DepthBaselinePass,
     compare_sampler: wgpu::Sampler,
     compare_nearest_sampler: wgpu::Sampler,
     gather_sampler: wgpu::Sampler,
@@ -352,6 +405,7 @@ impl<'g> Renderer<'g> {
             moment_pass: MomentPass::new(device),
             depth_reduce: DepthReducePass::new(device),
             map_preview: MapPreviewPass::new(device),
+            depth_baseline: DepthBaselinePass::new(device),
             layouts,
             compare_sampler,
             compare_nearest_sampler,
@@ -432,8 +486,15 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
-        let submitted =
-            self.submit(uploaded, scene, settings, true, request.shadow_map, request.fixed_layout.as_ref())?;
+        let submitted = self.submit(
+            uploaded,
+            scene,
+            settings,
+            true,
+            request.shadow_map,
+            request.fixed_layout.as_ref(),
+            None,
+        )?;
         self.read_frame(submitted, settings)
     }
 
@@ -445,7 +506,7 @@ impl<'g> Renderer<'g> {
         scene: &Scene,
         settings: &Settings,
     ) -> Result<LiveFrame, RenderError> {
-        let submitted = self.submit(uploaded, scene, settings, false, false, None)?;
+        let submitted = self.submit(uploaded, scene, settings, false, false, None, None)?;
         Ok(LiveFrame {
             color: submitted.color,
             shadow_map: submitted.shadow_map,
@@ -482,25 +543,152 @@ impl<'g> Renderer<'g> {
         uploaded: &GpuScene,
         scene: &Scene,
         settings: &Settings,
-    ) -> Result<(Option<PassTimings>, DrawStats), RenderError> {
-        let submitted = self.submit(uploaded, scene, settings, false, false, None)?;
-        Ok((submitted.timings, submitted.stats))
+        clock: ClockChoice,
+    ) -> Result<FrameCost, RenderError> {
+        let submitted = self.submit(uploaded, scene, settings, false, false, None, Some(clock))?;
+        Ok(FrameCost {
+            timings: submitted.timings,
+            passes: submitted.passes,
+            stats: submitted.stats,
+            lights: submitted.lights,
+            cpu: submitted.cpu,
+        })
     }
 
-    /// Records and submits every light's shadow and lighting passes, copying the
-    /// render targets (and the reported light's shadow map) out when asked, and reads
-    /// the pass timestamps.
-    fn submit(
+    /// Uploads the depth-only baseline's geometry for `scene`: every caster flattened
+    /// into world space ([`Renderer::time_depth_baseline`]).
+    pub fn upload_depth_baseline(&self, scene: &Scene) -> Result<DepthBaselineScene, RenderError> {
+        DepthBaselineScene::upload(self.gpu, scene)
+    }
+
+    /// Times the depth-only baseline drawing the shadow maps this frame would draw
+    /// (the same layers, resolution, cull mode and depth clamp): per light, the time
+    /// of all its layers; None for a dual-paraboloid map, which no matrix can draw.
+    pub fn time_depth_baseline(
+        &mut self,
+        baseline: &DepthBaselineScene,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        clock: ClockChoice,
+    ) -> Result<Vec<Option<f64>>, RenderError> {
+        let (times, _) =
+            self.record_depth_baseline(baseline, uploaded, scene, settings, Some(clock), false)?;
+        let times = times.map(|t| t.passes).unwrap_or_default();
+        let plan = self.plan_frame(uploaded, scene, settings, None)?;
+        Ok((0..plan.plans.len() as u32)
+            .map(|light| {
+                let mut layers = times.iter().filter(|p| p.light == Some(light)).peekable();
+                layers.peek()?;
+                Some(layers.map(|p| p.ms).sum())
+            })
+            .collect())
+    }
+
+    /// The depth-only baseline's first layer of the reported light's map, read back:
+    /// to check that it draws what the shadow pass draws.
+    pub fn depth_baseline_map(
+        &mut self,
+        baseline: &DepthBaselineScene,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<Vec<f32>, RenderError> {
+        let (_, map) = self.record_depth_baseline(baseline, uploaded, scene, settings, None, true)?;
+        map.ok_or_else(|| RenderError::Gpu {
+            during: "drawing the depth-only baseline",
+            message: "a dual-paraboloid map has no baseline".into(),
+        })
+    }
+
+    fn record_depth_baseline(
+        &mut self,
+        baseline: &DepthBaselineScene,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        clock: Option<ClockChoice>,
+        read_shown: bool,
+    ) -> Result<(Option<crate::timing::FrameTimes>, Option<Vec<f32>>), RenderError> {
+        settings.validate()?;
+        self.check_limits(settings)?;
+        let plan = self.plan_frame(uploaded, scene, settings, None)?;
+        let gpu = self.gpu;
+        let device = &gpu.device;
+        let layers: u32 = plan.plans.iter().map(|p| p.layout.projections.len() as u32).sum();
+        let (pending_times, pending_map) = gpu.checked("drawing the depth-only baseline", || {
+            let mut clock = PassClock::new(gpu, layers, clock.is_some(), clock == Some(ClockChoice::Cpu));
+            let mut encoder = device.create_command_encoder(&Default::default());
+            let mut pending_map = None;
+            for (index, light) in plan.plans.iter().enumerate() {
+                let mirrored = match (light.light, light.settings.shadow.map.omni) {
+                    (Light::Point(_), OmniMap::Cube) => true,
+                    (Light::Point(_), OmniMap::Paraboloid) => continue,
+                    _ => false,
+                };
+                let resolution = light.settings.shadow.map.resolution;
+                let count = light.layout.projections.len() as u32;
+                let map = device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("baseline depth"),
+                    size: wgpu::Extent3d {
+                        width: resolution,
+                        height: resolution,
+                        depth_or_array_layers: count,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: SHADOW_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                });
+                for layer in 0..count {
+                    let view = map.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: layer,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    });
+                    let slot =
+                        clock.begin(gpu, &mut encoder, PassKind::Shadow, Some(index as u32), Some(layer));
+                    self.depth_baseline.record(
+                        device,
+                        &mut encoder,
+                        baseline,
+                        light.light_gpu.cascade_clip_from_world[layer as usize],
+                        (light.settings.shadow.bias.cull, light.layout.depth_clamp, mirrored),
+                        &view,
+                        clock.render_writes(slot),
+                    );
+                    clock.end(gpu, &mut encoder, slot);
+                }
+                if read_shown && index == plan.shown {
+                    pending_map =
+                        Some(readback::record(device, &mut encoder, &map, wgpu::TextureAspect::DepthOnly));
+                }
+            }
+            let pending_times = clock.resolve(gpu, &mut encoder);
+            gpu.queue.submit([encoder.finish()]);
+            (pending_times, pending_map)
+        })?;
+        let times = pending_times.read(gpu)?;
+        let map = match pending_map {
+            Some(p) => Some(p.read::<f32>(gpu)?),
+            None => None,
+        };
+        Ok((times, map))
+    }
+
+    /// Everything about a frame that is decided before recording: the camera, and
+    /// each light's settings, layout (fitted, or `fixed_layout` for the reported
+    /// light) and uniform.
+    fn plan_frame(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
         settings: &Settings,
-        read_images: bool,
-        read_shadow_map: bool,
         fixed_layout: Option<&ShadowLayout>,
-    ) -> Result<Submitted, RenderError> {
-        settings.validate()?;
-        self.check_limits(settings)?;
+    ) -> Result<FramePlan, RenderError> {
         let camera = settings.resolve_camera(scene)?;
         let resolved = settings.resolve_lights(scene)?;
         let mask_path = settings.uses_shadow_mask(&resolved)?;
@@ -521,7 +709,6 @@ impl<'g> Renderer<'g> {
                     let sampled = match (&r.light, shadow.partition, shadow.cascades.sdsm) {
                         (Light::Directional(sun), Partition::Cascades, true) => self.sample_distribution(
                             uploaded,
-                            scene,
                             sun.direction,
                             &light_settings,
                             &camera,
@@ -530,7 +717,7 @@ impl<'g> Renderer<'g> {
                         _ => None,
                     };
                     shadow_layout(
-                        scene,
+                        &uploaded.bounds,
                         &r.light,
                         &camera,
                         aspect,
@@ -569,6 +756,31 @@ impl<'g> Renderer<'g> {
                 light_gpu,
             });
         }
+        Ok(FramePlan { camera, aspect, mask_path, shown, plans })
+    }
+
+    /// Records and submits every light's shadow and lighting passes, copying the
+    /// render targets (and the reported light's shadow map) out when asked, and reads
+    /// the pass times: timestamps where the device has them, and with `clock`, the
+    /// CPU wall clock where it has none.
+    #[allow(clippy::too_many_arguments)]
+    fn submit(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        read_images: bool,
+        read_shadow_map: bool,
+        fixed_layout: Option<&ShadowLayout>,
+        clock: Option<ClockChoice>,
+    ) -> Result<Submitted, RenderError> {
+        let started = Instant::now();
+        settings.validate()?;
+        self.check_limits(settings)?;
+        let FramePlan { camera, aspect, mask_path, shown, mut plans } =
+            self.plan_frame(uploaded, scene, settings, fixed_layout)?;
+        let (width, height) = (settings.image.width, settings.image.height);
+
         let clip_from_view = camera.clip_from_view(aspect);
         let camera_gpu = CameraGpu {
             clip_from_world: camera.clip_from_world(aspect),
@@ -580,12 +792,34 @@ impl<'g> Renderer<'g> {
             viewport: Vec4::new(width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32),
         };
 
+        let planned = Instant::now();
+
+        // Cull for every layer of every light, and for the camera, in parallel.
+        let camera_view = CullView {
+            frustum: Frustum::from_clip_from_world(camera.clip_from_world(aspect)),
+            near: true,
+            casters_only: false,
+        };
+        let layer_views = plans.iter().flat_map(|plan| {
+            plan.layout.projections.iter().map(|projection| CullView {
+                frustum: Frustum::from_clip_from_world(projection.clip_from_world()),
+                // A pass that clamps depth draws the casters before its near plane too.
+                near: !plan.layout.depth_clamp,
+                casters_only: true,
+            })
+        });
+        let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();
+        let mut culled = uploaded.cull(&views).into_iter();
+        let camera_visible = culled.next().expect("the camera's view was culled");
+        let layer_visible: Vec<Vec<Visible>> =
+            plans.iter().map(|plan| culled.by_ref().take(plan.layout.projections.len()).collect()).collect();
+        let cull_done = Instant::now();
+
         let gpu = self.gpu;
         let device = &gpu.device;
-        // Each light's passes, then the prepass's two.
-        let prepass_slot = TIMESTAMPS_PER_LIGHT * plans.len() as u32;
-        let timestamp_count = prepass_slot + 2;
-        let (pending, shadow_pending, timestamps, stats, layer_draws, color, shown_map) =
+        // Every layer of every light, each light's filter, mask and lighting, and the prepass.
+        let timed_passes = plans.iter().map(|p| p.layout.projections.len() as u32 + 3).sum::<u32>() + 1;
+        let (pending, shadow_pending, pending_times, stats, color, shown_map, submitted_at) =
             gpu.checked("rendering the frame", || {
                 let camera_buffer = uniform_buffer(device, "camera", &camera_gpu);
                 let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -596,16 +830,10 @@ impl<'g> Renderer<'g> {
                         resource: camera_buffer.as_entire_binding(),
                     }],
                 });
-                let queries = gpu.timestamp_period_ns.map(|_| {
-                    device.create_query_set(&wgpu::QuerySetDescriptor {
-                        label: Some("pass timestamps"),
-                        ty: wgpu::QueryType::Timestamp,
-                        count: timestamp_count,
-                    })
-                });
+                let mut clock =
+                    PassClock::new(gpu, timed_passes, clock.is_some(), clock == Some(ClockChoice::Cpu));
                 let mut encoder = device.create_command_encoder(&Default::default());
                 let mut stats = DrawStats::default();
-                let mut layer_draws = Vec::with_capacity(plans.len());
                 let mut shadow_pending = None;
                 let mut shown_map = None;
                 // On the mask path, one layer of the mask per light.
@@ -637,16 +865,15 @@ impl<'g> Renderer<'g> {
                 // (and on the mask path, for its mask pass).
                 let mut lit = Vec::with_capacity(plans.len());
                 for (index, plan) in plans.iter().enumerate() {
-                    let slot = TIMESTAMPS_PER_LIGHT * index as u32;
-                    let (shadow_map, draws) = self.record_shadow_maps(
+                    let shadow_map = self.record_shadow_maps(
                         &mut encoder,
                         uploaded,
                         plan,
-                        queries.as_ref(),
-                        slot,
+                        &layer_visible[index],
+                        &mut clock,
+                        index as u32,
                         &mut stats,
                     );
-                    layer_draws.push(draws);
                     if index == shown {
                         shown_map = Some(shadow_map.clone());
                     }
@@ -665,7 +892,8 @@ impl<'g> Renderer<'g> {
                     });
                     let shadow = &plan.settings.shadow;
                     let moment_map = plan.filterable_map.map(|map| {
-                        self.moment_pass.record(
+                        let slot = clock.begin(gpu, &mut encoder, PassKind::Filter, Some(index as u32), None);
+                        let moment_map = self.moment_pass.record(
                             device,
                             &mut encoder,
                             shadow.filter.technique,
@@ -676,12 +904,10 @@ impl<'g> Renderer<'g> {
                             plan.layout.projections.len() as u32,
                             &shadow_view,
                             &light_buffer,
-                            queries.as_ref().map(|query_set| wgpu::ComputePassTimestampWrites {
-                                query_set,
-                                beginning_of_pass_write_index: Some(slot + 4),
-                                end_of_pass_write_index: Some(slot + 5),
-                            }),
-                        )
+                            clock.compute_writes(slot),
+                        );
+                        clock.end(gpu, &mut encoder, slot);
+                        moment_map
                     });
                     let lookup = lookup_of(plan);
                     let cube_view = (lookup == Lookup::Cube).then(|| {
@@ -767,14 +993,14 @@ impl<'g> Renderer<'g> {
                     self.record_screen_space(
                         &mut encoder,
                         uploaded,
+                        &camera_visible,
                         &plans,
                         &lit,
                         &camera_buffer,
                         &camera_group,
                         &depth_view,
                         &mask_layers,
-                        queries.as_ref(),
-                        prepass_slot,
+                        &mut clock,
                         &mut stats,
                     );
                 }
@@ -782,7 +1008,6 @@ impl<'g> Renderer<'g> {
                     plans.iter().zip(&lit).enumerate()
                 {
                     let first = index == 0;
-                    let slot = TIMESTAMPS_PER_LIGHT * index as u32;
                     let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = target_views
                         .iter()
                         .enumerate()
@@ -802,6 +1027,7 @@ impl<'g> Renderer<'g> {
                         })
                         .collect();
                     let last = index + 1 == plans.len();
+                    let slot = clock.begin(gpu, &mut encoder, PassKind::Lighting, Some(index as u32), None);
                     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                         label: Some("lighting"),
                         color_attachments: &attachments,
@@ -817,11 +1043,7 @@ impl<'g> Renderer<'g> {
                             }),
                             stencil_ops: None,
                         }),
-                        timestamp_writes: queries.as_ref().map(|query_set| wgpu::RenderPassTimestampWrites {
-                            query_set,
-                            beginning_of_pass_write_index: Some(slot + 2),
-                            end_of_pass_write_index: Some(slot + 3),
-                        }),
+                        timestamp_writes: clock.render_writes(slot),
                         occlusion_query_set: None,
                         multiview_mask: None,
                     });
@@ -840,9 +1062,12 @@ impl<'g> Renderer<'g> {
                     pass.set_bind_group(2, shadow_group, &[]);
                     stats.pipeline_changes += 1;
                     stats.bind_group_changes += 3;
-                    let (draws, binds) = uploaded.draw_everything(&mut pass, 3);
+                    let (draws, binds) = uploaded.draw_visible(&mut pass, &camera_visible, 3);
                     stats.lighting_draws += draws;
+                    stats.lighting_instances += camera_visible.instances();
                     stats.bind_group_changes += binds;
+                    drop(pass);
+                    clock.end(gpu, &mut encoder, slot);
                 }
                 let pending: Vec<_> = if read_images {
                     targets
@@ -852,52 +1077,60 @@ impl<'g> Renderer<'g> {
                 } else {
                     Vec::new()
                 };
-                let timestamps = queries.as_ref().map(|query_set| {
-                    readback::record_timestamps(device, &mut encoder, query_set, timestamp_count)
-                });
+                let pending_times = clock.resolve(gpu, &mut encoder);
                 gpu.queue.submit([encoder.finish()]);
+                let submitted_at = Instant::now();
                 let shown_map = shown_map.expect("the reported light is one of the lights");
-                (pending, shadow_pending, timestamps, stats, layer_draws, targets[0].clone(), shown_map)
+                (pending, shadow_pending, pending_times, stats, targets[0].clone(), shown_map, submitted_at)
             })?;
-
-        let ticks = match timestamps {
-            Some(t) => Some(t.read(gpu)?),
-            None => None,
+        let cpu = CpuTimings {
+            plan_ms: (planned - started).as_secs_f64() * 1e3,
+            cull_ms: (cull_done - planned).as_secs_f64() * 1e3,
+            record_ms: (submitted_at - cull_done).as_secs_f64() * 1e3,
+            submit_ms: (submitted_at - started).as_secs_f64() * 1e3,
         };
-        let ms = |a: u32, b: u32| -> Option<f64> {
-            let (ticks, period) = (ticks.as_ref()?, gpu.timestamp_period_ns?);
-            Some(ticks[b as usize].saturating_sub(ticks[a as usize]) as f64 * period as f64 * 1e-6)
+
+        let times = pending_times.read(gpu)?;
+        let passes = times.as_ref().map_or_else(Vec::new, |t| t.passes.clone());
+        let time_of = |kind: PassKind, light: usize| -> Option<f64> {
+            let mut matching =
+                passes.iter().filter(|p| p.kind == kind && p.light == Some(light as u32)).peekable();
+            matching.peek()?;
+            Some(matching.map(|p| p.ms).sum())
         };
         let lights: Vec<LightStats> = plans
             .iter()
-            .zip(layer_draws)
+            .zip(&layer_visible)
             .enumerate()
-            .map(|(index, (plan, layer_draws))| {
-                let slot = TIMESTAMPS_PER_LIGHT * index as u32;
-                LightStats {
-                    name: plan.name.clone(),
-                    kind: plan.light.type_name(),
-                    technique: plan.settings.shadow.filter.technique,
-                    resolution: plan.settings.shadow.map.resolution,
-                    layer_draws,
-                    shadow_ms: ms(slot, slot + 1),
-                    filter_ms: plan.filterable_map.and_then(|_| ms(slot + 4, slot + 5)),
-                    lighting_ms: ms(slot + 2, slot + 3),
-                    mask_ms: if mask_path { ms(slot + 6, slot + 7) } else { None },
-                }
+            .map(|(index, (plan, layers))| LightStats {
+                name: plan.name.clone(),
+                kind: plan.light.type_name(),
+                technique: plan.settings.shadow.filter.technique,
+                resolution: plan.settings.shadow.map.resolution,
+                layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
+                layer_instances: layers.iter().map(Visible::instances).collect(),
+                layer_ms: passes
+                    .iter()
+                    .filter(|p| p.kind == PassKind::Shadow && p.light == Some(index as u32))
+                    .map(|p| p.ms)
+                    .collect(),
+                shadow_ms: time_of(PassKind::Shadow, index),
+                filter_ms: time_of(PassKind::Filter, index),
+                lighting_ms: time_of(PassKind::Lighting, index),
+                mask_ms: time_of(PassKind::Mask, index),
             })
             .collect();
-        let timings = ticks.as_ref().map(|_| {
+        let timings = times.as_ref().map(|t| {
             let sum = |f: fn(&LightStats) -> Option<f64>| lights.iter().filter_map(f).sum::<f64>();
-            let filtered = lights.iter().any(|l| l.filter_ms.is_some());
+            let any = |f: fn(&LightStats) -> Option<f64>| lights.iter().any(|l| f(l).is_some());
             PassTimings {
                 shadow_ms: sum(|l| l.shadow_ms),
-                filter_ms: filtered.then(|| sum(|l| l.filter_ms)),
+                filter_ms: any(|l| l.filter_ms).then(|| sum(|l| l.filter_ms)),
                 lighting_ms: sum(|l| l.lighting_ms),
-                prepass_ms: if mask_path { ms(prepass_slot, prepass_slot + 1) } else { None },
-                mask_ms: mask_path.then(|| sum(|l| l.mask_ms)),
-                // From the first shadow pass's start to the last lighting pass's end.
-                frame_ms: ms(0, prepass_slot - TIMESTAMPS_PER_LIGHT + 3).unwrap_or(0.0),
+                prepass_ms: passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
+                mask_ms: any(|l| l.mask_ms).then(|| sum(|l| l.mask_ms)),
+                frame_ms: t.frame_ms,
+                source: t.source,
             }
         });
         let plan = plans.swap_remove(shown);
@@ -907,6 +1140,8 @@ impl<'g> Renderer<'g> {
             color,
             shadow_map: shown_map,
             timings,
+            passes,
+            cpu,
             stats,
             lights,
             camera,
@@ -919,20 +1154,22 @@ impl<'g> Renderer<'g> {
     }
 
     /// Draws a light's shadow map, one depth pass per layer (cascade or cube face),
-    /// each drawing only the casters inside that layer's frustum. Returns the map and
-    /// the draws of each layer; the timestamps bracket all the layers.
+    /// each drawing the casters culled for that layer (`layers`), each timed alone.
+    /// Returns the map.
+    #[allow(clippy::too_many_arguments)]
     fn record_shadow_maps(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         uploaded: &GpuScene,
         plan: &LightPlan,
-        queries: Option<&wgpu::QuerySet>,
-        slot: u32,
+        layers: &[Visible],
+        clock: &mut PassClock,
+        light_index: u32,
         stats: &mut DrawStats,
-    ) -> (wgpu::Texture, Vec<u32>) {
-        let device = &self.gpu.device;
+    ) -> wgpu::Texture {
+        let gpu = self.gpu;
+        let device = &gpu.device;
         let resolution = plan.settings.shadow.map.resolution;
-        let layers = plan.layout.projections.len() as u32;
         let target = match (plan.light, plan.settings.shadow.map.omni) {
             (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
             (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
@@ -940,7 +1177,11 @@ impl<'g> Renderer<'g> {
         };
         let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow map"),
-            size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
+            size: wgpu::Extent3d {
+                width: resolution,
+                height: resolution,
+                depth_or_array_layers: layers.len() as u32,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -950,44 +1191,32 @@ impl<'g> Renderer<'g> {
                 | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let mut draws = Vec::with_capacity(layers as usize);
-        for layer in 0..layers {
-            let projection = &plan.layout.projections[layer as usize];
-            let layer_light = LightGpu {
-                clip_from_world: plan.light_gpu.cascade_clip_from_world[layer as usize],
-                ..plan.light_gpu
-            };
+        for (layer, visible) in layers.iter().enumerate() {
+            let layer_light =
+                LightGpu { clip_from_world: plan.light_gpu.cascade_clip_from_world[layer], ..plan.light_gpu };
             let (_, layer_group) = self.scene_group(uploaded, &layer_light);
             let layer_view = shadow_map.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer,
+                base_array_layer: layer as u32,
                 array_layer_count: Some(1),
                 ..Default::default()
             });
-            let (first, last) = (layer == 0, layer + 1 == layers);
-            let timestamps =
-                queries.filter(|_| first || last).map(|query_set| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: first.then_some(slot),
-                    end_of_pass_write_index: last.then_some(slot + 1),
-                });
-            // A pass that clamps depth draws the casters before its near plane too.
-            let frustum = Frustum::from_clip_from_world(projection.clip_from_world());
-            let before = stats.shadow_draws;
-            self.record_depth_pass(
+            let slot = clock.begin(gpu, encoder, PassKind::Shadow, Some(light_index), Some(layer as u32));
+            let drawn = self.record_depth_pass(
                 encoder,
                 uploaded,
                 &plan.settings,
                 &layer_group,
                 &layer_view,
-                Draws::Casters { inside: Some((&frustum, !plan.layout.depth_clamp)), target },
+                visible,
+                target,
                 plan.layout.depth_clamp,
-                timestamps,
-                stats,
+                clock.render_writes(slot),
             );
-            draws.push(stats.shadow_draws - before);
+            clock.end(gpu, encoder, slot);
+            stats.add(&drawn);
         }
-        (shadow_map, draws)
+        shadow_map
     }
 
     /// The mask path's screen-space passes: the depth-and-normal prepass into `depth`,
@@ -997,17 +1226,18 @@ impl<'g> Renderer<'g> {
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         uploaded: &GpuScene,
+        camera_visible: &Visible,
         plans: &[LightPlan],
         lit: &[LitGroups],
         camera_buffer: &wgpu::Buffer,
         camera_group: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
         mask_layers: &[wgpu::TextureView],
-        queries: Option<&wgpu::QuerySet>,
-        prepass_slot: u32,
+        clock: &mut PassClock,
         stats: &mut DrawStats,
     ) {
-        let device = &self.gpu.device;
+        let gpu = self.gpu;
+        let device = &gpu.device;
         let (width, height) = (depth.texture().width(), depth.texture().height());
         let prepass_target =
             |format| render_target(device, width, height, format, wgpu::TextureUsages::TEXTURE_BINDING);
@@ -1026,6 +1256,7 @@ impl<'g> Renderer<'g> {
                     },
                 })
             };
+            let slot = clock.begin(gpu, encoder, PassKind::Prepass, None, None);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("prepass"),
                 color_attachments: &[cleared(&normals), cleared(&view_depth)],
@@ -1037,11 +1268,7 @@ impl<'g> Renderer<'g> {
                     }),
                     stencil_ops: None,
                 }),
-                timestamp_writes: queries.map(|query_set| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(prepass_slot),
-                    end_of_pass_write_index: Some(prepass_slot + 1),
-                }),
+                timestamp_writes: clock.render_writes(slot),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -1052,9 +1279,11 @@ impl<'g> Renderer<'g> {
             pass.set_bind_group(1, camera_group, &[]);
             stats.pipeline_changes += 1;
             stats.bind_group_changes += 2;
-            let (draws, binds) = uploaded.draw_everything(&mut pass, 3);
+            let (draws, binds) = uploaded.draw_visible(&mut pass, camera_visible, 3);
             stats.prepass_draws += draws;
             stats.bind_group_changes += binds;
+            drop(pass);
+            clock.end(gpu, encoder, slot);
         }
         let screen_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("screen"),
@@ -1071,8 +1300,8 @@ impl<'g> Renderer<'g> {
         for (index, ((plan, (scene_group, _, mask_group, lookup)), layer)) in
             plans.iter().zip(lit).zip(mask_layers).enumerate()
         {
-            let slot = TIMESTAMPS_PER_LIGHT * index as u32;
             let mask_group = mask_group.as_ref().expect("a mask pass group on the mask path");
+            let slot = clock.begin(gpu, encoder, PassKind::Mask, Some(index as u32), None);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow mask"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -1085,11 +1314,7 @@ impl<'g> Renderer<'g> {
                     },
                 })],
                 depth_stencil_attachment: None,
-                timestamp_writes: queries.map(|query_set| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(slot + 6),
-                    end_of_pass_write_index: Some(slot + 7),
-                }),
+                timestamp_writes: clock.render_writes(slot),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -1101,6 +1326,8 @@ impl<'g> Renderer<'g> {
             stats.pipeline_changes += 1;
             stats.bind_group_changes += 3;
             pass.draw(0..3, 0..1);
+            drop(pass);
+            clock.end(gpu, encoder, slot);
         }
     }
 
@@ -1113,6 +1340,8 @@ impl<'g> Renderer<'g> {
             color: _,
             shadow_map: _,
             timings,
+            passes: _,
+            cpu: _,
             stats,
             lights,
             camera,
@@ -1186,7 +1415,6 @@ impl<'g> Renderer<'g> {
     fn sample_distribution(
         &mut self,
         uploaded: &GpuScene,
-        scene: &Scene,
         sun_direction: Vec3,
         settings: &Settings,
         camera: &Camera,
@@ -1214,16 +1442,21 @@ impl<'g> Renderer<'g> {
             let mut prepass = settings.clone();
             prepass.shadow.bias = BiasSettings::none();
             let mut encoder = device.create_command_encoder(&Default::default());
+            let seen = uploaded.cull(&[CullView {
+                frustum: Frustum::from_clip_from_world(camera.clip_from_world(aspect)),
+                near: true,
+                casters_only: false,
+            }]);
             self.record_depth_pass(
                 &mut encoder,
                 uploaded,
                 &prepass,
                 &group,
                 &depth.create_view(&Default::default()),
-                Draws::Everything,
+                &seen[0],
+                DepthTarget::Projected,
                 false,
                 None,
-                &mut DrawStats::default(),
             );
             let pending = self.depth_reduce.record(device, &mut encoder, &depth, camera.near, camera.far);
             gpu.queue.submit([encoder.finish()]);
@@ -1231,7 +1464,8 @@ impl<'g> Renderer<'g> {
         })?;
         let Some((near, far)) = pending.read(gpu)? else { return Ok(None) };
         let c = &settings.shadow.cascades;
-        let light_bounds = match cascade_splits(scene, camera, aspect, settings, Some((near, far))) {
+        let light_bounds = match cascade_splits(&uploaded.bounds, camera, aspect, settings, Some((near, far)))
+        {
             Some(splits) if c.sdsm_bounds => {
                 let blend = match c.cascade_selection {
                     CascadeSelection::Depth => c.cascade_blend,
@@ -1239,7 +1473,7 @@ impl<'g> Renderer<'g> {
                 };
                 let request = BoundsRequest {
                     world_from_clip: camera.clip_from_world(aspect).inverse(),
-                    light_from_world: directional_light_view(sun_direction, &scene.bounds()),
+                    light_from_world: directional_light_view(sun_direction, &uploaded.bounds),
                     near: camera.near,
                     far: camera.far,
                     splits: &splits,
@@ -1274,8 +1508,9 @@ impl<'g> Renderer<'g> {
     }
 
     /// Records a depth-only pass through `scene_group`'s projection with the shadow
-    /// pipelines: the shadow pass (every caster, from the light) or SDSM's prepass;
-    /// `unclipped` clamps depth instead of clipping it.
+    /// pipelines, drawing the runs `visible` holds: a shadow-map layer's casters, or
+    /// what the camera sees for SDSM's prepass. `unclipped` clamps depth instead of
+    /// clipping it. Returns the stats of what it recorded.
     #[allow(clippy::too_many_arguments)]
     fn record_depth_pass(
         &mut self,
@@ -1284,95 +1519,70 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         scene_group: &wgpu::BindGroup,
         shadow_view: &wgpu::TextureView,
-        draws: Draws,
+        visible: &Visible,
+        target: DepthTarget,
         unclipped: bool,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
-        stats: &mut DrawStats,
-    ) {
+    ) -> DrawStats {
         let device = &self.gpu.device;
         let shadow = &settings.shadow;
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: shadow_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
+        let mut stats = DrawStats::default();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: shadow_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
                 }),
-                timestamp_writes,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, scene_group, &[]);
-            stats.bind_group_changes += 1;
-            uploaded.bind_geometry(&mut pass);
-            // Opaque casters first (no bind group changes at all), then the
-            // alpha-masked ones, texture by texture.
-            let (inside, target) = match draws {
-                Draws::Casters { inside, target } => (inside, target),
-                Draws::Everything => (None, DepthTarget::Projected),
-            };
-            let visible = |instance: u32| {
-                inside.is_none_or(|(frustum, near)| {
-                    frustum.intersects(&uploaded.instance_bounds[instance as usize], near)
-                })
-            };
-            let mut pipeline = None;
-            for masked in [false, true] {
-                let mut bound = None;
-                let drawn = |d: &&crate::gpu_scene::Draw| match draws {
-                    Draws::Casters { .. } => d.casts_shadow,
-                    Draws::Everything => true,
-                };
-                for d in uploaded.draws.iter().filter(drawn).filter(|d| d.masked == masked) {
-                    // The runs of consecutive instances that survive culling.
-                    let end = d.instance + d.instance_count;
-                    let mut start = d.instance;
-                    while start < end {
-                        if !visible(start) {
-                            start += 1;
-                            continue;
-                        }
-                        let mut stop = start + 1;
-                        while stop < end && visible(stop) {
-                            stop += 1;
-                        }
-                        if pipeline != Some((d.double_sided, masked)) {
-                            pass.set_pipeline(self.shadow_pass.pipeline(
-                                device,
-                                &shadow.bias,
-                                d.double_sided,
-                                masked,
-                                unclipped,
-                                target,
-                            ));
-                            pipeline = Some((d.double_sided, masked));
-                            stats.pipeline_changes += 1;
-                        }
-                        if masked && bound != Some(d.material_group) {
-                            pass.set_bind_group(1, &uploaded.material_groups[d.material_group], &[]);
-                            bound = Some(d.material_group);
-                            stats.bind_group_changes += 1;
-                        }
-                        let run =
-                            crate::gpu_scene::Draw { instance: start, instance_count: stop - start, ..*d };
-                        GpuScene::draw_one(&mut pass, &run);
-                        stats.shadow_draws += 1;
-                        start = stop;
-                    }
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, scene_group, &[]);
+        pass.set_index_buffer(uploaded.indices.slice(..), wgpu::IndexFormat::Uint32);
+        stats.bind_group_changes += 1;
+        // The runs come opaque first (no bind group changes at all), then the
+        // alpha-masked ones, texture by texture: the pipeline and the material's bind
+        // group change only between batches that need it.
+        let mut pipeline = None;
+        let mut positions_only = None;
+        let mut bound = None;
+        for (batch, run) in &visible.runs {
+            let batch = &uploaded.batches[*batch as usize];
+            if pipeline != Some((batch.double_sided, batch.masked)) {
+                pass.set_pipeline(self.shadow_pass.pipeline(
+                    device,
+                    &shadow.bias,
+                    batch.double_sided,
+                    batch.masked,
+                    unclipped,
+                    target,
+                ));
+                pipeline = Some((batch.double_sided, batch.masked));
+                stats.pipeline_changes += 1;
+                let positions = ShadowPass::reads_positions_only(batch.masked, target);
+                if positions_only != Some(positions) {
+                    let vertices = if positions { &uploaded.positions } else { &uploaded.vertices };
+                    pass.set_vertex_buffer(0, vertices.slice(..));
+                    positions_only = Some(positions);
                 }
             }
+            if batch.masked && bound != Some(batch.material_group) {
+                pass.set_bind_group(1, &uploaded.material_groups[batch.material_group], &[]);
+                bound = Some(batch.material_group);
+                stats.bind_group_changes += 1;
+            }
+            GpuScene::draw_run(&mut pass, batch, run.clone());
+            stats.shadow_draws += 1;
+            stats.shadow_instances += run.end - run.start;
         }
+        stats
     }
 }
-
-/// Timestamp queries per light: begin and end of its shadow, lighting, moment and
-/// shadow-mask passes, in that order.
-const TIMESTAMPS_PER_LIGHT: u32 = 8;
 
 fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, contents: &T) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -1398,6 +1608,8 @@ struct Submitted {
     color: wgpu::Texture,
     shadow_map: wgpu::Texture,
     timings: Option<PassTimings>,
+    passes: Vec<PassTime>,
+    cpu: CpuTimings,
     stats: DrawStats,
     lights: Vec<LightStats>,
     camera: Camera,
@@ -1439,7 +1651,7 @@ pub struct ShadowLayout {
 /// search reads the true distance to each blocker, nor for stable cascades, whose depth
 /// range must not follow the camera, nor for warps, which rely on clipping.
 pub fn shadow_layout(
-    scene: &Scene,
+    scene_bounds: &Aabb,
     light: &Light,
     camera: &Camera,
     aspect: f32,
@@ -1466,7 +1678,7 @@ pub fn shadow_layout(
         let fit = settings.shadow.map.fit;
         let clamped = pancake && fit == Fit::Receivers && matches!(light, Light::Directional(_));
         ShadowLayout {
-            projections: vec![light_projection(scene, light, camera, aspect, fit, clamped)],
+            projections: vec![light_projection(scene_bounds, light, camera, aspect, fit, clamped)],
             splits: vec![0.0, f32::INFINITY],
             depth_clamp: clamped,
         }
@@ -1474,17 +1686,18 @@ pub fn shadow_layout(
     if let (Light::Directional(sun), Partition::Single, Some(warp)) =
         (light, settings.shadow.partition, warp_of(settings.shadow.map.warp))
     {
-        return warped_layout(scene, sun.direction, camera, aspect, warp).unwrap_or_else(single);
+        return warped_layout(scene_bounds, sun.direction, camera, aspect, warp).unwrap_or_else(single);
     }
     let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
         return single();
     };
-    let Some(splits) = cascade_splits(scene, camera, aspect, settings, sampled.map(|s| (s.near, s.far)))
+    let Some(splits) =
+        cascade_splits(scene_bounds, camera, aspect, settings, sampled.map(|s| (s.near, s.far)))
     else {
         return single();
     };
     let c = &settings.shadow.cascades;
-    let bounds = scene.bounds();
+    let bounds = *scene_bounds;
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
     let resolution = settings.shadow.map.resolution;
     // With selection by depth, the lighting pass blends the far end of each cascade
@@ -1531,7 +1744,7 @@ pub fn shadow_layout(
 /// stable cascades, and split by the scheme. None when the camera sees none of the
 /// scene.
 fn cascade_splits(
-    scene: &Scene,
+    scene_bounds: &Aabb,
     camera: &Camera,
     aspect: f32,
     settings: &Settings,
@@ -1541,7 +1754,7 @@ fn cascade_splits(
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
     // The view depths that hold any of the scene: beyond them a cascade would cover
     // nothing.
-    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&scene.bounds()));
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(scene_bounds));
     let (near, far) = seen_depth_range(camera, &receivers)?;
     let (near, far) = match sampled {
         Some((lo, hi)) => (lo.max(camera.near), hi.min(camera.far).max(lo.max(camera.near) * 1.001)),
@@ -1596,13 +1809,13 @@ fn warp_of(kind: WarpKind) -> Option<Warp> {
 /// A sun's single map warped over the receivers the camera sees; None when it sees
 /// none of the scene.
 fn warped_layout(
-    scene: &Scene,
+    scene_bounds: &Aabb,
     direction: Vec3,
     camera: &Camera,
     aspect: f32,
     warp: Warp,
 ) -> Option<ShadowLayout> {
-    let bounds = scene.bounds();
+    let bounds = *scene_bounds;
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
     let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
     let (near, far) = seen_depth_range(camera, &receivers)?;
@@ -1653,7 +1866,7 @@ fn render_target(
 /// first face (+x; [`shadow_layout`] has all six). `depth_clamp` pancakes a
 /// receiver-fitted sun map ([`LightProjection::pancaked`]).
 pub fn light_projection(
-    scene: &Scene,
+    scene_bounds: &Aabb,
     light: &Light,
     camera: &Camera,
     aspect: f32,
@@ -1662,13 +1875,13 @@ pub fn light_projection(
 ) -> LightProjection {
     match light {
         Light::Directional(sun) if fit == Fit::Receivers => {
-            let bounds = scene.bounds();
+            let bounds = *scene_bounds;
             let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
             let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
             let fitted = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
             if depth_clamp { fitted.pancaked(&receivers) } else { fitted }
         }
-        Light::Directional(sun) => directional_light_projection(sun.direction, &scene.bounds()),
+        Light::Directional(sun) => directional_light_projection(sun.direction, scene_bounds),
         Light::Spot(spot) => spot_light_projection(
             spot.position,
             spot.direction,

@@ -1,10 +1,19 @@
 //! A scene uploaded to the GPU: every mesh in one vertex and one index buffer, every
 //! instance in one storage buffer, so that a draw changes no bind group and no
-//! vertex buffer, only the index range and the instance index.
+//! vertex buffer, only the index range and the instance range. The instances are
+//! grouped into batches (same mesh, material texture and pipeline state), each with a
+//! [`CullTree`] and stored in its order, so that culling a batch against a frustum
+//! yields runs of consecutive instances: instanced draws, whatever the instance count.
 
-use glam::{Mat3, Mat4, Vec4};
-use gnomon_math::Aabb;
+use std::ops::Range;
+
+use glam::Vec4;
+use gnomon_math::{
+    Aabb,
+    culling::{CullTree, Frustum},
+};
 use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
+use rayon::prelude::*;
 use wgpu::util::DeviceExt;
 
 use crate::{
@@ -13,43 +22,66 @@ use crate::{
     passes::Layouts,
 };
 
-/// Where one mesh lives in the shared buffers.
-#[derive(Clone, Copy, Debug)]
-struct MeshRange {
-    first_index: u32,
-    index_count: u32,
-    base_vertex: i32,
-}
-
-/// One draw: a mesh range and the instance whose data the shaders read.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Draw {
+/// Instances that share a mesh, a material texture and the state their draws need:
+/// `first_instance .. first_instance + tree.len()` in the instance buffer.
+#[derive(Debug)]
+pub(crate) struct Batch {
     pub first_index: u32,
     pub index_count: u32,
     pub base_vertex: i32,
-    /// The first instance; the draw covers `instance .. instance + instance_count`.
-    pub instance: u32,
-    pub instance_count: u32,
+    pub first_instance: u32,
     pub casts_shadow: bool,
     /// Alpha-tested (glTF MASK): the shadow pass must sample the texture.
     pub masked: bool,
     /// Both faces cast shadows (glTF `doubleSided`), whatever the cull setting.
     pub double_sided: bool,
-    /// Index into [`GpuScene::material_groups`]: the texture this draw samples.
+    /// Index into [`GpuScene::material_groups`]: the texture this batch samples.
     pub material_group: usize,
+    /// The batch's instances, in the order the instance buffer holds them.
+    tree: CullTree,
+}
+
+/// What a view draws: the runs of instances of each batch that survive culling, in
+/// drawing order.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Visible {
+    /// (batch index, instance range in the instance buffer).
+    pub runs: Vec<(u32, Range<u32>)>,
+}
+
+impl Visible {
+    /// How many instances the runs hold.
+    pub fn instances(&self) -> u32 {
+        self.runs.iter().map(|(_, r)| r.end - r.start).sum()
+    }
+}
+
+/// One view to cull for: the casters seen by a shadow-map layer, or every instance
+/// seen by the camera.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CullView {
+    pub frustum: Frustum,
+    /// Whether the frustum's near plane counts (not for a pass that clamps depth).
+    pub near: bool,
+    pub casters_only: bool,
 }
 
 /// The GPU copy of a [`Scene`]'s geometry, instances and textures.
 pub struct GpuScene {
     pub(crate) vertices: wgpu::Buffer,
+    /// The vertices' positions alone, for the shadow pass's position-only stream.
+    pub(crate) positions: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
     pub(crate) instances: wgpu::Buffer,
-    /// Draws sorted by material group, so a bind group changes only between groups.
-    pub(crate) draws: Vec<Draw>,
+    /// Batches sorted by material group, so a bind group changes only between groups.
+    pub(crate) batches: Vec<Batch>,
+    /// The batches in shadow-pass order: opaque before alpha-masked, then by cull
+    /// state and texture, so that pipelines and bind groups change least.
+    shadow_order: Vec<u32>,
     /// One bind group per texture, plus a 1×1 white one (index 0) for untextured draws.
     pub(crate) material_groups: Vec<wgpu::BindGroup>,
-    /// Each instance's world-space bounds, for culling casters per light.
-    pub(crate) instance_bounds: Vec<Aabb>,
+    /// The world bounds of every instance: what a light's projection is fitted to.
+    pub(crate) bounds: Aabb,
 }
 
 impl GpuScene {
@@ -62,31 +94,76 @@ impl GpuScene {
         let mut indices = Vec::new();
         let mut ranges = Vec::with_capacity(scene.meshes.len());
         for mesh in &scene.meshes {
-            ranges.push(MeshRange {
-                first_index: indices.len() as u32,
-                index_count: mesh.indices.len() as u32,
-                base_vertex: vertices.len() as i32,
-            });
+            ranges.push((indices.len() as u32, mesh.indices.len() as u32, vertices.len() as i32));
             vertices.extend(mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).map(|((p, n), uv)| {
                 VertexGpu { position: p.to_array(), normal: n.to_array(), uv: uv.to_array() }
             }));
             indices.extend_from_slice(&mesh.indices);
         }
-        let instance_data: Vec<InstanceGpu> = scene
-            .instances
+        let positions: Vec<[f32; 3]> = vertices.iter().map(|v| v.position).collect();
+        let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
+
+        // Group the instances into batches by everything a draw of them shares.
+        type BatchKey = (usize, bool, bool, bool, usize);
+        let key_of = |i: usize| -> BatchKey {
+            let inst = &scene.instances[i];
+            let material = &scene.materials[inst.material];
+            (
+                material.base_color_texture.map_or(0, |t| t + 1),
+                matches!(material.alpha_mode, AlphaMode::Mask { .. }),
+                material.double_sided,
+                inst.casts_shadow,
+                inst.mesh,
+            )
+        };
+        let mut members: Vec<usize> = (0..scene.instances.len())
+            .filter(|&i| !scene.meshes[scene.instances[i].mesh].indices.is_empty())
+            .collect();
+        members.sort_by_key(|&i| (key_of(i), i));
+        let mut order: Vec<usize> = Vec::with_capacity(members.len());
+        let mut batches = Vec::new();
+        for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
+            let (material_group, masked, double_sided, casts_shadow, mesh) = key_of(group[0]);
+            let bounds: Vec<Aabb> = group
+                .iter()
+                .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
+                .collect();
+            let (tree, tree_order) = CullTree::build(&bounds);
+            let (first_index, index_count, base_vertex) = ranges[mesh];
+            batches.push(Batch {
+                first_index,
+                index_count,
+                base_vertex,
+                first_instance: order.len() as u32,
+                casts_shadow,
+                masked,
+                double_sided,
+                material_group,
+                tree,
+            });
+            order.extend(tree_order.iter().map(|&k| group[k as usize]));
+        }
+        let mut shadow_order: Vec<u32> = (0..batches.len() as u32).collect();
+        shadow_order.sort_by_key(|&b| {
+            let b = &batches[b as usize];
+            (b.masked, b.double_sided, b.material_group)
+        });
+        let bounds = batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
+
+        let instance_data: Vec<InstanceGpu> = order
             .iter()
-            .enumerate()
-            .map(|(i, inst)| {
+            .map(|&i| {
+                let inst = &scene.instances[i];
                 let material = &scene.materials[inst.material];
-                let normal = Mat3::from_mat4(inst.world_from_object).inverse().transpose();
                 let cutoff = match material.alpha_mode {
                     AlphaMode::Mask { cutoff } => cutoff,
                     AlphaMode::Opaque | AlphaMode::Blend => -1.0,
                 };
                 InstanceGpu {
                     world_from_object: inst.world_from_object,
-                    normal_from_object: Mat4::from_mat3(normal),
                     base_color: material.base_color.extend(material.alpha),
+                    // The object id is the scene's instance index + 1, whatever the
+                    // buffer's order.
                     material: Vec4::new(material.specular, material.shininess, (i + 1) as f32, cutoff),
                     texturing: Vec4::new(
                         f32::from(u8::from(material.base_color_texture.is_some())),
@@ -97,54 +174,73 @@ impl GpuScene {
                 }
             })
             .collect();
-        let mut draws: Vec<Draw> = scene
-            .instances
-            .iter()
-            .enumerate()
-            .filter(|(_, inst)| !scene.meshes[inst.mesh].indices.is_empty())
-            .map(|(i, inst)| {
-                let r = ranges[inst.mesh];
-                let material = &scene.materials[inst.material];
-                Draw {
-                    first_index: r.first_index,
-                    index_count: r.index_count,
-                    base_vertex: r.base_vertex,
-                    instance: i as u32,
-                    instance_count: 1,
-                    casts_shadow: inst.casts_shadow,
-                    masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
-                    double_sided: material.double_sided,
-                    material_group: material.base_color_texture.map_or(0, |t| t + 1),
-                }
-            })
-            .collect();
-        draws.sort_by_key(|d| (d.material_group, d.instance));
-        let draws = coalesce(draws);
+        let instance_bytes = std::mem::size_of_val(instance_data.as_slice()) as u64;
+        let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+        if instance_bytes > limit {
+            return Err(RenderError::SceneTooLarge {
+                scene: scene.name.clone(),
+                instances: instance_data.len(),
+                bytes: instance_bytes,
+                limit,
+            });
+        }
         let device = &gpu.device;
+        let buffer = |label: &str, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
         gpu.checked("uploading the scene", || Self {
-            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("scene vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            }),
-            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("scene indices"),
-                contents: bytemuck::cast_slice(&indices),
-                usage: wgpu::BufferUsages::INDEX,
-            }),
-            instances: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("scene instances"),
-                contents: bytemuck::cast_slice(&instance_data),
-                usage: wgpu::BufferUsages::STORAGE,
-            }),
-            draws,
+            vertices: buffer("scene vertices", bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX),
+            positions: buffer(
+                "scene positions",
+                bytemuck::cast_slice(&positions),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            indices: buffer("scene indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX),
+            instances: buffer(
+                "scene instances",
+                bytemuck::cast_slice(&instance_data),
+                wgpu::BufferUsages::STORAGE,
+            ),
+            batches,
+            shadow_order,
             material_groups: material_groups(gpu, scene, layouts),
-            instance_bounds: scene
-                .instances
-                .iter()
-                .map(|i| scene.meshes[i.mesh].bounds().transformed(i.world_from_object))
-                .collect(),
+            bounds,
         })
+    }
+
+    /// How many instances were uploaded (those with geometry).
+    pub fn instance_count(&self) -> usize {
+        self.batches.iter().map(|b| b.tree.len()).sum()
+    }
+
+    /// Culls every view, in parallel: the runs each one draws.
+    pub(crate) fn cull(&self, views: &[CullView]) -> Vec<Visible> {
+        views.par_iter().map(|view| self.cull_one(view)).collect()
+    }
+
+    fn cull_one(&self, view: &CullView) -> Visible {
+        let mut visible = Visible::default();
+        let mut runs = Vec::new();
+        let order: Box<dyn Iterator<Item = u32>> = if view.casters_only {
+            Box::new(self.shadow_order.iter().copied())
+        } else {
+            Box::new(0..self.batches.len() as u32)
+        };
+        for index in order {
+            let batch = &self.batches[index as usize];
+            if view.casters_only && !batch.casts_shadow {
+                continue;
+            }
+            runs.clear();
+            batch.tree.cull(&view.frustum, view.near, &mut runs);
+            let first = batch.first_instance;
+            visible.runs.extend(runs.iter().map(|r| (index, first + r.start..first + r.end)));
+        }
+        visible
     }
 
     /// Binds the shared vertex and index buffers.
@@ -153,54 +249,38 @@ impl GpuScene {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
     }
 
-    /// Binds the geometry and draws every instance as seen from the camera, each
-    /// material's texture bound as group `material_group` when it changes. Returns
-    /// (draw calls, bind group changes).
-    pub(crate) fn draw_everything(&self, pass: &mut wgpu::RenderPass<'_>, material_group: u32) -> (u32, u32) {
+    /// Binds the geometry and draws `visible`, each material's texture bound as group
+    /// `material_group` when it changes. Returns (draw calls, bind group changes).
+    pub(crate) fn draw_visible(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        visible: &Visible,
+        material_group: u32,
+    ) -> (u32, u32) {
         self.bind_geometry(pass);
         let (mut draws, mut binds) = (0, 0);
         let mut bound = None;
-        for d in &self.draws {
-            if bound != Some(d.material_group) {
-                pass.set_bind_group(material_group, &self.material_groups[d.material_group], &[]);
-                bound = Some(d.material_group);
+        for (batch, run) in &visible.runs {
+            let batch = &self.batches[*batch as usize];
+            if bound != Some(batch.material_group) {
+                pass.set_bind_group(material_group, &self.material_groups[batch.material_group], &[]);
+                bound = Some(batch.material_group);
                 binds += 1;
             }
-            Self::draw_one(pass, d);
+            Self::draw_run(pass, batch, run.clone());
             draws += 1;
         }
         (draws, binds)
     }
 
-    /// Issues one draw.
-    pub(crate) fn draw_one(pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
+    /// Issues one instanced draw of a batch's mesh.
+    pub(crate) fn draw_run(pass: &mut wgpu::RenderPass<'_>, batch: &Batch, instances: Range<u32>) {
         pass.draw_indexed(
-            d.first_index..d.first_index + d.index_count,
-            d.base_vertex,
-            d.instance..d.instance + d.instance_count,
+            batch.first_index..batch.first_index + batch.index_count,
+            batch.base_vertex,
+            instances,
         );
     }
-}
-
-/// Merges runs of draws of the same mesh with consecutive instances and the same
-/// state into one instanced draw: a row of identical columns is one draw call.
-fn coalesce(draws: Vec<Draw>) -> Vec<Draw> {
-    let mut out: Vec<Draw> = Vec::with_capacity(draws.len());
-    for d in draws {
-        if let Some(last) = out.last_mut()
-            && last.first_index == d.first_index
-            && last.index_count == d.index_count
-            && last.base_vertex == d.base_vertex
-            && last.instance + last.instance_count == d.instance
-            && (last.casts_shadow, last.masked, last.double_sided, last.material_group)
-                == (d.casts_shadow, d.masked, d.double_sided, d.material_group)
-        {
-            last.instance_count += 1;
-            continue;
-        }
-        out.push(d);
-    }
-    out
 }
 
 /// A bind group per texture (after a white 1×1 default at index 0), each texture

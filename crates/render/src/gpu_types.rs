@@ -8,7 +8,6 @@ use glam::{Mat4, Vec4};
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct InstanceGpu {
     pub world_from_object: Mat4,
-    pub normal_from_object: Mat4,
     /// rgb: base colour (linear); a: base alpha.
     pub base_color: Vec4,
     /// x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1),

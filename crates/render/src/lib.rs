@@ -19,13 +19,15 @@ mod gpu_types;
 mod passes;
 mod readback;
 pub mod techniques;
+pub mod timing;
 
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
-    DrawStats, Frame, LightStats, LiveFrame, OutputRequest, PassTimings, Renderer, ShadowLayout,
-    ShadowMapImage, light_projection,
+    CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, Renderer,
+    ShadowLayout, ShadowMapImage, light_projection,
 };
 pub use gpu_scene::GpuScene;
+pub use passes::depth_baseline::DepthBaselineScene;
 pub use readback::read_texture;
 pub use wgpu;
 
@@ -69,6 +71,11 @@ pub enum RenderError {
     Scene(#[from] SceneError),
     #[error("scene `{0}` has nothing to draw")]
     EmptyScene(String),
+    #[error(
+        "scene `{scene}`: its {instances} instances need {bytes} bytes of instance data, but this \
+         device binds at most {limit} bytes in one storage buffer; render fewer instances"
+    )]
+    SceneTooLarge { scene: String, instances: usize, bytes: u64, limit: u64 },
     #[error("the GPU reported an error while {during}: {message}")]
     Gpu { during: &'static str, message: String },
 }

@@ -2,8 +2,14 @@
 //! distinct meshes cost draw calls but no extra state changes.
 
 use glam::{Mat4, Vec3};
-use gnomon_render::{Gpu, OutputRequest, Renderer};
-use gnomon_scene::{Instance, Settings, builtin, geometry};
+use gnomon_render::{
+    Gpu, GpuScene, OutputRequest, Renderer,
+    timing::{ClockChoice, PassKind, PassTime, TimingSource},
+};
+use gnomon_scene::{
+    Instance, Scene, Settings, builtin, geometry,
+    settings::{LightKind, Partition},
+};
 
 fn small() -> Settings {
     let mut s = Settings::default();
@@ -48,7 +54,8 @@ fn thousands_of_distinct_meshes_add_no_state_changes() {
     };
     let few = stats_for(10);
     let many = stats_for(2000);
-    assert_eq!(many.lighting_draws, 2001, "one draw per distinct mesh: {many:?}");
+    assert_eq!(many.lighting_draws, many.lighting_instances, "one draw per distinct mesh: {many:?}");
+    assert!(many.lighting_instances > 1900, "the camera sees nearly all of them: {many:?}");
     assert_eq!(
         (many.pipeline_changes, many.bind_group_changes),
         (few.pipeline_changes, few.bind_group_changes),
@@ -63,10 +70,78 @@ fn timing_alone_submits_the_same_frame_as_a_full_render() {
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     let frame = renderer.render_uploaded(&uploaded, &scene, &small(), &OutputRequest::default()).unwrap();
-    let (timings, stats) = renderer.time_passes(&uploaded, &scene, &small()).unwrap();
-    assert_eq!(stats, frame.stats);
-    assert_eq!(timings.is_some(), gpu.timestamp_period_ns.is_some());
-    if let Some(t) = timings {
-        assert!(t.shadow_ms > 0.0 && t.lighting_ms > 0.0, "{t:?}");
+    let cost = renderer.time_passes(&uploaded, &scene, &small(), ClockChoice::Auto).unwrap();
+    assert_eq!(cost.stats, frame.stats);
+    let t = cost.timings.expect("timing always times, on the CPU clock at worst");
+    let expected = if gpu.timestamp_period_ns.is_some() {
+        TimingSource::GpuTimestamps
+    } else {
+        TimingSource::CpuWallClock
+    };
+    assert_eq!(t.source, expected);
+    assert!(t.shadow_ms > 0.0 && t.lighting_ms > 0.0, "{t:?}");
+    assert!(cost.cpu.submit_ms >= cost.cpu.cull_ms + cost.cpu.record_ms, "{:?}", cost.cpu);
+}
+
+#[test]
+fn every_cascade_and_every_light_is_timed_on_either_clock() {
+    // Three cascades of a sun, then the eight lights of `lamps` (cube faces, spots):
+    // one shadow time per layer, one lighting time per light, on GPU timestamps and on
+    // the CPU wall clock, with the layer times summing to the light's shadow time.
+    let gpu = Gpu::new_headless().unwrap();
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let mut cascaded = small();
+    cascaded.shadow.partition = Partition::Cascades;
+    cascaded.shadow.cascades.count = 3;
+    let mut all = small();
+    all.light.kind = LightKind::All;
+    for (scene, settings) in [(builtin::spheres(), cascaded), (builtin::lamps(), all)] {
+        let uploaded = renderer.upload(&scene).unwrap();
+        for clock in [ClockChoice::Auto, ClockChoice::Cpu] {
+            let cost = renderer.time_passes(&uploaded, &scene, &settings, clock).unwrap();
+            let t = cost.timings.unwrap();
+            if clock == ClockChoice::Cpu {
+                assert_eq!(t.source, TimingSource::CpuWallClock);
+            }
+            for (index, light) in cost.lights.iter().enumerate() {
+                let layers: Vec<&PassTime> = cost
+                    .passes
+                    .iter()
+                    .filter(|p| p.kind == PassKind::Shadow && p.light == Some(index as u32))
+                    .collect();
+                assert_eq!(layers.len(), light.layer_draws.len(), "{}: a time per layer", light.name);
+                assert!(layers.iter().enumerate().all(|(i, p)| p.layer == Some(i as u32) && p.ms > 0.0));
+                let sum: f64 = light.layer_ms.iter().sum();
+                assert!((sum - light.shadow_ms.unwrap()).abs() < 1e-9);
+                assert!(light.lighting_ms.unwrap() > 0.0);
+            }
+            assert!(t.frame_ms >= t.shadow_ms, "{t:?}");
+        }
+        assert!(cost_lights(&mut renderer, &uploaded, &scene, &settings) >= 1);
     }
+}
+
+fn cost_lights(renderer: &mut Renderer, uploaded: &GpuScene, scene: &Scene, settings: &Settings) -> usize {
+    renderer.time_passes(uploaded, scene, settings, ClockChoice::Auto).unwrap().lights.len()
+}
+
+#[test]
+fn culling_draws_only_what_the_light_and_camera_see_in_few_draws() {
+    // 20 000 objects, nine tenths of them far away: each pass draws about a tenth of
+    // them, in a number of draws far below the number of objects drawn.
+    let gpu = Gpu::new_headless().unwrap();
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let scene = builtin::build("instances:20000").unwrap();
+    let uploaded = renderer.upload(&scene).unwrap();
+    assert_eq!(uploaded.instance_count(), 20_001);
+    let cost = renderer.time_passes(&uploaded, &scene, &small(), ClockChoice::Auto).unwrap();
+    let light = &cost.lights[0];
+    assert_eq!(light.layer_instances.len(), 1, "a single map by default");
+    let near_objects = 2000;
+    // Every near object and the ground, and at most a few stragglers.
+    let drawn = light.layer_instances[0] as usize;
+    assert!((near_objects + 1..near_objects + 100).contains(&drawn), "{drawn} drawn into the map");
+    let seen = cost.stats.lighting_instances as usize;
+    assert!((near_objects / 2..near_objects + 100).contains(&seen), "{seen} drawn by the camera");
+    assert!(light.layer_draws[0] < 300, "{} draws for {drawn} instances", light.layer_draws[0]);
 }

@@ -42,10 +42,28 @@ pub const BUILTINS: &[Builtin] = &[
         description: "a courtyard lit by eight shadowed lights at once: a sun, three spots and four point lights",
         build: lamps,
     },
+    Builtin {
+        name: "instances",
+        description: "10 000 small objects, 90% of them far outside the view and the light's frustum; \
+                      `instances:N` for N of them (10 to 4 000 000): submission scaling",
+        build: || instances(DEFAULT_INSTANCES),
+    },
 ];
 
-/// Builds the built-in scene called `name`, or `None` when there is none.
+/// The `instances` scene's object count when none is given.
+pub const DEFAULT_INSTANCES: usize = 10_000;
+/// The most objects `instances:N` builds. The renderer keeps 112 bytes of instance
+/// data each in one storage buffer; lavapipe binds 128 MiB of it (1.19 million), and
+/// uploading more than a device binds fails with an error that says so.
+pub const MAX_INSTANCES: usize = 4_000_000;
+
+/// Builds the built-in scene called `name` (`instances:N` for N objects), or `None`
+/// when there is none.
 pub fn build(name: &str) -> Option<Scene> {
+    if let Some(count) = name.strip_prefix("instances:") {
+        let count: usize = count.replace('_', "").parse().ok()?;
+        return (10..=MAX_INSTANCES).contains(&count).then(|| instances(count));
+    }
     BUILTINS.iter().find(|b| b.name == name).map(|b| (b.build)())
 }
 
@@ -281,6 +299,82 @@ pub fn columns() -> Scene {
     )
 }
 
+/// `count` small objects (boxes, spheres and cylinders in three colours: nine
+/// batches) for scaling tests. A tenth of them stand on a 40 × 48 rectangle the
+/// camera sees whole (at any aspect from 1:1), shrunk as they crowd it; the other nine
+/// tenths stand on a ring 150 to 400 from its centre, beyond the camera's far plane: outside the view and, since
+/// a light's map is fitted to what the camera sees, outside every light frustum. The
+/// layout is a fixed pseudo-random sequence, the same on every run.
+pub fn instances(count: usize) -> Scene {
+    let mut b = SceneBuilder::new();
+    let ground = b.mesh(geometry::plane(820.0, 820.0));
+    let grey = b.material("ground", GROUND);
+    b.place("ground", ground, grey, Mat4::IDENTITY);
+    let meshes = [
+        b.mesh(geometry::cuboid(Vec3::splat(0.4))),
+        b.mesh(geometry::uv_sphere(0.45, 8, 5)),
+        b.mesh(geometry::cylinder(0.3, 1.0, 8)),
+    ];
+    let materials = [
+        b.material("warm", Vec3::new(0.8, 0.5, 0.3)),
+        b.material("cool", Vec3::new(0.3, 0.5, 0.8)),
+        b.material("green", Vec3::new(0.35, 0.7, 0.35)),
+    ];
+    let near_count = count / 10;
+    // Objects of about 0.8 shrink so that 1 000 of them cover the near square as
+    // sparsely as any larger number does.
+    let scale = (1000.0 / near_count.max(1) as f32).sqrt().min(1.0);
+    // A 64-bit LCG (Knuth's MMIX constants): no dependency, the same everywhere.
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    b.instances.reserve(count);
+    for i in 0..count {
+        let (position, size) = if i < near_count {
+            (Vec3::new(40.0 * uniform() - 20.0, 0.0, 48.0 * uniform() - 24.0), scale)
+        } else {
+            let angle = std::f32::consts::TAU * uniform();
+            // Uniform over the ring's area.
+            let radius = (150.0f32.powi(2) + uniform() * (400.0f32.powi(2) - 150.0f32.powi(2))).sqrt();
+            (Vec3::new(radius * angle.cos(), 0.0, radius * angle.sin()), 1.0)
+        };
+        let kind = i % 3;
+        // Boxes and spheres rest on the ground; cylinders start at it.
+        let lift = [0.4, 0.45, 0.0][kind] * size;
+        let world_from_object = Mat4::from_scale_rotation_translation(
+            Vec3::splat(size),
+            glam::Quat::from_rotation_y(std::f32::consts::TAU * uniform()),
+            position + Vec3::Y * lift,
+        );
+        b.instances.push(Instance {
+            name: format!("object {i}"),
+            mesh: meshes[kind],
+            material: materials[(i / 3) % 3],
+            world_from_object,
+            casts_shadow: true,
+        });
+    }
+    let camera = Camera {
+        eye: Vec3::new(0.0, 30.0, 50.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_degrees: 60.0,
+        near: 0.1,
+        far: 95.0,
+    };
+    let name =
+        if count == DEFAULT_INSTANCES { "instances".to_string() } else { format!("instances:{count}") };
+    b.finish(
+        &name,
+        camera,
+        sun(50.0, 30.0),
+        spot(Vec3::new(0.0, 18.0, 10.0), Vec3::ZERO, 50.0, 60.0),
+        point(Vec3::new(0.0, 4.0, 0.0), 30.0),
+    )
+}
+
 /// A 30 × 30 courtyard with a ring of 3 m pillars, crates and spheres, lit by eight
 /// shadowed lights of every type at once, each with its own shadow settings: a low
 /// sun with cascades, three spot lights and four coloured point lights (lamps) among
@@ -398,6 +492,26 @@ mod tests {
             assert!(scene.sun.direction.y < 0.0, "{}: the sun shines downward", b.name);
         }
         assert!(build("no-such-scene").is_none());
+    }
+
+    #[test]
+    fn instances_takes_its_count_and_keeps_nine_tenths_far_away() {
+        assert_eq!(build("instances").unwrap().instances.len(), 1 + DEFAULT_INSTANCES);
+        let scene = build("instances:2_000").unwrap();
+        assert_eq!(scene.name, "instances:2000");
+        assert_eq!(scene.instances.len(), 1 + 2000, "a ground and the objects");
+        let far = scene.instances[1..]
+            .iter()
+            .filter(|i| i.world_from_object.w_axis.truncate().length() >= 150.0)
+            .count();
+        assert_eq!(far, 1800);
+        for i in &scene.instances[1..] {
+            let lowest = scene.meshes[i.mesh].bounds().transformed(i.world_from_object).min.y;
+            assert!(lowest.abs() < 1e-4, "{} floats at {lowest}", i.name);
+        }
+        for bad in ["instances:", "instances:9", "instances:-5", "instances:many", "instances:4000001"] {
+            assert!(build(bad).is_none(), "{bad}");
+        }
     }
 
     #[test]

@@ -286,9 +286,12 @@ pub enum SceneError {
 impl Scene {
     /// World-space bounds of all instances.
     pub fn bounds(&self) -> Aabb {
+        // Each mesh's bounds once, not once per instance: a million instances of a
+        // few meshes must not walk a million vertex lists.
+        let mesh_bounds: Vec<Aabb> = self.meshes.iter().map(Mesh::bounds).collect();
         self.instances
             .iter()
-            .map(|i| self.meshes[i.mesh].bounds().transformed(i.world_from_object))
+            .map(|i| mesh_bounds[i.mesh].transformed(i.world_from_object))
             .fold(Aabb::EMPTY, Aabb::union)
     }
 

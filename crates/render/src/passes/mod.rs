@@ -1,6 +1,7 @@
 //! The render passes and the resources they share: bind group layouts, the WGSL
 //! composition, and the pipeline caches.
 
+pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
 pub(crate) mod lighting;
 pub(crate) mod map_preview;

@@ -1,10 +1,10 @@
 // Shadow pass: depth only, from the light. No fragment stage, so the cheapest path
 // the rasterizer has; bias and culling come from the pipeline state.
 
+// It reads the position-only vertex stream: nothing else is needed.
 @vertex
-fn vs_shadow(v: VertexIn, @builtin(instance_index) instance_index: u32) -> @builtin(position) vec4<f32> {
-    let inst = instances[instance_index];
-    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+fn vs_shadow(@location(0) position: vec3<f32>, @builtin(instance_index) instance_index: u32) -> @builtin(position) vec4<f32> {
+    let world = instances[instance_index].world_from_object * vec4<f32>(position, 1.0);
     return light.clip_from_world * world;
 }
 

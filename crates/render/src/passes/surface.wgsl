@@ -22,7 +22,7 @@ fn vs_surface(v: VertexIn, @builtin(instance_index) instance_index: u32) -> Surf
     var out: SurfaceVertex;
     out.clip = camera.clip_from_world * world;
     out.world = world.xyz;
-    out.normal = (inst.normal_from_object * vec4<f32>(v.normal, 0.0)).xyz;
+    out.normal = normal_from_object(inst.world_from_object) * v.normal;
     out.instance = instance_index;
     out.uv = v.uv;
     return out;

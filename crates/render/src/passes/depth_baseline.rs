@@ -1,0 +1,196 @@
+//! The depth-only baseline that the shadow pass is measured against: the same casters,
+//! pre-transformed to world space in one vertex buffer (positions only) and drawn with
+//! one draw call per cull state into the same layers at the same resolution, with a
+//! vertex-only pipeline that reads one matrix. No instance data, no culling work, no
+//! bias, no state changes: what any shadow pass must at least cost.
+
+use std::ops::Range;
+
+use glam::{Mat4, Vec3};
+use gnomon_scene::{Scene, settings::CullMode};
+use wgpu::util::DeviceExt;
+
+use super::SHADOW_FORMAT;
+use crate::{Gpu, RenderError};
+
+/// The casters of a scene, flattened for [`DepthBaselinePass`].
+pub struct DepthBaselineScene {
+    positions: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    /// Index ranges of the single-sided and the double-sided casters.
+    single_sided: Range<u32>,
+    double_sided: Range<u32>,
+    /// Triangles it draws per layer.
+    pub triangles: usize,
+}
+
+impl DepthBaselineScene {
+    /// Flattens every shadow-casting instance of `scene` into world space. Alpha-masked
+    /// casters are drawn solid: the baseline has no texture to test.
+    pub fn upload(gpu: &Gpu, scene: &Scene) -> Result<Self, RenderError> {
+        let mut positions: Vec<Vec3> = Vec::new();
+        let (mut single, mut double) = (Vec::new(), Vec::new());
+        for instance in scene.instances.iter().filter(|i| i.casts_shadow) {
+            let mesh = &scene.meshes[instance.mesh];
+            let base = positions.len() as u32;
+            positions.extend(mesh.positions.iter().map(|&p| instance.world_from_object.transform_point3(p)));
+            let indices =
+                if scene.materials[instance.material].double_sided { &mut double } else { &mut single };
+            indices.extend(mesh.indices.iter().map(|&i| base + i));
+        }
+        if single.is_empty() && double.is_empty() {
+            return Err(RenderError::EmptyScene(scene.name.clone()));
+        }
+        let triangles = (single.len() + double.len()) / 3;
+        let (single_len, double_len) = (single.len() as u32, double.len() as u32);
+        single.extend(double);
+        let device = &gpu.device;
+        gpu.checked("uploading the depth-only baseline", || Self {
+            positions: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("baseline positions"),
+                contents: bytemuck::cast_slice(&positions),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("baseline indices"),
+                contents: bytemuck::cast_slice(&single),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            single_sided: 0..single_len,
+            double_sided: single_len..single_len + double_len,
+            triangles,
+        })
+    }
+}
+
+/// The baseline's pipelines, one per (cull mode, unclipped depth, mirrored winding).
+pub(crate) struct DepthBaselinePass {
+    module: wgpu::ShaderModule,
+    group_layout: wgpu::BindGroupLayout,
+    layout: wgpu::PipelineLayout,
+    pipelines: std::collections::HashMap<(CullMode, bool, bool), wgpu::RenderPipeline>,
+}
+
+impl DepthBaselinePass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("depth-only baseline"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("depth_baseline.wgsl").into()),
+        });
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth-only baseline"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth-only baseline"),
+            bind_group_layouts: &[Some(&group_layout)],
+            immediate_size: 0,
+        });
+        Self { module, group_layout, layout, pipelines: Default::default() }
+    }
+
+    fn pipeline(&mut self, device: &wgpu::Device, key: (CullMode, bool, bool)) -> &wgpu::RenderPipeline {
+        let (module, layout) = (&self.module, &self.layout);
+        let (cull, unclipped, mirrored) = key;
+        self.pipelines.entry(key).or_insert_with(|| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("depth-only baseline"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_baseline"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: 12,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: match cull {
+                        CullMode::Back => Some(wgpu::Face::Back),
+                        CullMode::Front => Some(wgpu::Face::Front),
+                        CullMode::None => None,
+                    },
+                    unclipped_depth: unclipped,
+                    // A cube face's view is mirrored (`gnomon_math::omni`).
+                    front_face: if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: SHADOW_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+
+    /// Records the baseline's depth pass into `target` through `clip_from_world`,
+    /// culling `cull` faces of single-sided casters, clamping depth if `unclipped`,
+    /// with the winding flipped if `mirrored`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &DepthBaselineScene,
+        clip_from_world: Mat4,
+        (cull, unclipped, mirrored): (CullMode, bool, bool),
+        target: &wgpu::TextureView,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
+    ) {
+        let matrix = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("baseline clip_from_world"),
+            contents: bytemuck::bytes_of(&clip_from_world),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth-only baseline"),
+            layout: &self.group_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: matrix.as_entire_binding() }],
+        });
+        // Both pipelines exist before the pass borrows them.
+        self.pipeline(device, (cull, unclipped, mirrored));
+        self.pipeline(device, (CullMode::None, unclipped, mirrored));
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("depth-only baseline"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: target,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &group, &[]);
+        pass.set_vertex_buffer(0, scene.positions.slice(..));
+        pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (range, cull) in [(&scene.single_sided, cull), (&scene.double_sided, CullMode::None)] {
+            if !range.is_empty() {
+                pass.set_pipeline(&self.pipelines[&(cull, unclipped, mirrored)]);
+                pass.draw_indexed(range.clone(), 0, 0..1);
+            }
+        }
+    }
+}

@@ -1,0 +1,237 @@
+//! Pass timing: a timestamp query pair around every pass (each shadow-map layer of
+//! each light, the moment filter, the screen-space passes, each light's lighting), or,
+//! where the adapter has no timestamp queries, CPU wall-clock time around each pass
+//! with the frame cut into one submission per pass.
+
+use std::time::Instant;
+
+use crate::{Gpu, RenderError, readback};
+
+/// Which kind of pass a time belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PassKind {
+    /// The mask path's depth-and-normal prepass from the camera.
+    Prepass,
+    /// One layer (cascade, cube face, hemisphere or the single map) of a light's map.
+    Shadow,
+    /// A filterable technique's moment pass: encoding, blur and mipmaps.
+    Filter,
+    /// A light's screen-space shadow-mask pass.
+    Mask,
+    /// A light's lighting pass.
+    Lighting,
+}
+
+impl PassKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            PassKind::Prepass => "prepass",
+            PassKind::Shadow => "shadow",
+            PassKind::Filter => "filter",
+            PassKind::Mask => "mask",
+            PassKind::Lighting => "lighting",
+        }
+    }
+}
+
+/// How a frame's passes were timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimingSource {
+    /// Timestamp queries written by the GPU at each pass's start and end.
+    GpuTimestamps,
+    /// CPU wall-clock time around each pass, submitted and waited for alone. It
+    /// includes recording and submission, and serializes the frame, so it reads high.
+    CpuWallClock,
+}
+
+/// How [`crate::Renderer::time_passes`] should time passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ClockChoice {
+    /// Timestamp queries where the adapter has them, else the CPU wall clock.
+    #[default]
+    Auto,
+    /// The CPU wall clock, even where timestamps exist (to compare, or to test it).
+    Cpu,
+}
+
+/// One pass's time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassTime {
+    pub kind: PassKind,
+    /// The light's index in the frame, for per-light passes.
+    pub light: Option<u32>,
+    /// The map layer, for shadow passes.
+    pub layer: Option<u32>,
+    pub ms: f64,
+}
+
+/// A pass's place in the clock: its label and, for timestamps, its query pair.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slot(usize);
+
+enum Mode {
+    Off,
+    Gpu { query_set: wgpu::QuerySet, capacity: u32 },
+    Cpu { started: Option<Instant>, ms: Vec<f64>, first: Option<Instant>, last: Option<Instant> },
+}
+
+/// Times the passes of one frame as they are recorded.
+pub(crate) struct PassClock {
+    mode: Mode,
+    labels: Vec<(PassKind, Option<u32>, Option<u32>)>,
+}
+
+impl PassClock {
+    /// A clock for at most `capacity` passes: timestamps when the device has them,
+    /// else the CPU wall clock if `cpu_fallback`, else none at all. `force_cpu`
+    /// chooses the wall clock even where timestamps exist.
+    pub fn new(gpu: &Gpu, capacity: u32, cpu_fallback: bool, force_cpu: bool) -> Self {
+        let mode = match gpu.timestamp_period_ns {
+            Some(_) if !force_cpu => Mode::Gpu {
+                query_set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2 * capacity.max(1),
+                }),
+                capacity,
+            },
+            _ if cpu_fallback || force_cpu => {
+                Mode::Cpu { started: None, ms: Vec::new(), first: None, last: None }
+            }
+            _ => Mode::Off,
+        };
+        Self { mode, labels: Vec::new() }
+    }
+
+    /// Starts timing a pass. On the CPU clock, everything recorded so far is
+    /// submitted and waited for first, so the pass is timed alone.
+    pub fn begin(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        kind: PassKind,
+        light: Option<u32>,
+        layer: Option<u32>,
+    ) -> Slot {
+        let slot = Slot(self.labels.len());
+        self.labels.push((kind, light, layer));
+        match &mut self.mode {
+            Mode::Gpu { capacity, .. } => {
+                assert!(slot.0 < *capacity as usize, "more timed passes than the clock was made for");
+            }
+            Mode::Cpu { started, first, .. } => {
+                flush(gpu, encoder);
+                let now = Instant::now();
+                *started = Some(now);
+                first.get_or_insert(now);
+            }
+            Mode::Off => {}
+        }
+        slot
+    }
+
+    /// Ends timing the pass `slot` began (after the pass itself has ended).
+    pub fn end(&mut self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, slot: Slot) {
+        if let Mode::Cpu { started, ms, last, .. } = &mut self.mode {
+            flush(gpu, encoder);
+            let now = Instant::now();
+            let start = started.take().expect("a pass ends after it begins");
+            ms.resize(slot.0 + 1, 0.0);
+            ms[slot.0] = (now - start).as_secs_f64() * 1e3;
+            *last = Some(now);
+        }
+    }
+
+    /// The timestamp writes for a render pass in `slot`.
+    pub fn render_writes(&self, slot: Slot) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        match &self.mode {
+            Mode::Gpu { query_set, .. } => Some(wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(2 * slot.0 as u32),
+                end_of_pass_write_index: Some(2 * slot.0 as u32 + 1),
+            }),
+            _ => None,
+        }
+    }
+
+    /// The timestamp writes for a compute pass in `slot`.
+    pub fn compute_writes(&self, slot: Slot) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        match &self.mode {
+            Mode::Gpu { query_set, .. } => Some(wgpu::ComputePassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(2 * slot.0 as u32),
+                end_of_pass_write_index: Some(2 * slot.0 as u32 + 1),
+            }),
+            _ => None,
+        }
+    }
+
+    /// Records the copy of the timestamps out of the query set, at the frame's end.
+    pub fn resolve(self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) -> PendingTimes {
+        let pending = match &self.mode {
+            Mode::Gpu { query_set, .. } if !self.labels.is_empty() => Some(readback::record_timestamps(
+                &gpu.device,
+                encoder,
+                query_set,
+                2 * self.labels.len() as u32,
+            )),
+            _ => None,
+        };
+        PendingTimes { clock: self, pending }
+    }
+}
+
+/// Submits what `encoder` holds and waits for the GPU to finish it.
+fn flush(gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+    let done = std::mem::replace(encoder, gpu.device.create_command_encoder(&Default::default()));
+    gpu.queue.submit([done.finish()]);
+    // A failed wait leaves the time long, not wrong in kind; the error scope around
+    // the frame reports any device error.
+    let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+}
+
+/// A frame's pass times, waiting for the GPU.
+pub(crate) struct PendingTimes {
+    clock: PassClock,
+    pending: Option<readback::PendingTimestamps>,
+}
+
+/// A frame's pass times and the span of the whole frame.
+#[derive(Clone, Debug)]
+pub(crate) struct FrameTimes {
+    pub passes: Vec<PassTime>,
+    pub frame_ms: f64,
+    pub source: TimingSource,
+}
+
+impl PendingTimes {
+    /// Waits for the times; None when the frame was not timed.
+    pub fn read(self, gpu: &Gpu) -> Result<Option<FrameTimes>, RenderError> {
+        let labels = &self.clock.labels;
+        let pass = |i: usize, ms: f64| {
+            let (kind, light, layer) = labels[i];
+            PassTime { kind, light, layer, ms }
+        };
+        match (self.clock.mode, self.pending) {
+            (Mode::Gpu { .. }, Some(pending)) => {
+                let ticks = pending.read(gpu)?;
+                let period = f64::from(gpu.timestamp_period_ns.unwrap_or(1.0)) * 1e-6;
+                let passes = (0..labels.len())
+                    .map(|i| pass(i, ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period));
+                let first = (0..labels.len()).map(|i| ticks[2 * i]).min().unwrap_or(0);
+                let last = (0..labels.len()).map(|i| ticks[2 * i + 1]).max().unwrap_or(0);
+                Ok(Some(FrameTimes {
+                    passes: passes.collect(),
+                    frame_ms: last.saturating_sub(first) as f64 * period,
+                    source: TimingSource::GpuTimestamps,
+                }))
+            }
+            (Mode::Cpu { ms, first: Some(first), last: Some(last), .. }, _) => Ok(Some(FrameTimes {
+                passes: ms.into_iter().enumerate().map(|(i, ms)| pass(i, ms)).collect(),
+                frame_ms: (last - first).as_secs_f64() * 1e3,
+                source: TimingSource::CpuWallClock,
+            })),
+            _ => Ok(None),
+        }
+    }
+}
