@@ -29,7 +29,7 @@ use crate::{
     gpu_scene::{CullView, Visible},
     gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
-        Layouts, SHADOW_FORMAT,
+        Layouts, SHADOW_FORMAT, begin_depth_pass,
         depth_baseline::{DepthBaselinePass, DepthBaselineScene},
         depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
@@ -1527,21 +1527,7 @@ impl<'g> Renderer<'g> {
         let device = &self.gpu.device;
         let shadow = &settings.shadow;
         let mut stats = DrawStats::default();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shadow"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: shadow_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_depth_pass(encoder, "shadow", shadow_view, timestamp_writes);
         pass.set_bind_group(0, scene_group, &[]);
         pass.set_index_buffer(uploaded.indices.slice(..), wgpu::IndexFormat::Uint32);
         stats.bind_group_changes += 1;

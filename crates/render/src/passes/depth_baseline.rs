@@ -168,21 +168,7 @@ impl DepthBaselinePass {
         // Both pipelines exist before the pass borrows them.
         self.pipeline(device, (cull, unclipped, mirrored));
         self.pipeline(device, (CullMode::None, unclipped, mirrored));
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("depth-only baseline"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: target,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = super::begin_depth_pass(encoder, "depth-only baseline", target, timestamp_writes);
         pass.set_bind_group(0, &group, &[]);
         pass.set_vertex_buffer(0, scene.positions.slice(..));
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
