@@ -158,6 +158,14 @@ impl LightStats {
     }
 }
 
+/// What a depth-only baseline run measured and read.
+struct BaselineRun {
+    times: Option<crate::timing::FrameTimes>,
+    /// The reported light's first layer, when asked for.
+    shown_map: Option<Vec<f32>>,
+    lights: usize,
+}
+
 /// A frame, as decided before recording.
 struct FramePlan {
     camera: Camera,
@@ -572,11 +580,9 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         clock: ClockChoice,
     ) -> Result<Vec<Option<f64>>, RenderError> {
-        let (times, _) =
-            self.record_depth_baseline(baseline, uploaded, scene, settings, Some(clock), false)?;
-        let times = times.map(|t| t.passes).unwrap_or_default();
-        let plan = self.plan_frame(uploaded, scene, settings, None)?;
-        Ok((0..plan.plans.len() as u32)
+        let run = self.record_depth_baseline(baseline, uploaded, scene, settings, Some(clock), false)?;
+        let times = run.times.map(|t| t.passes).unwrap_or_default();
+        Ok((0..run.lights as u32)
             .map(|light| {
                 let mut layers = times.iter().filter(|p| p.light == Some(light)).peekable();
                 layers.peek()?;
@@ -594,13 +600,16 @@ impl<'g> Renderer<'g> {
         scene: &Scene,
         settings: &Settings,
     ) -> Result<Vec<f32>, RenderError> {
-        let (_, map) = self.record_depth_baseline(baseline, uploaded, scene, settings, None, true)?;
-        map.ok_or_else(|| RenderError::Gpu {
+        let run = self.record_depth_baseline(baseline, uploaded, scene, settings, None, true)?;
+        run.shown_map.ok_or_else(|| RenderError::Gpu {
             during: "drawing the depth-only baseline",
             message: "a dual-paraboloid map has no baseline".into(),
         })
     }
 
+    /// Records and submits the baseline's maps for the frame `settings` plans; returns
+    /// their times (with `clock`), the reported light's first layer (if `read_shown`)
+    /// and the number of lights.
     fn record_depth_baseline(
         &mut self,
         baseline: &DepthBaselineScene,
@@ -609,7 +618,7 @@ impl<'g> Renderer<'g> {
         settings: &Settings,
         clock: Option<ClockChoice>,
         read_shown: bool,
-    ) -> Result<(Option<crate::timing::FrameTimes>, Option<Vec<f32>>), RenderError> {
+    ) -> Result<BaselineRun, RenderError> {
         settings.validate()?;
         self.check_limits(settings)?;
         let plan = self.plan_frame(uploaded, scene, settings, None)?;
@@ -676,7 +685,7 @@ impl<'g> Renderer<'g> {
             Some(p) => Some(p.read::<f32>(gpu)?),
             None => None,
         };
-        Ok((times, map))
+        Ok(BaselineRun { times, shown_map: map, lights: plan.plans.len() })
     }
 
     /// Everything about a frame that is decided before recording: the camera, and
