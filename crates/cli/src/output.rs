@@ -218,10 +218,12 @@ pub fn shadow_map_to_gray16(
         // Warped depth is monotonic along each ray, which is all a picture needs.
         ProjectionKind::Orthographic { .. } | ProjectionKind::Warped { .. } => d,
     };
-    let covered = map.depth.iter().copied().filter(|&d| d < 1.0).map(linear);
+    // The first layer: the nearest cascade, or a cube's +x face.
+    let depth = map.layer(0);
+    let covered = depth.iter().copied().filter(|&d| d < 1.0).map(linear);
     let (lo, hi) = covered.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));
     let span = if hi > lo { hi - lo } else { 1.0 };
-    map.depth
+    depth
         .iter()
         .map(|&d| {
             if d >= 1.0 {

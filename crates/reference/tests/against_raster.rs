@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{compare, reference, render};
+use common::{compare, figures::figure, reference, render};
 use gnomon_reference::metrics::Metrics;
 use gnomon_scene::{
     Scene, Settings, builtin,
@@ -36,6 +36,11 @@ fn raising_the_bias_on_contact_raises_the_false_lit_rate() {
         100.0 * default.false_lit_rate,
         100.0 * planted.false_lit_rate
     );
+    figure(
+        "contact, hard: false lit, default bias → slope bias 40",
+        format!("{:.4}% → {:.4}%", 100.0 * default.false_lit_rate, 100.0 * planted.false_lit_rate),
+        "planted > default + 0.1 points",
+    );
     assert!(planted.false_lit_rate > default.false_lit_rate + 0.001, "{default:?}\n{planted:?}");
     assert!(planted.compared > 100_000 && planted.silhouette < planted.compared / 20);
 }
@@ -54,12 +59,18 @@ fn dropping_the_bias_on_grazing_raises_the_false_shadow_rate() {
         100.0 * default.false_shadow_rate,
         100.0 * planted.false_shadow_rate
     );
+    figure(
+        "grazing, hard: false shadow with the default bias",
+        format!("{:.4}%", 100.0 * default.false_shadow_rate),
+        "0.12%",
+    );
     assert!(planted.false_shadow_rate > 0.05, "{planted:?}");
-    assert!(default.false_shadow_rate < 0.005, "{default:?}");
+    // 0.069 % measured on lavapipe (was < 0.5 %).
+    assert!(default.false_shadow_rate < 0.0012, "{default:?}");
 }
 
 #[test]
-fn foundation_techniques_mismatch_under_one_percent_on_spheres() {
+fn foundation_techniques_mismatch_under_a_twentieth_of_a_percent_on_spheres() {
     let scene = builtin::spheres();
     let s = settings(1280, 720, Technique::Hard);
     let truth = reference(&scene, &s);
@@ -74,7 +85,13 @@ fn foundation_techniques_mismatch_under_one_percent_on_spheres() {
             m.compared,
             m.silhouette
         );
-        assert!(m.mismatch_rate < 0.01, "{technique:?}: {m:?}");
+        figure(
+            &format!("spheres, {}: mismatch", technique.name()),
+            format!("{:.3}%", 100.0 * m.mismatch_rate),
+            "0.05%",
+        );
+        // 0.028 % (hard), 0.023 % (pcf2x2), 0.015 % (pcf) measured on lavapipe (was < 1 %).
+        assert!(m.mismatch_rate < 0.0005, "{technique:?}: {m:?}");
         // Nearly every surface pixel is compared, not set aside as a silhouette.
         let surface = truth.object_id.iter().filter(|&&i| i != 0).count();
         assert!(m.compared > 600_000 && m.silhouette * 100 < surface, "{m:?} of {surface} surface pixels");

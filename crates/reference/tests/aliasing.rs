@@ -375,7 +375,10 @@ fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
     let clamped = render(&scene, &clamped_settings);
     let full = render(&scene, &full_settings);
     if !clamped.shadow_depth_clamp {
-        eprintln!("skipped: this device cannot draw with unclipped depth (DEPTH_CLIP_CONTROL)");
+        common::figures::skipped(
+            "pancaking_keeps_every_shadow_in_a_shorter_depth_range",
+            "this device cannot draw with unclipped depth (DEPTH_CLIP_CONTROL)",
+        );
         return;
     }
     assert!(!full.shadow_depth_clamp);

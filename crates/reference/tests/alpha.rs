@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{compare, reference, render};
+use common::{compare, figures::figure, reference, render};
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_scene::{
     AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry, settings::Technique,
@@ -177,11 +177,7 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 /// held to a regression bound.
 #[test]
 fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/tree/tree.glb");
-    if !path.is_file() {
-        eprintln!("skipped: {} is not present", path.display());
-        return;
-    }
+    let path = common::shared_scene("tree/tree.glb");
     let (mut scene, extras) = gnomon_scene::gltf_loader::load(&path).unwrap();
     assert!(!extras.has_camera, "the tree ships without a camera: the loader fits one");
     scene.sun.direction = -gnomon_scene::sun_direction(55.0, 200.0);
@@ -200,6 +196,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
         m
     };
     let fitted = measure(&scene, &s, "fitted view");
+    figure("tree, fitted view, pcf2x2: mismatch", format!("{:.3}%", 100.0 * fitted.mismatch_rate), "2%");
     assert!(fitted.compared > 40_000, "{fitted:?}");
     assert!(fitted.mismatch_rate < 0.02, "{fitted:?}");
 
@@ -212,6 +209,11 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     scene.camera.near = 0.01 * r;
     scene.camera.far = 10.0 * r;
     let close = measure(&scene, &s, "close view with ground");
+    figure(
+        "tree, close view with ground, pcf2x2: mismatch",
+        format!("{:.3}%", 100.0 * close.mismatch_rate),
+        "2.5%",
+    );
     assert!(close.compared > 300_000, "{close:?}");
     // Issue 4's 2 % is not met on this view (2.09 % measured, README); this bound
     // only guards it against getting worse.

@@ -2,6 +2,9 @@
 //! the penumbra of an area light behind a straight edge, Monte Carlo convergence,
 //! and determinism.
 
+mod common;
+
+use common::figures::figure;
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_reference::{ReferenceImage, ReferenceOptions, TracedScene, reference_visibility};
 use gnomon_scene::{
@@ -187,7 +190,10 @@ fn penumbra_width_matches_similar_triangles() {
         "penumbra: measured {measured:.4}, similar triangles {expected:.4}, error {:.2}%",
         100.0 * error
     );
-    assert!(error < 0.10, "penumbra width {measured} vs {expected}: {:.1}% off", 100.0 * error);
+    figure("penumbra width against similar triangles: error", format!("{:.2}%", 100.0 * error), "2.5%");
+    // 1.37 % measured (was < 10 %): 256 samples rarely see the thinnest sliver of the
+    // disk at the penumbra's ends, so the measured width falls a little short.
+    assert!(error < 0.025, "penumbra width {measured} vs {expected}: {:.2}% off", 100.0 * error);
     // It is centred on the edge's projection, x = 0.
     assert!((0.5 * (hi + lo)).abs() < 0.05 * expected, "centre {}", 0.5 * (hi + lo));
 }
@@ -210,22 +216,29 @@ fn standard_error_falls_with_the_sample_count_and_is_honest() {
                 / penumbra.len() as f64)
                 .sqrt();
         eprintln!("N = {n:5}: mean standard error {mean_se:.5}, RMS error against N = 16384 {rms_error:.5}");
-        // The reported standard error tracks the actual error.
-        assert!(
-            rms_error < 2.0 * mean_se && rms_error > 0.4 * mean_se,
-            "N = {n}: SE {mean_se} vs error {rms_error}"
+        // The reported standard error tracks the actual error: their ratio is 1 for an
+        // honest estimate; 1.06 to 1.16 measured (was 0.4 to 2).
+        let ratio = rms_error / mean_se;
+        figure(
+            &format!("reference, N = {n}: RMS error / reported standard error"),
+            format!("{ratio:.3}"),
+            "0.9 to 1.3",
         );
+        assert!((0.9..1.3).contains(&ratio), "N = {n}: SE {mean_se} vs error {rms_error}");
         points.push(((n as f64).ln(), mean_se.ln()));
     }
-    // Least-squares slope of log SE against log N: −0.5 for plain Monte Carlo, steeper
-    // with stratification.
+    // Least-squares slope of log SE against log N: −0.5 for plain Monte Carlo; −0.75
+    // for jittered samples of a 2D domain cut by an edge, which is what a disk light
+    // partly hidden behind an occluder's edge is (Mitchell 1996). −0.767 measured.
     let k = points.len() as f64;
     let (sx, sy) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
     let (mx, my) = (sx / k, sy / k);
     let slope = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
         / points.iter().map(|(x, _)| (x - mx).powi(2)).sum::<f64>();
     eprintln!("standard error ∝ N^{slope:.3}");
-    assert!((-1.0..=-0.45).contains(&slope), "slope {slope}");
+    figure("reference: standard error ∝ N^slope", format!("{slope:.3}"), "-0.9 to -0.65");
+    // Steeper than −0.65: plain Monte Carlo's −0.5 fails (was −1 to −0.45).
+    assert!((-0.9..=-0.65).contains(&slope), "slope {slope}");
 }
 
 #[test]

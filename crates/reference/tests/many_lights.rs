@@ -5,11 +5,16 @@
 
 mod common;
 
-use common::{compare, reference, render};
+use common::{compare, figures::figure, reference, render};
 use gnomon_scene::{
     Light, Settings, builtin,
     settings::{LightKind, Technique},
 };
+
+/// Each light's mismatch bound, about 1.7× what was measured on lavapipe (in %): sun
+/// 0.151, spots 0.055, 0.047, 0.143, point lights 0.327, 0.511, 0.394, 0.454 (was
+/// 1 % for all).
+const MISMATCH_BOUNDS: [f64; 8] = [0.0025, 0.001, 0.001, 0.0025, 0.0055, 0.0085, 0.0065, 0.0075];
 
 fn all_lights(index: usize) -> Settings {
     let mut s = Settings::default();
@@ -25,7 +30,7 @@ fn all_lights(index: usize) -> Settings {
 fn eight_mixed_lights_each_match_the_reference() {
     let scene = builtin::lamps();
     assert_eq!(scene.lights.len(), 8);
-    for index in 0..scene.lights.len() {
+    for (index, bound) in MISMATCH_BOUNDS.into_iter().enumerate() {
         let s = all_lights(index);
         let frame = render(&scene, &s);
         // Every light drew its own map, with its own settings.
@@ -53,7 +58,12 @@ fn eight_mixed_lights_each_match_the_reference() {
             m.mae
         );
         assert!(m.compared > frame.pixel_count() / 2);
-        assert!(m.mismatch_rate < 0.01, "light {index}: {m:?}");
+        figure(
+            &format!("lamps, light {index} ({}): mismatch", light.light.type_name()),
+            format!("{:.3}%", 100.0 * m.mismatch_rate),
+            format!("{:.2}%", 100.0 * bound),
+        );
+        assert!(m.mismatch_rate < bound, "light {index}: {m:?}");
 
         // The light's shadows do not depend on the other seven: alone in the
         // scene, with the same settings, it shades the same.

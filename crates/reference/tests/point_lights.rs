@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{compare, reference, render};
+use common::{compare, figures::figure, reference, render};
 use glam::{Mat4, Vec3};
 use gnomon_reference::{
     ReferenceImage,
@@ -185,7 +185,20 @@ fn no_band_of_mismatch_along_cube_face_seams() {
             100.0 * elsewhere
         );
         assert!(pixels > 5_000, "the seams cross the view: {pixels} pixels near them");
-        assert!(near_seam < 0.01, "{}: {:.3}% near the seams", technique.name(), 100.0 * near_seam);
+        // The seams are no worse than the rest of the image: measured 0.19–0.22 % near
+        // them and 0.23 % elsewhere (a ratio of 0.81–0.94; was < 1 % near them alone).
+        figure(
+            &format!("cube seams, {}: mismatch near the seams / elsewhere", technique.name()),
+            format!("{:.3}% / {:.3}%", 100.0 * near_seam, 100.0 * elsewhere),
+            "near < 1.25 × elsewhere and < 0.35%",
+        );
+        assert!(
+            near_seam < 1.25 * elsewhere && near_seam < 0.0035,
+            "{}: {:.3}% near the seams, {:.3}% elsewhere",
+            technique.name(),
+            100.0 * near_seam,
+            100.0 * elsewhere
+        );
 
         // A one-texel line of false shadow along every seam, as a gap between faces
         // would leave, is caught by the same measure.
@@ -198,7 +211,17 @@ fn no_band_of_mismatch_along_cube_face_seams() {
                 if on_seam { 0.0 } else { v }
             })
             .collect();
-        let (planted_rate, _, _) = seam_band_mismatch(&planted, &frame, &truth, band);
+        let (planted_rate, planted_elsewhere, _) = seam_band_mismatch(&planted, &frame, &truth, band);
+        figure(
+            &format!("cube seams, {}: a planted seam line", technique.name()),
+            format!("{:.2}%", 100.0 * planted_rate),
+            "caught: > 1.25 × elsewhere",
+        );
+        assert!(
+            planted_rate > 1.25 * planted_elsewhere,
+            "a planted seam line gives only {:.3}%",
+            100.0 * planted_rate
+        );
         assert!(planted_rate > 0.05, "a planted seam line gives only {:.3}%", 100.0 * planted_rate);
     }
 }
@@ -256,6 +279,11 @@ fn sphere_light_pcss_follows_the_monte_carlo_penumbra() {
     hard.shadow.filter.technique = Technique::Hard;
     let hard = compare(&render(&scene, &hard), &truth);
     eprintln!("sphere light r = 0.25: MAE pcss {:.4}, hard {:.4}", pcss.mae, hard.mae);
+    figure(
+        "sphere light, cube PCSS: MAE (hard)",
+        format!("{:.4} ({:.4})", pcss.mae, hard.mae),
+        "0.03, and < 0.7 × hard",
+    );
     assert!(pcss.mae < 0.7 * hard.mae, "pcss {pcss:?}\nhard {hard:?}");
     assert!(pcss.mae < 0.03, "{pcss:?}");
 }

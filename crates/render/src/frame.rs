@@ -30,13 +30,15 @@ use crate::{
     gpu_types::{CameraGpu, LightGpu, MAX_CASCADES},
     passes::{
         Layouts, SHADOW_FORMAT, begin_depth_pass,
-        depth_baseline::{DepthBaselinePass, DepthBaselineScene},
+        depth_baseline::{BaselineRaster, DepthBaselinePass, DepthBaselineScene},
         depth_reduce::{BoundsRequest, DepthReducePass},
         lighting::{self, LightingKey, LightingPass, LightingRole, Lookup},
         map_preview::MapPreviewPass,
         moments::MomentPass,
         screen_space::{self, MaskKey, ScreenSpacePass},
-        shadow::{DepthTarget, ShadowPass},
+        shadow::{
+            Coverage, DepthRange, DepthTarget, ShadowPass, ShadowPipelineKey, ShadowPipelineShape, Sides,
+        },
     },
     readback, techniques,
     timing::{ClockChoice, PassClock, PassKind, PassTime, TimingSource},
@@ -56,8 +58,20 @@ pub struct OutputRequest {
 #[derive(Clone, Debug)]
 pub struct ShadowMapImage {
     pub resolution: u32,
-    /// Raw depth in [0, 1], row-major, top row first (texture space, v down).
+    /// Array layers: cascades, cube faces (WebGPU's order) or paraboloids; 1 for a
+    /// single map.
+    pub layers: u32,
+    /// Raw depth in [0, 1], row-major, top row first (texture space, v down), layer
+    /// after layer.
     pub depth: Vec<f32>,
+}
+
+impl ShadowMapImage {
+    /// One layer's texels.
+    pub fn layer(&self, layer: u32) -> &[f32] {
+        let texels = (self.resolution * self.resolution) as usize;
+        &self.depth[layer as usize * texels..(layer as usize + 1) * texels]
+    }
 }
 
 /// Everything a frame produced. Images are row-major, top row first.
@@ -161,7 +175,7 @@ impl LightStats {
 /// What a depth-only baseline run measured and read.
 struct BaselineRun {
     times: Option<crate::timing::FrameTimes>,
-    /// The reported light's first layer, when asked for.
+    /// The reported light's map, every layer, when asked for.
     shown_map: Option<Vec<f32>>,
     lights: usize,
 }
@@ -591,8 +605,9 @@ impl<'g> Renderer<'g> {
             .collect())
     }
 
-    /// The depth-only baseline's first layer of the reported light's map, read back:
-    /// to check that it draws what the shadow pass draws.
+    /// The depth-only baseline's map of the reported light, every layer, read back
+    /// (as [`ShadowMapImage::depth`] lays them out): to check that it draws what the
+    /// shadow pass draws.
     pub fn depth_baseline_map(
         &mut self,
         baseline: &DepthBaselineScene,
@@ -630,10 +645,10 @@ impl<'g> Renderer<'g> {
             let mut encoder = device.create_command_encoder(&Default::default());
             let mut pending_map = None;
             for (index, light) in plan.plans.iter().enumerate() {
-                let mirrored = match (light.light, light.settings.shadow.map.omni) {
-                    (Light::Point(_), OmniMap::Cube) => true,
-                    (Light::Point(_), OmniMap::Paraboloid) => continue,
-                    _ => false,
+                let target = match depth_target(light) {
+                    // No matrix draws a paraboloid: the baseline has none.
+                    DepthTarget::Paraboloid => continue,
+                    target @ (DepthTarget::Projected | DepthTarget::CubeFace) => target,
                 };
                 let resolution = light.settings.shadow.map.resolution;
                 let count = light.layout.projections.len() as u32;
@@ -665,7 +680,11 @@ impl<'g> Renderer<'g> {
                         &mut encoder,
                         baseline,
                         light.light_gpu.cascade_clip_from_world[layer as usize],
-                        (light.settings.shadow.bias.cull, light.layout.depth_clamp, mirrored),
+                        BaselineRaster {
+                            bias: &light.settings.shadow.bias,
+                            depth_range: DepthRange::clamped_if(light.layout.depth_clamp),
+                            target,
+                        },
                         &view,
                         clock.render_writes(slot),
                     );
@@ -1179,11 +1198,7 @@ impl<'g> Renderer<'g> {
         let gpu = self.gpu;
         let device = &gpu.device;
         let resolution = plan.settings.shadow.map.resolution;
-        let target = match (plan.light, plan.settings.shadow.map.omni) {
-            (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
-            (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
-            _ => DepthTarget::Projected,
-        };
+        let target = depth_target(plan);
         let shadow_map = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow map"),
             size: wgpu::Extent3d {
@@ -1369,7 +1384,11 @@ impl<'g> Renderer<'g> {
         let normal_w: Vec<Vec4> = next().read(gpu)?;
         let object_id: Vec<u32> = next().read(gpu)?;
         let shadow_map = match shadow_pending {
-            Some(p) => Some(ShadowMapImage { resolution, depth: p.read(gpu)? }),
+            Some(p) => {
+                let depth: Vec<f32> = p.read(gpu)?;
+                let layers = (depth.len() / (resolution * resolution) as usize) as u32;
+                Some(ShadowMapImage { resolution, layers, depth })
+            }
             None => None,
         };
 
@@ -1538,33 +1557,33 @@ impl<'g> Renderer<'g> {
         let mut stats = DrawStats::default();
         let mut pass = begin_depth_pass(encoder, "shadow", shadow_view, timestamp_writes);
         pass.set_bind_group(0, scene_group, &[]);
-        pass.set_index_buffer(uploaded.indices.slice(..), wgpu::IndexFormat::Uint32);
         stats.bind_group_changes += 1;
         // The runs come opaque first (no bind group changes at all), then the
         // alpha-masked ones, texture by texture: the pipeline and the material's bind
         // group change only between batches that need it.
-        let mut pipeline = None;
-        let mut positions_only = None;
+        let mut pipeline: Option<ShadowPipelineKey> = None;
         let mut bound = None;
         for (batch, run) in &visible.runs {
             let batch = &uploaded.batches[*batch as usize];
-            if pipeline != Some((batch.double_sided, batch.masked)) {
-                pass.set_pipeline(self.shadow_pass.pipeline(
-                    device,
-                    &shadow.bias,
-                    batch.double_sided,
-                    batch.masked,
-                    unclipped,
-                    target,
-                ));
-                pipeline = Some((batch.double_sided, batch.masked));
-                stats.pipeline_changes += 1;
-                let positions = ShadowPass::reads_positions_only(batch.masked, target);
-                if positions_only != Some(positions) {
-                    let vertices = if positions { &uploaded.positions } else { &uploaded.vertices };
-                    pass.set_vertex_buffer(0, vertices.slice(..));
-                    positions_only = Some(positions);
+            let key = ShadowPipelineKey::new(
+                &shadow.bias,
+                if batch.double_sided { Sides::Double } else { Sides::Single },
+                if batch.masked { Coverage::Masked } else { Coverage::Opaque },
+                DepthRange::clamped_if(unclipped),
+                target,
+            );
+            if pipeline != Some(key) {
+                let stream = ShadowPipelineShape::of(&key).stream;
+                match pipeline {
+                    None => uploaded.bind_geometry(&mut pass, stream),
+                    Some(previous) if ShadowPipelineShape::of(&previous).stream != stream => {
+                        uploaded.bind_stream(&mut pass, stream)
+                    }
+                    Some(_) => {}
                 }
+                pass.set_pipeline(self.shadow_pass.pipeline(device, &key));
+                pipeline = Some(key);
+                stats.pipeline_changes += 1;
             }
             if batch.masked && bound != Some(batch.material_group) {
                 pass.set_bind_group(1, &uploaded.material_groups[batch.material_group], &[]);
@@ -1885,6 +1904,15 @@ pub fn light_projection(
             spot.range,
         ),
         Light::Point(point) => cube_face_projections(point.position, point.shadow_near(), point.range)[0],
+    }
+}
+
+/// What a light's shadow pass stores.
+fn depth_target(plan: &LightPlan) -> DepthTarget {
+    match (plan.light, plan.settings.shadow.map.omni) {
+        (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
+        (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
+        (Light::Directional(_) | Light::Spot(_), _) => DepthTarget::Projected,
     }
 }
 

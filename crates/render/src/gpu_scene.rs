@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt;
 
 use crate::{
     Gpu, RenderError,
-    gpu_types::{InstanceGpu, VertexGpu},
+    gpu_types::{INSTANCE_SLOT, InstanceGpu, VertexGpu, VertexStream},
     passes::Layouts,
 };
 
@@ -200,10 +200,12 @@ impl GpuScene {
                 wgpu::BufferUsages::VERTEX,
             ),
             indices: buffer("scene indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX),
+            // Vertex stages read the matrices as per-instance attributes, fragment
+            // stages the materials from storage (`InstanceGpu`).
             instances: buffer(
                 "scene instances",
                 bytemuck::cast_slice(&instance_data),
-                wgpu::BufferUsages::STORAGE,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
             ),
             batches,
             shadow_order,
@@ -243,10 +245,21 @@ impl GpuScene {
         visible
     }
 
-    /// Binds the shared vertex and index buffers.
-    pub(crate) fn bind_geometry(&self, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_vertex_buffer(0, self.vertices.slice(..));
+    /// Binds the shared index buffer, the instance transforms and `stream`: what
+    /// every pipeline declaring [`VertexStream::buffers`] reads.
+    pub(crate) fn bind_geometry(&self, pass: &mut wgpu::RenderPass<'_>, stream: VertexStream) {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_vertex_buffer(INSTANCE_SLOT, self.instances.slice(..));
+        self.bind_stream(pass, stream);
+    }
+
+    /// Binds `stream` alone, for a pass that changes streams between pipelines.
+    pub(crate) fn bind_stream(&self, pass: &mut wgpu::RenderPass<'_>, stream: VertexStream) {
+        let vertices = match stream {
+            VertexStream::Full => &self.vertices,
+            VertexStream::PositionsOnly => &self.positions,
+        };
+        pass.set_vertex_buffer(0, vertices.slice(..));
     }
 
     /// Binds the geometry and draws `visible`, each material's texture bound as group
@@ -257,7 +270,7 @@ impl GpuScene {
         visible: &Visible,
         material_group: u32,
     ) -> (u32, u32) {
-        self.bind_geometry(pass);
+        self.bind_geometry(pass, VertexStream::Full);
         let (mut draws, mut binds) = (0, 0);
         let mut bound = None;
         for (batch, run) in &visible.runs {

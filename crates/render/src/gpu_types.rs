@@ -3,7 +3,10 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
 
-/// One entry of the instance storage buffer (`Instance` in `scene_common.wgsl`).
+/// One entry of the instance buffer (`Instance` in `scene_common.wgsl`). The buffer is
+/// bound twice: as a storage buffer, where fragment stages read the material, and as
+/// vertex buffer [`INSTANCE_SLOT`], where vertex stages read `world_from_object`
+/// ([`InstanceGpu::transform_layout`]).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct InstanceGpu {
@@ -89,6 +92,59 @@ pub struct CameraGpu {
     pub viewport: Vec4,
 }
 
+/// The vertex-buffer slot of the instance transforms, after the vertices (slot 0).
+pub const INSTANCE_SLOT: u32 = 1;
+
+impl InstanceGpu {
+    /// `world_from_object`'s four columns as per-instance vertex attributes, locations
+    /// 3 to 6 (`InstanceTransform` in `scene_common.wgsl`), at the start of each entry.
+    ///
+    /// Why not read the matrix from the storage buffer by `instance_index`: that is a
+    /// gather in every vertex invocation, and a CPU rasterizer pays it per vertex
+    /// (lavapipe: Sponza's shadow pass took 1.6–1.8× a depth-only pass that reads no
+    /// instance data, and 0.94× once the matrix came as an attribute). Per-instance
+    /// attributes are fetched once per instance on every kind of device.
+    pub const TRANSFORM_ATTRIBUTES: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
+        3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4
+    ];
+
+    pub const fn transform_layout() -> wgpu::VertexBufferLayout<'static> {
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<InstanceGpu>() as u64,
+            step_mode: wgpu::VertexStepMode::Instance,
+            attributes: &Self::TRANSFORM_ATTRIBUTES,
+        }
+    }
+}
+
+/// Which vertex stream a geometry pass reads from slot 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum VertexStream {
+    /// Position, normal and texture coordinate ([`VertexGpu`]).
+    Full,
+    /// Positions alone (12 bytes a vertex): what opaque casters drawn into a projected
+    /// map need, and a third of the bytes fetched.
+    PositionsOnly,
+}
+
+impl VertexStream {
+    /// The vertex buffers a pipeline drawing scene geometry declares: the stream in
+    /// slot 0, the instance transforms in slot [`INSTANCE_SLOT`].
+    pub const fn buffers(self) -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
+        let vertices = match self {
+            VertexStream::Full => VertexGpu::layout(),
+            VertexStream::PositionsOnly => wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &POSITION_ATTRIBUTES,
+            },
+        };
+        [Some(vertices), Some(InstanceGpu::transform_layout())]
+    }
+}
+
+const POSITION_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
+
 /// One vertex: position, normal, texture coordinate (locations 0, 1, 2).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -102,7 +158,7 @@ impl VertexGpu {
     pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
         wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
 
-    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+    pub const fn layout() -> wgpu::VertexBufferLayout<'static> {
         wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<VertexGpu>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,

@@ -8,25 +8,28 @@ pub(crate) struct PendingReadback {
     buffer: wgpu::Buffer,
     width: u32,
     height: u32,
+    /// Array layers, each `height` rows.
+    layers: u32,
     bytes_per_texel: u32,
     padded_bytes_per_row: u32,
 }
 
-/// Records a copy of mip 0 of `texture` (of `aspect`) into a mappable buffer.
+/// Records a copy of mip 0 of `texture` (of `aspect`), every array layer, into a
+/// mappable buffer.
 pub(crate) fn record(
     device: &wgpu::Device,
     encoder: &mut wgpu::CommandEncoder,
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
 ) -> PendingReadback {
-    let (width, height) = (texture.width(), texture.height());
+    let (width, height, layers) = (texture.width(), texture.height(), texture.depth_or_array_layers());
     let bytes_per_texel = texture.format().block_copy_size(Some(aspect)).unwrap_or(4);
     let unpadded = width * bytes_per_texel;
     let padded_bytes_per_row =
         unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
-        size: padded_bytes_per_row as u64 * height as u64,
+        size: padded_bytes_per_row as u64 * height as u64 * layers as u64,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
@@ -40,9 +43,9 @@ pub(crate) fn record(
                 rows_per_image: Some(height),
             },
         },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        wgpu::Extent3d { width, height, depth_or_array_layers: layers },
     );
-    PendingReadback { buffer, width, height, bytes_per_texel, padded_bytes_per_row }
+    PendingReadback { buffer, width, height, layers, bytes_per_texel, padded_bytes_per_row }
 }
 
 /// Copies mip 0 of a colour `texture` back to the CPU and waits for it: texels
@@ -117,18 +120,20 @@ impl PendingTimestamps {
 
 impl PendingReadback {
     /// Maps the buffer (after the copy's submission) and returns the tightly packed
-    /// texels, top row first.
+    /// texels, top row first, layer after layer.
     pub fn read<T: bytemuck::Pod>(self, gpu: &Gpu) -> Result<Vec<T>, RenderError> {
         let slice = self.buffer.slice(..);
         map_blocking(gpu, &slice)?;
         let row = (self.width * self.bytes_per_texel) as usize;
-        let mut bytes = Vec::with_capacity(row * self.height as usize);
+        let rows = (self.height * self.layers) as usize;
+        let mut bytes = Vec::with_capacity(row * rows);
         {
             let mapped = slice.get_mapped_range().map_err(|e| RenderError::Gpu {
                 during: "mapping a readback buffer",
                 message: e.to_string(),
             })?;
-            for y in 0..self.height as usize {
+            // With rows_per_image = height, layer after layer is row after row.
+            for y in 0..rows {
                 let start = y * self.padded_bytes_per_row as usize;
                 bytes.extend_from_slice(&mapped[start..start + row]);
             }

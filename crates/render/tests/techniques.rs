@@ -166,17 +166,40 @@ fn filterable_techniques_also_work_with_16_bit_moment_maps() {
     }
 }
 
+/// The world size of a texel of a sun's map fitted to the whole scene (`--fit scene`),
+/// from the geometry alone: the map's window is the scene's bounding box seen along
+/// the light, with the light's up toward +y, and a box of sides s spans Σ |aᵢ| sᵢ
+/// along a unit axis a. The renderer uses the larger of the two spans.
+fn analytic_sun_texel(scene: &Scene, resolution: u32) -> f32 {
+    let (lo, hi) = scene
+        .instances
+        .iter()
+        .flat_map(|i| scene.meshes[i.mesh].positions.iter().map(|&p| i.world_from_object.transform_point3(p)))
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let size = hi - lo;
+    let forward = scene.sun.direction.normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let span = |axis: Vec3| (axis.abs() * size).element_sum();
+    span(right).max(span(up)) / resolution as f32
+}
+
 #[test]
 fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
     // Under a sun the map is orthographic: one texel is the same world size
-    // everywhere, so W texels and W·texel world units are the same kernel.
+    // everywhere, so W texels and W·texel world units are the same kernel. The texel
+    // comes from the scene's geometry, not from the renderer's own texel size.
     let scene = square_under_sun().scene;
+    let texel = analytic_sun_texel(&scene, RESOLUTION);
     for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
         let mut s = settings(320, 240, RESOLUTION);
+        s.shadow.map.fit = gnomon_scene::settings::Fit::Scene;
         s.shadow.filter.technique = technique;
         s.shadow.filter.pcf_kernel = 5.0;
         let in_texels = render(&scene, &s);
-        let texel = in_texels.light_projection.texel_world_size(RESOLUTION, 0.0);
+        // The fit pads the window by a thousandth of the scene's radius a side.
+        let reported = in_texels.light_projection.texel_world_size(RESOLUTION, 0.0);
+        assert!((reported / texel - 1.0).abs() < 0.005, "texel {reported}, analytic {texel}");
         s.shadow.filter.kernel_unit = gnomon_scene::settings::KernelUnit::World;
         s.shadow.filter.pcf_kernel = 5.0 * texel;
         let in_world = render(&scene, &s);

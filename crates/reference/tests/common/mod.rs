@@ -2,6 +2,9 @@
 //! test binary, a render, a reference trace and the comparison of the two.
 #![allow(dead_code)]
 
+#[path = "../../../render/tests/support/figures.rs"]
+pub mod figures;
+
 use std::sync::OnceLock;
 
 use gnomon_reference::{
@@ -38,4 +41,19 @@ pub fn compare(frame: &Frame, reference: &ReferenceImage) -> Metrics {
         RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
     let classes = metrics::classify(raster, reference);
     metrics::measure(raster, reference, &classes)
+}
+
+/// A file of the shared scene collection (`../shared/scenes` beside the checkout),
+/// which CI always has. A test that needs one fails, naming it, when it is missing:
+/// a silent skip would let a regression through.
+pub fn shared_scene(relative: &str) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    let path = root.join(relative);
+    assert!(
+        path.is_file(),
+        "{} is missing: this test reads the shared scenes, expected in `shared/scenes` beside the \
+         checkout (CI provides them; see README, \"Tests\")",
+        path.display()
+    );
+    path
 }

@@ -1,16 +1,20 @@
 //! The depth-only baseline that the shadow pass is measured against: the same casters,
 //! pre-transformed to world space in one vertex buffer (positions only) and drawn with
 //! one draw call per cull state into the same layers at the same resolution, with a
-//! vertex-only pipeline that reads one matrix. No instance data, no culling work, no
-//! bias, no state changes: what any shadow pass must at least cost.
+//! vertex-only pipeline that reads one matrix and rasterizes as the shadow pass does
+//! (cull mode, winding, depth clamp and bias). No instance data, no culling work, no
+//! state changes: what any shadow pass must at least cost.
 
 use std::ops::Range;
 
 use glam::{Mat4, Vec3};
-use gnomon_scene::{Scene, settings::CullMode};
+use gnomon_scene::{Scene, settings::BiasSettings};
 use wgpu::util::DeviceExt;
 
-use super::SHADOW_FORMAT;
+use super::{
+    SHADOW_FORMAT,
+    shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape, Sides},
+};
 use crate::{Gpu, RenderError};
 
 /// The casters of a scene, flattened for [`DepthBaselinePass`].
@@ -63,12 +67,27 @@ impl DepthBaselineScene {
     }
 }
 
-/// The baseline's pipelines, one per (cull mode, unclipped depth, mirrored winding).
+/// The baseline's pipelines, one per shadow-pipeline key it stands in for.
 pub(crate) struct DepthBaselinePass {
     module: wgpu::ShaderModule,
     group_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
-    pipelines: std::collections::HashMap<(CullMode, bool, bool), wgpu::RenderPipeline>,
+    pipelines: std::collections::HashMap<ShadowPipelineKey, wgpu::RenderPipeline>,
+}
+
+/// How the shadow pass would rasterize a layer: the baseline rasterizes the same way,
+/// so that the two draw the same depth map.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BaselineRaster<'a> {
+    pub bias: &'a BiasSettings,
+    pub depth_range: DepthRange,
+    pub target: DepthTarget,
+}
+
+impl BaselineRaster<'_> {
+    fn key(&self, sides: Sides) -> ShadowPipelineKey {
+        ShadowPipelineKey::new(self.bias, sides, Coverage::Opaque, self.depth_range, self.target)
+    }
 }
 
 impl DepthBaselinePass {
@@ -98,10 +117,14 @@ impl DepthBaselinePass {
         Self { module, group_layout, layout, pipelines: Default::default() }
     }
 
-    fn pipeline(&mut self, device: &wgpu::Device, key: (CullMode, bool, bool)) -> &wgpu::RenderPipeline {
+    /// The pipeline standing in for the shadow pipeline of `key`: its own vertex stage
+    /// and no fragment stage, with the shadow pipeline's culling, winding, depth range
+    /// and bias ([`ShadowPipelineShape`]). A distance map's bias is written by its
+    /// fragment stage, so the baseline of a cube face or paraboloid has none.
+    fn pipeline(&mut self, device: &wgpu::Device, key: ShadowPipelineKey) -> &wgpu::RenderPipeline {
         let (module, layout) = (&self.module, &self.layout);
-        let (cull, unclipped, mirrored) = key;
         self.pipelines.entry(key).or_insert_with(|| {
+            let shape = ShadowPipelineShape::of(&key);
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("depth-only baseline"),
                 layout: Some(layout),
@@ -116,14 +139,9 @@ impl DepthBaselinePass {
                     })],
                 },
                 primitive: wgpu::PrimitiveState {
-                    cull_mode: match cull {
-                        CullMode::Back => Some(wgpu::Face::Back),
-                        CullMode::Front => Some(wgpu::Face::Front),
-                        CullMode::None => None,
-                    },
-                    unclipped_depth: unclipped,
-                    // A cube face's view is mirrored (`gnomon_math::omni`).
-                    front_face: if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+                    cull_mode: shape.cull_mode,
+                    unclipped_depth: shape.unclipped_depth,
+                    front_face: shape.front_face,
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -131,7 +149,7 @@ impl DepthBaselinePass {
                     depth_write_enabled: Some(true),
                     depth_compare: Some(wgpu::CompareFunction::LessEqual),
                     stencil: Default::default(),
-                    bias: Default::default(),
+                    bias: shape.bias,
                 }),
                 multisample: Default::default(),
                 fragment: None,
@@ -142,8 +160,7 @@ impl DepthBaselinePass {
     }
 
     /// Records the baseline's depth pass into `target` through `clip_from_world`,
-    /// culling `cull` faces of single-sided casters, clamping depth if `unclipped`,
-    /// with the winding flipped if `mirrored`.
+    /// rasterized as `raster` says the shadow pass would.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -151,7 +168,7 @@ impl DepthBaselinePass {
         encoder: &mut wgpu::CommandEncoder,
         scene: &DepthBaselineScene,
         clip_from_world: Mat4,
-        (cull, unclipped, mirrored): (CullMode, bool, bool),
+        raster: BaselineRaster<'_>,
         target: &wgpu::TextureView,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) {
@@ -165,16 +182,18 @@ impl DepthBaselinePass {
             layout: &self.group_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: matrix.as_entire_binding() }],
         });
+        let (single, double) = (raster.key(Sides::Single), raster.key(Sides::Double));
         // Both pipelines exist before the pass borrows them.
-        self.pipeline(device, (cull, unclipped, mirrored));
-        self.pipeline(device, (CullMode::None, unclipped, mirrored));
+        self.pipeline(device, single);
+        self.pipeline(device, double);
+        // The same pass set-up (attachment, load and store) as the shadow pass's.
         let mut pass = super::begin_depth_pass(encoder, "depth-only baseline", target, timestamp_writes);
         pass.set_bind_group(0, &group, &[]);
         pass.set_vertex_buffer(0, scene.positions.slice(..));
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (range, cull) in [(&scene.single_sided, cull), (&scene.double_sided, CullMode::None)] {
+        for (range, key) in [(&scene.single_sided, single), (&scene.double_sided, double)] {
             if !range.is_empty() {
-                pass.set_pipeline(&self.pipelines[&(cull, unclipped, mirrored)]);
+                pass.set_pipeline(&self.pipelines[&key]);
                 pass.draw_indexed(range.clone(), 0, 0..1);
             }
         }

@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use gnomon_scene::settings::Technique;
 
 use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
-use crate::{gpu_types::VertexGpu, techniques};
+use crate::{gpu_types::VertexStream, techniques};
 
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub(crate) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
@@ -102,6 +102,16 @@ pub(crate) fn camera_shading_wgsl() -> Vec<String> {
 /// from the camera: the lighting pass and the prepass.
 pub(crate) const SURFACE_WGSL: &str = include_str!("surface.wgsl");
 
+/// The lighting pass's WGSL for `key`, composed.
+pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
+    let mut parts = camera_shading_wgsl();
+    parts.extend(visibility_wgsl(key.technique, key.lookup));
+    parts.push(SURFACE_WGSL.to_owned());
+    parts.push(include_str!("lighting.wgsl").to_owned());
+    let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+    compose_wgsl(&refs)
+}
+
 /// Lighting pipelines, one per technique, lookup and role, built on first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
@@ -132,12 +142,7 @@ impl LightingPass {
         };
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
-            let mut parts = camera_shading_wgsl();
-            parts.extend(visibility_wgsl(key.technique, key.lookup));
-            parts.push(SURFACE_WGSL.to_owned());
-            parts.push(include_str!("lighting.wgsl").to_owned());
-            let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
-            let source = compose_wgsl(&refs);
+            let source = lighting_wgsl(key);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(key.technique.name()),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -176,7 +181,7 @@ impl LightingPass {
                     module: &module,
                     entry_point: Some("vs_surface"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(VertexGpu::layout())],
+                    buffers: &VertexStream::Full.buffers(),
                 },
                 // Both sides are drawn, as a ray tracer sees them; the shader flips the
                 // normal of back faces.

@@ -11,7 +11,7 @@ use super::{
     Layouts, compose_wgsl,
     lighting::{self, Lookup},
 };
-use crate::gpu_types::VertexGpu;
+use crate::gpu_types::VertexStream;
 
 /// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
 pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -30,6 +30,17 @@ pub(crate) struct MaskKey {
     pub lookup: Lookup,
 }
 
+/// The prepass's WGSL, composed: the lighting pass's vertex stage (`vs_surface`) and
+/// its own fragment stage.
+pub(crate) fn prepass_wgsl() -> String {
+    let mut parts = lighting::camera_shading_wgsl();
+    parts.push(lighting::SURFACE_WGSL.to_owned());
+    parts.push(include_str!("octahedron.wgsl").to_owned());
+    parts.push(include_str!("prepass.wgsl").to_owned());
+    let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+    compose_wgsl(&refs)
+}
+
 pub(crate) struct ScreenSpacePass {
     prepass: wgpu::RenderPipeline,
     mask_layout: wgpu::PipelineLayout,
@@ -43,14 +54,9 @@ impl ScreenSpacePass {
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.camera), None, Some(&layouts.material)],
             immediate_size: 0,
         });
-        let mut parts = lighting::camera_shading_wgsl();
-        parts.push(lighting::SURFACE_WGSL.to_owned());
-        parts.push(include_str!("octahedron.wgsl").to_owned());
-        parts.push(include_str!("prepass.wgsl").to_owned());
-        let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("prepass"),
-            source: wgpu::ShaderSource::Wgsl(compose_wgsl(&refs).into()),
+            source: wgpu::ShaderSource::Wgsl(prepass_wgsl().into()),
         });
         let prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("prepass"),
@@ -59,7 +65,7 @@ impl ScreenSpacePass {
                 module: &module,
                 entry_point: Some("vs_surface"),
                 compilation_options: Default::default(),
-                buffers: &[Some(VertexGpu::layout())],
+                buffers: &VertexStream::Full.buffers(),
             },
             // Both sides, as the lighting pass draws them.
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },

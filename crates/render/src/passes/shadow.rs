@@ -3,24 +3,19 @@
 //! A point light's cube faces write distance over range instead, with the same bias
 //! applied in the fragment stage (`shadow_depth.wgsl`), and flip their winding: the
 //! face views are mirrored (`gnomon_math::omni`).
+//!
+//! Opaque casters into a projected map take the cheapest path a rasterizer has: no
+//! fragment stage, a 12-byte position stream, the instance's matrix as a per-instance
+//! attribute, and no storage buffer read. [`ShadowPipelineShape`] states each
+//! pipeline's shape as data, and the tests below hold the opaque one to that, so that
+//! the pass stays within reach of the depth-only baseline (`depth_baseline`).
 
 use std::collections::HashMap;
 
 use gnomon_scene::settings::{BiasSettings, CullMode};
 
 use super::{LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADOW_FORMAT, compose_wgsl};
-use crate::gpu_types::VertexGpu;
-
-/// What makes two shadow pipelines differ.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
-struct ShadowPipelineKey {
-    cull: CullMode,
-    depth_bias: i32,
-    slope_bias_bits: u32,
-    masked: bool,
-    unclipped: bool,
-    target: DepthTarget,
-}
+use crate::gpu_types::VertexStream;
 
 /// What a shadow pass stores in its depth attachment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -33,9 +28,143 @@ pub(crate) enum DepthTarget {
     Paraboloid,
 }
 
-/// Shadow-pass pipelines, built on first use for each bias, cull and alpha-test
-/// combination. Opaque casters use a vertex-only pipeline; alpha-masked casters add a
-/// fragment stage that discards cut-out texels.
+/// Whether a caster's surface is cut by its texture's alpha.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Coverage {
+    Opaque,
+    /// Alpha-masked: the fragment stage discards cut-out texels.
+    Masked,
+}
+
+/// What depth outside the projection's near and far planes does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum DepthRange {
+    Clipped,
+    /// Clamped onto the range (pancaking); needs `Features::DEPTH_CLIP_CONTROL`.
+    Clamped,
+}
+
+impl DepthRange {
+    pub fn clamped_if(clamp: bool) -> Self {
+        if clamp { DepthRange::Clamped } else { DepthRange::Clipped }
+    }
+}
+
+/// Everything that makes two shadow pipelines differ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct ShadowPipelineKey {
+    pub cull: CullMode,
+    pub depth_bias: i32,
+    slope_bias_bits: u32,
+    pub coverage: Coverage,
+    pub depth_range: DepthRange,
+    pub target: DepthTarget,
+}
+
+impl ShadowPipelineKey {
+    /// The key for casters drawn with `bias`; double-sided casters are never culled.
+    pub fn new(
+        bias: &BiasSettings,
+        sides: Sides,
+        coverage: Coverage,
+        depth_range: DepthRange,
+        target: DepthTarget,
+    ) -> Self {
+        Self {
+            cull: match sides {
+                Sides::Double => CullMode::None,
+                Sides::Single => bias.cull,
+            },
+            depth_bias: bias.depth_bias,
+            slope_bias_bits: bias.slope_bias.to_bits(),
+            coverage,
+            depth_range,
+            target,
+        }
+    }
+
+    pub fn slope_bias(&self) -> f32 {
+        f32::from_bits(self.slope_bias_bits)
+    }
+}
+
+/// Whether a caster's material is drawn from both sides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Sides {
+    Single,
+    Double,
+}
+
+/// A shadow pipeline's shape: its entry points, what it reads and how it rasterizes.
+/// The pipeline is built from this and nothing else, so a test can inspect it without
+/// a device.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ShadowPipelineShape {
+    pub label: &'static str,
+    pub vertex_entry: &'static str,
+    /// None: depth only, the rasterizer's fixed-function path.
+    pub fragment_entry: Option<&'static str>,
+    pub stream: VertexStream,
+    pub front_face: wgpu::FrontFace,
+    pub cull_mode: Option<wgpu::Face>,
+    pub unclipped_depth: bool,
+    pub bias: wgpu::DepthBiasState,
+}
+
+impl ShadowPipelineShape {
+    pub fn of(key: &ShadowPipelineKey) -> Self {
+        use {Coverage::*, DepthTarget::*};
+        let (label, vertex_entry, fragment_entry) = match (key.target, key.coverage) {
+            (Projected, Opaque) => ("shadow depth", "vs_shadow", None),
+            (Projected, Masked) => {
+                ("shadow depth, alpha-masked", "vs_shadow_masked", Some("fs_shadow_masked"))
+            }
+            (CubeFace, Opaque) => {
+                ("shadow distance (cube face)", "vs_shadow_distance", Some("fs_shadow_distance"))
+            }
+            (CubeFace, Masked) => {
+                ("shadow distance (cube face)", "vs_shadow_distance", Some("fs_shadow_distance_masked"))
+            }
+            (Paraboloid, Opaque) => {
+                ("shadow distance (paraboloid)", "vs_shadow_paraboloid", Some("fs_shadow_paraboloid"))
+            }
+            (Paraboloid, Masked) => {
+                ("shadow distance (paraboloid)", "vs_shadow_paraboloid", Some("fs_shadow_paraboloid_masked"))
+            }
+        };
+        let writes_distance = key.target != Projected;
+        Self {
+            label,
+            vertex_entry,
+            fragment_entry,
+            // Only opaque casters into a projected map need nothing but the position.
+            stream: if key.coverage == Opaque && !writes_distance {
+                VertexStream::PositionsOnly
+            } else {
+                VertexStream::Full
+            },
+            // A cube face's and a paraboloid's views are mirrored (`gnomon_math::omni`).
+            front_face: if writes_distance { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+            cull_mode: match key.cull {
+                CullMode::Back => Some(wgpu::Face::Back),
+                CullMode::Front => Some(wgpu::Face::Front),
+                CullMode::None => None,
+            },
+            unclipped_depth: key.depth_range == DepthRange::Clamped,
+            // The clamp stays 0: wgpu 30 does not enable the Vulkan feature
+            // (depthBiasClamp) that a non-zero clamp needs. A distance pass biases the
+            // depth it writes itself (the rasterizer's bias does not reach a written
+            // depth).
+            bias: if writes_distance {
+                wgpu::DepthBiasState::default()
+            } else {
+                wgpu::DepthBiasState { constant: key.depth_bias, slope_scale: key.slope_bias(), clamp: 0.0 }
+            },
+        }
+    }
+}
+
+/// Shadow-pass pipelines, built on first use for each key.
 pub(crate) struct ShadowPass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
@@ -43,30 +172,16 @@ pub(crate) struct ShadowPass {
     pipelines: HashMap<ShadowPipelineKey, wgpu::RenderPipeline>,
 }
 
-/// The shadow pass's position-only vertex stream: opaque casters into a projected map
-/// read nothing else, and a third of the bytes fetched is a third of the bandwidth.
-const POSITIONS: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 12,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 0,
-        shader_location: 0,
-    }],
-};
+/// The shadow pass's WGSL, composed.
+pub(crate) fn shadow_wgsl() -> String {
+    compose_wgsl(&[LIGHT_WGSL, SCENE_COMMON_WGSL, include_str!("shadow_depth.wgsl")])
+}
 
 impl ShadowPass {
-    /// Whether this pipeline reads the position-only stream
-    /// ([`crate::GpuScene`]'s `positions`) rather than the full vertices.
-    pub fn reads_positions_only(masked: bool, target: DepthTarget) -> bool {
-        !masked && target == DepthTarget::Projected
-    }
-
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let source = compose_wgsl(&[LIGHT_WGSL, SCENE_COMMON_WGSL, include_str!("shadow_depth.wgsl")]);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow depth"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
+            source: wgpu::ShaderSource::Wgsl(shadow_wgsl().into()),
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow depth"),
@@ -81,62 +196,28 @@ impl ShadowPass {
         Self { module, layout, masked_layout, pipelines: HashMap::new() }
     }
 
-    /// The pipeline for casters with these bias settings; `double_sided` casters are
-    /// never culled, `masked` ones run the alpha test, and `unclipped` clamps depth
-    /// instead of clipping it (pancaking; needs `Features::DEPTH_CLIP_CONTROL`), and
-    /// `target` says what the pass stores.
-    pub fn pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        bias: &BiasSettings,
-        double_sided: bool,
-        masked: bool,
-        unclipped: bool,
-        target: DepthTarget,
-    ) -> &wgpu::RenderPipeline {
-        let key = ShadowPipelineKey {
-            cull: if double_sided { CullMode::None } else { bias.cull },
-            depth_bias: bias.depth_bias,
-            slope_bias_bits: bias.slope_bias.to_bits(),
-            masked,
-            unclipped,
-            target,
-        };
-        let writes_distance = target != DepthTarget::Projected;
+    /// The pipeline for `key`, built from its [`ShadowPipelineShape`].
+    pub fn pipeline(&mut self, device: &wgpu::Device, key: &ShadowPipelineKey) -> &wgpu::RenderPipeline {
         let module = &self.module;
-        let layout = if masked { &self.masked_layout } else { &self.layout };
-        self.pipelines.entry(key).or_insert_with(|| {
+        let layout = match key.coverage {
+            Coverage::Opaque => &self.layout,
+            Coverage::Masked => &self.masked_layout,
+        };
+        self.pipelines.entry(*key).or_insert_with(|| {
+            let shape = ShadowPipelineShape::of(key);
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(match (target, masked) {
-                    (DepthTarget::CubeFace, _) => "shadow distance (cube face)",
-                    (DepthTarget::Paraboloid, _) => "shadow distance (paraboloid)",
-                    (DepthTarget::Projected, true) => "shadow depth, alpha-masked",
-                    (DepthTarget::Projected, false) => "shadow depth",
-                }),
+                label: Some(shape.label),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module,
-                    entry_point: Some(match (target, masked) {
-                        (DepthTarget::CubeFace, _) => "vs_shadow_distance",
-                        (DepthTarget::Paraboloid, _) => "vs_shadow_paraboloid",
-                        (DepthTarget::Projected, true) => "vs_shadow_masked",
-                        (DepthTarget::Projected, false) => "vs_shadow",
-                    }),
+                    entry_point: Some(shape.vertex_entry),
                     compilation_options: Default::default(),
-                    buffers: &[Some(if Self::reads_positions_only(masked, target) {
-                        POSITIONS
-                    } else {
-                        VertexGpu::layout()
-                    })],
+                    buffers: &shape.stream.buffers(),
                 },
                 primitive: wgpu::PrimitiveState {
-                    cull_mode: match key.cull {
-                        CullMode::Back => Some(wgpu::Face::Back),
-                        CullMode::Front => Some(wgpu::Face::Front),
-                        CullMode::None => None,
-                    },
-                    unclipped_depth: key.unclipped,
-                    front_face: if writes_distance { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+                    cull_mode: shape.cull_mode,
+                    unclipped_depth: shape.unclipped_depth,
+                    front_face: shape.front_face,
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -144,30 +225,12 @@ impl ShadowPass {
                     depth_write_enabled: Some(true),
                     depth_compare: Some(wgpu::CompareFunction::LessEqual),
                     stencil: Default::default(),
-                    // The clamp stays 0: wgpu 30 does not enable the Vulkan feature
-                    // (depthBiasClamp) that a non-zero clamp needs. A cube face biases
-                    // the depth it writes itself (the rasterizer's bias does not reach
-                    // a written depth).
-                    bias: if writes_distance {
-                        wgpu::DepthBiasState::default()
-                    } else {
-                        wgpu::DepthBiasState {
-                            constant: key.depth_bias,
-                            slope_scale: f32::from_bits(key.slope_bias_bits),
-                            clamp: 0.0,
-                        }
-                    },
+                    bias: shape.bias,
                 }),
                 multisample: Default::default(),
-                fragment: (masked || writes_distance).then_some(wgpu::FragmentState {
+                fragment: shape.fragment_entry.map(|entry| wgpu::FragmentState {
                     module,
-                    entry_point: Some(match (target, masked) {
-                        (DepthTarget::CubeFace, true) => "fs_shadow_distance_masked",
-                        (DepthTarget::CubeFace, false) => "fs_shadow_distance",
-                        (DepthTarget::Paraboloid, true) => "fs_shadow_paraboloid_masked",
-                        (DepthTarget::Paraboloid, false) => "fs_shadow_paraboloid",
-                        (DepthTarget::Projected, _) => "fs_shadow_masked",
-                    }),
+                    entry_point: Some(entry),
                     compilation_options: Default::default(),
                     targets: &[],
                 }),
@@ -177,3 +240,7 @@ impl ShadowPass {
         })
     }
 }
+
+#[cfg(test)]
+#[path = "shadow_tests.rs"]
+mod tests;

@@ -1,10 +1,11 @@
 // Shadow pass: depth only, from the light. No fragment stage, so the cheapest path
 // the rasterizer has; bias and culling come from the pipeline state.
 
-// It reads the position-only vertex stream: nothing else is needed.
+// It reads the position-only vertex stream and the instance's matrix as attributes:
+// nothing else, and no storage buffer (a test holds it to that).
 @vertex
-fn vs_shadow(@location(0) position: vec3<f32>, @builtin(instance_index) instance_index: u32) -> @builtin(position) vec4<f32> {
-    let world = instances[instance_index].world_from_object * vec4<f32>(position, 1.0);
+fn vs_shadow(@location(0) position: vec3<f32>, transform: InstanceTransform) -> @builtin(position) vec4<f32> {
+    let world = world_from_object_of(transform) * vec4<f32>(position, 1.0);
     return light.clip_from_world * world;
 }
 
@@ -20,10 +21,13 @@ struct MaskedOut {
 };
 
 @vertex
-fn vs_shadow_masked(v: VertexIn, @builtin(instance_index) instance_index: u32) -> MaskedOut {
-    let inst = instances[instance_index];
+fn vs_shadow_masked(
+    v: VertexIn,
+    transform: InstanceTransform,
+    @builtin(instance_index) instance_index: u32,
+) -> MaskedOut {
     var out: MaskedOut;
-    out.clip = light.clip_from_world * (inst.world_from_object * vec4<f32>(v.position, 1.0));
+    out.clip = light.clip_from_world * (world_from_object_of(transform) * vec4<f32>(v.position, 1.0));
     out.uv = v.uv;
     out.instance = instance_index;
     return out;
@@ -50,9 +54,12 @@ struct DistanceOut {
 };
 
 @vertex
-fn vs_shadow_distance(v: VertexIn, @builtin(instance_index) instance_index: u32) -> DistanceOut {
-    let inst = instances[instance_index];
-    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+fn vs_shadow_distance(
+    v: VertexIn,
+    transform: InstanceTransform,
+    @builtin(instance_index) instance_index: u32,
+) -> DistanceOut {
+    let world = world_from_object_of(transform) * vec4<f32>(v.position, 1.0);
     var out: DistanceOut;
     out.clip = light.clip_from_world * world;
     out.world = world.xyz;
@@ -90,9 +97,12 @@ fn fs_shadow_distance_masked(in: DistanceOut) -> @builtin(frag_depth) f32 {
 // vertices where the true image of an edge is curved: the method's known error, which
 // finer tessellation would reduce. Fragments of the other hemisphere are discarded.
 @vertex
-fn vs_shadow_paraboloid(v: VertexIn, @builtin(instance_index) instance_index: u32) -> DistanceOut {
-    let inst = instances[instance_index];
-    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+fn vs_shadow_paraboloid(
+    v: VertexIn,
+    transform: InstanceTransform,
+    @builtin(instance_index) instance_index: u32,
+) -> DistanceOut {
+    let world = world_from_object_of(transform) * vec4<f32>(v.position, 1.0);
     let d = (light.clip_from_world * world).xyz;
     let n = d / max(length(d), 1e-20);
     var out: DistanceOut;

@@ -16,13 +16,17 @@ struct SurfaceVertex {
 };
 
 @vertex
-fn vs_surface(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertex {
-    let inst = instances[instance_index];
-    let world = inst.world_from_object * vec4<f32>(v.position, 1.0);
+fn vs_surface(
+    v: VertexIn,
+    transform: InstanceTransform,
+    @builtin(instance_index) instance_index: u32,
+) -> SurfaceVertex {
+    let world_from_object = world_from_object_of(transform);
+    let world = world_from_object * vec4<f32>(v.position, 1.0);
     var out: SurfaceVertex;
     out.clip = camera.clip_from_world * world;
     out.world = world.xyz;
-    out.normal = normal_from_object(inst.world_from_object) * v.normal;
+    out.normal = normal_from_object(world_from_object) * v.normal;
     out.instance = instance_index;
     out.uv = v.uv;
     return out;

@@ -2,6 +2,8 @@
 //! rays for ground truth on small procedural scenes, and pixel footprints.
 #![allow(dead_code)]
 
+pub mod figures;
+
 use std::sync::OnceLock;
 
 use glam::{Mat4, Vec3};
