@@ -4,7 +4,11 @@
 
 mod common;
 
-use common::{compare, figures::figure, reference, render};
+use common::{
+    compare,
+    figures::{figure, percent},
+    reference, render,
+};
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_scene::{
     AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry, settings::Technique,
@@ -175,6 +179,11 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 /// depends on the sun and the framing; the README lists the other views measured,
 /// including those above 2 %. A close view with a ground, where 2 % is not met, is
 /// held to a regression bound.
+/// Issue 4's 2 % on the fitted view (1.674 % measured), and a regression bound on the
+/// close view with a ground (2.092 % measured), where 2 % is not met.
+const TREE_FITTED_MISMATCH: f64 = 0.02;
+const TREE_CLOSE_MISMATCH: f64 = 0.025;
+
 #[test]
 fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let Some(path) = common::shared_scene("tree/tree.glb") else { return };
@@ -196,9 +205,13 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
         m
     };
     let fitted = measure(&scene, &s, "fitted view");
-    figure("tree, fitted view, pcf2x2: mismatch", format!("{:.3}%", 100.0 * fitted.mismatch_rate), "2%");
+    figure(
+        "tree, fitted view, pcf2x2: mismatch",
+        percent(fitted.mismatch_rate),
+        percent(TREE_FITTED_MISMATCH),
+    );
     assert!(fitted.compared > 40_000, "{fitted:?}");
-    assert!(fitted.mismatch_rate < 0.02, "{fitted:?}");
+    assert!(fitted.mismatch_rate < TREE_FITTED_MISMATCH, "{fitted:?}");
 
     // Close to the tree, with a ground three times its width.
     let b = scene.bounds();
@@ -211,13 +224,13 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let close = measure(&scene, &s, "close view with ground");
     figure(
         "tree, close view with ground, pcf2x2: mismatch",
-        format!("{:.3}%", 100.0 * close.mismatch_rate),
-        "2.5%",
+        percent(close.mismatch_rate),
+        percent(TREE_CLOSE_MISMATCH),
     );
     assert!(close.compared > 300_000, "{close:?}");
-    // Issue 4's 2 % is not met on this view (2.09 % measured, README); this bound
-    // only guards it against getting worse.
-    assert!(close.mismatch_rate < 0.025, "{close:?}");
+    // Issue 4's 2 % is not met on this view (README); this bound only guards it
+    // against getting worse.
+    assert!(close.mismatch_rate < TREE_CLOSE_MISMATCH, "{close:?}");
 }
 
 #[test]

@@ -53,11 +53,10 @@ fn pcss_beats_every_fixed_pcf_kernel_on_contact() {
     figure(
         "contact, spot r = 0.5: PCSS MAE (best fixed PCF)",
         format!("{:.4} ({:.4})", pcss.mae, best_fixed.0),
-        "0.005",
+        PCSS_MAE_BOUND,
     );
     assert!(pcss.compared > 50_000, "{} pixels compared", pcss.compared);
-    // 0.0030 measured on lavapipe; the best fixed kernel's 0.0063 would fail.
-    assert!(pcss.mae < 0.005, "PCSS MAE {}", pcss.mae);
+    assert!(pcss.mae < PCSS_MAE_BOUND, "PCSS MAE {}", pcss.mae);
     assert!(
         pcss.mae < best_fixed.0,
         "PCSS MAE {} is not below the best fixed kernel's {} ({})",
@@ -86,6 +85,11 @@ fn vsm_stays_close_to_the_monte_carlo_reference_on_contact() {
     assert!(vsm.compared > 50_000, "{} pixels compared", vsm.compared);
     assert!(vsm.mae < VSM_MAE_BOUND, "VSM MAE {}", vsm.mae);
 }
+
+/// PCSS's MAE bound on `contact`: 0.0030 measured on lavapipe (1.5×). The best fixed
+/// kernel's 0.0063 fails it, and so does a PCSS penumbra estimated 20 % too wide
+/// (0.0048).
+const PCSS_MAE_BOUND: f64 = 0.0045;
 
 /// VSM's MAE bound on `contact`: 0.0167 measured on lavapipe (its fixed-width blur
 /// against penumbrae that widen from each contact; PCSS gets 0.0030 there).

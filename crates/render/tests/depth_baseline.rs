@@ -139,13 +139,12 @@ fn the_baseline_draws_the_cube_faces_the_shadow_pass_draws() {
     let covered = theirs.iter().filter(|&&d| d < 1.0).count();
     let gained = ours.iter().zip(&theirs).filter(|(a, b)| **a < 1.0 && **b >= 1.0).count();
     let lost = ours.iter().zip(&theirs).filter(|(a, b)| **a >= 1.0 && **b < 1.0).count();
-    figure(
-        "biased cube faces vs baseline: texels lost to the bias",
-        format!("{lost} of {covered}"),
-        "0.05 %",
-    );
+    // 6 of 834,823 measured.
+    let lost_share = lost as f64 / covered as f64;
+    let bound = 5e-4;
+    figure("biased cube faces vs baseline: share of texels lost to the bias", lost_share, bound);
     assert_eq!(gained, 0, "the biased shadow pass covers {gained} texels the baseline does not");
-    assert!(lost * 2000 < covered, "the bias pushed {lost} of {covered} texels past the range");
+    assert!(lost_share < bound, "the bias pushed {lost} of {covered} texels past the range");
 }
 
 /// Instanced casters: the shadow pass transforms object positions on the GPU, the
@@ -169,13 +168,14 @@ fn instanced_casters_differ_from_the_baseline_by_rounding_alone() {
     // round a position differently (fused multiply-adds): a triangle edge through a
     // texel centre may then fall either way, and a depth move by a few ulps (2⁻²⁴
     // each, ~1e-7 at depth 1).
+    let (coverage_bound, depth_bound) = (4, 1e-6);
     figure(
         "instanced shadow pass vs baseline: coverage differences, worst depth",
         format!("{coverage}, {worst:e}"),
-        "4, 1e-6",
+        format!("{coverage_bound}, {depth_bound:e}"),
     );
-    assert!(coverage <= 4, "coverage differs in {coverage} texels");
-    assert!(worst < 1e-6, "depths differ by up to {worst}");
+    assert!(coverage <= coverage_bound, "coverage differs in {coverage} texels");
+    assert!(worst < depth_bound, "depths differ by up to {worst}");
 }
 
 /// The baseline is timed per light, on the GPU clock or the CPU's, and its times fit

@@ -19,6 +19,11 @@ pub fn skipped(what: &str, why: &str) {
     line(format!("skipped: {what}: {why}\n"));
 }
 
+/// A rate as a percentage, for figures and their bounds.
+pub fn percent(rate: f64) -> String {
+    format!("{:.3}%", 100.0 * rate)
+}
+
 /// One write of a whole line, so that tests running in parallel do not interleave.
 fn line(text: String) {
     let _ = std::io::stderr().lock().write_all(text.as_bytes());
