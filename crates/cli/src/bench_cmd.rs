@@ -82,13 +82,16 @@ struct Config {
     settings: Settings,
 }
 
-/// The median and 95th percentile of one measured quantity, in milliseconds.
+/// The median and 95th percentile of one measured quantity, in milliseconds, and every
+/// frame's value in the order the frames were timed (for re-analysis: frame i of one
+/// quantity and frame i of another were measured in the same frame).
 #[derive(Serialize, Clone, Debug)]
 struct Summary {
     name: String,
     median_ms: f64,
     p95_ms: f64,
     samples: usize,
+    values_ms: Vec<f64>,
 }
 
 #[derive(Serialize, Debug)]
@@ -355,7 +358,13 @@ fn summarize(name: &str, values: &[f64]) -> Summary {
     } else {
         0.5 * (sorted[sorted.len() / 2 - 1] + sorted[sorted.len() / 2])
     };
-    Summary { name: name.to_string(), median_ms: median, p95_ms: rank(0.95), samples: sorted.len() }
+    Summary {
+        name: name.to_string(),
+        median_ms: median,
+        p95_ms: rank(0.95),
+        samples: sorted.len(),
+        values_ms: values.to_vec(),
+    }
 }
 
 /// The report as markdown: the device, then a table of passes per configuration,
