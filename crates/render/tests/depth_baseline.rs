@@ -75,19 +75,22 @@ fn the_baseline_draws_every_projected_layer_exactly_as_the_shadow_pass() {
     let mut front = small();
     front.shadow.bias.cull = gnomon_scene::settings::CullMode::Front;
     assert!(small().shadow.bias.slope_bias > 0.0, "the default bias is on, and compared");
-    for (what, scene, settings, layers) in [
-        ("sun", baked(builtin::spheres()), small(), 1),
-        ("cascades", baked(builtin::spheres()), cascaded, 4),
-        ("spot", baked(builtin::contact()), spot, 1),
-        ("sun, front faces", baked(builtin::columns()), front, 1),
+    // Each map must hold casters for the comparison to mean anything: a twentieth of
+    // every layer (36,758 to 232,182 of 262,144 texels measured), but where front
+    // faces are culled, which leaves only the columns' inner faces (2,603 measured).
+    let texels = 512 * 512;
+    for (what, scene, settings, layers, min_covered) in [
+        ("sun", baked(builtin::spheres()), small(), 1, texels / 20),
+        ("cascades", baked(builtin::spheres()), cascaded, 4, texels / 20),
+        ("spot", baked(builtin::contact()), spot, 1, texels / 20),
+        ("sun, front faces", baked(builtin::columns()), front, 1, 1000),
     ] {
         let (ours, theirs, drawn_layers) = both_maps(&mut renderer, &scene, &settings);
-        assert_eq!(drawn_layers, layers, "{what}");
-        let texels = ours.len() / layers as usize;
+        assert_eq!((drawn_layers, ours.len()), (layers, layers as usize * texels), "{what}");
         for layer in 0..layers as usize {
             let range = layer * texels..(layer + 1) * texels;
             let covered = ours[range.clone()].iter().filter(|&&d| d < 1.0).count();
-            assert!(covered > 1000, "{what}, layer {layer}: only {covered} texels hold casters");
+            assert!(covered > min_covered, "{what}, layer {layer}: only {covered} texels hold casters");
         }
         let differ = ours.iter().zip(&theirs).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
         figure(&format!("depth-only baseline vs shadow pass, {what}: texels differing"), differ, "0");
