@@ -16,6 +16,7 @@ mod device;
 mod frame;
 mod gpu_scene;
 mod gpu_types;
+mod layout;
 mod passes;
 mod readback;
 pub mod techniques;
@@ -24,9 +25,10 @@ pub mod timing;
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
     CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, Renderer,
-    ShadowLayout, ShadowMapImage, light_projection,
+    ShadowMapImage,
 };
 pub use gpu_scene::GpuScene;
+pub use layout::{ShadowLayout, light_projection};
 pub use passes::depth_baseline::DepthBaselineScene;
 pub use readback::read_texture;
 pub use wgpu;

@@ -17,7 +17,7 @@ use super::{
 };
 use crate::{Gpu, RenderError};
 
-/// The casters of a scene, flattened for [`DepthBaselinePass`].
+/// The casters of a scene, flattened for the depth-only baseline pass.
 pub struct DepthBaselineScene {
     positions: wgpu::Buffer,
     indices: wgpu::Buffer,

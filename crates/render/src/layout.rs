@@ -1,0 +1,282 @@
+//! Where a light's shadow map looks: the GPU-free layout of its layers. Fitting a
+//! sun's map to the scene or to the receivers, cascade splits and fits (tight, stable,
+//! SDSM's sample bounds), warps, the filter margin a fitted cascade keeps, and the
+//! depth range the camera sees. The renderer draws what this decides.
+
+use glam::Vec3;
+use gnomon_math::{
+    Aabb, LightProjection, cascades, directional_light_projection,
+    fitting::{Hexahedron, fit_directional_to_receivers, intersection_vertices},
+    omni::{cube_face_projections, paraboloid_projections},
+    spot_light_projection,
+    warping::{Warp, WarpView, fit_warped},
+};
+use gnomon_scene::{
+    Camera, Light, Settings,
+    settings::{
+        CascadeFit, CascadeSelection, Fit, KernelUnit, OmniMap, Partition, SplitScheme, Technique, WarpKind,
+    },
+};
+
+/// What SDSM measured of the camera's samples (Lauritzen, Salvi & Lefohn 2011).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleDistribution {
+    /// The nearest and farthest view depth seen.
+    pub near: f32,
+    pub far: f32,
+    /// With --sdsm-bounds, per cascade: the light-space (min x, min y, max x, max y) of
+    /// the samples it serves, its blend band included; None for a cascade that serves
+    /// none.
+    pub light_bounds: Option<Vec<Option<[f32; 4]>>>,
+}
+
+/// The layers of a light's shadow map: their projections, and the view depths
+/// that bound them when they are cascades.
+#[derive(Clone, Debug)]
+pub struct ShadowLayout {
+    pub projections: Vec<LightProjection>,
+    /// One more than the projections: cascade i covers view depths `splits[i]` to
+    /// `splits[i + 1]`. A single map covers 0 to infinity.
+    pub splits: Vec<f32>,
+    /// Draw with depth clamping ("pancaking"): the projections' near planes sit at the
+    /// nearest receiver, and casters before them are clamped onto them.
+    pub depth_clamp: bool,
+}
+
+/// The shadow layout of `light` under `settings`: one map, or for a sun with
+/// `--partition cascades`, one per slice of the view frustum, all sharing one depth
+/// range so that every layer stores depth the same way; for a point light, the six
+/// faces of its cube.
+///
+/// `sampled`, for SDSM, is what [`crate::Renderer`]'s reductions measured of the camera's
+/// samples: the cascades split the range of view depths it saw instead of the range
+/// where the view frustum meets the scene's bounds, and with --sdsm-bounds each tight
+/// cascade narrows to the light-space bounds of its own samples.
+///
+/// `depth_clamp` says the device can draw with unclipped depth; with it, and
+/// `--depth-clamp true` (the default), where a sun's map
+/// follows the receivers (--fit receivers, tight cascades) its near plane then moves up
+/// to the nearest receiver ([`LightProjection::pancaked`]). Not for PCSS, whose blocker
+/// search reads the true distance to each blocker, nor for stable cascades, whose depth
+/// range must not follow the camera, nor for warps, which rely on clipping.
+pub fn shadow_layout(
+    scene_bounds: &Aabb,
+    light: &Light,
+    camera: &Camera,
+    aspect: f32,
+    settings: &Settings,
+    sampled: Option<&SampleDistribution>,
+    depth_clamp: bool,
+) -> ShadowLayout {
+    if let Light::Point(point) = light {
+        // Six 90° faces from the light's position, or two paraboloids; near and far
+        // from its range.
+        let (near, far) = (point.shadow_near(), point.range);
+        return ShadowLayout {
+            projections: match settings.shadow.map.omni {
+                OmniMap::Cube => cube_face_projections(point.position, near, far).to_vec(),
+                OmniMap::Paraboloid => paraboloid_projections(point.position, near, far).to_vec(),
+            },
+            splits: vec![0.0, f32::INFINITY],
+            depth_clamp: false,
+        };
+    }
+    let pancake =
+        depth_clamp && settings.shadow.map.depth_clamp && settings.shadow.filter.technique != Technique::Pcss;
+    let single = || {
+        let fit = settings.shadow.map.fit;
+        let clamped = pancake && fit == Fit::Receivers && matches!(light, Light::Directional(_));
+        ShadowLayout {
+            projections: vec![light_projection(scene_bounds, light, camera, aspect, fit, clamped)],
+            splits: vec![0.0, f32::INFINITY],
+            depth_clamp: clamped,
+        }
+    };
+    if let (Light::Directional(sun), Partition::Single, Some(warp)) =
+        (light, settings.shadow.partition, warp_of(settings.shadow.map.warp))
+    {
+        return warped_layout(scene_bounds, sun.direction, camera, aspect, warp).unwrap_or_else(single);
+    }
+    let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
+        return single();
+    };
+    let Some(splits) =
+        cascade_splits(scene_bounds, camera, aspect, settings, sampled.map(|s| (s.near, s.far)))
+    else {
+        return single();
+    };
+    let c = &settings.shadow.cascades;
+    let bounds = *scene_bounds;
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    let resolution = settings.shadow.map.resolution;
+    // With selection by depth, the lighting pass blends the far end of each cascade
+    // into the next one, so each slice starts at its predecessor's blend band.
+    let blend = match c.cascade_selection {
+        CascadeSelection::Depth => c.cascade_blend,
+        CascadeSelection::Projection => 0.0,
+    };
+    let samples = sampled.and_then(|s| s.light_bounds.as_ref());
+    let fitted: Vec<LightProjection> = (0..splits.len() - 1)
+        .map(|i| {
+            let from = if i == 0 { splits[0] } else { splits[i] - blend * (splits[i] - splits[i - 1]) };
+            let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
+            match c.cascade_fit {
+                CascadeFit::Tight => {
+                    let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice, pancake);
+                    match samples.and_then(|s| s.get(i).copied().flatten()) {
+                        Some(window) => cascades::fit_cascade_to_samples(
+                            &tight,
+                            window,
+                            filter_margin_texels(settings, &tight),
+                            resolution,
+                        ),
+                        None => tight,
+                    }
+                }
+                CascadeFit::Stable => {
+                    cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
+                }
+            }
+        })
+        .collect();
+    let near_plane = fitted.iter().map(|p| p.near).fold(f32::INFINITY, f32::min);
+    let far_plane = fitted.iter().map(|p| p.far).fold(f32::NEG_INFINITY, f32::max);
+    ShadowLayout {
+        projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
+        splits,
+        depth_clamp: pancake && c.cascade_fit == CascadeFit::Tight,
+    }
+}
+
+/// The view depths bounding a sun's cascades: the range where the view frustum meets
+/// the scene's bounds, or `sampled` (SDSM), cut at the shadow distance, quantized for
+/// stable cascades, and split by the scheme. None when the camera sees none of the
+/// scene.
+pub(crate) fn cascade_splits(
+    scene_bounds: &Aabb,
+    camera: &Camera,
+    aspect: f32,
+    settings: &Settings,
+    sampled: Option<(f32, f32)>,
+) -> Option<Vec<f32>> {
+    let c = &settings.shadow.cascades;
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    // The view depths that hold any of the scene: beyond them a cascade would cover
+    // nothing.
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(scene_bounds));
+    let (near, far) = seen_depth_range(camera, &receivers)?;
+    let (near, far) = match sampled {
+        Some((lo, hi)) => (lo.max(camera.near), hi.min(camera.far).max(lo.max(camera.near) * 1.001)),
+        None => (near, far),
+    };
+    let far = far.min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
+    // Stable cascades split a range that moves in steps, so that their slices do not
+    // change size with every move of the camera.
+    let (near, far) = match c.cascade_fit {
+        CascadeFit::Stable => {
+            let (n, f) = cascades::quantized_depth_range(near, far);
+            (n.max(camera.near), f.min(camera.far))
+        }
+        CascadeFit::Tight => (near, far),
+    };
+    let scheme = match c.split {
+        SplitScheme::Uniform => cascades::SplitScheme::Uniform,
+        SplitScheme::Log => cascades::SplitScheme::Logarithmic,
+        SplitScheme::Practical => cascades::SplitScheme::Practical { lambda: c.split_lambda },
+    };
+    Some(cascades::split_distances(scheme, c.count as usize, near, far))
+}
+
+/// Texels a sample-fitted cascade keeps around its samples: the technique's filter
+/// reach and the normal offset, plus two for the bilinear footprint and the pixel's
+/// own extent.
+fn filter_margin_texels(settings: &Settings, tight: &LightProjection) -> f32 {
+    let f = &settings.shadow.filter;
+    let texel = tight.texel_world_size(settings.shadow.map.resolution, 0.0).max(1e-9);
+    let kernel = match f.kernel_unit {
+        KernelUnit::Texels => f.pcf_kernel,
+        KernelUnit::World => f.pcf_kernel / texel,
+    };
+    let reach = match f.technique {
+        Technique::Hard | Technique::Pcf2x2 => 0.0,
+        Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => 0.5 * kernel,
+        Technique::Pcss => f.pcss.max_radius,
+        _ => f.moments.blur_radius as f32,
+    };
+    2.0 + reach + settings.shadow.bias.normal_offset
+}
+
+fn warp_of(kind: WarpKind) -> Option<Warp> {
+    match kind {
+        WarpKind::None => None,
+        WarpKind::Psm => Some(Warp::Perspective),
+        WarpKind::Lispsm => Some(Warp::LightSpacePerspective),
+        WarpKind::Tsm => Some(Warp::Trapezoidal),
+    }
+}
+
+/// A sun's single map warped over the receivers the camera sees; None when it sees
+/// none of the scene.
+fn warped_layout(
+    scene_bounds: &Aabb,
+    direction: Vec3,
+    camera: &Camera,
+    aspect: f32,
+    warp: Warp,
+) -> Option<ShadowLayout> {
+    let bounds = *scene_bounds;
+    let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
+    let (near, far) = seen_depth_range(camera, &receivers)?;
+    let view = WarpView { eye: camera.eye, forward: (camera.target - camera.eye).normalize(), near, far };
+    Some(ShadowLayout {
+        projections: vec![fit_warped(warp, direction, &bounds, &receivers, &view)],
+        splits: vec![0.0, f32::INFINITY],
+        depth_clamp: false,
+    })
+}
+
+/// The view depths, within the camera's planes, that hold any of `receivers`.
+fn seen_depth_range(camera: &Camera, receivers: &[Vec3]) -> Option<(f32, f32)> {
+    if receivers.is_empty() {
+        return None;
+    }
+    let view_from_world = camera.view_from_world();
+    let depths = receivers.iter().map(|p| -view_from_world.transform_point3(*p).z);
+    let (seen_near, seen_far) = depths.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let near = seen_near.max(camera.near);
+    Some((near, seen_far.min(camera.far).max(near * 1.001)))
+}
+
+/// The shadow projection of `light`: for a sun, an orthographic box fitted to the
+/// scene's bounds or to the receivers `camera` can see ([`Fit`]); for a spot, the
+/// perspective frustum of its cone out to its range; for a point light, its cube's
+/// first face (+x; `shadow_layout` has all six). `depth_clamp` pancakes a
+/// receiver-fitted sun map ([`LightProjection::pancaked`]).
+pub fn light_projection(
+    scene_bounds: &Aabb,
+    light: &Light,
+    camera: &Camera,
+    aspect: f32,
+    fit: Fit,
+    depth_clamp: bool,
+) -> LightProjection {
+    match light {
+        Light::Directional(sun) if fit == Fit::Receivers => {
+            let bounds = *scene_bounds;
+            let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+            let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
+            let fitted = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
+            if depth_clamp { fitted.pancaked(&receivers) } else { fitted }
+        }
+        Light::Directional(sun) => directional_light_projection(sun.direction, scene_bounds),
+        Light::Spot(spot) => spot_light_projection(
+            spot.position,
+            spot.direction,
+            spot.outer_angle_degrees.to_radians(),
+            spot.shadow_near(),
+            spot.range,
+        ),
+        Light::Point(point) => cube_face_projections(point.position, point.shadow_near(), point.range)[0],
+    }
+}
