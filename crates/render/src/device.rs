@@ -13,6 +13,18 @@ pub struct GpuInfo {
     pub driver_info: String,
 }
 
+impl GpuInfo {
+    fn of(adapter: wgpu::AdapterInfo) -> Self {
+        GpuInfo {
+            adapter: adapter.name,
+            backend: format!("{:?}", adapter.backend),
+            device_type: format!("{:?}", adapter.device_type),
+            driver: adapter.driver,
+            driver_info: adapter.driver_info,
+        }
+    }
+}
+
 impl std::fmt::Display for GpuInfo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -23,7 +35,10 @@ impl std::fmt::Display for GpuInfo {
     }
 }
 
-/// An open device and its queue, with no window.
+/// An open device and its queue: opened by Gnomon with no window
+/// ([`Gpu::new_headless`]), or the host application's own ([`Gpu::from_host`]).
+/// Cloning shares the device (wgpu's handles are reference-counted).
+#[derive(Clone, Debug)]
 pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -84,14 +99,24 @@ impl Gpu {
         })?;
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
-        let info = GpuInfo {
-            adapter: adapter_info.name,
-            backend: format!("{:?}", adapter_info.backend),
-            device_type: format!("{:?}", adapter_info.device_type),
-            driver: adapter_info.driver,
-            driver_info: adapter_info.driver_info,
-        };
-        Ok(Self { device, queue, info, limits, timestamp_period_ns })
+        Ok(Self { device, queue, info: GpuInfo::of(adapter_info), limits, timestamp_period_ns })
+    }
+
+    /// Wraps a device the host application already has, sharing it: Gnomon draws
+    /// with whatever features and limits the host asked for, and uses timestamp
+    /// queries, 32-bit float filtering and unclipped depth only where the device has
+    /// them enabled.
+    pub fn from_host(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let adapter_info = adapter.get_info();
+        let timestamp_period_ns =
+            device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
+        Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            info: GpuInfo::of(adapter_info),
+            limits: device.limits(),
+            timestamp_period_ns,
+        }
     }
 
     /// Runs `f`, turning any validation, out-of-memory or internal error it raises

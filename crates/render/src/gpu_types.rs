@@ -1,4 +1,5 @@
-//! Plain-old-data mirrors of the WGSL structs in `passes/*.wgsl`.
+//! Plain-old-data mirrors of the vertex and instance data in `passes/*.wgsl`; the
+//! uniforms are in [`crate::uniforms`].
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
@@ -18,78 +19,6 @@ pub struct InstanceGpu {
     pub material: Vec4,
     /// x: 1 when the base colour is multiplied by the bound texture.
     pub texturing: Vec4,
-}
-
-/// The light uniform (`Light` in `scene_common.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable, Default)]
-pub struct LightGpu {
-    pub clip_from_world: Mat4,
-    pub light_from_world: Mat4,
-    /// rgb: colour × intensity.
-    pub radiance: Vec4,
-    /// xyz: the sun's travel direction or the spot's axis; w: 0 for a sun, 1 for a
-    /// spot, 2 for a point light.
-    pub direction: Vec4,
-    /// xyz: spot or point light position; w: its range.
-    pub position: Vec4,
-    /// x: cos(inner angle), y: cos(outer angle), z: map near plane, w: map far plane.
-    pub cone: Vec4,
-    /// x: texel world size of an orthographic map; y: texel world size per unit of
-    /// distance for a perspective map; z: normal offset in texels; w: map resolution.
-    pub texel: Vec4,
-    /// The PCF kernel: x: width, y: 1 when the width is in world units, z: Poisson
-    /// taps, w: 1 for receiver-plane depth bias.
-    pub kernel: Vec4,
-    /// PCSS: x: light size (spot disk radius in world units, or tan of the sun's
-    /// angular radius), y: blocker-search taps, z: largest radius in texels.
-    pub pcss: Vec4,
-    /// Technique parameters, defined by each technique module.
-    pub params: [Vec4; 2],
-    /// rgb: ambient light.
-    pub ambient: Vec4,
-    /// Each layer's (cascade's) clip_from_world; layer 0 equals `clip_from_world`.
-    pub cascade_clip_from_world: [Mat4; MAX_CASCADES],
-    /// x: each layer's texel world size (orthographic; the largest for a warped map;
-    /// 0 for a perspective map); y: 1 for a warped layer, whose texel size the shader
-    /// measures locally; z: the world step of that measurement.
-    pub cascade_texel: [Vec4; MAX_CASCADES],
-    /// The view depths where the cascades start and end, packed four to a vector:
-    /// cascade i spans split i to split i + 1.
-    pub cascade_splits: [Vec4; 3],
-    /// x: layer count, y: 1 to select cascades by projection, z: blend band as a
-    /// fraction of a cascade's depth range, w: moment-map layers per cascade.
-    pub cascades: Vec4,
-    /// The rasterizer's depth bias, for the passes that write their own depth (a
-    /// point light's distance cube): x: constant bias in units of the depth's last
-    /// mantissa bit, y: slope-scaled bias.
-    pub raster_bias: Vec4,
-    /// Contact shadows: x: ray length in world units, y: steps (0 when off), z:
-    /// thickness as a fraction of view depth, w: the ray's start offset along the
-    /// normal in world units.
-    pub contact: Vec4,
-    /// x: the view depth where contact shadows end.
-    pub contact_range: Vec4,
-}
-
-/// The most cascades a light may have (the size of the uniform arrays).
-pub const MAX_CASCADES: usize = 8;
-
-/// The camera uniform (`Camera` in `camera.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub struct CameraGpu {
-    pub clip_from_world: Mat4,
-    pub view_from_world: Mat4,
-    pub world_from_view: Mat4,
-    pub eye: Vec4,
-    /// x: 1 to tint pixels by their cascade.
-    pub debug: Vec4,
-    /// x: clip_from_view's x scale, y: its y scale (a symmetric perspective), z: the
-    /// near plane, w: the far plane.
-    pub projection: Vec4,
-    /// x, y: the image's width and height in pixels; z, w: their inverses.
-    pub viewport: Vec4,
 }
 
 /// The vertex-buffer slot of the instance transforms, after the vertices (slot 0).

@@ -18,14 +18,16 @@ mod gpu_scene;
 mod gpu_types;
 mod layout;
 mod passes;
+mod pool;
 mod readback;
 pub mod techniques;
 pub mod timing;
+pub mod uniforms;
 
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
-    CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, Renderer,
-    ShadowMapImage,
+    CpuTimings, Creations, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
+    Renderer, ShadowMapImage,
 };
 pub use gpu_scene::GpuScene;
 pub use layout::{ShadowLayout, light_projection};

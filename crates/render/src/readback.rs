@@ -1,7 +1,7 @@
 //! Copying textures back to the CPU: row padding to wgpu's 256-byte alignment on
 //! the way out, and removed again on the way in.
 
-use crate::{Gpu, RenderError};
+use crate::{Gpu, RenderError, pool::Pool};
 
 /// A texture copy recorded into an encoder, waiting to be mapped.
 pub(crate) struct PendingReadback {
@@ -17,7 +17,7 @@ pub(crate) struct PendingReadback {
 /// Records a copy of mip 0 of `texture` (of `aspect`), every array layer, into a
 /// mappable buffer.
 pub(crate) fn record(
-    device: &wgpu::Device,
+    pool: &mut Pool,
     encoder: &mut wgpu::CommandEncoder,
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
@@ -27,12 +27,11 @@ pub(crate) fn record(
     let unpadded = width * bytes_per_texel;
     let padded_bytes_per_row =
         unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: padded_bytes_per_row as u64 * height as u64 * layers as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
+    let buffer = pool.buffer(
+        "readback",
+        padded_bytes_per_row as u64 * height as u64 * layers as u64,
+        wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+    );
     encoder.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
         wgpu::TexelCopyBufferInfo {
@@ -52,7 +51,7 @@ pub(crate) fn record(
 /// row-major, top row first, in the texture's own format.
 pub fn read_texture<T: bytemuck::Pod>(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<T>, RenderError> {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let pending = record(&gpu.device, &mut encoder, texture, wgpu::TextureAspect::All);
+    let pending = record(&mut Pool::new(&gpu.device), &mut encoder, texture, wgpu::TextureAspect::All);
     gpu.queue.submit([encoder.finish()]);
     pending.read(gpu)
 }
@@ -79,24 +78,19 @@ pub(crate) struct PendingTimestamps {
 
 /// Records the resolve of `count` timestamps from `query_set` and their copy out.
 pub(crate) fn record_timestamps(
-    device: &wgpu::Device,
+    pool: &mut Pool,
     encoder: &mut wgpu::CommandEncoder,
     query_set: &wgpu::QuerySet,
     count: u32,
 ) -> PendingTimestamps {
     let size = (count as u64) * wgpu::QUERY_SIZE as u64;
-    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("timestamp resolve"),
+    let resolve = pool.buffer(
+        "timestamp resolve",
         size,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("timestamp readback"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
+        wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+    );
+    let buffer =
+        pool.buffer("timestamp readback", size, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
     encoder.resolve_query_set(query_set, 0..count, &resolve, 0);
     encoder.copy_buffer_to_buffer(&resolve, 0, &buffer, 0, size);
     PendingTimestamps { buffer }

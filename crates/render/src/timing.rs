@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use crate::{Gpu, RenderError, readback};
+use crate::{Gpu, RenderError, pool::Pool, readback};
 
 /// Which kind of pass a time belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -83,18 +83,17 @@ pub(crate) struct PassClock {
 
 impl PassClock {
     /// A clock for at most `capacity` passes: timestamps when the device has them,
-    /// else the CPU wall clock if `cpu_fallback`, else none at all. `force_cpu`
-    /// chooses the wall clock even where timestamps exist.
-    pub fn new(gpu: &Gpu, capacity: u32, cpu_fallback: bool, force_cpu: bool) -> Self {
+    /// else, when a clock is `wanted`, the CPU wall clock, else none at all.
+    /// [`ClockChoice::Cpu`] chooses the wall clock even where timestamps exist.
+    pub fn new(gpu: &Gpu, pool: &mut Pool, capacity: u32, wanted: Option<ClockChoice>) -> Self {
+        let cpu_fallback = wanted.is_some();
+        let force_cpu = wanted == Some(ClockChoice::Cpu);
         let mode = match gpu.timestamp_period_ns {
-            Some(_) if !force_cpu => Mode::Gpu {
-                query_set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2 * capacity.max(1),
-                }),
-                capacity,
-            },
+            // Query sets are pooled by size: round the count up to a power of two, so
+            // that frames of nearby pass counts share one.
+            Some(_) if !force_cpu => {
+                Mode::Gpu { query_set: pool.timestamps(2 * capacity.max(1).next_power_of_two()), capacity }
+            }
             _ if cpu_fallback || force_cpu => {
                 Mode::Cpu { started: None, ms: Vec::new(), first: None, last: None }
             }
@@ -167,14 +166,11 @@ impl PassClock {
     }
 
     /// Records the copy of the timestamps out of the query set, at the frame's end.
-    pub fn resolve(self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) -> PendingTimes {
+    pub fn resolve(self, pool: &mut Pool, encoder: &mut wgpu::CommandEncoder) -> PendingTimes {
         let pending = match &self.mode {
-            Mode::Gpu { query_set, .. } if !self.labels.is_empty() => Some(readback::record_timestamps(
-                &gpu.device,
-                encoder,
-                query_set,
-                2 * self.labels.len() as u32,
-            )),
+            Mode::Gpu { query_set, .. } if !self.labels.is_empty() => {
+                Some(readback::record_timestamps(pool, encoder, query_set, 2 * self.labels.len() as u32))
+            }
             _ => None,
         };
         PendingTimes { clock: self, pending }

@@ -923,10 +923,10 @@ impl ShadowSettings {
         let f = &s.filter;
         match f.kernel_unit {
             KernelUnit::Texels => check(
-                f.pcf_kernel.is_finite() && (1.0..=32.0).contains(&f.pcf_kernel),
+                f.pcf_kernel.is_finite() && (1.0..=MAX_KERNEL_TEXELS).contains(&f.pcf_kernel),
                 "--pcf-kernel",
                 f.pcf_kernel,
-                "1 to 32 texels (or a world width with --kernel-unit world)",
+                format!("1 to {MAX_KERNEL_TEXELS} texels (or a world width with --kernel-unit world)"),
             )?,
             KernelUnit::World => check(
                 f.pcf_kernel.is_finite() && f.pcf_kernel > 0.0,
@@ -981,7 +981,7 @@ impl ShadowSettings {
             )?;
         }
         let c = &s.cascades;
-        check((1..=8).contains(&c.count), "--cascades", c.count, "1 to 8")?;
+        check((1..=MAX_CASCADES).contains(&c.count), "--cascades", c.count, format!("1 to {MAX_CASCADES}"))?;
         check(
             c.split_lambda.is_finite() && (0.0..=1.0).contains(&c.split_lambda),
             "--split-lambda",
@@ -1038,6 +1038,12 @@ fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
 
 /// The largest shadow map Gnomon allows, whatever the device.
 pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
+
+/// The most cascades a light may have: the renderer sizes its uniforms by it.
+pub const MAX_CASCADES: u32 = 8;
+
+/// The widest PCF kernel, in texels (a world-unit kernel is clamped to it too).
+pub const MAX_KERNEL_TEXELS: f32 = 32.0;
 /// The smallest shadow map Gnomon allows.
 pub const MIN_SHADOW_RESOLUTION: u32 = 256;
 

@@ -44,11 +44,11 @@ pub(crate) fn run(options: ViewerOptions) -> anyhow::Result<RunReport> {
 /// What exists once the window is open.
 struct Live {
     window: Arc<Window>,
-    /// Lives as long as the process: the renderer borrows it.
-    gpu: &'static gnomon_render::Gpu,
+    /// The window's device, which the renderer shares.
+    gpu: gnomon_render::Gpu,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    renderer: Renderer<'static>,
+    renderer: Renderer,
     uploaded: GpuScene,
     egui: egui_winit::State,
     painter: egui_wgpu::Renderer,
@@ -123,10 +123,7 @@ impl App {
         let adapter =
             pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, Some(&surface)))
                 .map_err(|_| RenderError::no_adapter())?;
-        // The renderer borrows the device for as long as it lives, and both live as long
-        // as the window: to the end of the process.
-        let gpu: &'static gnomon_render::Gpu =
-            Box::leak(Box::new(gnomon_render::Gpu::with_adapter(&adapter, |_| {})?));
+        let gpu = gnomon_render::Gpu::with_adapter(&adapter, |_| {})?;
         eprintln!("gnomon view: {}", gpu.info);
         let size = window.inner_size();
         let mut config = surface
@@ -138,7 +135,7 @@ impl App {
             config.format = *srgb;
         }
         surface.configure(&gpu.device, &config);
-        let renderer = Renderer::new(gpu)?;
+        let renderer = Renderer::new(&gpu)?;
         let uploaded = renderer.upload(&self.model.scene)?;
         let egui_ctx = egui::Context::default();
         let egui = egui_winit::State::new(
@@ -174,7 +171,7 @@ impl App {
             self.model.pending.push(action);
         }
         let Some(live) = self.live.as_mut() else { return Ok(()) };
-        let gpu = live.gpu;
+        let gpu = live.gpu.clone();
         let (device, queue) = (&gpu.device, &gpu.queue);
 
         // The scene, live, at the size the central view had last frame.
@@ -356,7 +353,7 @@ impl App {
         // Applied above; egui insists that they are drained.
         output.textures_delta.clear();
         if let Some(texture) = shot_texture {
-            let texels: Vec<u8> = gnomon_render::read_texture(gpu, &texture)?;
+            let texels: Vec<u8> = gnomon_render::read_texture(&gpu, &texture)?;
             let rgba = to_rgba(texels, texture.format());
             for path in screenshots {
                 reproduce::save_png(&path, texture.width(), texture.height(), &rgba)?;

@@ -5,12 +5,16 @@ struct Camera {
     clip_from_world: mat4x4<f32>,
     view_from_world: mat4x4<f32>,
     world_from_view: mat4x4<f32>,
-    eye: vec4<f32>,
-    debug: vec4<f32>,       // x: 1 to tint pixels by their cascade
-    // x: clip_from_view[0][0], y: clip_from_view[1][1] (a symmetric perspective),
-    // z: near plane, w: far plane.
-    projection: vec4<f32>,
-    viewport: vec4<f32>,    // x, y: width and height in pixels; z, w: their inverses
+    eye: vec3<f32>,
+    tint_cascades: u32,     // 1 to tint pixels by their cascade
+    scale_x: f32,           // clip_from_view[0][0] and [1][1] (a symmetric perspective)
+    scale_y: f32,
+    near: f32,
+    far: f32,
+    width: f32,             // the image in pixels
+    height: f32,
+    inv_width: f32,
+    inv_height: f32,
 };
 
 @group(1) @binding(0) var<uniform> camera: Camera;

@@ -16,39 +16,39 @@ const CONTACT_OWN_PLANE: f32 = 1e-3;
 const CONTACT_EDGE_FADE: f32 = 0.05;
 
 // 1 when the ray from `world` toward the light (unit `l`) meets nothing in the depth
-// buffer within `light.contact.x`; down to 0 where it does, faded near the screen's
-// edges and over the last quarter of `light.contact_range.x` in view depth.
+// buffer within `light.contact_length`; down to 0 where it does, faded near the screen's
+// edges and over the last quarter of `light.contact_distance` in view depth.
 fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pixel: vec2<f32>, view_depth: f32) -> f32 {
-    let far = light.contact_range.x;
+    let far = light.contact_distance;
     let distance_fade = 1.0 - smoothstep(0.75 * far, far, view_depth);
     if distance_fade <= 0.0 {
         return 1.0;
     }
-    var ray_length = light.contact.x;
-    if light.direction.w > 0.5 {
+    var ray_length = light.contact_length;
+    if light.kind != LIGHT_SUN {
         // Never past a spot or point light.
-        ray_length = min(ray_length, distance(light.position.xyz, world));
+        ray_length = min(ray_length, distance(light.position, world));
     }
-    let start_world = world + geometric_n * light.contact.w;
+    let start_world = world + geometric_n * light.contact_bias;
     let start = (camera.view_from_world * vec4<f32>(start_world, 1.0)).xyz;
     var end = (camera.view_from_world * vec4<f32>(start_world + l * ray_length, 1.0)).xyz;
     // Keep the ray in front of the camera's near plane.
-    let near = camera.projection.z;
+    let near = camera.near;
     if end.z > -near {
         end = mix(start, end, (-near - start.z) / (end.z - start.z) * 0.999);
     }
-    let steps = u32(light.contact.y);
+    let steps = light.contact_steps;
     let jitter = interleaved_gradient_noise(pixel);
     let own = vec2<i32>(pixel);
     for (var i = 0u; i < steps; i++) {
         let p = mix(start, end, (f32(i) + jitter) / f32(steps));
         let ray_depth = -p.z;
-        let ndc = p.xy * camera.projection.xy / ray_depth;
+        let ndc = p.xy * vec2<f32>(camera.scale_x, camera.scale_y) / ray_depth;
         let uv = ndc * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5);
         if any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0)) {
             break;
         }
-        let texel = vec2<i32>(uv * camera.viewport.xy);
+        let texel = vec2<i32>(uv * vec2<f32>(camera.width, camera.height));
         if all(texel == own) {
             // The receiver itself.
             continue;
@@ -60,7 +60,7 @@ fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pi
             continue;
         }
         let behind = ray_depth - scene_depth;
-        if scene_depth > 0.0 && behind > 0.0 && behind < light.contact.z * scene_depth {
+        if scene_depth > 0.0 && behind > 0.0 && behind < light.contact_thickness * scene_depth {
             let edge = min(min(uv.x, 1.0 - uv.x), min(uv.y, 1.0 - uv.y));
             return 1.0 - smoothstep(0.0, CONTACT_EDGE_FADE, edge) * distance_fade;
         }

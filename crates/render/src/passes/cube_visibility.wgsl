@@ -17,17 +17,17 @@ fn shadow_visibility(
     view_depth: f32,
 ) -> vec2<f32> {
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let offset_world = light.texel.z * cube_texel_world_size(world - light.position.xyz) * slope;
+    let offset_world = light.normal_offset * cube_texel_world_size(world - light.position) * slope;
     var q: CubeQuery;
-    q.offset = world + n * offset_world - light.position.xyz;
-    q.depth = length(q.offset) / light.position.w;
+    q.offset = world + n * offset_world - light.position;
+    q.depth = length(q.offset) / light.range;
     q.texel_world = cube_texel_world_size(q.offset);
     q.pixel = pixel;
     let frame = orthonormal_pair(normalize(q.offset));
     q.tangent = frame[0];
     q.bitangent = frame[1];
     let plane = cross(world_dx, world_dy);
-    if light.kernel.w > 0.5 && dot(plane, plane) > 0.0 {
+    if light.receiver_plane_bias == 1u && dot(plane, plane) > 0.0 {
         q.plane_normal = normalize(plane);
     }
     return vec2<f32>(sample_shadow_cube(q), f32(cube_face(q.offset)));

@@ -15,7 +15,10 @@ use super::{
     SHADOW_FORMAT,
     shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape, Sides},
 };
-use crate::{Gpu, RenderError};
+use crate::{
+    Gpu, RenderError,
+    pool::{Binding, Pool},
+};
 
 /// The casters of a scene, flattened for the depth-only baseline pass.
 pub struct DepthBaselineScene {
@@ -73,6 +76,13 @@ pub(crate) struct DepthBaselinePass {
     group_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     pipelines: std::collections::HashMap<ShadowPipelineKey, wgpu::RenderPipeline>,
+}
+
+/// One layer the baseline draws.
+pub(crate) struct BaselineLayer<'a> {
+    pub clip_from_world: Mat4,
+    pub raster: BaselineRaster<'a>,
+    pub target: &'a wgpu::TextureView,
 }
 
 /// How the shadow pass would rasterize a layer: the baseline rasterizes the same way,
@@ -159,29 +169,21 @@ impl DepthBaselinePass {
         })
     }
 
-    /// Records the baseline's depth pass into `target` through `clip_from_world`,
-    /// rasterized as `raster` says the shadow pass would.
-    #[allow(clippy::too_many_arguments)]
+    /// Records the baseline's depth pass into `layer.target` through
+    /// `layer.clip_from_world`, rasterized as `layer.raster` says the shadow pass would.
     pub fn record(
         &mut self,
-        device: &wgpu::Device,
+        gpu: &Gpu,
+        pool: &mut Pool,
         encoder: &mut wgpu::CommandEncoder,
         scene: &DepthBaselineScene,
-        clip_from_world: Mat4,
-        raster: BaselineRaster<'_>,
-        target: &wgpu::TextureView,
+        layer: BaselineLayer<'_>,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) {
-        let matrix = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("baseline clip_from_world"),
-            contents: bytemuck::bytes_of(&clip_from_world),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("depth-only baseline"),
-            layout: &self.group_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: matrix.as_entire_binding() }],
-        });
+        let BaselineLayer { clip_from_world, raster, target } = layer;
+        let device = &gpu.device;
+        let matrix = pool.uniform(&gpu.queue, "baseline clip_from_world", &clip_from_world);
+        let group = pool.bind_group("depth-only baseline", &self.group_layout, &[Binding::Buffer(matrix)]);
         let (single, double) = (raster.key(Sides::Single), raster.key(Sides::Double));
         // Both pipelines exist before the pass borrows them.
         self.pipeline(device, single);

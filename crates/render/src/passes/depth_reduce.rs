@@ -6,7 +6,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
-use wgpu::util::DeviceExt;
+
+use crate::pool::{Binding, Pool, ViewKey};
 
 /// The reduction pipelines and their bind group layout (both read the depth buffer,
 /// fold into a storage buffer and take a uniform).
@@ -25,11 +26,16 @@ pub(crate) struct PendingSampleBounds {
 /// The bounds pass's uniform: see `sample_bounds.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct BoundsParams {
-    world_from_clip: Mat4,
-    light_from_world: Mat4,
-    splits: [f32; 12],
-    planes: Vec4,
+pub(crate) struct BoundsParams {
+    pub world_from_clip: Mat4,
+    pub light_from_world: Mat4,
+    /// The view depths bounding the cascades, four to a vector (a uniform array's
+    /// elements are 16 bytes apart): `splits[i / 4][i % 4]`.
+    pub splits: [Vec4; 3],
+    pub near: f32,
+    pub far: f32,
+    pub cascade_count: u32,
+    pub blend: f32,
 }
 
 /// What the bounds pass needs to know of the camera and the cascades.
@@ -49,12 +55,29 @@ pub(crate) struct PendingDepthRange {
     buffer: wgpu::Buffer,
 }
 
+/// The camera's planes (`Planes` in `depth_reduce.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct Planes {
-    near: f32,
-    far: f32,
-    _pad: [f32; 2],
+pub(crate) struct Planes {
+    pub near: f32,
+    pub far: f32,
+    pub _pad0: f32,
+    pub _pad1: f32,
+}
+
+impl Planes {
+    pub fn new(near: f32, far: f32) -> Self {
+        Self { near, far, _pad0: 0.0, _pad1: 0.0 }
+    }
+}
+
+/// One reduction: its pipeline, the depth it reads, the buffer it folds into and its
+/// uniform.
+struct Dispatch<'a> {
+    pipeline: &'a wgpu::ComputePipeline,
+    depth: &'a wgpu::Texture,
+    output: &'a wgpu::Buffer,
+    params: &'a wgpu::Buffer,
 }
 
 impl DepthReducePass {
@@ -96,7 +119,7 @@ impl DepthReducePass {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("depth_reduce.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("depth_reduce.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(reduce_wgsl().into()),
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("depth reduction"),
@@ -113,7 +136,7 @@ impl DepthReducePass {
         });
         let bounds_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("sample_bounds.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("sample_bounds.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(bounds_wgsl().into()),
         });
         let bounds_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("sample bounds"),
@@ -130,7 +153,8 @@ impl DepthReducePass {
     /// the result out.
     pub fn record_bounds(
         &self,
-        device: &wgpu::Device,
+        pool: &mut Pool,
+        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         depth: &wgpu::Texture,
         request: &BoundsRequest,
@@ -138,11 +162,7 @@ impl DepthReducePass {
         let count = request.splits.len().saturating_sub(1).min(MAX_BOUNDS);
         // Minima start at the largest encoding, maxima at the smallest.
         let initial: Vec<u32> = (0..4 * MAX_BOUNDS).map(|i| if i % 4 < 2 { u32::MAX } else { 0 }).collect();
-        let bounds = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("sample bounds"),
-            contents: bytemuck::cast_slice(&initial),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
+        let bounds = pool.storage(queue, "sample bounds", &initial, wgpu::BufferUsages::COPY_SRC);
         let mut splits = [0.0f32; 12];
         for (slot, z) in splits.iter_mut().zip(request.splits) {
             *slot = z.min(f32::MAX);
@@ -150,48 +170,39 @@ impl DepthReducePass {
         let params = BoundsParams {
             world_from_clip: request.world_from_clip,
             light_from_world: request.light_from_world,
-            splits,
-            planes: Vec4::new(request.near, request.far, count as f32, request.blend),
+            splits: [
+                Vec4::from_slice(&splits[0..4]),
+                Vec4::from_slice(&splits[4..8]),
+                Vec4::from_slice(&splits[8..12]),
+            ],
+            near: request.near,
+            far: request.far,
+            cascade_count: count as u32,
+            blend: request.blend,
         };
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("sample bounds parameters"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        self.dispatch(device, encoder, &self.bounds_pipeline, depth, &bounds, &params, "sample bounds");
+        let params = pool.uniform(queue, "sample bounds parameters", &params);
+        let dispatch = Dispatch { pipeline: &self.bounds_pipeline, depth, output: &bounds, params: &params };
+        self.dispatch(pool, encoder, dispatch, "sample bounds");
         let size = (16 * MAX_BOUNDS) as u64;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sample bounds readback"),
+        let buffer = pool.buffer(
+            "sample bounds readback",
             size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        );
         encoder.copy_buffer_to_buffer(&bounds, 0, &buffer, 0, size);
         PendingSampleBounds { buffer, count }
     }
 
-    /// Binds `depth`, `output` and `params` and runs `pipeline` over 16×16 tiles.
-    #[allow(clippy::too_many_arguments)]
-    fn dispatch(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        pipeline: &wgpu::ComputePipeline,
-        depth: &wgpu::Texture,
-        output: &wgpu::Buffer,
-        params: &wgpu::Buffer,
-        label: &str,
-    ) {
-        let view = depth.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(label),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
-            ],
-        });
+    /// Binds the dispatch's depth, output and parameters and runs its pipeline over
+    /// 16×16 tiles.
+    fn dispatch(&self, pool: &mut Pool, encoder: &mut wgpu::CommandEncoder, d: Dispatch, label: &str) {
+        let Dispatch { pipeline, depth, output, params } = d;
+        let view = pool.view(depth, ViewKey::default());
+        let group = pool.bind_group(
+            label,
+            &self.layout,
+            &[Binding::View(view), Binding::Buffer(output.clone()), Binding::Buffer(params.clone())],
+        );
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
         pass.set_pipeline(pipeline);
@@ -203,29 +214,21 @@ impl DepthReducePass {
     /// `far`) and the copy of its result out.
     pub fn record(
         &self,
-        device: &wgpu::Device,
+        pool: &mut Pool,
+        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         depth: &wgpu::Texture,
-        near: f32,
-        far: f32,
+        planes: Planes,
     ) -> PendingDepthRange {
-        let range = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("depth range"),
-            contents: bytemuck::cast_slice(&[u32::MAX, 0u32]),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
-        let planes = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("camera planes"),
-            contents: bytemuck::bytes_of(&Planes { near, far, _pad: [0.0; 2] }),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        self.dispatch(device, encoder, &self.pipeline, depth, &range, &planes, "depth reduction");
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("depth range readback"),
-            size: 8,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+        let range = pool.storage(queue, "depth range", &[u32::MAX, 0u32], wgpu::BufferUsages::COPY_SRC);
+        let planes = pool.uniform(queue, "camera planes", &planes);
+        let dispatch = Dispatch { pipeline: &self.pipeline, depth, output: &range, params: &planes };
+        self.dispatch(pool, encoder, dispatch, "depth reduction");
+        let buffer = pool.buffer(
+            "depth range readback",
+            8,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        );
         encoder.copy_buffer_to_buffer(&range, 0, &buffer, 0, 8);
         PendingDepthRange { buffer }
     }
@@ -242,7 +245,7 @@ impl PendingDepthRange {
 }
 
 /// Cascades the bounds pass serves, as the lighting pass's uniform allows.
-const MAX_BOUNDS: usize = 8;
+const MAX_BOUNDS: usize = crate::uniforms::MAX_CASCADES;
 
 /// Inverts the shader's order-preserving encoding.
 fn decode(bits: u32) -> f32 {
@@ -263,6 +266,16 @@ impl PendingSampleBounds {
             })
             .collect())
     }
+}
+
+/// `depth_reduce.wgsl`, composed.
+pub(crate) fn reduce_wgsl() -> String {
+    super::compose_wgsl(&[include_str!("depth_reduce.wgsl")])
+}
+
+/// `sample_bounds.wgsl`, composed.
+pub(crate) fn bounds_wgsl() -> String {
+    super::compose_wgsl(&[include_str!("sample_bounds.wgsl")])
 }
 
 #[cfg(test)]

@@ -6,8 +6,13 @@
 
 @group(0) @binding(0) var depth_buffer: texture_depth_2d;
 @group(0) @binding(1) var<storage, read_write> depth_range: array<atomic<u32>, 2>;
-// x: camera near, y: camera far.
-@group(0) @binding(2) var<uniform> planes: vec4<f32>;
+struct Planes {
+    near: f32,
+    far: f32,
+    _pad0: f32,
+    _pad1: f32,
+};
+@group(0) @binding(2) var<uniform> planes: Planes;
 
 var<workgroup> tile_min: atomic<u32>;
 var<workgroup> tile_max: atomic<u32>;
@@ -25,8 +30,8 @@ fn reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocatio
         // Depth 1 is the cleared background: no sample there.
         if d < 1.0 {
             // The camera's D3D-style depth d = f(z − n) / (z (f − n)), inverted.
-            let n = planes.x;
-            let f = planes.y;
+            let n = planes.near;
+            let f = planes.far;
             let z = n * f / (f - d * (f - n));
             atomicMin(&tile_min, bitcast<u32>(z));
             atomicMax(&tile_max, bitcast<u32>(z));

@@ -9,7 +9,7 @@
 // shading.wgsl.
 
 // Cascade tints of the debug view.
-const CASCADE_TINTS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
+const CASCADE_TINTS: array<vec3<f32>, MAX_CASCADES> = array<vec3<f32>, MAX_CASCADES>(
     vec3<f32>(1.0, 0.35, 0.35), vec3<f32>(0.35, 1.0, 0.35), vec3<f32>(0.4, 0.5, 1.0), vec3<f32>(1.0, 1.0, 0.3),
     vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
 );
@@ -46,12 +46,12 @@ fn fs_main(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut
     }
     let albedo = base_color_of(inst, in.uv).rgb;
     let n_dot_l = max(dot(n, l), 0.0);
-    let v = normalize(camera.eye.xyz - in.world);
+    let v = normalize(camera.eye - in.world);
     let h = normalize(l + v);
     let specular = inst.material.x * pow(max(dot(n, h), 0.0), inst.material.y) * select(0.0, 1.0, n_dot_l > 0.0);
-    let direct = light.radiance.rgb * cone * (albedo * n_dot_l + vec3<f32>(specular));
-    var color = light.ambient.rgb * albedo + visibility * direct;
-    if camera.debug.x > 0.5 {
+    let direct = light.radiance * cone * (albedo * n_dot_l + vec3<f32>(specular));
+    var color = light.ambient * albedo + visibility * direct;
+    if camera.tint_cascades == 1u {
         color *= CASCADE_TINTS[layer];
     }
 

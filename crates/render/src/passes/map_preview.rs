@@ -2,21 +2,39 @@
 //! side by side in grayscale, as a colour texture a UI can show.
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec4;
 use gnomon_math::{LightProjection, ProjectionKind};
-use wgpu::util::DeviceExt;
 
-use crate::gpu_types::MAX_CASCADES;
+use crate::{
+    Gpu,
+    pool::{Binding, Pool, ViewKey},
+    uniforms::MAX_CASCADES,
+};
 
 /// The preview's texel format: plain 8-bit, shown as is.
 pub(crate) const PREVIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// See `map_preview.wgsl`.
+/// One layer of the preview (`PreviewLayer` in `map_preview.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Default, Pod, Zeroable)]
+pub(crate) struct PreviewLayer {
+    /// 1 for a perspective layer, whose depth is linearized first.
+    pub perspective: u32,
+    pub near: f32,
+    pub far: f32,
+    pub _pad: f32,
+}
+
+/// The preview's uniform (`Preview` in `map_preview.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct PreviewParams {
-    tile: Vec4,
-    layers: [Vec4; MAX_CASCADES],
+pub(crate) struct PreviewParams {
+    /// Tile side in pixels.
+    pub tile: f32,
+    pub layer_count: u32,
+    /// The map's texels per side.
+    pub resolution: f32,
+    pub _pad: f32,
+    pub layers: [PreviewLayer; MAX_CASCADES],
 }
 
 pub(crate) struct MapPreviewPass {
@@ -44,7 +62,7 @@ impl MapPreviewPass {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("map preview"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("map_preview.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(preview_wgsl().into()),
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("map preview"),
@@ -79,51 +97,44 @@ impl MapPreviewPass {
     /// square, into a new texture.
     pub fn draw(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        gpu: &Gpu,
+        pool: &mut Pool,
         map: &wgpu::Texture,
         projections: &[LightProjection],
         tile: u32,
     ) -> wgpu::Texture {
+        let device = &gpu.device;
         let count = (map.depth_or_array_layers() as usize).min(MAX_CASCADES);
-        let mut layers = [Vec4::ZERO; MAX_CASCADES];
+        let mut layers = [PreviewLayer::default(); MAX_CASCADES];
         for (slot, projection) in layers.iter_mut().zip(projections) {
             let perspective = matches!(projection.kind, ProjectionKind::Perspective { .. });
-            *slot = Vec4::new(perspective as u8 as f32, projection.near, projection.far, 0.0);
+            *slot = PreviewLayer {
+                perspective: perspective.into(),
+                near: projection.near,
+                far: projection.far,
+                _pad: 0.0,
+            };
         }
-        let params =
-            PreviewParams { tile: Vec4::new(tile as f32, count as f32, map.width() as f32, 0.0), layers };
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("map preview"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let view = map.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            aspect: wgpu::TextureAspect::DepthOnly,
-            ..Default::default()
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("map preview"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
-            ],
-        });
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("map preview"),
-            size: wgpu::Extent3d { width: tile * count as u32, height: tile, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: PREVIEW_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+        let params = PreviewParams {
+            tile: tile as f32,
+            layer_count: count as u32,
+            resolution: map.width() as f32,
+            _pad: 0.0,
+            layers,
+        };
+        let buffer = pool.uniform(&gpu.queue, "map preview", &params);
+        let view = pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
+        let group =
+            pool.bind_group("map preview", &self.layout, &[Binding::View(view), Binding::Buffer(buffer)]);
+        let target = pool.texture(
+            "map preview",
+            wgpu::Extent3d { width: tile * count as u32, height: tile, depth_or_array_layers: 1 },
+            PREVIEW_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let target_view = target.create_view(&Default::default());
+        );
+        let target_view = pool.view(&target, ViewKey::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -146,7 +157,12 @@ impl MapPreviewPass {
             pass.set_bind_group(0, &group, &[]);
             pass.draw(0..3, 0..1);
         }
-        queue.submit([encoder.finish()]);
+        gpu.queue.submit([encoder.finish()]);
         target
     }
+}
+
+/// `map_preview.wgsl`, composed.
+pub(crate) fn preview_wgsl() -> String {
+    super::compose_wgsl(&[include_str!("map_preview.wgsl")])
 }

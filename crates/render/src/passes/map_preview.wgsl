@@ -1,12 +1,19 @@
 // The shadow map preview: every layer of a depth map side by side, in grayscale
 // (near black, far white), for the viewer's debug panel.
 
+struct PreviewLayer {
+    perspective: u32,  // 1: its depth is linearized first
+    near: f32,
+    far: f32,
+    _pad: f32,
+}
+
 struct Preview {
-    // x: tile side in pixels, y: layer count, z: map resolution.
-    tile: vec4<f32>,
-    // Per layer: x = 1 for a perspective layer (its depth is linearized first),
-    // y = near, z = far.
-    layers: array<vec4<f32>, 8>,
+    tile: f32,         // tile side in pixels
+    layer_count: u32,
+    resolution: f32,   // the map's texels per side
+    _pad: f32,
+    layers: array<PreviewLayer, MAX_CASCADES>,
 }
 
 @group(0) @binding(0) var map: texture_depth_2d_array;
@@ -21,23 +28,23 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f
 
 @fragment
 fn fs_preview(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let tile = preview.tile.x;
-    let layer = min(u32(frag.x / tile), u32(preview.tile.y) - 1u);
+    let tile = preview.tile;
+    let layer = min(u32(frag.x / tile), preview.layer_count - 1u);
     let local = vec2<f32>(frag.x - f32(layer) * tile, frag.y);
     // A dark seam between layers.
     if (layer > 0u && local.x < 2.0) {
         return vec4<f32>(0.45, 0.08, 0.08, 1.0);
     }
-    let resolution = preview.tile.z;
+    let resolution = preview.resolution;
     let texel = vec2<i32>(clamp(local / tile * resolution, vec2<f32>(0.0), vec2<f32>(resolution - 1.0)));
     let depth = textureLoad(map, texel, i32(layer), 0);
     let params = preview.layers[layer];
     var shade = depth;
-    if (params.x > 0.5 && depth < 1.0) {
+    if (params.perspective == 1u && depth < 1.0) {
         // Reversed from the [0, 1] perspective depth d = f (z - n) / (z (f - n)) to the
         // distance z, then stretched over n..f so that the gradient is visible.
-        let near = params.y;
-        let far = params.z;
+        let near = params.near;
+        let far = params.far;
         let distance = near * far / (far - depth * (far - near));
         shade = (distance - near) / (far - near);
     }

@@ -9,6 +9,9 @@ pub(crate) mod moments;
 pub(crate) mod screen_space;
 pub(crate) mod shadow;
 
+#[cfg(test)]
+mod interface_tests;
+
 /// The shadow map's texel format.
 pub(crate) const SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -33,10 +36,13 @@ pub(crate) fn begin_depth_pass<'e>(
     })
 }
 
-/// Concatenates WGSL sources into one module. WGSL allows module-scope declarations
+/// Concatenates WGSL sources into one module, after the constants generated from
+/// Rust ([`crate::uniforms::wgsl_constants`]). WGSL allows module-scope declarations
 /// in any order, so the shared declarations, the technique and the pass compose freely.
 pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
-    parts.join("\n")
+    let mut all = vec![crate::uniforms::wgsl_constants()];
+    all.extend(parts.iter().map(|p| (*p).to_owned()));
+    all.join("\n")
 }
 
 /// The light uniform's struct and depth conventions, shared by every pass.

@@ -6,22 +6,32 @@ use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 use gnomon_scene::settings::{MomentSettings, Technique};
-use wgpu::util::DeviceExt;
 
 use super::{LIGHT_WGSL, compose_wgsl};
-use crate::techniques::{self, FilterableMap};
+use crate::{
+    pool::{Binding, Pool, ViewKey},
+    techniques::{self, FilterableMap},
+};
 
 const WORKGROUP: u32 = 8;
 
 /// `FilterParams` in `moments_filter.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct FilterParamsGpu {
-    direction: [i32; 2],
-    radius: i32,
-    log_c: f32,
-    sigma: f32,
-    _pad: [f32; 3],
+pub(crate) struct FilterParamsGpu {
+    pub direction: [i32; 2],
+    pub radius: i32,
+    pub log_c: f32,
+    pub sigma: f32,
+    pub _pad0: f32,
+    pub _pad1: f32,
+    pub _pad2: f32,
+}
+
+impl FilterParamsGpu {
+    fn new(direction: [i32; 2], radius: i32, log_c: f32, sigma: f32) -> Self {
+        Self { direction, radius, log_c, sigma, _pad0: 0.0, _pad1: 0.0, _pad2: 0.0 }
+    }
 }
 
 /// Pipelines for one storage format (WGSL names the format of a storage texture).
@@ -38,12 +48,42 @@ pub(crate) struct MomentPass {
     light_layout: wgpu::BindGroupLayout,
     depth_layout: wgpu::BindGroupLayout,
     formats: HashMap<wgpu::TextureFormat, FormatPipelines>,
+    /// Writes the filters' parameters.
+    queue: wgpu::Queue,
+}
+
+/// What the moment pass filters: a light's depth map and the technique's map.
+pub(crate) struct MomentInput<'a> {
+    pub technique: Technique,
+    pub map: FilterableMap,
+    pub settings: &'a MomentSettings,
+    pub format: wgpu::TextureFormat,
+    pub resolution: u32,
+    pub cascades: u32,
+    /// The light's depth map, every layer.
+    pub depth_view: &'a wgpu::TextureView,
+    pub light_buffer: &'a wgpu::Buffer,
 }
 
 /// A filtered moment map, ready to bind to the lighting pass.
 pub(crate) struct MomentMap {
     /// All layers and mip levels (the view keeps the texture alive).
     pub view: wgpu::TextureView,
+}
+
+/// The moment pass's encoding WGSL for a technique and storage format, composed.
+pub(crate) fn encode_wgsl(technique: Technique, format: wgpu::TextureFormat) -> String {
+    let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned()];
+    parts.extend(techniques::shared_wgsl());
+    parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+    parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
+    let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+    compose_wgsl(&refs)
+}
+
+/// The blur and downsampling WGSL for a storage format, composed.
+pub(crate) fn filter_wgsl(format: wgpu::TextureFormat) -> String {
+    compose_wgsl(&[&include_str!("moments_filter.wgsl").replace("MOMENT_FORMAT", wgsl_format(format))])
 }
 
 fn wgsl_format(format: wgpu::TextureFormat) -> &'static str {
@@ -69,7 +109,7 @@ fn storage_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLa
 }
 
 impl MomentPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("moments: light"),
             entries: &[compute_entry(
@@ -92,7 +132,7 @@ impl MomentPass {
                 },
             )],
         });
-        Self { light_layout, depth_layout, formats: HashMap::new() }
+        Self { light_layout, depth_layout, formats: HashMap::new(), queue: queue.clone() }
     }
 
     fn format_pipelines(
@@ -127,10 +167,9 @@ impl MomentPass {
                     ),
                 ],
             });
-            let source = include_str!("moments_filter.wgsl").replace("MOMENT_FORMAT", wgsl_format(format));
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("moments: filter"),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
+                source: wgpu::ShaderSource::Wgsl(filter_wgsl(format).into()),
             });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("moments: filter"),
@@ -167,14 +206,9 @@ impl MomentPass {
         let pipelines = self.formats.get_mut(&format).expect("format pipelines are built first");
         let storage_layout = &pipelines.storage_layout;
         pipelines.encode.entry(technique).or_insert_with(|| {
-            let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned()];
-            parts.extend(techniques::shared_wgsl());
-            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
-            parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
-            let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("moments: encode"),
-                source: wgpu::ShaderSource::Wgsl(compose_wgsl(&refs).into()),
+                source: wgpu::ShaderSource::Wgsl(encode_wgsl(technique, format).into()),
             });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("moments: encode"),
@@ -192,91 +226,60 @@ impl MomentPass {
         })
     }
 
-    /// Records the encoding, blur and mipmaps of `technique`'s map from the depth
-    /// map `depth_view` into a new texture, in one compute pass.
-    #[allow(clippy::too_many_arguments)]
+    /// Records the encoding, blur and mipmaps of `input.technique`'s map from the
+    /// depth map into a pooled texture, in one compute pass.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
+        pool: &mut Pool,
         encoder: &mut wgpu::CommandEncoder,
-        technique: Technique,
-        map: FilterableMap,
-        settings: &MomentSettings,
-        format: wgpu::TextureFormat,
-        resolution: u32,
-        cascades: u32,
-        depth_view: &wgpu::TextureView,
-        light_buffer: &wgpu::Buffer,
+        input: &MomentInput,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
     ) -> MomentMap {
+        let MomentInput { technique, map, settings, format, resolution, cascades, .. } = *input;
         self.format_pipelines(device, format);
         self.encode_pipeline(device, technique, format);
         let pipelines = &self.formats[&format];
         let mip_levels = if settings.mipmaps && map.mipmapped { resolution.ilog2() + 1 } else { 1 };
         // The technique's layers, for every cascade in turn.
         let layers = map.layers * cascades;
-        let texture = |label, mips| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers },
-                mip_level_count: mips,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-        };
-        let moments = texture("moment map", mip_levels);
-        let level_view = |t: &wgpu::Texture, level: u32| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                base_mip_level: level,
-                mip_level_count: Some(1),
-                ..Default::default()
-            })
+        let size = wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers };
+        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
+        let moments = pool.texture_with_mips("moment map", size, mip_levels, format, usage);
+        let level = |level: u32| ViewKey {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            base_mip: level,
+            mips: Some(1),
+            ..Default::default()
         };
         let log_c = map.log_space_exponent.unwrap_or(0.0);
-        let filter_group = |source: &wgpu::TextureView,
+        let filter_group = |pool: &mut Pool,
+                            source: &wgpu::TextureView,
                             target: &wgpu::TextureView,
                             params: FilterParamsGpu| {
-            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("moments: filter parameters"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("moments: filter"),
-                layout: &pipelines.filter_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(target) },
-                    wgpu::BindGroupEntry { binding: 2, resource: buffer.as_entire_binding() },
-                ],
-            })
+            let buffer = pool.uniform(&self.queue, "moments: filter parameters", &params);
+            pool.bind_group(
+                "moments: filter",
+                &pipelines.filter_layout,
+                &[Binding::View(source.clone()), Binding::View(target.clone()), Binding::Buffer(buffer)],
+            )
         };
-        let light_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("moments: light"),
-            layout: &self.light_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 1, resource: light_buffer.as_entire_binding() }],
-        });
-        let depth_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("moments: depth map"),
-            layout: &self.depth_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(depth_view),
-            }],
-        });
-        let top = level_view(&moments, 0);
-        let encode_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("moments: encode target"),
-            layout: &pipelines.storage_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&top),
-            }],
-        });
+        let light_group = pool.bind_group_numbered(
+            "moments: light",
+            &self.light_layout,
+            vec![(1, Binding::Buffer(input.light_buffer.clone()))],
+        );
+        let depth_group = pool.bind_group(
+            "moments: depth map",
+            &self.depth_layout,
+            &[Binding::View(input.depth_view.clone())],
+        );
+        let top = pool.view(&moments, level(0));
+        let encode_group = pool.bind_group(
+            "moments: encode target",
+            &pipelines.storage_layout,
+            &[Binding::View(top.clone())],
+        );
         let groups = |size: u32| size.div_ceil(WORKGROUP);
 
         let mut pass = encoder
@@ -288,19 +291,14 @@ impl MomentPass {
         pass.dispatch_workgroups(groups(resolution), groups(resolution), layers);
 
         if settings.blur_radius > 0 {
-            let scratch = texture("moment map blur scratch", 1);
-            let scratch_view = level_view(&scratch, 0);
+            let scratch = pool.texture("moment map blur scratch", size, format, usage);
+            let scratch_view = pool.view(&scratch, level(0));
             let radius = settings.blur_radius as i32;
-            let params = |direction| FilterParamsGpu {
-                direction,
-                radius,
-                log_c,
-                sigma: 0.5 * settings.blur_radius as f32,
-                _pad: [0.0; 3],
-            };
+            let params =
+                |direction| FilterParamsGpu::new(direction, radius, log_c, 0.5 * settings.blur_radius as f32);
             // Horizontal into the scratch texture, vertical back.
-            let horizontal = filter_group(&top, &scratch_view, params([1, 0]));
-            let vertical = filter_group(&scratch_view, &top, params([0, 1]));
+            let horizontal = filter_group(pool, &top, &scratch_view, params([1, 0]));
+            let vertical = filter_group(pool, &scratch_view, &top, params([0, 1]));
             pass.set_pipeline(&pipelines.blur);
             for group in [&horizontal, &vertical] {
                 pass.set_bind_group(0, group, &[]);
@@ -310,21 +308,17 @@ impl MomentPass {
 
         if mip_levels > 1 {
             pass.set_pipeline(&pipelines.downsample);
-            for level in 1..mip_levels {
-                let size = (resolution >> level).max(1);
-                let params =
-                    FilterParamsGpu { direction: [0, 0], radius: 0, log_c, sigma: 1.0, _pad: [0.0; 3] };
-                let group =
-                    filter_group(&level_view(&moments, level - 1), &level_view(&moments, level), params);
+            for mip in 1..mip_levels {
+                let size = (resolution >> mip).max(1);
+                let params = FilterParamsGpu::new([0, 0], 0, log_c, 1.0);
+                let (source, target) = (pool.view(&moments, level(mip - 1)), pool.view(&moments, level(mip)));
+                let group = filter_group(pool, &source, &target, params);
                 pass.set_bind_group(0, &group, &[]);
                 pass.dispatch_workgroups(groups(size), groups(size), layers);
             }
         }
         drop(pass);
-        let view = moments.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let view = pool.view(&moments, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
         MomentMap { view }
     }
 }

@@ -8,7 +8,7 @@ fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {
     let d = (light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0)).xyz;
     let len = length(d);
     let xy = d.xy / max(len + d.z, 1e-20);
-    return vec3<f32>(xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5), len / light.position.w);
+    return vec3<f32>(xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5), len / light.range);
 }
 
 // World size of a texel across the ray at `world`: xy = tan(θ/2) has dxy/dθ =
@@ -18,7 +18,7 @@ fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {
 fn paraboloid_texel_world_size(layer: u32, world: vec3<f32>) -> f32 {
     let d = (light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0)).xyz;
     let len = max(length(d), 1e-20);
-    return (len + d.z) * 2.0 / light.texel.w;
+    return (len + d.z) * 2.0 / light.resolution;
 }
 
 fn shadow_visibility(
@@ -33,13 +33,13 @@ fn shadow_visibility(
     let below = (light.cascade_clip_from_world[0u] * vec4<f32>(world, 1.0)).z >= 0.0;
     let layer = select(1u, 0u, below);
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let p = world + n * (light.texel.z * paraboloid_texel_world_size(layer, world) * slope);
+    let p = world + n * (light.normal_offset * paraboloid_texel_world_size(layer, world) * slope);
     var q: ShadowQuery;
     q.coords = paraboloid_map_coords(layer, p);
     q.coords_dx = paraboloid_map_coords(layer, p + world_dx) - q.coords;
     q.coords_dy = paraboloid_map_coords(layer, p + world_dy) - q.coords;
     q.pixel = pixel;
-    q.distance = length(p - light.position.xyz);
+    q.distance = length(p - light.position);
     q.layer = layer;
     return vec2<f32>(sample_shadow(q), f32(layer));
 }

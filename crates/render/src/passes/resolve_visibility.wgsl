@@ -18,7 +18,7 @@ fn pixel_visibility(
     view_depth: f32,
 ) -> vec2<f32> {
     var shadow = shadow_visibility(world, n, l, world_dx, world_dy, pixel, view_depth);
-    if light.direction.w > 0.5 && cone <= 0.0 {
+    if light.kind != LIGHT_SUN && cone <= 0.0 {
         // Outside a spot's cone or a light's range no light arrives: visibility 0 by
         // definition.
         shadow.x = 0.0;

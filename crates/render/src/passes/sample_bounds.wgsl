@@ -6,25 +6,25 @@
 // memory, then folds it into the global bounds with atomics. Floats are stored in an
 // order-preserving u32 encoding so that atomicMin/atomicMax compare them.
 
-struct Params {
+struct BoundsParams {
     world_from_clip: mat4x4<f32>,
     light_from_world: mat4x4<f32>,
     // The view depths bounding the cascades: splits[0] to splits[count].
     splits: array<vec4<f32>, 3>,
-    // x: camera near, y: camera far, z: cascade count, w: the blend band, as a fraction
-    // of a cascade's depth range over which the lighting pass also reads the next
-    // cascade (0 when it picks cascades by projection).
-    planes: vec4<f32>,
+    near: f32,            // the camera's planes
+    far: f32,
+    cascade_count: u32,
+    // The blend band, as a fraction of a cascade's depth range over which the lighting
+    // pass also reads the next cascade (0 when it picks cascades by projection).
+    blend: f32,
 }
-
-const MAX_CASCADES: u32 = 8u;
 
 @group(0) @binding(0) var depth_buffer: texture_depth_2d;
 // Per cascade: min x, min y, max x, max y, encoded.
-@group(0) @binding(1) var<storage, read_write> bounds: array<atomic<u32>, 32>;
-@group(0) @binding(2) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read_write> bounds: array<atomic<u32>, 4u * MAX_CASCADES>;
+@group(0) @binding(2) var<uniform> params: BoundsParams;
 
-var<workgroup> tile: array<atomic<u32>, 32>;
+var<workgroup> tile: array<atomic<u32>, 4u * MAX_CASCADES>;
 
 // Flips the sign bit of a positive float and every bit of a negative one, so that the
 // encoded u32s order like the floats.
@@ -51,9 +51,9 @@ fn bounds_of_samples(
     if all(id.xy < size) {
         let d = textureLoad(depth_buffer, vec2<i32>(id.xy), 0);
         if d < 1.0 {
-            let n = params.planes.x;
-            let f = params.planes.y;
-            let count = u32(params.planes.z);
+            let n = params.near;
+            let f = params.far;
+            let count = params.cascade_count;
             let view_depth = n * f / (f - d * (f - n));
             // The pixel's centre in NDC (y up), back to world space.
             let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
@@ -66,7 +66,7 @@ fn bounds_of_samples(
                 // end of the previous one.
                 var start = split(i);
                 if i > 0u {
-                    start -= params.planes.w * (split(i) - split(i - 1u));
+                    start -= params.blend * (split(i) - split(i - 1u));
                 }
                 if view_depth >= start && view_depth <= split(i + 1u) {
                     atomicMin(&tile[i * 4u], encoded.x);

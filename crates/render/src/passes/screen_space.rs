@@ -41,6 +41,17 @@ pub(crate) fn prepass_wgsl() -> String {
     compose_wgsl(&refs)
 }
 
+/// The shadow-mask pass's WGSL for `key`, composed.
+pub(crate) fn mask_wgsl(key: MaskKey) -> String {
+    let mut parts = lighting::camera_shading_wgsl();
+    parts.extend(lighting::visibility_wgsl(key.technique, key.lookup));
+    parts.push(include_str!("octahedron.wgsl").to_owned());
+    parts.push(include_str!("contact.wgsl").to_owned());
+    parts.push(include_str!("shadow_mask.wgsl").to_owned());
+    let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+    compose_wgsl(&refs)
+}
+
 pub(crate) struct ScreenSpacePass {
     prepass: wgpu::RenderPipeline,
     mask_layout: wgpu::PipelineLayout,
@@ -105,15 +116,9 @@ impl ScreenSpacePass {
     pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
         let layout = &self.mask_layout;
         self.masks.entry(key).or_insert_with(|| {
-            let mut parts = lighting::camera_shading_wgsl();
-            parts.extend(lighting::visibility_wgsl(key.technique, key.lookup));
-            parts.push(include_str!("octahedron.wgsl").to_owned());
-            parts.push(include_str!("contact.wgsl").to_owned());
-            parts.push(include_str!("shadow_mask.wgsl").to_owned());
-            let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("shadow mask"),
-                source: wgpu::ShaderSource::Wgsl(compose_wgsl(&refs).into()),
+                source: wgpu::ShaderSource::Wgsl(mask_wgsl(key).into()),
             });
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("shadow mask"),

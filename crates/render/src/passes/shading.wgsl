@@ -10,17 +10,17 @@ const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 // range test for a point light.
 // Returns (unit direction to the light, cone factor in [0, 1]).
 fn light_geometry(world: vec3<f32>) -> vec4<f32> {
-    if light.direction.w < 0.5 {
-        return vec4<f32>(-light.direction.xyz, 1.0);
+    if light.kind == LIGHT_SUN {
+        return vec4<f32>(-light.direction, 1.0);
     }
-    let to_light = light.position.xyz - world;
+    let to_light = light.position - world;
     let dist = length(to_light);
     let l = to_light / dist;
-    if light.direction.w > 1.5 {
-        return vec4<f32>(l, select(0.0, 1.0, dist <= light.position.w));
+    if light.kind == LIGHT_POINT {
+        return vec4<f32>(l, select(0.0, 1.0, dist <= light.range));
     }
-    let cos_angle = dot(-l, light.direction.xyz);
-    let inside = cos_angle >= light.cone.y && dist <= light.position.w;
-    let falloff = smoothstep(light.cone.y, light.cone.x, cos_angle);
+    let cos_angle = dot(-l, light.direction);
+    let inside = cos_angle >= light.cos_outer && dist <= light.range;
+    let falloff = smoothstep(light.cos_outer, light.cos_inner, cos_angle);
     return vec4<f32>(l, select(0.0, falloff, inside));
 }

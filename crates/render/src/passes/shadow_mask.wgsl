@@ -25,19 +25,19 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
 // The world point that the ray through pixel position `pixel` (in pixels, centres at
 // .5) meets at view depth `view_depth`.
 fn world_at(pixel: vec2<f32>, view_depth: f32) -> vec3<f32> {
-    let ndc = vec2<f32>(pixel.x * camera.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * camera.viewport.w * 2.0);
-    let view = vec3<f32>(ndc * view_depth / camera.projection.xy, -view_depth);
+    let ndc = vec2<f32>(pixel.x * camera.inv_width * 2.0 - 1.0, 1.0 - pixel.y * camera.inv_height * 2.0);
+    let view = vec3<f32>(ndc * view_depth / vec2<f32>(camera.scale_x, camera.scale_y), -view_depth);
     return (camera.world_from_view * vec4<f32>(view, 1.0)).xyz;
 }
 
 // Where the ray through `pixel` meets the plane through `origin` with normal `n`.
 fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let direction = world_at(pixel, 1.0) - camera.eye.xyz;
+    let direction = world_at(pixel, 1.0) - camera.eye;
     let along = dot(direction, n);
     if abs(along) < 1e-12 {
         return origin;
     }
-    return camera.eye.xyz + direction * (dot(origin - camera.eye.xyz, n) / along);
+    return camera.eye + direction * (dot(origin - camera.eye, n) / along);
 }
 
 @fragment
@@ -64,7 +64,7 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     let geometry = light_geometry(world);
     let l = geometry.xyz;
     var shadow = pixel_visibility(world, n, geometric_n, l, geometry.w, world_dx, world_dy, frag.xy, view_depth);
-    if light.contact.y > 0.0 && shadow.x > 0.0 {
+    if light.contact_steps > 0u && shadow.x > 0.0 {
         shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
     }
     return shadow.x + 2.0 * shadow.y;

@@ -45,7 +45,7 @@ struct SurfaceNormals {
 fn surface_normals(in: SurfaceVertex, front: bool) -> SurfaceNormals {
     var out: SurfaceNormals;
     out.geometric = normalize(cross(dpdx(in.world), dpdy(in.world)));
-    if dot(out.geometric, camera.eye.xyz - in.world) < 0.0 {
+    if dot(out.geometric, camera.eye - in.world) < 0.0 {
         out.geometric = -out.geometric;
     }
     out.shading = normalize(in.normal);

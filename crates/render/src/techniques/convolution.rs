@@ -1,10 +1,11 @@
 //! `convolution`: convolution shadow maps (Annen et al. 2007), a truncated Fourier
 //! series of the depth test with ringing attenuation.
 
-use glam::Vec4;
+use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use crate::uniforms::TechniqueParams;
 
 pub struct Convolution;
 
@@ -15,9 +16,13 @@ impl ShadowTechnique for Convolution {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("convolution.wgsl")]
     }
-    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
+    /// integers.x = terms M; reals = (attenuation α, scale s, offset o, 0).
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> TechniqueParams {
         let m = &s.moments;
-        [Vec4::new(m.csm_terms as f32, m.csm_attenuation, m.csm_scale, m.csm_offset), Vec4::ZERO]
+        TechniqueParams {
+            reals: Vec4::new(m.csm_attenuation, m.csm_scale, m.csm_offset, 0.0),
+            integers: UVec4::new(m.csm_terms, 0, 0, 0),
+        }
     }
     fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {
         // A sin and a cos per term, four channels per layer.

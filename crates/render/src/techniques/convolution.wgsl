@@ -7,7 +7,7 @@
 // high terms. The reconstruction f is then sharpened: visibility = s·(f − ½ + o) + ½.
 //
 // Layer j holds (sin, cos) of terms 2j and 2j + 1 (0-based).
-// params[0]: x: M, y: α, z: s, w: o.
+// params.integers.x: M; params.reals: x: α, y: s, z: o.
 
 const PI: f32 = 3.14159265;
 
@@ -22,9 +22,9 @@ fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
-    let terms = u32(light.params[0].x);
+    let terms = light.params.integers.x;
     let m = f32(terms);
-    let alpha = light.params[0].y;
+    let alpha = light.params.reals.x;
     let z = receiver_moment_depth(q);
     var f = 0.5;
     for (var layer = 0u; 2u * layer < terms; layer++) {
@@ -41,5 +41,5 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
             f += 2.0 * a / c * (sin_d * cos(c * z) - cos_d * sin(c * z));
         }
     }
-    return clamp(light.params[0].z * (f - 0.5 + light.params[0].w) + 0.5, 0.0, 1.0);
+    return clamp(light.params.reals.y * (f - 0.5 + light.params.reals.z) + 0.5, 0.0, 1.0);
 }

@@ -41,8 +41,8 @@ fn cube_tap_depth(q: CubeQuery, direction: vec3<f32>) -> f32 {
     if s <= 0.0 {
         return q.depth;
     }
-    let depth = s * length(direction) / light.position.w;
-    let reach = MAX_CUBE_RECEIVER_SLOPE * length(direction - q.offset) / light.position.w;
+    let depth = s * length(direction) / light.range;
+    let reach = MAX_CUBE_RECEIVER_SLOPE * length(direction - q.offset) / light.range;
     return clamp(depth, q.depth - reach, q.depth + reach);
 }
 
@@ -63,7 +63,7 @@ fn orthonormal_pair(n: vec3<f32>) -> mat2x3<f32> {
 // of that across the ray (gnomon_math::omni::cube_texel_world_size).
 fn cube_texel_world_size(offset: vec3<f32>) -> f32 {
     let m = max(abs(offset.x), max(abs(offset.y), abs(offset.z)));
-    return 2.0 * m * m / (light.texel.w * max(length(offset), 1e-20));
+    return 2.0 * m * m / (light.resolution * max(length(offset), 1e-20));
 }
 
 // The lookup direction `texels` (across the ray) from the receiver's.
@@ -115,8 +115,8 @@ fn cube_pcf_grid(q: CubeQuery, width: f32, tent: bool) -> f32 {
 
 // The kernel width in texels at this receiver (kernel_width_texels for the cube).
 fn cube_kernel_width_texels(q: CubeQuery) -> f32 {
-    if light.kernel.y > 0.5 {
-        return clamp(light.kernel.x / q.texel_world, 1.0, 32.0);
+    if light.kernel_in_world == 1u {
+        return clamp(light.kernel_width / q.texel_world, 1.0, MAX_KERNEL_TEXELS);
     }
-    return light.kernel.x;
+    return light.kernel_width;
 }

@@ -4,6 +4,7 @@ use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use crate::uniforms::TechniqueParams;
 
 pub struct Esm;
 
@@ -14,8 +15,9 @@ impl ShadowTechnique for Esm {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("esm.wgsl")]
     }
-    fn params(&self, s: &FilterSettings, _: MapPrecision) -> [Vec4; 2] {
-        [Vec4::new(s.moments.esm_exponent, 0.0, 0.0, 0.0), Vec4::ZERO]
+    /// reals.x = the exponent c.
+    fn params(&self, s: &FilterSettings, _: MapPrecision) -> TechniqueParams {
+        TechniqueParams { reals: Vec4::new(s.moments.esm_exponent, 0.0, 0.0, 0.0), ..Default::default() }
     }
     fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {
         // The lookup filters bilinearly in log space by hand, at the top level only.

@@ -17,8 +17,9 @@ mod pcf;
 mod pcss;
 mod variance;
 
-use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
+
+use crate::uniforms::TechniqueParams;
 
 /// A map of functions of depth that a filterable technique samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,9 +47,10 @@ pub trait ShadowTechnique: Sync {
     fn technique(&self) -> Technique;
     /// WGSL sources, concatenated after the shared ones, defining `sample_shadow`.
     fn wgsl(&self) -> &'static [&'static str];
-    /// The technique's parameters, passed to the shader as `light.params`.
-    fn params(&self, _settings: &FilterSettings, _precision: MapPrecision) -> [Vec4; 2] {
-        [Vec4::ZERO; 2]
+    /// The technique's parameters, passed to the shader as `light.params`; the
+    /// technique documents what it puts where.
+    fn params(&self, _settings: &FilterSettings, _precision: MapPrecision) -> TechniqueParams {
+        TechniqueParams::default()
     }
     /// WGSL sources defining `fn sample_shadow_cube(q: CubeQuery) -> f32`, the lookup
     /// in a point light's cube map (see `cube.wgsl`), for the techniques that have one

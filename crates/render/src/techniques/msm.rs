@@ -1,10 +1,11 @@
 //! Moment shadow maps (Peters & Klein 2015): four moments, with the Hamburger and
 //! the Hausdorff bounds, and their optimised quantisation for 16-bit maps.
 
-use glam::Vec4;
+use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use crate::uniforms::TechniqueParams;
 
 /// One moment-map technique: the two differ only in the bound they reconstruct.
 pub struct Msm {
@@ -22,13 +23,14 @@ impl ShadowTechnique for Msm {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("msm.wgsl")]
     }
-    /// params[0] = (moment bias, 1 for Hausdorff, 1 for the optimised 16-bit basis, 0).
-    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
+    /// reals.x = moment bias; integers = (1 for Hausdorff, 1 for the optimised 16-bit
+    /// basis, 0, 0).
+    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> TechniqueParams {
         let quantised = precision == MapPrecision::Half;
-        [
-            Vec4::new(s.moments.moment_bias, self.hausdorff as u8 as f32, quantised as u8 as f32, 0.0),
-            Vec4::ZERO,
-        ]
+        TechniqueParams {
+            reals: Vec4::new(s.moments.moment_bias, 0.0, 0.0, 0.0),
+            integers: UVec4::new(self.hausdorff.into(), quantised.into(), 0, 0),
+        }
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })

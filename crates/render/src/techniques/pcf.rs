@@ -2,7 +2,7 @@
 //! results. W. Reeves, D. Salesin, R. Cook, "Rendering antialiased shadows with depth
 //! maps", SIGGRAPH 1987. Every variant reads the comparison sampler, whose linear
 //! filter is the hardware's 2×2 bilinear PCF; the kernel width and receiver-plane
-//! bias are common settings, carried in `light.kernel`.
+//! bias are common settings, carried in `light.kernel_width`, `kernel_in_world`, `poisson_taps` and `receiver_plane_bias`.
 
 use gnomon_scene::settings::Technique;
 
@@ -81,11 +81,11 @@ impl ShadowTechnique for PcfPoisson {
 
     fn wgsl(&self) -> &'static [&'static str] {
         &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
-           return pcf_poisson(q, 0.5 * kernel_width_texels(q), u32(light.kernel.z));\n}\n"]
+           return pcf_poisson(q, 0.5 * kernel_width_texels(q), light.poisson_taps);\n}\n"]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    \
-                return cube_pcf_poisson(q, 0.5 * cube_kernel_width_texels(q), u32(light.kernel.z));\n}\n"])
+                return cube_pcf_poisson(q, 0.5 * cube_kernel_width_texels(q), light.poisson_taps);\n}\n"])
     }
 }

@@ -1,6 +1,6 @@
 //! `pcss`: percentage-closer soft shadows (Fernando 2005). The light's size is the
 //! light's own (spot disk radius, point light sphere radius or sun angular diameter), the same parameter the
-//! reference's area light uses; the search settings are carried in `light.pcss`.
+//! reference's area light uses; the search settings are carried in `light.light_size`, `blocker_taps` and `max_penumbra_texels`.
 
 use gnomon_scene::settings::Technique;
 

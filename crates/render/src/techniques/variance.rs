@@ -2,10 +2,11 @@
 //! exponential variance shadow maps in two- and four-component forms (Lauritzen &
 //! McCool 2008).
 
-use glam::Vec4;
+use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use crate::uniforms::TechniqueParams;
 
 /// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
 /// 16-bit float (max 65504): ln(65504) / 2.
@@ -15,12 +16,12 @@ pub const HALF_MAX_EXPONENT: f32 = 5.54;
 /// `variance.wgsl`: 0 none (VSM), 2 positive (EVSM2), 4 positive and negative (EVSM4).
 pub struct Chebyshev {
     technique: Technique,
-    variant: f32,
+    variant: u32,
 }
 
-pub static VSM: Chebyshev = Chebyshev { technique: Technique::Vsm, variant: 0.0 };
-pub static EVSM2: Chebyshev = Chebyshev { technique: Technique::Evsm2, variant: 2.0 };
-pub static EVSM4: Chebyshev = Chebyshev { technique: Technique::Evsm4, variant: 4.0 };
+pub static VSM: Chebyshev = Chebyshev { technique: Technique::Vsm, variant: 0 };
+pub static EVSM2: Chebyshev = Chebyshev { technique: Technique::Evsm2, variant: 2 };
+pub static EVSM4: Chebyshev = Chebyshev { technique: Technique::Evsm4, variant: 4 };
 
 impl ShadowTechnique for Chebyshev {
     fn technique(&self) -> Technique {
@@ -29,15 +30,20 @@ impl ShadowTechnique for Chebyshev {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("variance.wgsl")]
     }
-    /// params[0] = (variant, c⁺, c⁻, minimum variance), params[1].x = bleeding
-    /// reduction. At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
-    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> [Vec4; 2] {
+    /// integers.x = variant; reals = (c⁺, c⁻, minimum variance, bleeding reduction).
+    /// At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
+    fn params(&self, s: &FilterSettings, precision: MapPrecision) -> TechniqueParams {
         let m = &s.moments;
         let limit = if precision == MapPrecision::Half { HALF_MAX_EXPONENT } else { f32::MAX };
-        [
-            Vec4::new(self.variant, m.evsm_positive.min(limit), m.evsm_negative.min(limit), m.min_variance),
-            Vec4::new(m.bleeding_reduction, 0.0, 0.0, 0.0),
-        ]
+        TechniqueParams {
+            reals: Vec4::new(
+                m.evsm_positive.min(limit),
+                m.evsm_negative.min(limit),
+                m.min_variance,
+                m.bleeding_reduction,
+            ),
+            integers: UVec4::new(self.variant, 0, 0, 0),
+        }
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })

@@ -6,19 +6,19 @@
 // shrinks the variance that causes light bleeding. Both bounds use the same
 // Chebyshev inequality; EVSM keeps the smaller.
 //
-// params[0]: x: variant (0 VSM, 2 EVSM2, 4 EVSM4), y: c⁺, z: c⁻,
-//            w: minimum variance; params[1].x: bleeding reduction.
+// params.integers.x: variant (0 VSM, 2 EVSM2, 4 EVSM4); params.reals: x: c⁺, y: c⁻,
+// z: minimum variance, w: bleeding reduction.
 
 fn warp_positive(d: f32) -> f32 {
-    return exp(light.params[0].y * (2.0 * d - 1.0));
+    return exp(light.params.reals.x * (2.0 * d - 1.0));
 }
 
 fn warp_negative(d: f32) -> f32 {
-    return -exp(-light.params[0].z * (2.0 * d - 1.0));
+    return -exp(-light.params.reals.y * (2.0 * d - 1.0));
 }
 
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
-    if light.params[0].x < 0.5 {
+    if light.params.integers.x == 0u {
         return vec4<f32>(d, d * d, 0.0, 0.0);
     }
     let p = warp_positive(d);
@@ -29,24 +29,24 @@ fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
 fn sample_shadow(q: ShadowQuery) -> f32 {
     let m = sample_moments(q, 0u);
     let d = receiver_moment_depth(q);
-    let min_variance = light.params[0].w;
-    let variant = light.params[0].x;
+    let min_variance = light.params.reals.z;
+    let variant = light.params.integers.x;
     var p = 1.0;
-    if variant < 0.5 {
+    if variant == 0u {
         p = chebyshev_upper_bound(m.x, m.y, d, min_variance);
     } else {
         // The minimum variance is given in depth units; a warp w stretches depths
         // near d by w'(d), so variances by w'(d)² (Lauritzen 2008).
-        let cp = light.params[0].y;
+        let cp = light.params.reals.x;
         let wp = warp_positive(d);
         let dp = 2.0 * cp * wp;
         p = chebyshev_upper_bound(m.x, m.y, wp, min_variance * dp * dp);
-        if variant > 3.0 {
-            let cn = light.params[0].z;
+        if variant == 4u {
+            let cn = light.params.reals.y;
             let wn = warp_negative(d);
             let dn = 2.0 * cn * wn;
             p = min(p, chebyshev_upper_bound(m.z, m.w, wn, min_variance * dn * dn));
         }
     }
-    return reduce_bleeding(p, light.params[1].x);
+    return reduce_bleeding(p, light.params.reals.w);
 }

@@ -1,0 +1,137 @@
+//! The bind groups a frame builds from its resources: the camera, each light's scene
+//! group (instances and uniform), and the shadow group of the lighting and mask
+//! passes, with the samplers and the placeholders bound where a light has no moment
+//! map, cube map or mask. Made once with the renderer; the groups come from the pool.
+
+use crate::{
+    gpu_scene::GpuScene,
+    passes::{Layouts, SHADOW_FORMAT, screen_space},
+    pool::{Binding, Pool},
+};
+
+/// Samplers and placeholder textures, made once.
+pub(crate) struct FixedBindings {
+    compare_sampler: wgpu::Sampler,
+    compare_nearest_sampler: wgpu::Sampler,
+    gather_sampler: wgpu::Sampler,
+    moment_sampler: wgpu::Sampler,
+    /// Bound in place of a moment map for the depth-comparison techniques.
+    placeholder_moments: wgpu::TextureView,
+    /// Bound in place of a cube map for the lights that are not point lights.
+    placeholder_cube: wgpu::TextureView,
+    /// Bound in place of the shadow mask on the forward path and in the mask pass.
+    pub placeholder_mask: wgpu::TextureView,
+}
+
+/// The textures of a light's shadow group.
+pub(crate) struct ShadowViews<'a> {
+    /// The depth map, every layer (a 2D array).
+    pub map: &'a wgpu::TextureView,
+    pub moments: Option<&'a wgpu::TextureView>,
+    /// A point light's map as a cube.
+    pub cube: Option<&'a wgpu::TextureView>,
+    /// The light's layer of the shadow mask, on the mask path's lighting pass.
+    pub mask: Option<&'a wgpu::TextureView>,
+}
+
+fn placeholder(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    layers: u32,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+impl FixedBindings {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let linear_clamped = wgpu::SamplerDescriptor {
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        };
+        let view_as = |texture: wgpu::Texture, dimension| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(dimension),
+                ..Default::default()
+            })
+        };
+        Self {
+            compare_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow compare"),
+                // Lit when the receiver's depth ≤ the stored occluder depth.
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..linear_clamped.clone()
+            }),
+            compare_nearest_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow compare, nearest"),
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            }),
+            gather_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow gather"),
+                ..Default::default()
+            }),
+            moment_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("moment map"),
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..linear_clamped
+            }),
+            placeholder_moments: view_as(
+                placeholder(device, "no moment map", wgpu::TextureFormat::Rgba16Float, 1),
+                wgpu::TextureViewDimension::D2Array,
+            ),
+            placeholder_cube: view_as(
+                placeholder(device, "no cube map", SHADOW_FORMAT, 6),
+                wgpu::TextureViewDimension::Cube,
+            ),
+            placeholder_mask: view_as(
+                placeholder(device, "no shadow mask", screen_space::MASK_FORMAT, 1),
+                wgpu::TextureViewDimension::D2,
+            ),
+        }
+    }
+
+    /// Group 2 of the lighting and mask passes: a light's maps and their samplers.
+    pub fn shadow_group(&self, pool: &mut Pool, layouts: &Layouts, views: ShadowViews) -> wgpu::BindGroup {
+        pool.bind_group(
+            "shadow map",
+            &layouts.shadow,
+            &[
+                Binding::View(views.map.clone()),
+                Binding::Sampler(self.compare_sampler.clone()),
+                Binding::View(views.moments.unwrap_or(&self.placeholder_moments).clone()),
+                Binding::Sampler(self.moment_sampler.clone()),
+                Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
+                Binding::Sampler(self.compare_nearest_sampler.clone()),
+                Binding::Sampler(self.gather_sampler.clone()),
+                Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone()),
+            ],
+        )
+    }
+}
+
+/// Group 0 of the geometry passes: the instances and the light's uniform `light`.
+pub(crate) fn scene_group(
+    pool: &mut Pool,
+    layouts: &Layouts,
+    uploaded: &GpuScene,
+    light: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    pool.bind_group(
+        "scene",
+        &layouts.scene,
+        &[Binding::Buffer(uploaded.instances.clone()), Binding::Buffer(light.clone())],
+    )
+}

@@ -1,0 +1,201 @@
+//! The renderer: what it keeps across frames (pipelines, layouts, samplers and the
+//! pool of transient resources) and its entry points. A frame is planned
+//! ([`plan`]: camera, lights, layouts, uniforms), culled and recorded ([`record`]:
+//! shadow maps, moment maps, screen-space passes, lighting), submitted, and read
+//! back ([`outputs`]). The depth-only baseline lives in [`baseline`].
+
+mod baseline;
+mod bindings;
+mod outputs;
+mod plan;
+mod record;
+mod screen;
+
+use gnomon_scene::{Scene, Settings, settings::MomentFormat};
+
+pub use crate::pool::Creations;
+pub use outputs::{
+    CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
+    ShadowMapImage,
+};
+
+use crate::{
+    Gpu, GpuScene, RenderError,
+    passes::{
+        Layouts, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass, lighting,
+        lighting::LightingPass, map_preview::MapPreviewPass, moments::MomentPass,
+        screen_space::ScreenSpacePass, shadow::ShadowPass,
+    },
+    pool::Pool,
+    timing::ClockChoice,
+};
+use bindings::FixedBindings;
+use record::{Readback, SubmitRequest};
+
+/// The pass pipelines, built once (and per variant on first use).
+struct Passes {
+    shadow: ShadowPass,
+    lighting: LightingPass,
+    screen_space: ScreenSpacePass,
+    moments: MomentPass,
+    depth_reduce: DepthReducePass,
+    map_preview: MapPreviewPass,
+    depth_baseline: DepthBaselinePass,
+}
+
+/// The renderer: everything a frame reuses. Create one per device and keep it; a
+/// steady sequence of frames creates no texture, buffer or bind group after the
+/// first ([`Renderer::creations`]).
+pub struct Renderer {
+    gpu: Gpu,
+    layouts: Layouts,
+    passes: Passes,
+    fixed: FixedBindings,
+    pool: Pool,
+}
+
+impl Renderer {
+    /// A renderer on `gpu`'s device (which it shares, not copies).
+    pub fn new(gpu: &Gpu) -> Result<Self, RenderError> {
+        gpu.checked("creating the renderer", || {
+            let device = &gpu.device;
+            let layouts = Layouts::new(device);
+            let passes = Passes {
+                shadow: ShadowPass::new(device, &layouts),
+                lighting: LightingPass::new(device, &layouts),
+                screen_space: ScreenSpacePass::new(device, &layouts),
+                moments: MomentPass::new(device, &gpu.queue),
+                depth_reduce: DepthReducePass::new(device),
+                map_preview: MapPreviewPass::new(device),
+                depth_baseline: DepthBaselinePass::new(device),
+            };
+            Self {
+                gpu: Gpu::clone(gpu),
+                fixed: FixedBindings::new(device),
+                pool: Pool::new(device),
+                layouts,
+                passes,
+            }
+        })
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// How many GPU resources the renderer's frames have created so far: after the
+    /// first frame of given settings, the same frame again adds none.
+    pub fn creations(&self) -> Creations {
+        self.pool.creations()
+    }
+
+    /// Uploads `scene` and renders it. To render one scene many times, upload it once
+    /// with [`Renderer::upload`] and call [`Renderer::render_uploaded`].
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
+        settings.validate()?;
+        let uploaded = self.upload(scene)?;
+        self.render_uploaded(&uploaded, scene, settings, request)
+    }
+
+    /// Uploads a scene's geometry, instances and textures.
+    pub fn upload(&self, scene: &Scene) -> Result<GpuScene, RenderError> {
+        GpuScene::upload(&self.gpu, scene, &self.layouts)
+    }
+
+    /// Checks `settings` against the device's limits.
+    pub fn check_limits(&self, settings: &Settings) -> Result<(), RenderError> {
+        let limits = &self.gpu.limits;
+        let adapter = self.gpu.info.adapter.clone();
+        let max = limits.max_texture_dimension_2d;
+        let requested = settings.shadow.map.resolution;
+        if requested > max {
+            return Err(RenderError::ShadowMapTooLarge { requested, max, adapter });
+        }
+        let (width, height) = (settings.image.width, settings.image.height);
+        if width > max || height > max {
+            return Err(RenderError::ImageTooLarge { width, height, max, adapter });
+        }
+        self.moment_format(settings)?;
+        let needed = lighting::target_bytes_per_pixel();
+        if limits.max_color_attachment_bytes_per_sample < needed {
+            return Err(RenderError::AttachmentsTooLarge {
+                available: limits.max_color_attachment_bytes_per_sample,
+                needed,
+                adapter,
+            });
+        }
+        Ok(())
+    }
+
+    /// The moment map's format for these settings on this device.
+    pub fn moment_format(&self, settings: &Settings) -> Result<wgpu::TextureFormat, RenderError> {
+        let filterable = self.gpu.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        match settings.shadow.filter.moments.moment_format {
+            MomentFormat::Rgba16float => Ok(wgpu::TextureFormat::Rgba16Float),
+            MomentFormat::Auto if !filterable => Ok(wgpu::TextureFormat::Rgba16Float),
+            MomentFormat::Auto => Ok(wgpu::TextureFormat::Rgba32Float),
+            MomentFormat::Rgba32float if filterable => Ok(wgpu::TextureFormat::Rgba32Float),
+            MomentFormat::Rgba32float => {
+                Err(RenderError::MomentFormatUnsupported { adapter: self.gpu.info.adapter.clone() })
+            }
+        }
+    }
+
+    /// Renders an uploaded scene. `scene` must be the one `uploaded` was made from.
+    pub fn render_uploaded(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
+        let submit = SubmitRequest {
+            readback: Readback { images: true, shadow_map: request.shadow_map },
+            fixed_layout: request.fixed_layout.as_ref(),
+            clock: None,
+        };
+        let submitted = self.submit(uploaded, scene, settings, submit)?;
+        submitted.read(&self.gpu, settings)
+    }
+
+    /// Renders an uploaded scene and leaves the image and the shadow map on the GPU,
+    /// for a window to draw ([`LiveFrame`]). Its textures stay valid until the next
+    /// frame.
+    pub fn render_live(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<LiveFrame, RenderError> {
+        let submit = SubmitRequest { readback: Readback::NONE, fixed_layout: None, clock: None };
+        Ok(self.submit(uploaded, scene, settings, submit)?.live())
+    }
+
+    /// The shadow map of `frame`, every layer side by side in grayscale (near black,
+    /// far white; perspective layers linearized), each `tile` pixels square: an
+    /// `Rgba8Unorm` texture for a UI to show.
+    pub fn preview_shadow_map(&mut self, frame: &LiveFrame, tile: u32) -> Result<wgpu::Texture, RenderError> {
+        let Self { gpu, passes, pool, .. } = self;
+        gpu.checked("drawing the shadow map preview", || {
+            passes.map_preview.draw(gpu, pool, &frame.shadow_map, &frame.layout.projections, tile.max(8))
+        })
+    }
+
+    /// Renders an uploaded scene for its pass times and draw counts alone: nothing is
+    /// read back but the timestamps, so timing loops don't pay for image copies.
+    pub fn time_passes(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        clock: ClockChoice,
+    ) -> Result<FrameCost, RenderError> {
+        let submit = SubmitRequest { readback: Readback::NONE, fixed_layout: None, clock: Some(clock) };
+        Ok(self.submit(uploaded, scene, settings, submit)?.cost())
+    }
+}

@@ -1,0 +1,451 @@
+//! What a frame gives back: the images and maps read from the GPU ([`Frame`]), the
+//! textures left on it for a window ([`LiveFrame`]), and what each pass drew and cost
+//! ([`DrawStats`], [`LightStats`], [`PassTimings`], [`CpuTimings`], [`FrameCost`]).
+
+use glam::{Vec3, Vec4};
+use gnomon_math::{
+    LightProjection,
+    omni::{cube_texel_world_size, paraboloid_texel_world_size},
+};
+use gnomon_scene::{Camera, Light, settings::Technique};
+
+use crate::{
+    Gpu, RenderError,
+    gpu_scene::Visible,
+    layout::ShadowLayout,
+    readback::PendingReadback,
+    timing::{PassKind, PassTime, TimingSource},
+};
+
+/// Optional outputs of a frame.
+#[derive(Clone, Debug, Default)]
+pub struct OutputRequest {
+    /// Read the shadow map back (resolution² floats).
+    pub shadow_map: bool,
+    /// Draw the shadow maps with this layout instead of fitting one to the camera:
+    /// frozen cascades, to watch how a layout fitted to one view serves another.
+    pub fixed_layout: Option<ShadowLayout>,
+}
+
+/// The light's depth map as rendered, with what is needed to interpret it.
+#[derive(Clone, Debug)]
+pub struct ShadowMapImage {
+    pub resolution: u32,
+    /// Array layers: cascades, cube faces (WebGPU's order) or paraboloids; 1 for a
+    /// single map.
+    pub layers: u32,
+    /// Raw depth in [0, 1], row-major, top row first (texture space, v down), layer
+    /// after layer.
+    pub depth: Vec<f32>,
+}
+
+impl ShadowMapImage {
+    /// One layer's texels.
+    pub fn layer(&self, layer: u32) -> &[f32] {
+        let texels = (self.resolution * self.resolution) as usize;
+        &self.depth[layer as usize * texels..(layer as usize + 1) * texels]
+    }
+}
+
+/// Everything a frame produced. Images are row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// RGBA8, sRGB-encoded.
+    pub color: Vec<u8>,
+    /// Shadow factor in [0, 1] (1 lit); 0 outside a spot light's cone or range;
+    /// NaN where no surface is seen (background).
+    pub visibility: Vec<f32>,
+    /// World-space position of the visible surface; NaN for background.
+    pub position: Vec<Vec3>,
+    /// World-space unit normal of the visible surface, facing the camera; NaN for background.
+    pub normal: Vec<Vec3>,
+    /// View-space depth (distance along the camera's axis); NaN for background.
+    pub depth: Vec<f32>,
+    /// Instance index + 1 of the visible surface; 0 for background.
+    pub object_id: Vec<u32>,
+    pub camera: Camera,
+    /// The light whose visibility the frame reports: the one light, or with
+    /// `--light all` the one at `--light-index`. The shadow-map fields below are its.
+    pub light: Light,
+    /// The shadow map's projection (the first cascade's, with cascades).
+    pub light_projection: LightProjection,
+    /// Every layer's projection: one per cascade, or just `light_projection`.
+    pub cascades: Vec<LightProjection>,
+    /// The view depths bounding the cascades (one more than there are cascades).
+    pub cascade_splits: Vec<f32>,
+    /// The shadow map was drawn with depth clamping: its near plane sits at the nearest
+    /// receiver, and casters before it are clamped onto it.
+    pub shadow_depth_clamp: bool,
+    pub shadow_resolution: u32,
+    pub shadow_map: Option<ShadowMapImage>,
+    /// GPU time of each pass, where the device has timestamp queries.
+    pub timings: Option<PassTimings>,
+    /// Draw calls and state changes, every light together.
+    pub stats: DrawStats,
+    /// What each light drew and cost, in the order they were drawn.
+    pub lights: Vec<LightStats>,
+    /// The moment map's texel format, for the filterable techniques.
+    pub moment_format: Option<wgpu::TextureFormat>,
+    /// Shadows were resolved in a screen-space mask (a prepass, then one mask pass
+    /// per light), not per fragment in the lighting passes.
+    pub shadow_mask: bool,
+}
+
+/// A frame left on the GPU for a window to show: nothing is read back but the pass
+/// timestamps, so it costs what the passes cost.
+#[derive(Clone, Debug)]
+pub struct LiveFrame {
+    /// The lit image, RGBA8 sRGB, bindable as a texture.
+    pub color: wgpu::Texture,
+    /// The reported light's shadow map: a Depth32Float 2D array, one layer per cascade
+    /// (six for a cube), bindable as a texture.
+    pub shadow_map: wgpu::Texture,
+    pub camera: Camera,
+    pub light: Light,
+    /// The reported light's layers and cascade splits.
+    pub layout: ShadowLayout,
+    pub timings: Option<PassTimings>,
+    pub stats: DrawStats,
+    pub lights: Vec<LightStats>,
+    pub shadow_mask: bool,
+}
+
+/// What one light of a frame drew and cost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightStats {
+    /// The light's name in the scene's list, or its type for a single light.
+    pub name: String,
+    /// "sun", "spot" or "point".
+    pub kind: &'static str,
+    pub technique: Technique,
+    /// Texels per side of each of its layers.
+    pub resolution: u32,
+    /// Draw calls into each layer of its map (one per cascade, six for a cube): the
+    /// casters that survived culling against that layer's frustum.
+    pub layer_draws: Vec<u32>,
+    /// Instances drawn into each layer: those whose bounds reach into its frustum.
+    pub layer_instances: Vec<u32>,
+    /// The time of each layer's shadow pass, where the frame was timed.
+    pub layer_ms: Vec<f64>,
+    /// Time of its shadow passes (every layer), moment pass and lighting pass, where
+    /// the frame was timed.
+    pub shadow_ms: Option<f64>,
+    pub filter_ms: Option<f64>,
+    pub lighting_ms: Option<f64>,
+    /// GPU time of its shadow-mask pass, on the mask path.
+    pub mask_ms: Option<f64>,
+}
+
+impl LightStats {
+    /// Draw calls into its map, every layer together.
+    pub fn shadow_draws(&self) -> u32 {
+        self.layer_draws.iter().sum()
+    }
+}
+
+/// What a frame submitted: the CPU-side cost of drawing the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Draw calls in the shadow pass.
+    pub shadow_draws: u32,
+    /// Draw calls in the lighting pass.
+    pub lighting_draws: u32,
+    /// Draw calls in the mask path's prepass.
+    pub prepass_draws: u32,
+    /// Pipeline changes, every pass together.
+    pub pipeline_changes: u32,
+    /// Bind group changes, every pass together.
+    pub bind_group_changes: u32,
+    /// Instances drawn into shadow maps, every layer of every light together.
+    pub shadow_instances: u32,
+    /// Instances the camera sees, drawn by the lighting pass.
+    pub lighting_instances: u32,
+}
+
+impl DrawStats {
+    pub(crate) fn add(&mut self, other: &DrawStats) {
+        self.shadow_draws += other.shadow_draws;
+        self.lighting_draws += other.lighting_draws;
+        self.prepass_draws += other.prepass_draws;
+        self.pipeline_changes += other.pipeline_changes;
+        self.bind_group_changes += other.bind_group_changes;
+        self.shadow_instances += other.shadow_instances;
+        self.lighting_instances += other.lighting_instances;
+    }
+}
+
+/// What a frame cost the CPU, in milliseconds: fitting the lights' projections,
+/// culling (every layer and the camera, in parallel), and recording and submitting
+/// the commands. `submit_ms` is the whole, from the call to the queue's submit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CpuTimings {
+    pub plan_ms: f64,
+    pub cull_ms: f64,
+    pub record_ms: f64,
+    pub submit_ms: f64,
+}
+
+/// What timing one frame measured: the summary, each pass, the draws and the CPU
+/// cost ([`Renderer::time_passes`]).
+#[derive(Clone, Debug)]
+pub struct FrameCost {
+    /// None only when the frame was not timed.
+    pub timings: Option<PassTimings>,
+    /// Each pass's time: every layer of every light's map, filters, screen-space
+    /// passes and lighting.
+    pub passes: Vec<PassTime>,
+    pub stats: DrawStats,
+    pub lights: Vec<LightStats>,
+    pub cpu: CpuTimings,
+}
+
+/// GPU time per pass, in milliseconds, from timestamp queries; with many lights,
+/// each kind of pass summed over the lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassTimings {
+    pub shadow_ms: f64,
+    /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
+    pub filter_ms: Option<f64>,
+    pub lighting_ms: f64,
+    /// On the mask path: the depth-and-normal prepass, and the mask passes.
+    pub prepass_ms: Option<f64>,
+    pub mask_ms: Option<f64>,
+    /// The whole frame on the GPU, from the first shadow pass's start to the last
+    /// lighting pass's end (SDSM's prepass not included).
+    pub frame_ms: f64,
+    /// GPU timestamps, or the CPU wall clock where the adapter has none.
+    pub source: TimingSource,
+}
+
+impl Frame {
+    pub fn pixel_count(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+
+    /// The shadow layout this frame was drawn with, to draw others with it
+    /// ([`OutputRequest::fixed_layout`]).
+    pub fn shadow_layout(&self) -> ShadowLayout {
+        ShadowLayout {
+            projections: self.cascades.clone(),
+            splits: self.cascade_splits.clone(),
+            depth_clamp: self.shadow_depth_clamp,
+        }
+    }
+
+    /// World size of one shadow texel at `world` (which must be in front of the light).
+    pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
+        if let Light::Point(point) = self.light {
+            if let [lower, upper] = self.cascades.as_slice() {
+                // Dual paraboloids: the lower hemisphere holds y at or below the light.
+                let hemisphere = if world.y <= point.position.y { lower } else { upper };
+                let offset = hemisphere.light_from_world.transform_point3(world);
+                return paraboloid_texel_world_size(offset, self.shadow_resolution);
+            }
+            return cube_texel_world_size(world - point.position, self.shadow_resolution);
+        }
+        let distance = -self.light_projection.light_from_world.transform_point3(world).z;
+        self.light_projection.texel_world_size(self.shadow_resolution, distance)
+    }
+}
+
+/// The copies a frame recorded, waiting for its submission.
+#[derive(Default)]
+pub(super) struct FrameReadbacks {
+    /// Every render target, in `lighting::TARGETS` order; empty when not asked for.
+    pub targets: Vec<PendingReadback>,
+    /// The reported light's map, every layer.
+    pub shadow_map: Option<PendingReadback>,
+}
+
+/// A frame submitted to the GPU, its pass times read, its images waiting.
+pub(super) struct Submitted {
+    readbacks: FrameReadbacks,
+    /// The colour target and the reported light's shadow map, for [`LiveFrame`].
+    color: wgpu::Texture,
+    shadow_map: wgpu::Texture,
+    timings: Option<PassTimings>,
+    passes: Vec<PassTime>,
+    cpu: CpuTimings,
+    stats: DrawStats,
+    lights: Vec<LightStats>,
+    camera: Camera,
+    /// The reported light, its map's resolution, layout and moment format.
+    light: Light,
+    resolution: u32,
+    layout: ShadowLayout,
+    moment_format: Option<wgpu::TextureFormat>,
+    shadow_mask: bool,
+}
+
+impl Submitted {
+    /// Reads the pass times of a recorded frame and gathers what it reports.
+    pub(super) fn new(
+        gpu: &Gpu,
+        plan: super::plan::FramePlan,
+        culled: &super::record::Culled,
+        recorded: super::record::Recorded,
+        cpu: CpuTimings,
+    ) -> Result<Self, RenderError> {
+        let times = recorded.times.read(gpu)?;
+        let passes = times.as_ref().map_or_else(Vec::new, |t| t.passes.clone());
+        let lights: Vec<LightStats> = plan
+            .lights
+            .iter()
+            .zip(&culled.layers)
+            .enumerate()
+            .map(|(index, (light, layers))| light_stats(light, layers, &passes, index as u32))
+            .collect();
+        let timings = times.as_ref().map(|t| PassTimings {
+            shadow_ms: sum_of(&lights, |l| l.shadow_ms).unwrap_or(0.0),
+            filter_ms: sum_of(&lights, |l| l.filter_ms),
+            lighting_ms: sum_of(&lights, |l| l.lighting_ms).unwrap_or(0.0),
+            prepass_ms: passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
+            mask_ms: sum_of(&lights, |l| l.mask_ms),
+            frame_ms: t.frame_ms,
+            source: t.source,
+        });
+        let super::plan::FramePlan { camera, mask_path, shown, lights: mut plans, .. } = plan;
+        let shown = plans.swap_remove(shown);
+        Ok(Submitted {
+            readbacks: recorded.readbacks,
+            color: recorded.color,
+            shadow_map: recorded.shadow_map,
+            timings,
+            passes,
+            cpu,
+            stats: recorded.stats,
+            lights,
+            camera,
+            light: shown.light,
+            resolution: shown.settings.shadow.map.resolution,
+            layout: shown.layout,
+            moment_format: shown.filterable_map.is_some().then_some(shown.moment_format),
+            shadow_mask: mask_path,
+        })
+    }
+
+    /// The frame left on the GPU.
+    pub(super) fn live(self) -> LiveFrame {
+        LiveFrame {
+            color: self.color,
+            shadow_map: self.shadow_map,
+            camera: self.camera,
+            light: self.light,
+            layout: self.layout,
+            timings: self.timings,
+            stats: self.stats,
+            lights: self.lights,
+            shadow_mask: self.shadow_mask,
+        }
+    }
+
+    /// What the frame cost.
+    pub(super) fn cost(self) -> FrameCost {
+        FrameCost {
+            timings: self.timings,
+            passes: self.passes,
+            stats: self.stats,
+            lights: self.lights,
+            cpu: self.cpu,
+        }
+    }
+
+    /// Reads the frame's images back and assembles the [`Frame`].
+    pub(super) fn read(self, gpu: &Gpu, settings: &gnomon_scene::Settings) -> Result<Frame, RenderError> {
+        let (width, height) = (settings.image.width, settings.image.height);
+        let resolution = self.resolution;
+        let mut pending = self.readbacks.targets.into_iter();
+        let mut next = || pending.next().expect("one readback per target");
+        let color: Vec<u8> = next().read(gpu)?;
+        let mut visibility: Vec<f32> = next().read(gpu)?;
+        let position_w: Vec<Vec4> = next().read(gpu)?;
+        let normal_w: Vec<Vec4> = next().read(gpu)?;
+        let object_id: Vec<u32> = next().read(gpu)?;
+        let shadow_map = match self.readbacks.shadow_map {
+            Some(p) => {
+                let depth: Vec<f32> = p.read(gpu)?;
+                let layers = (depth.len() / (resolution * resolution) as usize) as u32;
+                Some(ShadowMapImage { resolution, layers, depth })
+            }
+            None => None,
+        };
+        // Background pixels get NaN, as documented, decided by the object id (0).
+        let nan3 = Vec3::splat(f32::NAN);
+        let mut position = Vec::with_capacity(position_w.len());
+        let mut depth = Vec::with_capacity(position_w.len());
+        for (i, p) in position_w.iter().enumerate() {
+            if object_id[i] == 0 {
+                visibility[i] = f32::NAN;
+                position.push(nan3);
+                depth.push(f32::NAN);
+            } else {
+                position.push(p.truncate());
+                depth.push(p.w);
+            }
+        }
+        let normal = normal_w
+            .iter()
+            .zip(&object_id)
+            .map(|(n, &id)| if id == 0 { nan3 } else { n.truncate() })
+            .collect();
+        let layout = self.layout;
+        Ok(Frame {
+            width,
+            height,
+            color,
+            visibility,
+            position,
+            normal,
+            depth,
+            object_id,
+            camera: self.camera,
+            light: self.light,
+            light_projection: layout.projections[0],
+            cascades: layout.projections,
+            cascade_splits: layout.splits,
+            shadow_depth_clamp: layout.depth_clamp,
+            shadow_resolution: resolution,
+            shadow_map,
+            timings: self.timings,
+            stats: self.stats,
+            lights: self.lights,
+            moment_format: self.moment_format,
+            shadow_mask: self.shadow_mask,
+        })
+    }
+}
+
+/// The sum over the lights of a time some of them have; None when none has it.
+fn sum_of(lights: &[LightStats], time: fn(&LightStats) -> Option<f64>) -> Option<f64> {
+    let times: Vec<f64> = lights.iter().filter_map(time).collect();
+    (!times.is_empty()).then(|| times.iter().sum())
+}
+
+/// What one light drew (`layers`: its culled casters per layer) and cost.
+fn light_stats(
+    light: &super::plan::LightPlan,
+    layers: &[Visible],
+    passes: &[PassTime],
+    index: u32,
+) -> LightStats {
+    let of_kind = |kind: PassKind| passes.iter().filter(move |p| p.kind == kind && p.light == Some(index));
+    let time_of = |kind: PassKind| {
+        let times: Vec<f64> = of_kind(kind).map(|p| p.ms).collect();
+        (!times.is_empty()).then(|| times.iter().sum())
+    };
+    LightStats {
+        name: light.name.clone(),
+        kind: light.light.type_name(),
+        technique: light.settings.shadow.filter.technique,
+        resolution: light.settings.shadow.map.resolution,
+        layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
+        layer_instances: layers.iter().map(Visible::instances).collect(),
+        layer_ms: of_kind(PassKind::Shadow).map(|p| p.ms).collect(),
+        shadow_ms: time_of(PassKind::Shadow),
+        filter_ms: time_of(PassKind::Filter),
+        lighting_ms: time_of(PassKind::Lighting),
+        mask_ms: time_of(PassKind::Mask),
+    }
+}

@@ -1,0 +1,238 @@
+//! Frame planning: everything decided before recording. The camera, each light's
+//! settings, shadow layout (fitted, frozen, or from SDSM's sample distribution),
+//! map formats and uniform, and how its map is drawn and looked up.
+
+use glam::Vec3;
+use gnomon_math::{culling::Frustum, fitting::directional_light_view};
+use gnomon_scene::{
+    Camera, Light, Scene, Settings,
+    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition},
+};
+
+use super::Renderer;
+use crate::{
+    GpuScene, RenderError,
+    gpu_scene::CullView,
+    layout::{SampleDistribution, ShadowLayout, cascade_splits, shadow_layout},
+    passes::{
+        SHADOW_FORMAT,
+        depth_reduce::{BoundsRequest, Planes},
+        lighting::Lookup,
+        shadow::DepthTarget,
+    },
+    pool::ViewKey,
+    techniques,
+    uniforms::{LightGpu, LightInputs},
+};
+
+/// A frame, as decided before recording.
+pub(super) struct FramePlan {
+    pub camera: Camera,
+    pub aspect: f32,
+    /// Whether the lights' shadows go through the screen-space mask path.
+    pub mask_path: bool,
+    /// The reported light's index.
+    pub shown: usize,
+    pub lights: Vec<LightPlan>,
+}
+
+/// One light of a frame, as decided before recording.
+pub(super) struct LightPlan {
+    pub name: String,
+    pub light: Light,
+    /// The render's settings with this light's shadow settings.
+    pub settings: Settings,
+    pub layout: ShadowLayout,
+    pub filterable_map: Option<techniques::FilterableMap>,
+    pub moment_format: wgpu::TextureFormat,
+    pub light_gpu: LightGpu,
+}
+
+impl LightPlan {
+    /// What its shadow pass stores.
+    pub fn depth_target(&self) -> DepthTarget {
+        match (self.light, self.settings.shadow.map.omni) {
+            (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
+            (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
+            (Light::Directional(_) | Light::Spot(_), _) => DepthTarget::Projected,
+        }
+    }
+
+    /// How the lighting pass looks its map up.
+    pub fn lookup(&self) -> Lookup {
+        match self.depth_target() {
+            DepthTarget::CubeFace => Lookup::Cube,
+            DepthTarget::Paraboloid => Lookup::Paraboloid,
+            DepthTarget::Projected => Lookup::Map,
+        }
+    }
+
+    /// Layers of its map.
+    pub fn layers(&self) -> u32 {
+        self.layout.projections.len() as u32
+    }
+}
+
+impl Renderer {
+    /// Everything about a frame that is decided before recording: the camera, and
+    /// each light's settings, layout (fitted, or `fixed_layout` for the reported
+    /// light) and uniform.
+    pub(super) fn plan_frame(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        fixed_layout: Option<&ShadowLayout>,
+    ) -> Result<FramePlan, RenderError> {
+        let camera = settings.resolve_camera(scene)?;
+        let resolved = settings.resolve_lights(scene)?;
+        let mask_path = settings.uses_shadow_mask(&resolved)?;
+        let shown = if settings.light.kind == LightKind::All { settings.light.light_index } else { 0 };
+        let aspect = settings.image.width as f32 / settings.image.height as f32;
+        let mut lights = Vec::with_capacity(resolved.len());
+        for (index, r) in resolved.into_iter().enumerate() {
+            let light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
+            self.check_limits(&light_settings)?;
+            let layout = match fixed_layout {
+                Some(layout) if index == shown => layout.clone(),
+                _ => self.fit_layout(uploaded, &r.light, &light_settings, &camera, aspect)?,
+            };
+            let shadow = &light_settings.shadow;
+            let technique = techniques::lookup(shadow.filter.technique);
+            let filterable_map = technique.filterable_map(&shadow.filter);
+            let moment_format = self.moment_format(&light_settings)?;
+            let precision = match moment_format {
+                wgpu::TextureFormat::Rgba16Float => techniques::MapPrecision::Half,
+                _ => techniques::MapPrecision::Single,
+            };
+            let mut light_gpu = LightGpu::new(&LightInputs {
+                scene,
+                light: &r.light,
+                layout: &layout,
+                settings: &light_settings,
+                params: technique.params(&shadow.filter, precision),
+                filterable_map,
+            });
+            if index > 0 {
+                // Ambient light is added once, by the first light's pass.
+                light_gpu.ambient = Vec3::ZERO;
+            }
+            lights.push(LightPlan {
+                name: r.name,
+                light: r.light,
+                settings: light_settings,
+                layout,
+                filterable_map,
+                moment_format,
+                light_gpu,
+            });
+        }
+        Ok(FramePlan { camera, aspect, mask_path, shown, lights })
+    }
+
+    /// A light's layout fitted to the camera (and for a sun's SDSM cascades, to the
+    /// depths the camera sees).
+    fn fit_layout(
+        &mut self,
+        uploaded: &GpuScene,
+        light: &Light,
+        settings: &Settings,
+        camera: &Camera,
+        aspect: f32,
+    ) -> Result<ShadowLayout, RenderError> {
+        let shadow = &settings.shadow;
+        let sampled = match (light, shadow.partition, shadow.cascades.sdsm) {
+            (Light::Directional(sun), Partition::Cascades, true) => {
+                self.sample_distribution(uploaded, sun.direction, settings, camera, aspect)?
+            }
+            _ => None,
+        };
+        let depth_clamp = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+        Ok(shadow_layout(&uploaded.bounds, light, camera, aspect, settings, sampled.as_ref(), depth_clamp))
+    }
+
+    /// SDSM's sample distribution: draws the scene's depth from the camera and
+    /// reduces it on the GPU to the nearest and farthest view depth seen, then, with
+    /// SDSM bounds, to each cascade's light-space bounds of the samples it serves.
+    /// Blocks on the results, which the cascades' fit needs before the shadow pass.
+    fn sample_distribution(
+        &mut self,
+        uploaded: &GpuScene,
+        sun_direction: Vec3,
+        settings: &Settings,
+        camera: &Camera,
+        aspect: f32,
+    ) -> Result<Option<SampleDistribution>, RenderError> {
+        let gpu = self.gpu.clone();
+        let clip_from_world = camera.clip_from_world(aspect);
+        let (depth, pending) = gpu.checked("reducing the camera's depth (SDSM)", || {
+            let (width, height) = (settings.image.width, settings.image.height);
+            let depth = self.pool.texture(
+                "camera depth prepass",
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                SHADOW_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            // The shadow pass's pipelines draw it, with the camera's projection and no
+            // bias, receivers that cast no shadow included.
+            let camera_as_light = LightGpu { clip_from_world, ..Default::default() };
+            let mut prepass = settings.clone();
+            prepass.shadow.bias = BiasSettings::none();
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let seen = uploaded.cull(&[CullView {
+                frustum: Frustum::from_clip_from_world(clip_from_world),
+                near: true,
+                casters_only: false,
+            }]);
+            let view = self.pool.view(&depth, ViewKey::default());
+            let pass = super::record::DepthPass {
+                settings: &prepass,
+                light: &camera_as_light,
+                target_view: &view,
+                visible: &seen[0],
+                target: DepthTarget::Projected,
+                unclipped: false,
+            };
+            self.record_depth_pass(&mut encoder, uploaded, &pass, None);
+            let planes = Planes::new(camera.near, camera.far);
+            let pending =
+                self.passes.depth_reduce.record(&mut self.pool, &gpu.queue, &mut encoder, &depth, planes);
+            gpu.queue.submit([encoder.finish()]);
+            (depth, pending)
+        })?;
+        let Some((near, far)) = pending.read(&gpu)? else { return Ok(None) };
+        let c = &settings.shadow.cascades;
+        let splits = cascade_splits(&uploaded.bounds, camera, aspect, settings, Some((near, far)));
+        let light_bounds = match splits {
+            Some(splits) if c.sdsm_bounds => {
+                let blend = match c.cascade_selection {
+                    CascadeSelection::Depth => c.cascade_blend,
+                    CascadeSelection::Projection => 0.0,
+                };
+                let request = BoundsRequest {
+                    world_from_clip: clip_from_world.inverse(),
+                    light_from_world: directional_light_view(sun_direction, &uploaded.bounds),
+                    near: camera.near,
+                    far: camera.far,
+                    splits: &splits,
+                    blend,
+                };
+                let pending = gpu.checked("bounding the camera's samples in light space (SDSM)", || {
+                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                    let pending = self.passes.depth_reduce.record_bounds(
+                        &mut self.pool,
+                        &gpu.queue,
+                        &mut encoder,
+                        &depth,
+                        &request,
+                    );
+                    gpu.queue.submit([encoder.finish()]);
+                    pending
+                })?;
+                Some(pending.read(&gpu)?)
+            }
+            _ => None,
+        };
+        Ok(Some(SampleDistribution { near, far, light_bounds }))
+    }
+}

@@ -1,0 +1,524 @@
+//! Recording a frame: culling every layer and the camera, then each light's shadow
+//! maps (one depth pass per layer) and moment map, the screen-space passes on the
+//! mask path, and each light's lighting pass, into one command buffer. Every
+//! resource comes from the renderer's pool.
+
+use std::time::Instant;
+
+use gnomon_math::culling::Frustum;
+use gnomon_scene::{Scene, Settings};
+
+use super::{
+    Renderer,
+    bindings::{ShadowViews, scene_group},
+    outputs::{DrawStats, FrameReadbacks, Submitted},
+    plan::{FramePlan, LightPlan},
+};
+use crate::{
+    GpuScene, RenderError,
+    gpu_scene::{CullView, Visible},
+    gpu_types::VertexStream,
+    layout::ShadowLayout,
+    passes::{
+        SHADOW_FORMAT, begin_depth_pass,
+        lighting::{self, LightingKey, LightingRole, Lookup},
+        moments::MomentInput,
+        screen_space,
+        shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape, Sides},
+    },
+    pool::{Binding, ViewKey},
+    readback,
+    timing::{ClockChoice, PassClock, PassKind},
+    uniforms::{CameraGpu, LightGpu},
+};
+
+/// What a submission copies back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Readback {
+    /// The render targets: colour, visibility, position, normal, object id.
+    pub images: bool,
+    /// The reported light's shadow map, every layer.
+    pub shadow_map: bool,
+}
+
+impl Readback {
+    pub const NONE: Readback = Readback { images: false, shadow_map: false };
+}
+
+/// What a submission is asked for besides the image.
+pub(super) struct SubmitRequest<'a> {
+    pub readback: Readback,
+    /// The reported light's layout, instead of fitting one.
+    pub fixed_layout: Option<&'a ShadowLayout>,
+    /// How to time the passes; None leaves them untimed.
+    pub clock: Option<ClockChoice>,
+}
+
+/// What every recording step appends to: the encoder, the pass clock and the counts.
+pub(super) struct Recording {
+    pub encoder: wgpu::CommandEncoder,
+    pub clock: PassClock,
+    pub stats: DrawStats,
+}
+
+/// Which casters each layer of each light draws, and what the camera sees.
+pub(super) struct Culled {
+    pub camera: Visible,
+    /// Per light, per layer.
+    pub layers: Vec<Vec<Visible>>,
+}
+
+/// A light's groups for its passes from the camera.
+pub(super) struct LightBindings {
+    /// Group 0: the instances and the light's uniform.
+    pub scene: wgpu::BindGroup,
+    /// Its uniform, which the mask pass's groups bind too.
+    pub lighting: wgpu::BindGroup,
+    /// The mask pass's shadow group, on the mask path.
+    pub mask: Option<wgpu::BindGroup>,
+    pub lookup: Lookup,
+}
+
+/// One depth-only pass: a shadow-map layer, or SDSM's camera prepass.
+pub(super) struct DepthPass<'a> {
+    pub settings: &'a Settings,
+    /// The uniform whose `clip_from_world` projects the geometry.
+    pub light: &'a LightGpu,
+    pub target_view: &'a wgpu::TextureView,
+    pub visible: &'a Visible,
+    pub target: DepthTarget,
+    /// Clamp depth instead of clipping it.
+    pub unclipped: bool,
+}
+
+/// The camera-sized render targets of the lighting passes.
+struct LightingTargets {
+    /// One per `lighting::TARGETS`, the colour image first.
+    textures: Vec<wgpu::Texture>,
+    views: Vec<wgpu::TextureView>,
+    depth: wgpu::TextureView,
+}
+
+/// What every light's lighting pass shares.
+struct SharedLighting<'a> {
+    plan: &'a FramePlan,
+    camera_group: &'a wgpu::BindGroup,
+    targets: &'a LightingTargets,
+    /// What the camera sees.
+    visible: &'a Visible,
+}
+
+/// Background colour of the image, linear RGB.
+const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
+
+impl Renderer {
+    /// Plans, culls, records and submits a frame, and reads its pass times.
+    pub(super) fn submit(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        request: SubmitRequest,
+    ) -> Result<Submitted, RenderError> {
+        let started = Instant::now();
+        self.pool.end_frame();
+        settings.validate()?;
+        self.check_limits(settings)?;
+        let plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
+        let planned = Instant::now();
+        let culled = cull(uploaded, &plan);
+        let cull_done = Instant::now();
+        let gpu = self.gpu.clone();
+        let recorded = gpu.checked("rendering the frame", || {
+            self.record_frame(uploaded, settings, &plan, &culled, &request)
+        })?;
+        let cpu = super::CpuTimings {
+            plan_ms: (planned - started).as_secs_f64() * 1e3,
+            cull_ms: (cull_done - planned).as_secs_f64() * 1e3,
+            record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
+            submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
+        };
+        Submitted::new(&gpu, plan, &culled, recorded, cpu)
+    }
+
+    /// Records every pass of the frame and submits it.
+    fn record_frame(
+        &mut self,
+        uploaded: &GpuScene,
+        settings: &Settings,
+        plan: &FramePlan,
+        culled: &Culled,
+        request: &SubmitRequest,
+    ) -> Recorded {
+        let gpu = self.gpu.clone();
+        let (width, height) = (settings.image.width, settings.image.height);
+        // Every layer of every light, each light's filter, mask and lighting, and the prepass.
+        let timed_passes = plan.lights.iter().map(|p| p.layers() + 3).sum::<u32>() + 1;
+        let mut rec = Recording {
+            encoder: gpu.device.create_command_encoder(&Default::default()),
+            clock: PassClock::new(&gpu, &mut self.pool, timed_passes, request.clock),
+            stats: DrawStats::default(),
+        };
+        let camera_gpu = CameraGpu::new(&plan.camera, width, height, settings.image.debug_view);
+        let camera_buffer = self.pool.uniform(&gpu.queue, "camera", &camera_gpu);
+        let camera_group =
+            self.pool.bind_group("camera", &self.layouts.camera, &[Binding::Buffer(camera_buffer.clone())]);
+        // On the mask path, one layer of the mask per light.
+        let mask_layers =
+            if plan.mask_path { self.mask_layers(width, height, plan.lights.len()) } else { vec![] };
+        let mut readbacks = FrameReadbacks::default();
+        let mut lit = Vec::with_capacity(plan.lights.len());
+        let mut shown_map = None;
+        for (index, light) in plan.lights.iter().enumerate() {
+            let map = self.record_shadow_maps(&mut rec, uploaded, light, &culled.layers[index], index as u32);
+            if index == plan.shown {
+                if request.readback.shadow_map {
+                    let aspect = wgpu::TextureAspect::DepthOnly;
+                    readbacks.shadow_map =
+                        Some(readback::record(&mut self.pool, &mut rec.encoder, &map, aspect));
+                }
+                shown_map = Some(map.clone());
+            }
+            lit.push(self.light_bindings(
+                &mut rec,
+                uploaded,
+                light,
+                index as u32,
+                &map,
+                mask_layers.get(index),
+            ));
+        }
+        let targets = self.lighting_targets(width, height);
+        if plan.mask_path {
+            let screen = super::screen::ScreenInputs {
+                camera_visible: &culled.camera,
+                camera_buffer: &camera_buffer,
+                camera_group: &camera_group,
+                depth: &targets.depth,
+                mask_layers: &mask_layers,
+            };
+            self.record_screen_space(&mut rec, uploaded, plan, &lit, &screen);
+        }
+        let shared =
+            SharedLighting { plan, camera_group: &camera_group, targets: &targets, visible: &culled.camera };
+        for (index, bindings) in lit.iter().enumerate() {
+            self.record_lighting(&mut rec, uploaded, &shared, index, bindings);
+        }
+        if request.readback.images {
+            readbacks.targets = targets
+                .textures
+                .iter()
+                .map(|t| readback::record(&mut self.pool, &mut rec.encoder, t, wgpu::TextureAspect::All))
+                .collect();
+        }
+        let Recording { mut encoder, clock, stats } = rec;
+        let times = clock.resolve(&mut self.pool, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+        Recorded {
+            readbacks,
+            times,
+            stats,
+            color: targets.textures[0].clone(),
+            shadow_map: shown_map.expect("the reported light is one of the lights"),
+            submitted_at: Instant::now(),
+        }
+    }
+
+    /// One layer of the shadow mask per light.
+    fn mask_layers(&mut self, width: u32, height: u32, lights: usize) -> Vec<wgpu::TextureView> {
+        let mask = self.pool.texture(
+            "shadow mask",
+            wgpu::Extent3d { width, height, depth_or_array_layers: lights as u32 },
+            screen_space::MASK_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        (0..lights as u32).map(|layer| self.pool.view(&mask, ViewKey::layer(layer))).collect()
+    }
+
+    /// The colour and data targets of the lighting passes, and their depth buffer.
+    fn lighting_targets(&mut self, width: u32, height: u32) -> LightingTargets {
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let textures: Vec<wgpu::Texture> = lighting::TARGETS
+            .iter()
+            .map(|&format| {
+                let usage = attachment | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING;
+                self.pool.texture("render target", size, format, usage)
+            })
+            .collect();
+        let views = textures.iter().map(|t| self.pool.view(t, ViewKey::default())).collect();
+        let depth = self.pool.texture("depth", size, lighting::DEPTH_FORMAT, attachment);
+        let depth = self.pool.view(&depth, ViewKey::default());
+        LightingTargets { textures, views, depth }
+    }
+
+    /// Draws a light's shadow map, one depth pass per layer (cascade or cube face),
+    /// each drawing the casters culled for that layer (`layers`), each timed alone.
+    /// Returns the map.
+    fn record_shadow_maps(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        light: &LightPlan,
+        layers: &[Visible],
+        light_index: u32,
+    ) -> wgpu::Texture {
+        let resolution = light.settings.shadow.map.resolution;
+        let map = self.pool.texture(
+            "shadow map",
+            wgpu::Extent3d {
+                width: resolution,
+                height: resolution,
+                depth_or_array_layers: layers.len() as u32,
+            },
+            SHADOW_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        );
+        for (layer, visible) in layers.iter().enumerate() {
+            let layer_view = self.pool.view(&map, ViewKey::layer(layer as u32));
+            let layer_light = light.light_gpu.for_layer(layer);
+            let pass = DepthPass {
+                settings: &light.settings,
+                light: &layer_light,
+                target_view: &layer_view,
+                visible,
+                target: light.depth_target(),
+                unclipped: light.layout.depth_clamp,
+            };
+            let slot = rec.clock.begin(
+                &self.gpu,
+                &mut rec.encoder,
+                PassKind::Shadow,
+                Some(light_index),
+                Some(layer as u32),
+            );
+            let drawn =
+                self.record_depth_pass(&mut rec.encoder, uploaded, &pass, rec.clock.render_writes(slot));
+            rec.clock.end(&self.gpu, &mut rec.encoder, slot);
+            rec.stats.add(&drawn);
+        }
+        map
+    }
+
+    /// A light's uniform, its moment map (recorded here) and its groups for the passes
+    /// from the camera.
+    fn light_bindings(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        light: &LightPlan,
+        index: u32,
+        map: &wgpu::Texture,
+        mask_layer: Option<&wgpu::TextureView>,
+    ) -> LightBindings {
+        let gpu = self.gpu.clone();
+        let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
+        let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
+        let map_view = self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
+        let shadow = &light.settings.shadow;
+        let moment_map = light.filterable_map.map(|filterable| {
+            let input = MomentInput {
+                technique: shadow.filter.technique,
+                map: filterable,
+                settings: &shadow.filter.moments,
+                format: light.moment_format,
+                resolution: shadow.map.resolution,
+                cascades: light.layers(),
+                depth_view: &map_view,
+                light_buffer: &light_buffer,
+            };
+            let slot = rec.clock.begin(&gpu, &mut rec.encoder, PassKind::Filter, Some(index), None);
+            let writes = rec.clock.compute_writes(slot);
+            let moments =
+                self.passes.moments.record(&gpu.device, &mut self.pool, &mut rec.encoder, &input, writes);
+            rec.clock.end(&gpu, &mut rec.encoder, slot);
+            moments
+        });
+        let lookup = light.lookup();
+        let cube = (lookup == Lookup::Cube)
+            .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
+        let views = |mask| ShadowViews {
+            map: &map_view,
+            moments: moment_map.as_ref().map(|m| &m.view),
+            cube: cube.as_ref(),
+            mask,
+        };
+        // The mask pass writes the layer its light's lighting pass reads.
+        let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, views(mask_layer));
+        let mask = mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, views(None)));
+        LightBindings { scene, lighting, mask, lookup }
+    }
+
+    /// One light's lighting pass, adding its light to the targets (the first light
+    /// clears them).
+    fn record_lighting(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        shared: &SharedLighting,
+        index: usize,
+        bindings: &LightBindings,
+    ) {
+        let SharedLighting { plan, camera_group, targets, visible: camera_visible } = *shared;
+        let light = &plan.lights[index];
+        let first = index == 0;
+        let last = index + 1 == plan.lights.len();
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = targets
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, view)| {
+                // The colour image gets an opaque sky; the data targets zero (object
+                // id 0 marks background). Later lights add to them.
+                let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: if first { wgpu::LoadOp::Clear(clear) } else { wgpu::LoadOp::Load },
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        let gpu = &self.gpu;
+        let slot = rec.clock.begin(gpu, &mut rec.encoder, PassKind::Lighting, Some(index as u32), None);
+        let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lighting"),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &targets.depth,
+                depth_ops: Some(wgpu::Operations {
+                    // The mask path's prepass has drawn the depth already.
+                    load: if first && !plan.mask_path {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: rec.clock.render_writes(slot),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let key = LightingKey {
+            technique: light.settings.shadow.filter.technique,
+            lookup: if plan.mask_path { Lookup::Mask } else { bindings.lookup },
+            role: if first {
+                LightingRole::First
+            } else {
+                LightingRole::Added { visibility: index == plan.shown }
+            },
+        };
+        pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));
+        pass.set_bind_group(0, &bindings.scene, &[]);
+        pass.set_bind_group(1, camera_group, &[]);
+        pass.set_bind_group(2, &bindings.lighting, &[]);
+        rec.stats.pipeline_changes += 1;
+        rec.stats.bind_group_changes += 3;
+        let (draws, binds) = uploaded.draw_visible(&mut pass, camera_visible, 3);
+        rec.stats.lighting_draws += draws;
+        rec.stats.lighting_instances += camera_visible.instances();
+        rec.stats.bind_group_changes += binds;
+        drop(pass);
+        rec.clock.end(gpu, &mut rec.encoder, slot);
+    }
+
+    /// Records a depth-only pass with the shadow pipelines, drawing the runs
+    /// `pass.visible` holds: a shadow-map layer's casters, or what the camera sees for
+    /// SDSM's prepass. Returns the stats of what it recorded.
+    pub(super) fn record_depth_pass(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        depth: &DepthPass,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
+    ) -> DrawStats {
+        let gpu = &self.gpu;
+        let light_buffer = self.pool.uniform(&gpu.queue, "light", depth.light);
+        let group = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
+        let bias = &depth.settings.shadow.bias;
+        let mut stats = DrawStats::default();
+        let mut pass = begin_depth_pass(encoder, "shadow", depth.target_view, timestamp_writes);
+        pass.set_bind_group(0, &group, &[]);
+        stats.bind_group_changes += 1;
+        // The runs come opaque first (no bind group changes at all), then the
+        // alpha-masked ones, texture by texture: the pipeline and the material's bind
+        // group change only between batches that need it.
+        let mut pipeline: Option<ShadowPipelineKey> = None;
+        let mut stream: Option<VertexStream> = None;
+        let mut bound = None;
+        for (batch, run) in &depth.visible.runs {
+            let batch = &uploaded.batches[*batch as usize];
+            let key = ShadowPipelineKey::new(
+                bias,
+                if batch.double_sided { Sides::Double } else { Sides::Single },
+                if batch.masked { Coverage::Masked } else { Coverage::Opaque },
+                DepthRange::clamped_if(depth.unclipped),
+                depth.target,
+            );
+            if pipeline != Some(key) {
+                let wanted = ShadowPipelineShape::of(&key).stream;
+                match stream {
+                    None => uploaded.bind_geometry(&mut pass, wanted),
+                    Some(bound_stream) if bound_stream != wanted => uploaded.bind_stream(&mut pass, wanted),
+                    Some(_) => {}
+                }
+                stream = Some(wanted);
+                pass.set_pipeline(self.passes.shadow.pipeline(&gpu.device, &key));
+                pipeline = Some(key);
+                stats.pipeline_changes += 1;
+            }
+            if batch.masked && bound != Some(batch.material_group) {
+                pass.set_bind_group(1, &uploaded.material_groups[batch.material_group], &[]);
+                bound = Some(batch.material_group);
+                stats.bind_group_changes += 1;
+            }
+            GpuScene::draw_run(&mut pass, batch, run.clone());
+            stats.shadow_draws += 1;
+            stats.shadow_instances += run.end - run.start;
+        }
+        stats
+    }
+}
+
+/// What recording left for the frame to read.
+pub(super) struct Recorded {
+    pub readbacks: FrameReadbacks,
+    pub times: crate::timing::PendingTimes,
+    pub stats: DrawStats,
+    pub color: wgpu::Texture,
+    pub shadow_map: wgpu::Texture,
+    pub submitted_at: Instant,
+}
+
+/// Culls for every layer of every light, and for the camera, in parallel.
+fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
+    let camera_view = CullView {
+        frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
+        near: true,
+        casters_only: false,
+    };
+    let layer_views = plan.lights.iter().flat_map(|light| {
+        light.layout.projections.iter().map(|projection| CullView {
+            frustum: Frustum::from_clip_from_world(projection.clip_from_world()),
+            // A pass that clamps depth draws the casters before its near plane too.
+            near: !light.layout.depth_clamp,
+            casters_only: true,
+        })
+    });
+    let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();
+    let mut culled = uploaded.cull(&views).into_iter();
+    let camera = culled.next().expect("the camera's view was culled");
+    let layers = plan
+        .lights
+        .iter()
+        .map(|light| culled.by_ref().take(light.layout.projections.len()).collect())
+        .collect();
+    Culled { camera, layers }
+}

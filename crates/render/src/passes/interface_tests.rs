@@ -1,0 +1,144 @@
+//! The Rust↔WGSL interface, checked without a device: every shader variant Gnomon can
+//! build (technique × light lookup × forward or mask path × role, the moment passes
+//! per format, and every fixed pass) composes and validates with naga, as wgpu would
+//! compile it; and every uniform struct's WGSL size and field offsets equal the Rust
+//! type's (`uniforms::struct_layouts`).
+
+use std::collections::BTreeMap;
+
+use gnomon_scene::settings::Technique;
+use wgpu::naga;
+
+use super::{
+    depth_reduce, lighting,
+    lighting::{LightingKey, LightingRole, Lookup},
+    map_preview, moments, screen_space, shadow,
+};
+use crate::uniforms::{self, LightKindGpu, StructLayout};
+
+/// The lookups a technique's map can be read through.
+fn lookups(technique: Technique) -> Vec<Lookup> {
+    let mut all = vec![Lookup::Map, Lookup::Mask];
+    if technique.supports_point_lights() {
+        all.push(Lookup::Cube);
+        if technique != Technique::Pcss {
+            all.push(Lookup::Paraboloid);
+        }
+    }
+    all
+}
+
+/// Every composed shader, named.
+fn every_variant() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for &technique in Technique::all() {
+        for lookup in lookups(technique) {
+            for role in [
+                LightingRole::First,
+                LightingRole::Added { visibility: true },
+                LightingRole::Added { visibility: false },
+            ] {
+                let key = LightingKey { technique, lookup, role };
+                out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+            }
+            if lookup != Lookup::Mask {
+                let key = screen_space::MaskKey { technique, lookup };
+                out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+            }
+        }
+        if technique.is_filterable() {
+            for format in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba32Float] {
+                out.push((
+                    format!("moments encode {technique:?} {format:?}"),
+                    moments::encode_wgsl(technique, format),
+                ));
+            }
+        }
+    }
+    for format in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba32Float] {
+        out.push((format!("moments filter {format:?}"), moments::filter_wgsl(format)));
+    }
+    out.push(("shadow".into(), shadow::shadow_wgsl()));
+    out.push(("prepass".into(), screen_space::prepass_wgsl()));
+    out.push(("depth reduce".into(), depth_reduce::reduce_wgsl()));
+    out.push(("sample bounds".into(), depth_reduce::bounds_wgsl()));
+    out.push(("map preview".into(), map_preview::preview_wgsl()));
+    out
+}
+
+fn parse(name: &str, source: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    module
+}
+
+/// Compares a WGSL struct with its Rust mirror.
+fn check_layout(variant: &str, module: &naga::Module, layout: &StructLayout) -> bool {
+    let Some(ty) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(layout.wgsl_name)) else {
+        return false;
+    };
+    let naga::TypeInner::Struct { members, span } = &ty.1.inner else {
+        panic!("{variant}: `{}` is not a struct", layout.wgsl_name)
+    };
+    let wgsl: Vec<(&str, usize)> =
+        members.iter().map(|m| (m.name.as_deref().unwrap_or("?"), m.offset as usize)).collect();
+    assert_eq!(
+        wgsl, layout.fields,
+        "{variant}: `{}`'s fields (name, offset) differ from Rust's",
+        layout.wgsl_name
+    );
+    assert_eq!(*span as usize, layout.size, "{variant}: `{}`'s size differs from Rust's", layout.wgsl_name);
+    true
+}
+
+#[test]
+fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
+    let variants = every_variant();
+    // Every technique reaches the lighting pass on the forward and mask paths.
+    assert!(variants.len() > 3 * 2 * Technique::all().len(), "{} variants", variants.len());
+    let layouts = uniforms::struct_layouts();
+    let mut found: BTreeMap<&str, usize> = layouts.iter().map(|l| (l.wgsl_name, 0)).collect();
+    for (name, source) in &variants {
+        let module = parse(name, source);
+        for layout in &layouts {
+            if check_layout(name, &module, layout) {
+                *found.get_mut(layout.wgsl_name).expect("listed") += 1;
+            }
+        }
+    }
+    for (name, count) in found {
+        assert!(count > 0, "no shader declares `{name}`: the layout check never ran for it");
+    }
+}
+
+#[test]
+fn generated_constants_are_what_rust_says() {
+    let source =
+        format!("{}\nfn f() -> u32 {{ return MAX_CASCADES + LIGHT_POINT; }}", uniforms::wgsl_constants());
+    let module = parse("constants", &source);
+    let value = |name: &str| {
+        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref other => panic!("{name} = {other:?}"),
+        }
+    };
+    assert_eq!(value("MAX_CASCADES") as usize, uniforms::MAX_CASCADES);
+    for kind in LightKindGpu::ALL {
+        assert_eq!(value(kind.wgsl_name()), kind as u32);
+    }
+}
+
+/// A layout check that would pass whatever the offsets were proves nothing: a Rust
+/// struct with a field moved must fail it.
+#[test]
+#[should_panic(expected = "differ from Rust's")]
+fn a_moved_field_fails_the_layout_check() {
+    let mut layout = uniforms::struct_layouts().into_iter().find(|l| l.wgsl_name == "Light").unwrap();
+    layout.fields.swap(2, 3);
+    let module = parse("shadow", &shadow::shadow_wgsl());
+    check_layout("shadow", &module, &layout);
+}

@@ -1,0 +1,132 @@
+//! Persistence (issue 21): the renderer keeps its GPU resources across frames. After a
+//! warm-up frame, the same frame again creates no texture, view, buffer, query set or
+//! bind group, for every technique, every light kind (sun, spot, point through a cube
+//! and through paraboloids, all of `lamps` at once), on the forward and mask paths and
+//! through every entry point (read back, live, timed); and a changed setting creates
+//! only what depends on it.
+
+use gnomon_render::{Creations, Gpu, OutputRequest, Renderer, timing::ClockChoice};
+use gnomon_scene::{
+    Scene, Settings, builtin,
+    settings::{LightKind, OmniMap, Partition, ShadowPath, Technique},
+};
+
+/// Frames checked after the warm-up.
+const STEADY_FRAMES: usize = 10;
+
+fn small(technique: Technique, light: LightKind) -> Settings {
+    let mut s = Settings::default();
+    s.image.width = 48;
+    s.image.height = 32;
+    s.shadow.map.resolution = 256;
+    s.shadow.filter.technique = technique;
+    s.light.kind = light;
+    s
+}
+
+/// Renders `settings` once to warm up, then [`STEADY_FRAMES`] times through each
+/// entry point, and returns what the steady frames created.
+fn created_in_steady_state(renderer: &mut Renderer, scene: &Scene, settings: &Settings) -> Creations {
+    let uploaded = renderer.upload(scene).unwrap();
+    let request = OutputRequest { shadow_map: true, ..Default::default() };
+    // Warm up every entry point: each holds its own readbacks.
+    renderer.render_uploaded(&uploaded, scene, settings, &request).unwrap();
+    renderer.render_live(&uploaded, scene, settings).unwrap();
+    renderer.time_passes(&uploaded, scene, settings, ClockChoice::Auto).unwrap();
+    let before = renderer.creations();
+    for frame in 0..STEADY_FRAMES {
+        match frame % 3 {
+            0 => drop(renderer.render_uploaded(&uploaded, scene, settings, &request).unwrap()),
+            1 => drop(renderer.render_live(&uploaded, scene, settings).unwrap()),
+            _ => drop(renderer.time_passes(&uploaded, scene, settings, ClockChoice::Auto).unwrap()),
+        }
+    }
+    let after = renderer.creations();
+    Creations {
+        textures: after.textures - before.textures,
+        views: after.views - before.views,
+        buffers: after.buffers - before.buffers,
+        bind_groups: after.bind_groups - before.bind_groups,
+        query_sets: after.query_sets - before.query_sets,
+    }
+}
+
+/// Every light kind a technique can shadow, with its settings adjusted.
+fn light_cases(technique: Technique) -> Vec<(&'static str, Settings)> {
+    let mut cases =
+        vec![("sun", small(technique, LightKind::Sun)), ("spot", small(technique, LightKind::Spot))];
+    let mut cascades = small(technique, LightKind::Sun);
+    cascades.shadow.partition = Partition::Cascades;
+    cascades.shadow.cascades.count = 3;
+    cases.push(("sun, 3 cascades", cascades));
+    let mut mask = small(technique, LightKind::Sun);
+    mask.screen.shadow_path = ShadowPath::Mask;
+    cases.push(("sun, mask path", mask));
+    if technique.supports_point_lights() {
+        cases.push(("point, cube", small(technique, LightKind::Point)));
+        if technique != Technique::Pcss {
+            let mut paraboloid = small(technique, LightKind::Point);
+            paraboloid.shadow.map.omni = OmniMap::Paraboloid;
+            cases.push(("point, paraboloids", paraboloid));
+        }
+    }
+    cases
+}
+
+#[test]
+fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
+    let gpu = Gpu::new_headless().unwrap();
+    let scene = builtin::spheres();
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for &technique in Technique::all() {
+        for (name, settings) in light_cases(technique) {
+            // A fresh renderer per case, so that each case warms up alone.
+            let mut renderer = Renderer::new(&gpu).unwrap();
+            let created = created_in_steady_state(&mut renderer, &scene, &settings);
+            checked += 1;
+            if created.total() != 0 {
+                failures.push(format!("{technique:?}, {name}: {created:?}"));
+            }
+        }
+    }
+    println!("figure: persistence: {checked} cases × {STEADY_FRAMES} steady frames, creations 0 expected");
+    assert!(failures.is_empty(), "steady frames created resources:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
+    let gpu = Gpu::new_headless().unwrap();
+    let scene = builtin::lamps();
+    for path in [ShadowPath::Forward, ShadowPath::Mask] {
+        let mut settings = small(Technique::Pcf, LightKind::All);
+        settings.screen.shadow_path = path;
+        let mut renderer = Renderer::new(&gpu).unwrap();
+        let created = created_in_steady_state(&mut renderer, &scene, &settings);
+        assert_eq!(created.total(), 0, "{path:?}: {created:?}");
+    }
+}
+
+/// The pool keys resources by their description: a changed setting makes what
+/// depends on it (a larger map: a texture, its views and the groups that bind it),
+/// and nothing else; going back finds the first resources again.
+#[test]
+fn a_changed_setting_creates_only_what_depends_on_it() {
+    let gpu = Gpu::new_headless().unwrap();
+    let scene = builtin::spheres();
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let uploaded = renderer.upload(&scene).unwrap();
+    let small_map = small(Technique::Pcf, LightKind::Sun);
+    let mut large_map = small_map.clone();
+    large_map.shadow.map.resolution = 512;
+    renderer.render_live(&uploaded, &scene, &small_map).unwrap();
+    renderer.render_live(&uploaded, &scene, &small_map).unwrap();
+    let warm = renderer.creations();
+    renderer.render_live(&uploaded, &scene, &large_map).unwrap();
+    let changed = renderer.creations();
+    assert_eq!(changed.textures - warm.textures, 1, "one new shadow map: {warm:?} → {changed:?}");
+    assert_eq!(changed.buffers, warm.buffers, "no buffer depends on the map's size");
+    assert!(changed.bind_groups > warm.bind_groups, "the groups binding the map are new");
+    renderer.render_live(&uploaded, &scene, &small_map).unwrap();
+    assert_eq!(renderer.creations(), changed, "the first map was kept");
+}
