@@ -214,6 +214,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             push("CPU cull".into(), cost.cpu.cull_ms);
             push("CPU record".into(), cost.cpu.record_ms);
             push("wall frame".into(), wall_ms);
+            // What the frame costs beyond its GPU work and the CPU's submission: resource
+            // creation, stalls and readback waits. 1 means nothing is wasted.
+            push("wall ÷ (GPU + CPU)".into(), wall_ms / (timings.frame_ms + cost.cpu.submit_ms));
             for (light, stats) in cost.lights.iter().enumerate() {
                 for (layer, ms) in stats.layer_ms.iter().enumerate() {
                     push(format!("shadow L{light} layer {layer}"), *ms);
@@ -400,7 +403,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
     }
     // In frame order, whichever configurations have them.
-    const ORDER: [&str; 11] = [
+    const ORDER: [&str; 12] = [
         "shadow",
         "filter",
         "prepass",
@@ -412,6 +415,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         "CPU cull",
         "CPU record",
         "wall frame",
+        "wall ÷ (GPU + CPU)",
     ];
     columns.sort_by_key(|c| ORDER.iter().position(|o| o == c).unwrap_or(ORDER.len()));
     let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));

@@ -72,9 +72,29 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("gnomon: error: {e:#}");
+            eprintln!("gnomon: error: {}{e:#}", flag_of(&e).unwrap_or_default());
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The command-line flag behind a library error that names a setting: the library
+/// speaks in settings, the user typed flags.
+fn flag_of(e: &anyhow::Error) -> Option<String> {
+    use gnomon_render::RenderError;
+    let render = e.chain().find_map(|cause| cause.downcast_ref::<RenderError>())?;
+    match render {
+        RenderError::ShadowMapTooLarge { requested, .. } => Some(format!("--shadow-res = {requested}: ")),
+        RenderError::MomentFormatUnsupported { .. } => Some("--moment-format rgba32float: ".into()),
+        RenderError::NoAdapter { .. }
+        | RenderError::DeviceRequest { .. }
+        | RenderError::ImageTooLarge { .. }
+        | RenderError::AttachmentsTooLarge { .. }
+        | RenderError::Settings(_)
+        | RenderError::Scene(_)
+        | RenderError::EmptyScene(_)
+        | RenderError::SceneTooLarge { .. }
+        | RenderError::Gpu { .. } => None,
     }
 }
 

@@ -7,7 +7,6 @@
 
 use std::ops::Range;
 
-use glam::Vec4;
 use gnomon_math::{
     Aabb,
     culling::{CullTree, Frustum},
@@ -94,7 +93,11 @@ impl GpuScene {
         let mut indices = Vec::new();
         let mut ranges = Vec::with_capacity(scene.meshes.len());
         for mesh in &scene.meshes {
-            ranges.push((indices.len() as u32, mesh.indices.len() as u32, vertices.len() as i32));
+            ranges.push(MeshRange {
+                first_index: indices.len() as u32,
+                index_count: mesh.indices.len() as u32,
+                base_vertex: vertices.len() as i32,
+            });
             vertices.extend(mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).map(|((p, n), uv)| {
                 VertexGpu { position: p.to_array(), normal: n.to_array(), uv: uv.to_array() }
             }));
@@ -103,46 +106,7 @@ impl GpuScene {
         let positions: Vec<[f32; 3]> = vertices.iter().map(|v| v.position).collect();
         let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
 
-        // Group the instances into batches by everything a draw of them shares.
-        type BatchKey = (usize, bool, bool, bool, usize);
-        let key_of = |i: usize| -> BatchKey {
-            let inst = &scene.instances[i];
-            let material = &scene.materials[inst.material];
-            (
-                material.base_color_texture.map_or(0, |t| t + 1),
-                matches!(material.alpha_mode, AlphaMode::Mask { .. }),
-                material.double_sided,
-                inst.casts_shadow,
-                inst.mesh,
-            )
-        };
-        let mut members: Vec<usize> = (0..scene.instances.len())
-            .filter(|&i| !scene.meshes[scene.instances[i].mesh].indices.is_empty())
-            .collect();
-        members.sort_by_key(|&i| (key_of(i), i));
-        let mut order: Vec<usize> = Vec::with_capacity(members.len());
-        let mut batches = Vec::new();
-        for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
-            let (material_group, masked, double_sided, casts_shadow, mesh) = key_of(group[0]);
-            let bounds: Vec<Aabb> = group
-                .iter()
-                .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
-                .collect();
-            let (tree, tree_order) = CullTree::build(&bounds);
-            let (first_index, index_count, base_vertex) = ranges[mesh];
-            batches.push(Batch {
-                first_index,
-                index_count,
-                base_vertex,
-                first_instance: order.len() as u32,
-                casts_shadow,
-                masked,
-                double_sided,
-                material_group,
-                tree,
-            });
-            order.extend(tree_order.iter().map(|&k| group[k as usize]));
-        }
+        let (batches, order) = batch_instances(scene, &ranges, &mesh_bounds);
         let mut shadow_order: Vec<u32> = (0..batches.len() as u32).collect();
         shadow_order.sort_by_key(|&b| {
             let b = &batches[b as usize];
@@ -150,30 +114,7 @@ impl GpuScene {
         });
         let bounds = batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
 
-        let instance_data: Vec<InstanceGpu> = order
-            .iter()
-            .map(|&i| {
-                let inst = &scene.instances[i];
-                let material = &scene.materials[inst.material];
-                let cutoff = match material.alpha_mode {
-                    AlphaMode::Mask { cutoff } => cutoff,
-                    AlphaMode::Opaque | AlphaMode::Blend => -1.0,
-                };
-                InstanceGpu {
-                    world_from_object: inst.world_from_object,
-                    base_color: material.base_color.extend(material.alpha),
-                    // The object id is the scene's instance index + 1, whatever the
-                    // buffer's order.
-                    material: Vec4::new(material.specular, material.shininess, (i + 1) as f32, cutoff),
-                    texturing: Vec4::new(
-                        f32::from(u8::from(material.base_color_texture.is_some())),
-                        0.0,
-                        0.0,
-                        0.0,
-                    ),
-                }
-            })
-            .collect();
+        let instance_data = instance_data(scene, &order);
         let instance_bytes = std::mem::size_of_val(instance_data.as_slice()) as u64;
         let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         if instance_bytes > limit {
@@ -354,6 +295,98 @@ fn material_groups(gpu: &Gpu, scene: &Scene, layouts: &Layouts) -> Vec<wgpu::Bin
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
                 ],
             })
+        })
+        .collect()
+}
+
+/// Where a mesh lies in the shared vertex and index buffers.
+#[derive(Clone, Copy, Debug)]
+struct MeshRange {
+    first_index: u32,
+    index_count: u32,
+    base_vertex: i32,
+}
+
+/// What the instances of one batch share: one draw covers them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct BatchKey {
+    /// The base-colour texture's bind group (0 for none).
+    material_group: usize,
+    masked: bool,
+    double_sided: bool,
+    casts_shadow: bool,
+    mesh: usize,
+}
+
+/// Groups the instances into batches by everything a draw of them shares, each with
+/// its culling tree; returns the batches and the instances in buffer order.
+fn batch_instances(scene: &Scene, ranges: &[MeshRange], mesh_bounds: &[Aabb]) -> (Vec<Batch>, Vec<usize>) {
+    let key_of = |i: usize| {
+        let inst = &scene.instances[i];
+        let material = &scene.materials[inst.material];
+        BatchKey {
+            material_group: material.base_color_texture.map_or(0, |t| t + 1),
+            masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
+            double_sided: material.double_sided,
+            casts_shadow: inst.casts_shadow,
+            mesh: inst.mesh,
+        }
+    };
+    let mut members: Vec<usize> = (0..scene.instances.len())
+        .filter(|&i| !scene.meshes[scene.instances[i].mesh].indices.is_empty())
+        .collect();
+    members.sort_by_key(|&i| (key_of(i), i));
+    let mut order: Vec<usize> = Vec::with_capacity(members.len());
+    let mut batches = Vec::new();
+    for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
+        let BatchKey { material_group, masked, double_sided, casts_shadow, mesh } = key_of(group[0]);
+        let bounds: Vec<Aabb> = group
+            .iter()
+            .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
+            .collect();
+        let (tree, tree_order) = CullTree::build(&bounds);
+        let MeshRange { first_index, index_count, base_vertex } = ranges[mesh];
+        batches.push(Batch {
+            first_index,
+            index_count,
+            base_vertex,
+            first_instance: order.len() as u32,
+            casts_shadow,
+            masked,
+            double_sided,
+            material_group,
+            tree,
+        });
+        order.extend(tree_order.iter().map(|&k| group[k as usize]));
+    }
+    (batches, order)
+}
+
+/// Each instance's GPU record, in buffer order.
+fn instance_data(scene: &Scene, order: &[usize]) -> Vec<InstanceGpu> {
+    order
+        .iter()
+        .map(|&i| {
+            let inst = &scene.instances[i];
+            let material = &scene.materials[inst.material];
+            let cutoff = match material.alpha_mode {
+                AlphaMode::Mask { cutoff } => cutoff,
+                AlphaMode::Opaque | AlphaMode::Blend => -1.0,
+            };
+            InstanceGpu {
+                world_from_object: inst.world_from_object,
+                base_color: material.base_color.extend(material.alpha),
+                // The object id is the scene's instance index + 1, whatever the
+                // buffer's order.
+                specular: material.specular,
+                shininess: material.shininess,
+                object_id: (i + 1) as u32,
+                alpha_cutoff: cutoff,
+                textured: material.base_color_texture.is_some().into(),
+                _pad0: 0,
+                _pad1: 0,
+                _pad2: 0,
+            }
         })
         .collect()
 }

@@ -14,11 +14,18 @@ pub struct InstanceGpu {
     pub world_from_object: Mat4,
     /// rgb: base colour (linear); a: base alpha.
     pub base_color: Vec4,
-    /// x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1),
-    /// w: alpha cutoff for MASK materials, −1 for none.
-    pub material: Vec4,
-    /// x: 1 when the base colour is multiplied by the bound texture.
-    pub texturing: Vec4,
+    /// Specular weight and Blinn-Phong exponent.
+    pub specular: f32,
+    pub shininess: f32,
+    /// The scene's instance index + 1 (0 marks the background).
+    pub object_id: u32,
+    /// Alpha cutoff of a MASK material; −1 for none.
+    pub alpha_cutoff: f32,
+    /// 1 when the base colour is multiplied by the bound texture.
+    pub textured: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// The vertex-buffer slot of the instance transforms, after the vertices (slot 0).

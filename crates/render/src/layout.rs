@@ -197,12 +197,8 @@ fn filter_margin_texels(settings: &Settings, tight: &LightProjection) -> f32 {
         KernelUnit::Texels => f.pcf_kernel,
         KernelUnit::World => f.pcf_kernel / texel,
     };
-    let reach = match f.technique {
-        Technique::Hard | Technique::Pcf2x2 => 0.0,
-        Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => 0.5 * kernel,
-        Technique::Pcss => f.pcss.max_radius,
-        _ => f.moments.blur_radius as f32,
-    };
+    // Each technique states its own reach (`ShadowTechnique::filter_reach_texels`).
+    let reach = crate::techniques::lookup(f.technique).filter_reach_texels(f, kernel);
     2.0 + reach + settings.shadow.bias.normal_offset
 }
 

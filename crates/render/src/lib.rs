@@ -50,8 +50,8 @@ pub enum RenderError {
     #[error("could not open the GPU device on adapter `{adapter}`: {reason}")]
     DeviceRequest { adapter: String, reason: String },
     #[error(
-        "--shadow-res = {requested} is larger than this device allows: adapter `{adapter}` supports \
-         2D textures up to {max} texels (and Gnomon up to {})",
+        "a shadow map of {requested}² texels (`shadow.map.resolution`) is larger than this device \
+         allows: adapter `{adapter}` supports 2D textures up to {max} texels (and Gnomon up to {})",
         gnomon_scene::settings::MAX_SHADOW_RESOLUTION
     )]
     ShadowMapTooLarge { requested: u32, max: u32, adapter: String },
@@ -65,8 +65,8 @@ pub enum RenderError {
     )]
     AttachmentsTooLarge { available: u32, needed: u32, adapter: String },
     #[error(
-        "--moment-format rgba32float needs 32-bit float filtering, which adapter `{adapter}` does not \
-         have; use --moment-format rgba16float or auto"
+        "the moment format rgba32float (`shadow.filter.moments.moment_format`) needs 32-bit float \
+         filtering, which adapter `{adapter}` does not have; choose rgba16float or auto"
     )]
     MomentFormatUnsupported { adapter: String },
     #[error(transparent)]

@@ -93,6 +93,8 @@ struct BindGroupKey {
 struct Kept<T> {
     value: T,
     used: u64,
+    /// Held past its frame ([`Pool::hold`]): not handed out, not dropped.
+    held: bool,
 }
 
 /// Entries of one description; `used == frame` marks those this frame holds.
@@ -100,13 +102,13 @@ struct Shelf<T>(Vec<Kept<T>>);
 
 impl<T: Clone> Shelf<T> {
     fn take(&mut self, frame: u64) -> Option<T> {
-        let free = self.0.iter_mut().find(|k| k.used != frame)?;
+        let free = self.0.iter_mut().find(|k| k.used != frame && !k.held)?;
         free.used = frame;
         Some(free.value.clone())
     }
 
     fn evict(&mut self, frame: u64) {
-        self.0.retain(|k| k.used + KEEP_FRAMES >= frame);
+        self.0.retain(|k| k.held || k.used + KEEP_FRAMES >= frame);
     }
 }
 
@@ -183,7 +185,7 @@ impl Pool {
             view_formats: &[],
         });
         self.created.textures += 1;
-        shelf.0.push(Kept { value: texture.clone(), used: frame });
+        shelf.0.push(Kept { value: texture.clone(), used: frame, held: false });
         texture
     }
 
@@ -203,7 +205,7 @@ impl Pool {
             ..Default::default()
         });
         self.created.views += 1;
-        self.views.insert((texture.clone(), key), Kept { value: view.clone(), used: frame });
+        self.views.insert((texture.clone(), key), Kept { value: view.clone(), used: frame, held: false });
         view
     }
 
@@ -222,8 +224,31 @@ impl Pool {
             mapped_at_creation: false,
         });
         self.created.buffers += 1;
-        shelf.0.push(Kept { value: buffer.clone(), used: frame });
+        shelf.0.push(Kept { value: buffer.clone(), used: frame, held: false });
         buffer
+    }
+
+    /// Keeps `buffer` (one of the pool's) from being handed out again, past the frame
+    /// that took it, until [`Pool::release`]: for a readback mapped frames later.
+    pub fn hold(&mut self, buffer: &wgpu::Buffer) {
+        self.set_held(buffer, true);
+    }
+
+    /// Lets a buffer [`Pool::hold`] kept be handed out again.
+    pub fn release(&mut self, buffer: &wgpu::Buffer) {
+        self.set_held(buffer, false);
+    }
+
+    fn set_held(&mut self, buffer: &wgpu::Buffer, held: bool) {
+        let key = BufferKey { size: buffer.size(), usage: buffer.usage() };
+        if let Some(kept) =
+            self.buffers.get_mut(&key).and_then(|s| s.0.iter_mut().find(|k| &k.value == buffer))
+        {
+            kept.held = held;
+            // Held is in use: its age counts from its release, not from the frame that
+            // took it.
+            kept.used = self.frame;
+        }
     }
 
     /// A uniform buffer holding `value`, written through the queue.
@@ -269,7 +294,7 @@ impl Pool {
             count,
         });
         self.created.query_sets += 1;
-        shelf.0.push(Kept { value: set.clone(), used: frame });
+        shelf.0.push(Kept { value: set.clone(), used: frame, held: false });
         set
     }
 
@@ -318,7 +343,7 @@ impl Pool {
             entries: &entries,
         });
         self.created.bind_groups += 1;
-        self.bind_groups.insert(key, Kept { value: group.clone(), used: frame });
+        self.bind_groups.insert(key, Kept { value: group.clone(), used: frame, held: false });
         group
     }
 

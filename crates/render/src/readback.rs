@@ -76,6 +76,44 @@ pub(crate) struct PendingTimestamps {
     buffer: wgpu::Buffer,
 }
 
+/// Timestamps being mapped in the background.
+pub(crate) struct MappingTimestamps {
+    buffer: wgpu::Buffer,
+    state: std::sync::Arc<std::sync::Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>,
+}
+
+impl MappingTimestamps {
+    fn state(&self) -> Option<Result<(), wgpu::BufferAsyncError>> {
+        self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone()
+    }
+
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// The ticks, waiting for the mapping if it has not finished.
+    pub fn read(self, gpu: &Gpu) -> Result<Vec<u64>, RenderError> {
+        while self.state().is_none() {
+            gpu.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| RenderError::Gpu { during: "waiting for the GPU", message: e.to_string() })?;
+        }
+        if let Some(Err(e)) = self.state() {
+            return Err(RenderError::Gpu { during: "mapping timestamps", message: e.to_string() });
+        }
+        let ticks = {
+            let mapped = self
+                .buffer
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu { during: "mapping timestamps", message: e.to_string() })?;
+            bytemuck::cast_slice::<u8, u64>(&mapped).to_vec()
+        };
+        self.buffer.unmap();
+        Ok(ticks)
+    }
+}
+
 /// Records the resolve of `count` timestamps from `query_set` and their copy out.
 pub(crate) fn record_timestamps(
     pool: &mut Pool,
@@ -97,18 +135,20 @@ pub(crate) fn record_timestamps(
 }
 
 impl PendingTimestamps {
-    /// The raw timestamp ticks, after the submission.
-    pub fn read(self, gpu: &Gpu) -> Result<Vec<u64>, RenderError> {
-        let slice = self.buffer.slice(..);
-        map_blocking(gpu, &slice)?;
-        let ticks = {
-            let mapped = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Gpu { during: "mapping timestamps", message: e.to_string() })?;
-            bytemuck::cast_slice::<u8, u64>(&mapped).to_vec()
-        };
-        self.buffer.unmap();
-        Ok(ticks)
+    /// The buffer the ticks are copied into.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// Starts mapping the buffer (after the submission) without waiting: the ticks
+    /// are ready once [`MappingTimestamps::is_ready`] says so.
+    pub fn begin_map(self) -> MappingTimestamps {
+        let state = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let sender = state.clone();
+        self.buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            *sender.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
+        });
+        MappingTimestamps { buffer: self.buffer, state }
     }
 }
 

@@ -173,7 +173,7 @@ impl PassClock {
             }
             _ => None,
         };
-        PendingTimes { clock: self, pending }
+        PendingTimes { clock: self, ticks: pending.map(Ticks::Recorded) }
     }
 }
 
@@ -189,7 +189,14 @@ fn flush(gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
 /// A frame's pass times, waiting for the GPU.
 pub(crate) struct PendingTimes {
     clock: PassClock,
-    pending: Option<readback::PendingTimestamps>,
+    ticks: Option<Ticks>,
+}
+
+/// The GPU's timestamps: copied out in the frame's commands, then (after the frame's
+/// submission) being mapped.
+enum Ticks {
+    Recorded(readback::PendingTimestamps),
+    Mapping(readback::MappingTimestamps),
 }
 
 /// A frame's pass times and the span of the whole frame.
@@ -201,16 +208,39 @@ pub(crate) struct FrameTimes {
 }
 
 impl PendingTimes {
-    /// Waits for the times; None when the frame was not timed.
+    /// Starts mapping the timestamps in the background: call once the frame is
+    /// submitted.
+    pub fn submitted(self) -> Self {
+        let ticks = self.ticks.map(|t| match t {
+            Ticks::Recorded(recorded) => Ticks::Mapping(recorded.begin_map()),
+            mapping @ Ticks::Mapping(_) => mapping,
+        });
+        PendingTimes { clock: self.clock, ticks }
+    }
+
+    /// The buffer the GPU's timestamps are copied into, while they are pending.
+    pub fn ticks_buffer(&self) -> Option<&wgpu::Buffer> {
+        match &self.ticks {
+            None => None,
+            Some(Ticks::Recorded(recorded)) => Some(recorded.buffer()),
+            Some(Ticks::Mapping(mapping)) => Some(mapping.buffer()),
+        }
+    }
+
+    /// The times, waiting for them if they are not ready; None when the frame was
+    /// not timed.
     pub fn read(self, gpu: &Gpu) -> Result<Option<FrameTimes>, RenderError> {
         let labels = &self.clock.labels;
         let pass = |i: usize, ms: f64| {
             let (kind, light, layer) = labels[i];
             PassTime { kind, light, layer, ms }
         };
-        match (self.clock.mode, self.pending) {
-            (Mode::Gpu { .. }, Some(pending)) => {
-                let ticks = pending.read(gpu)?;
+        match (self.clock.mode, self.ticks) {
+            (Mode::Gpu { .. }, Some(ticks)) => {
+                let ticks = match ticks {
+                    Ticks::Recorded(recorded) => recorded.begin_map().read(gpu)?,
+                    Ticks::Mapping(mapping) => mapping.read(gpu)?,
+                };
                 let period = f64::from(gpu.timestamp_period_ns.unwrap_or(1.0)) * 1e-6;
                 let passes = (0..labels.len())
                     .map(|i| pass(i, ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period));

@@ -382,6 +382,10 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             contact_bias, contact_distance, params, cascade_clip_from_world, cascades,
         }),
         struct_layout!(TechniqueParams as "TechniqueParams" { reals, integers }),
+        struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
+            world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,
+            _pad2,
+        }),
         struct_layout!(CascadeGpu as "Cascade" {
             texel_world, warp_step, split_start, split_end, warped, _pad0, _pad1, _pad2,
         }),

@@ -15,7 +15,9 @@ fn a_shadow_map_larger_than_the_device_allows_is_refused_by_name() {
     let err = renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap_err();
     assert!(matches!(err, RenderError::ShadowMapTooLarge { requested: 2048, max: 1024, .. }), "{err:?}");
     let message = err.to_string();
-    assert!(message.contains("--shadow-res") && message.contains("1024"), "{message}");
+    // The library names the setting, not a command-line flag.
+    assert!(message.contains("shadow.map.resolution") && message.contains("1024"), "{message}");
+    assert!(!message.contains("--"), "{message}");
     // Within the limit the same renderer works.
     s.shadow.map.resolution = 1024;
     renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap();

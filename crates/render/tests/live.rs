@@ -59,3 +59,29 @@ fn the_map_preview_shows_every_cascade_in_gray_side_by_side() {
     let seam = &texels[((tile / 2 * 3 * tile + tile) * 4) as usize..][..3];
     assert!(seam[0] > seam[1] + 40, "no seam colour at the second cascade's edge: {seam:?}");
 }
+
+/// Live frames do not wait for their own timestamps: each reports the previous
+/// frame's pass times, and the first reports none.
+#[test]
+fn live_frames_report_the_previous_frames_times() {
+    let gpu = Gpu::new_headless().unwrap();
+    if gpu.timestamp_period_ns.is_none() {
+        println!("skipped: live frame timings: the adapter has no timestamp queries");
+        return;
+    }
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let scene = builtin::spheres();
+    let uploaded = renderer.upload(&scene).unwrap();
+    let settings = small();
+    let first = renderer.render_live(&uploaded, &scene, &settings).unwrap();
+    assert!(first.timings.is_none(), "the first live frame has no earlier frame to report");
+    for _ in 0..4 {
+        let live = renderer.render_live(&uploaded, &scene, &settings).unwrap();
+        let timings = live.timings.expect("the previous frame's times");
+        assert_eq!(live.timings_age, 1);
+        assert!(timings.shadow_ms > 0.0 && timings.lighting_ms > 0.0, "{timings:?}");
+        assert!(timings.frame_ms >= timings.shadow_ms, "{timings:?}");
+        let light = &live.lights[0];
+        assert!(light.shadow_ms.is_some() && !light.layer_ms.is_empty(), "{light:?}");
+    }
+}

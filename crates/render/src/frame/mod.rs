@@ -6,6 +6,7 @@
 
 mod baseline;
 mod bindings;
+mod late;
 mod outputs;
 mod plan;
 mod record;
@@ -30,7 +31,8 @@ use crate::{
     timing::ClockChoice,
 };
 use bindings::FixedBindings;
-use record::{Readback, SubmitRequest};
+use late::LateTimes;
+use record::{Readback, SubmitRequest, TimesWanted};
 
 /// The pass pipelines, built once (and per variant on first use).
 struct Passes {
@@ -52,6 +54,8 @@ pub struct Renderer {
     passes: Passes,
     fixed: FixedBindings,
     pool: Pool,
+    /// Live frames' pass times, read when they arrive.
+    late_times: LateTimes,
 }
 
 impl Renderer {
@@ -73,6 +77,7 @@ impl Renderer {
                 gpu: Gpu::clone(gpu),
                 fixed: FixedBindings::new(device),
                 pool: Pool::new(device),
+                late_times: LateTimes::default(),
                 layouts,
                 passes,
             }
@@ -158,6 +163,7 @@ impl Renderer {
             readback: Readback { images: true, shadow_map: request.shadow_map },
             fixed_layout: request.fixed_layout.as_ref(),
             clock: None,
+            times: TimesWanted::Now,
         };
         let submitted = self.submit(uploaded, scene, settings, submit)?;
         submitted.read(&self.gpu, settings)
@@ -165,15 +171,22 @@ impl Renderer {
 
     /// Renders an uploaded scene and leaves the image and the shadow map on the GPU,
     /// for a window to draw ([`LiveFrame`]). Its textures stay valid until the next
-    /// frame.
+    /// frame. It does not wait for the GPU to finish it: its pass times are the
+    /// previous frame's, read once this one is submitted ([`LiveFrame::timings_age`]).
     pub fn render_live(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
         settings: &Settings,
     ) -> Result<LiveFrame, RenderError> {
-        let submit = SubmitRequest { readback: Readback::NONE, fixed_layout: None, clock: None };
-        Ok(self.submit(uploaded, scene, settings, submit)?.live())
+        let submit = SubmitRequest {
+            readback: Readback::NONE,
+            fixed_layout: None,
+            clock: None,
+            times: TimesWanted::Late,
+        };
+        let submitted = self.submit(uploaded, scene, settings, submit)?;
+        Ok(submitted.live(self.late_times.latest_age()))
     }
 
     /// The shadow map of `frame`, every layer side by side in grayscale (near black,
@@ -195,7 +208,12 @@ impl Renderer {
         settings: &Settings,
         clock: ClockChoice,
     ) -> Result<FrameCost, RenderError> {
-        let submit = SubmitRequest { readback: Readback::NONE, fixed_layout: None, clock: Some(clock) };
+        let submit = SubmitRequest {
+            readback: Readback::NONE,
+            fixed_layout: None,
+            clock: Some(clock),
+            times: TimesWanted::Now,
+        };
         Ok(self.submit(uploaded, scene, settings, submit)?.cost())
     }
 }

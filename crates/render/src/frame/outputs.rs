@@ -14,7 +14,7 @@ use crate::{
     gpu_scene::Visible,
     layout::ShadowLayout,
     readback::PendingReadback,
-    timing::{PassKind, PassTime, TimingSource},
+    timing::{FrameTimes, PassKind, PassTime, TimingSource},
 };
 
 /// Optional outputs of a frame.
@@ -106,8 +106,13 @@ pub struct LiveFrame {
     pub light: Light,
     /// The reported light's layers and cascade splits.
     pub layout: ShadowLayout,
+    /// The pass times of the previous live frame (None for the first): a live frame
+    /// does not wait for the GPU to finish it.
     pub timings: Option<PassTimings>,
+    /// How many frames before this one `timings` and `lights`' times were taken.
+    pub timings_age: u32,
     pub stats: DrawStats,
+    /// What each light drew (this frame) and cost (`timings_age` frames ago).
     pub lights: Vec<LightStats>,
     pub shadow_mask: bool,
 }
@@ -282,53 +287,35 @@ pub(super) struct Submitted {
 impl Submitted {
     /// Reads the pass times of a recorded frame and gathers what it reports.
     pub(super) fn new(
-        gpu: &Gpu,
         plan: super::plan::FramePlan,
-        culled: &super::record::Culled,
         recorded: super::record::Recorded,
+        timed: TimedLights,
         cpu: CpuTimings,
-    ) -> Result<Self, RenderError> {
-        let times = recorded.times.read(gpu)?;
-        let passes = times.as_ref().map_or_else(Vec::new, |t| t.passes.clone());
-        let lights: Vec<LightStats> = plan
-            .lights
-            .iter()
-            .zip(&culled.layers)
-            .enumerate()
-            .map(|(index, (light, layers))| light_stats(light, layers, &passes, index as u32))
-            .collect();
-        let timings = times.as_ref().map(|t| PassTimings {
-            shadow_ms: sum_of(&lights, |l| l.shadow_ms).unwrap_or(0.0),
-            filter_ms: sum_of(&lights, |l| l.filter_ms),
-            lighting_ms: sum_of(&lights, |l| l.lighting_ms).unwrap_or(0.0),
-            prepass_ms: passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
-            mask_ms: sum_of(&lights, |l| l.mask_ms),
-            frame_ms: t.frame_ms,
-            source: t.source,
-        });
+    ) -> Self {
         let super::plan::FramePlan { camera, mask_path, shown, lights: mut plans, .. } = plan;
         let shown = plans.swap_remove(shown);
-        Ok(Submitted {
+        Submitted {
             readbacks: recorded.readbacks,
             color: recorded.color,
             shadow_map: recorded.shadow_map,
-            timings,
-            passes,
+            timings: timed.timings,
+            passes: timed.passes,
             cpu,
             stats: recorded.stats,
-            lights,
+            lights: timed.lights,
             camera,
             light: shown.light,
             resolution: shown.settings.shadow.map.resolution,
             layout: shown.layout,
             moment_format: shown.filterable_map.is_some().then_some(shown.moment_format),
             shadow_mask: mask_path,
-        })
+        }
     }
 
-    /// The frame left on the GPU.
-    pub(super) fn live(self) -> LiveFrame {
+    /// The frame left on the GPU; its times are `timings_age` frames old.
+    pub(super) fn live(self, timings_age: u32) -> LiveFrame {
         LiveFrame {
+            timings_age,
             color: self.color,
             shadow_map: self.shadow_map,
             camera: self.camera,
@@ -423,29 +410,66 @@ fn sum_of(lights: &[LightStats], time: fn(&LightStats) -> Option<f64>) -> Option
     (!times.is_empty()).then(|| times.iter().sum())
 }
 
-/// What one light drew (`layers`: its culled casters per layer) and cost.
-fn light_stats(
-    light: &super::plan::LightPlan,
-    layers: &[Visible],
-    passes: &[PassTime],
-    index: u32,
-) -> LightStats {
-    let of_kind = |kind: PassKind| passes.iter().filter(move |p| p.kind == kind && p.light == Some(index));
-    let time_of = |kind: PassKind| {
-        let times: Vec<f64> = of_kind(kind).map(|p| p.ms).collect();
-        (!times.is_empty()).then(|| times.iter().sum())
-    };
-    LightStats {
-        name: light.name.clone(),
-        kind: light.light.type_name(),
-        technique: light.settings.shadow.filter.technique,
-        resolution: light.settings.shadow.map.resolution,
-        layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
-        layer_instances: layers.iter().map(Visible::instances).collect(),
-        layer_ms: of_kind(PassKind::Shadow).map(|p| p.ms).collect(),
-        shadow_ms: time_of(PassKind::Shadow),
-        filter_ms: time_of(PassKind::Filter),
-        lighting_ms: time_of(PassKind::Lighting),
-        mask_ms: time_of(PassKind::Mask),
+/// What each light of a frame drew, with the frame's pass times once they are read.
+#[derive(Clone)]
+pub(super) struct TimedLights {
+    pub lights: Vec<LightStats>,
+    pub passes: Vec<PassTime>,
+    pub timings: Option<PassTimings>,
+}
+
+impl TimedLights {
+    /// What each light drew (its culled casters per layer), not yet timed.
+    pub fn untimed(plan: &super::plan::FramePlan, culled: &super::record::Culled) -> Self {
+        let lights = plan
+            .lights
+            .iter()
+            .zip(&culled.layers)
+            .map(|(light, layers)| LightStats {
+                name: light.name.clone(),
+                kind: light.light.type_name(),
+                technique: light.settings.shadow.filter.technique,
+                resolution: light.settings.shadow.map.resolution,
+                layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
+                layer_instances: layers.iter().map(Visible::instances).collect(),
+                layer_ms: Vec::new(),
+                shadow_ms: None,
+                filter_ms: None,
+                lighting_ms: None,
+                mask_ms: None,
+            })
+            .collect();
+        TimedLights { lights, passes: Vec::new(), timings: None }
+    }
+
+    /// With the frame's pass times (None when it was not timed).
+    pub fn timed(mut self, times: Option<FrameTimes>) -> Self {
+        let Some(times) = times else { return self };
+        for (index, light) in self.lights.iter_mut().enumerate() {
+            let index = Some(index as u32);
+            let of_kind =
+                |kind: PassKind| times.passes.iter().filter(move |p| p.kind == kind && p.light == index);
+            let time_of = |kind: PassKind| {
+                let ms: Vec<f64> = of_kind(kind).map(|p| p.ms).collect();
+                (!ms.is_empty()).then(|| ms.iter().sum())
+            };
+            light.layer_ms = of_kind(PassKind::Shadow).map(|p| p.ms).collect();
+            light.shadow_ms = time_of(PassKind::Shadow);
+            light.filter_ms = time_of(PassKind::Filter);
+            light.lighting_ms = time_of(PassKind::Lighting);
+            light.mask_ms = time_of(PassKind::Mask);
+        }
+        let lights = &self.lights;
+        self.timings = Some(PassTimings {
+            shadow_ms: sum_of(lights, |l| l.shadow_ms).unwrap_or(0.0),
+            filter_ms: sum_of(lights, |l| l.filter_ms),
+            lighting_ms: sum_of(lights, |l| l.lighting_ms).unwrap_or(0.0),
+            prepass_ms: times.passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
+            mask_ms: sum_of(lights, |l| l.mask_ms),
+            frame_ms: times.frame_ms,
+            source: times.source,
+        });
+        self.passes = times.passes;
+        self
     }
 }

@@ -11,7 +11,7 @@ use gnomon_scene::{Scene, Settings};
 use super::{
     Renderer,
     bindings::{ShadowViews, scene_group},
-    outputs::{DrawStats, FrameReadbacks, Submitted},
+    outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
 };
 use crate::{
@@ -28,7 +28,7 @@ use crate::{
     },
     pool::{Binding, ViewKey},
     readback,
-    timing::{ClockChoice, PassClock, PassKind},
+    timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::{CameraGpu, LightGpu},
 };
 
@@ -50,8 +50,19 @@ pub(super) struct SubmitRequest<'a> {
     pub readback: Readback,
     /// The reported light's layout, instead of fitting one.
     pub fixed_layout: Option<&'a ShadowLayout>,
-    /// How to time the passes; None leaves them untimed.
+    /// How to time the passes; None leaves them untimed (but timestamps, where the
+    /// device has them, are still taken).
     pub clock: Option<ClockChoice>,
+    pub times: TimesWanted,
+}
+
+/// When the frame's pass times are read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum TimesWanted {
+    /// Before the call returns: it waits for the GPU to finish the frame.
+    Now,
+    /// A frame or two later, without waiting ([`super::late::LateTimes`]).
+    Late,
 }
 
 /// What every recording step appends to: the encoder, the pass clock and the counts.
@@ -129,7 +140,7 @@ impl Renderer {
         let culled = cull(uploaded, &plan);
         let cull_done = Instant::now();
         let gpu = self.gpu.clone();
-        let recorded = gpu.checked("rendering the frame", || {
+        let mut recorded = gpu.checked("rendering the frame", || {
             self.record_frame(uploaded, settings, &plan, &culled, &request)
         })?;
         let cpu = super::CpuTimings {
@@ -138,7 +149,14 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        Submitted::new(&gpu, plan, &culled, recorded, cpu)
+        let untimed = TimedLights::untimed(&plan, &culled);
+        let times = recorded.times.take().map(PendingTimes::submitted);
+        let timed = match (request.times, times) {
+            (_, None) => untimed,
+            (TimesWanted::Now, Some(times)) => untimed.timed(times.read(&gpu)?),
+            (TimesWanted::Late, Some(times)) => self.late_times.push(&gpu, &mut self.pool, times, untimed)?,
+        };
+        Ok(Submitted::new(plan, recorded, timed, cpu))
     }
 
     /// Records every pass of the frame and submits it.
@@ -216,7 +234,7 @@ impl Renderer {
         gpu.queue.submit([encoder.finish()]);
         Recorded {
             readbacks,
-            times,
+            times: Some(times),
             stats,
             color: targets.textures[0].clone(),
             shadow_map: shown_map.expect("the reported light is one of the lights"),
@@ -490,7 +508,8 @@ impl Renderer {
 /// What recording left for the frame to read.
 pub(super) struct Recorded {
     pub readbacks: FrameReadbacks,
-    pub times: crate::timing::PendingTimes,
+    /// Taken by the frame's timing once submitted.
+    pub times: Option<PendingTimes>,
     pub stats: DrawStats,
     pub color: wgpu::Texture,
     pub shadow_map: wgpu::Texture,

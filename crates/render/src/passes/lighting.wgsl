@@ -48,7 +48,7 @@ fn fs_main(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut
     let n_dot_l = max(dot(n, l), 0.0);
     let v = normalize(camera.eye - in.world);
     let h = normalize(l + v);
-    let specular = inst.material.x * pow(max(dot(n, h), 0.0), inst.material.y) * select(0.0, 1.0, n_dot_l > 0.0);
+    let specular = inst.specular * pow(max(dot(n, h), 0.0), inst.shininess) * select(0.0, 1.0, n_dot_l > 0.0);
     let direct = light.radiance * cone * (albedo * n_dot_l + vec3<f32>(specular));
     var color = light.ambient * albedo + visibility * direct;
     if camera.tint_cascades == 1u {
@@ -60,6 +60,6 @@ fn fs_main(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut
     out.visibility = visibility;
     out.position = vec4<f32>(in.world, view_depth);
     out.normal = vec4<f32>(n, 0.0);
-    out.object_id = u32(inst.material.z);
+    out.object_id = inst.object_id;
     return out;
 }

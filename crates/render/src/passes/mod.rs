@@ -79,118 +79,66 @@ pub(crate) struct Layouts {
 impl Layouts {
     pub fn new(device: &wgpu::Device) -> Self {
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let scene = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                uniform_entry(1, vf),
-            ],
-        });
-        let camera = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("camera"),
-            entries: &[uniform_entry(0, vf)],
-        });
-        let shadow = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow map"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::Cube,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 6,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
-                    count: None,
-                },
-                unfilterable_texture_entry(7),
-            ],
-        });
-        let screen = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("screen"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                unfilterable_texture_entry(1),
-                unfilterable_texture_entry(2),
-            ],
-        });
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("material"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        Self { scene, camera, screen, shadow, material }
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+        };
+        let instances = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let depth = |dimension| texture(wgpu::TextureSampleType::Depth, dimension);
+        let filterable = |dimension| texture(wgpu::TextureSampleType::Float { filterable: true }, dimension);
+        let sampler = |kind| wgpu::BindingType::Sampler(kind);
+        use wgpu::{SamplerBindingType as S, TextureViewDimension as D};
+        Self {
+            scene: layout(
+                "scene",
+                &[
+                    wgpu::BindGroupLayoutEntry { binding: 0, visibility: vf, ty: instances, count: None },
+                    uniform_entry(1, vf),
+                ],
+            ),
+            camera: layout("camera", &[uniform_entry(0, vf)]),
+            shadow: layout(
+                "shadow map",
+                &[
+                    fragment_entry(0, depth(D::D2Array)),
+                    fragment_entry(1, sampler(S::Comparison)),
+                    fragment_entry(2, filterable(D::D2Array)),
+                    fragment_entry(3, sampler(S::Filtering)),
+                    fragment_entry(4, depth(D::Cube)),
+                    fragment_entry(5, sampler(S::Comparison)),
+                    fragment_entry(6, sampler(S::NonFiltering)),
+                    unfilterable_texture_entry(7),
+                ],
+            ),
+            screen: layout(
+                "screen",
+                &[
+                    uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
+                    unfilterable_texture_entry(1),
+                    unfilterable_texture_entry(2),
+                ],
+            ),
+            material: layout(
+                "material",
+                &[fragment_entry(0, filterable(D::D2)), fragment_entry(1, sampler(S::Filtering))],
+            ),
+        }
     }
+}
+
+/// A texture binding of one sample, read by fragment stages.
+fn texture(
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindingType {
+    wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false }
+}
+
+fn fragment_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::FRAGMENT, ty, count: None }
 }
 
 fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {

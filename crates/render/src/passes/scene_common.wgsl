@@ -5,10 +5,14 @@
 struct Instance {
     world_from_object: mat4x4<f32>,
     base_color: vec4<f32>,  // rgb: base colour, a: base alpha
-    // x: specular weight, y: Blinn-Phong exponent, z: object id (instance index + 1),
-    // w: alpha cutoff of a MASK material, −1 for none.
-    material: vec4<f32>,
-    texturing: vec4<f32>,   // x: 1 when the base colour texture is used
+    specular: f32,          // specular weight
+    shininess: f32,         // Blinn-Phong exponent
+    object_id: u32,         // the scene's instance index + 1
+    alpha_cutoff: f32,      // of a MASK material; −1 for none
+    textured: u32,          // 1 when the base colour is multiplied by the bound texture
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 struct VertexIn {
@@ -55,7 +59,7 @@ fn normal_from_object(m: mat4x4<f32>) -> mat3x3<f32> {
 // has one. Sampled at mip 0, as the reference ray tracer samples it.
 fn base_color_of(inst: Instance, uv: vec2<f32>) -> vec4<f32> {
     var c = inst.base_color;
-    if inst.texturing.x > 0.5 {
+    if inst.textured == 1u {
         c *= textureSampleLevel(base_color_texture, base_color_sampler, uv, 0.0);
     }
     return c;
@@ -63,5 +67,5 @@ fn base_color_of(inst: Instance, uv: vec2<f32>) -> vec4<f32> {
 
 // Whether an instance's surface is cut away at this point (alpha-masked materials).
 fn alpha_cut(inst: Instance, uv: vec2<f32>) -> bool {
-    return inst.material.w >= 0.0 && base_color_of(inst, uv).a < inst.material.w;
+    return inst.alpha_cutoff >= 0.0 && base_color_of(inst, uv).a < inst.alpha_cutoff;
 }

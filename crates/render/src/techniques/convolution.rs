@@ -13,6 +13,11 @@ impl ShadowTechnique for Convolution {
     fn technique(&self) -> Technique {
         Technique::Convolution
     }
+
+    /// The moment map's blur radius.
+    fn filter_reach_texels(&self, s: &FilterSettings, _: f32) -> f32 {
+        s.moments.blur_radius as f32
+    }
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("convolution.wgsl")]
     }

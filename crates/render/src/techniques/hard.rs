@@ -1,7 +1,7 @@
 //! `hard`: Williams' original depth comparison, one point sample, no filtering.
 //! L. Williams, "Casting curved shadows on curved surfaces", SIGGRAPH 1978.
 
-use gnomon_scene::settings::Technique;
+use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::ShadowTechnique;
 
@@ -10,6 +10,11 @@ pub struct Hard;
 impl ShadowTechnique for Hard {
     fn technique(&self) -> Technique {
         Technique::Hard
+    }
+
+    /// One point sample: no reach.
+    fn filter_reach_texels(&self, _: &FilterSettings, _: f32) -> f32 {
+        0.0
     }
 
     fn wgsl(&self) -> &'static [&'static str] {

@@ -58,6 +58,10 @@ pub trait ShadowTechnique: Sync {
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         None
     }
+    /// How far, in texels, the technique's lookup reaches from the receiver's texel
+    /// (beyond the bilinear footprint): a sample-fitted cascade keeps this margin
+    /// around its samples. `kernel_texels` is the PCF kernel's width in texels.
+    fn filter_reach_texels(&self, settings: &FilterSettings, kernel_texels: f32) -> f32;
     /// The filterable map the technique samples, if any.
     fn filterable_map(&self, _settings: &FilterSettings) -> Option<FilterableMap> {
         None

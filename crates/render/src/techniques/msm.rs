@@ -20,6 +20,11 @@ impl ShadowTechnique for Msm {
     fn technique(&self) -> Technique {
         self.technique
     }
+
+    /// The moment map's blur radius.
+    fn filter_reach_texels(&self, s: &FilterSettings, _: f32) -> f32 {
+        s.moments.blur_radius as f32
+    }
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("msm.wgsl")]
     }

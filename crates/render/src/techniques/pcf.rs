@@ -4,7 +4,7 @@
 //! filter is the hardware's 2×2 bilinear PCF; the kernel width and receiver-plane
 //! bias are common settings, carried in `light.kernel_width`, `kernel_in_world`, `poisson_taps` and `receiver_plane_bias`.
 
-use gnomon_scene::settings::Technique;
+use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::ShadowTechnique;
 
@@ -24,6 +24,11 @@ impl ShadowTechnique for Pcf2x2 {
         Technique::Pcf2x2
     }
 
+    /// One bilinear tap: no reach beyond its footprint.
+    fn filter_reach_texels(&self, _: &FilterSettings, _: f32) -> f32 {
+        0.0
+    }
+
     fn wgsl(&self) -> &'static [&'static str] {
         &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
            return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.layer, q.coords.z);\n}\n"]
@@ -39,6 +44,11 @@ impl ShadowTechnique for Pcf2x2 {
 impl ShadowTechnique for PcfBox {
     fn technique(&self) -> Technique {
         Technique::Pcf
+    }
+
+    /// Half the kernel's width each side.
+    fn filter_reach_texels(&self, _: &FilterSettings, kernel_texels: f32) -> f32 {
+        0.5 * kernel_texels
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
@@ -60,6 +70,11 @@ impl ShadowTechnique for PcfTent {
         Technique::PcfTent
     }
 
+    /// Half the kernel's width each side.
+    fn filter_reach_texels(&self, _: &FilterSettings, kernel_texels: f32) -> f32 {
+        0.5 * kernel_texels
+    }
+
     fn wgsl(&self) -> &'static [&'static str] {
         &[
             PCF_WGSL,
@@ -77,6 +92,11 @@ impl ShadowTechnique for PcfTent {
 impl ShadowTechnique for PcfPoisson {
     fn technique(&self) -> Technique {
         Technique::PcfPoisson
+    }
+
+    /// The disk's radius, half the kernel's width.
+    fn filter_reach_texels(&self, _: &FilterSettings, kernel_texels: f32) -> f32 {
+        0.5 * kernel_texels
     }
 
     fn wgsl(&self) -> &'static [&'static str] {

@@ -2,7 +2,7 @@
 //! light's own (spot disk radius, point light sphere radius or sun angular diameter), the same parameter the
 //! reference's area light uses; the search settings are carried in `light.light_size`, `blocker_taps` and `max_penumbra_texels`.
 
-use gnomon_scene::settings::Technique;
+use gnomon_scene::settings::{FilterSettings, Technique};
 
 use super::ShadowTechnique;
 
@@ -11,6 +11,11 @@ pub struct Pcss;
 impl ShadowTechnique for Pcss {
     fn technique(&self) -> Technique {
         Technique::Pcss
+    }
+
+    /// The largest penumbra radius it may filter with.
+    fn filter_reach_texels(&self, s: &FilterSettings, _: f32) -> f32 {
+        s.pcss.max_radius
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
