@@ -224,7 +224,7 @@ impl LightEntry {
 /// settings as valid shadow settings.
 pub fn check_light_shadow(table: &toml::Table) -> Result<ShadowSettings, String> {
     let mut merged = toml::Value::try_from(ShadowSettings::default()).map_err(|e| e.to_string())?;
-    overlay(&mut merged, &toml::Value::Table(table.clone()));
+    crate::settings::overlay(&mut merged, &toml::Value::Table(table.clone()));
     let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
     shadow.validate().map_err(|e| e.to_string())?;
     Ok(shadow)
@@ -398,26 +398,9 @@ pub fn merge_settings(file: &toml::Value, command_line: &Settings) -> Result<Set
     let defaults = toml::Value::try_from(Settings::default()).map_err(|e| e.to_string())?;
     let cli = toml::Value::try_from(command_line).map_err(|e| e.to_string())?;
     let mut merged = toml::Value::try_from(Settings::default()).map_err(|e| e.to_string())?;
-    overlay(&mut merged, file);
+    crate::settings::overlay(&mut merged, file);
     overlay_changes(&mut merged, &cli, &defaults);
     merged.try_into().map_err(|e: toml::de::Error| e.to_string())
-}
-
-/// Copies every value of `from` into `into`, recursing into tables.
-pub(crate) fn overlay(into: &mut toml::Value, from: &toml::Value) {
-    match (into, from) {
-        (toml::Value::Table(a), toml::Value::Table(b)) => {
-            for (k, v) in b {
-                match a.get_mut(k) {
-                    Some(slot) => overlay(slot, v),
-                    None => {
-                        a.insert(k.clone(), v.clone());
-                    }
-                }
-            }
-        }
-        (slot, v) => *slot = v.clone(),
-    }
 }
 
 /// Copies the values of `cli` that differ from `defaults` into `into`.

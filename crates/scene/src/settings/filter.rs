@@ -1,0 +1,311 @@
+//! The shadow filter: the technique and its parameters (PCF kernel, PCSS, the
+//! moment maps of the filterable techniques), with their checks.
+
+use super::*;
+
+/// How the shadow map is sampled and filtered.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Technique {
+    /// One point-sampled depth comparison: Williams (1978), the textbook algorithm.
+    Hard,
+    /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
+    #[default]
+    #[value(name = "pcf2x2")]
+    #[serde(rename = "pcf2x2")]
+    Pcf2x2,
+    /// Box PCF of width --pcf-kernel, from bilinear comparison taps with exact area
+    /// weights (Castaño 2013): a W×W box in ⌈(W+1)/2⌉² taps.
+    Pcf,
+    /// Tent PCF of width --pcf-kernel from bilinear comparison taps (Castaño 2013):
+    /// smoother edges than the box at the same cost.
+    PcfTent,
+    /// PCF over a Poisson disk of diameter --pcf-kernel, rotated per pixel by
+    /// interleaved gradient noise (Jimenez 2014): noise instead of banding.
+    PcfPoisson,
+    /// Percentage-closer soft shadows (Fernando 2005): a blocker search, then PCF
+    /// whose width follows the light's size and the blocker distance.
+    Pcss,
+    /// Variance shadow maps (Donnelly & Lauritzen 2006): blurred (d, d²) and
+    /// Chebyshev's bound.
+    Vsm,
+    /// Exponential shadow maps (Annen et al. 2008): exp(c·d), filtered in log space.
+    Esm,
+    /// Exponential variance shadow maps, positive exponent only (Lauritzen 2008).
+    Evsm2,
+    /// Exponential variance shadow maps with positive and negative exponents.
+    Evsm4,
+    /// Moment shadow maps (Peters & Klein 2015), four moments, Hamburger bound.
+    MsmHamburger,
+    /// Moment shadow maps, four moments, Hausdorff bound (depths in [0, 1]).
+    MsmHausdorff,
+    /// Convolution shadow maps (Annen et al. 2007): a Fourier series of the depth test.
+    Convolution,
+}
+
+impl Technique {
+    /// The name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Hard => "hard",
+            Technique::Pcf2x2 => "pcf2x2",
+            Technique::Pcf => "pcf",
+            Technique::PcfTent => "pcf-tent",
+            Technique::PcfPoisson => "pcf-poisson",
+            Technique::Pcss => "pcss",
+            Technique::Vsm => "vsm",
+            Technique::Esm => "esm",
+            Technique::Evsm2 => "evsm2",
+            Technique::Evsm4 => "evsm4",
+            Technique::MsmHamburger => "msm-hamburger",
+            Technique::MsmHausdorff => "msm-hausdorff",
+            Technique::Convolution => "convolution",
+        }
+    }
+
+    pub fn all() -> &'static [Technique] {
+        Technique::value_variants()
+    }
+
+    /// Whether the technique can shadow a point light, from its cube map: the
+    /// depth-comparison techniques, which sample the cube by direction.
+    pub fn supports_point_lights(self) -> bool {
+        matches!(
+            self,
+            Technique::Hard
+                | Technique::Pcf2x2
+                | Technique::Pcf
+                | Technique::PcfTent
+                | Technique::PcfPoisson
+                | Technique::Pcss
+        )
+    }
+
+    /// Whether the technique filters a map of moments (or other functions of depth)
+    /// instead of comparing depths.
+    pub fn is_filterable(self) -> bool {
+        matches!(
+            self,
+            Technique::Vsm
+                | Technique::Esm
+                | Technique::Evsm2
+                | Technique::Evsm4
+                | Technique::MsmHamburger
+                | Technique::MsmHausdorff
+                | Technique::Convolution
+        )
+    }
+}
+
+/// The unit of a PCF kernel's width.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum KernelUnit {
+    /// Shadow-map texels: the same blur everywhere in the map.
+    #[default]
+    Texels,
+    /// World units at the receiver: the same softness in the world whatever the
+    /// map's resolution or, for a spot light, the distance (capped at 32 texels).
+    World,
+}
+
+/// The filter axis: which technique, and its parameters.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FilterSettings {
+    /// Shadow filtering technique.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    pub technique: Technique,
+    /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
+    /// 1 to 32 texels, or a world width > 0.
+    #[arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter")]
+    pub pcf_kernel: f32,
+    /// Unit of --pcf-kernel.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    pub kernel_unit: KernelUnit,
+    /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64.
+    #[arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter")]
+    pub poisson_samples: u32,
+    /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
+    /// across the kernel along the receiver's plane, from the screen-space derivatives
+    /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
+    #[arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter")]
+    pub receiver_plane_bias: bool,
+    #[command(flatten)]
+    pub pcss: PcssSettings,
+    #[command(flatten)]
+    pub moments: MomentSettings,
+}
+
+impl Default for FilterSettings {
+    fn default() -> Self {
+        Self {
+            technique: Technique::default(),
+            pcf_kernel: 3.0,
+            kernel_unit: KernelUnit::default(),
+            poisson_samples: 32,
+            receiver_plane_bias: true,
+            pcss: PcssSettings::default(),
+            moments: MomentSettings::default(),
+        }
+    }
+}
+
+/// PCSS: the light's size comes from the light (--spot-radius or
+/// --sun-angular-diameter), the same parameter the reference's area light uses.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PcssSettings {
+    /// Depth taps of PCSS's blocker search: 8 to 64.
+    #[arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS")]
+    pub blocker_samples: u32,
+    /// Largest blocker-search and penumbra radius, in texels: 1 to 64. Wider
+    /// penumbrae are clipped to it.
+    #[arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS")]
+    pub max_radius: f32,
+}
+
+impl Default for PcssSettings {
+    fn default() -> Self {
+        Self { blocker_samples: 32, max_radius: 32.0 }
+    }
+}
+
+/// Storage format of a filterable moment map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MomentFormat {
+    /// 32-bit float where the adapter can filter it, else 16-bit (the GL backend).
+    #[default]
+    Auto,
+    /// 32-bit float per channel (needs FLOAT32_FILTERABLE).
+    Rgba32float,
+    /// 16-bit float per channel: half the memory and bandwidth. MSM then stores its
+    /// moments in Peters & Klein's optimised basis (use --moment-bias 6e-5), and EVSM
+    /// exponents must be at most 5.54.
+    Rgba16float,
+}
+
+/// Parameters of the filterable techniques: VSM, ESM, EVSM, MSM and convolution.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MomentSettings {
+    /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):
+    /// 0 (no blur) to 16.
+    #[arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps")]
+    pub blur_radius: u32,
+    /// Build mipmaps of the moment map and sample them trilinearly (VSM, EVSM, MSM,
+    /// convolution), against aliasing when the map is minified on screen.
+    #[arg(long, help_heading = "Filterable maps")]
+    pub mipmaps: bool,
+    /// Texel format of the moment map.
+    #[arg(long, value_enum, default_value_t, help_heading = "Filterable maps")]
+    pub moment_format: MomentFormat,
+    /// Smallest variance Chebyshev's bound may use (VSM, EVSM), in units of the
+    /// normalised light depth squared: ≥ 0. Hides acne from quantisation.
+    #[arg(long, value_name = "VARIANCE", default_value_t = MomentSettings::default().min_variance, help_heading = "Filterable maps")]
+    pub min_variance: f32,
+    /// Light-bleeding reduction (VSM, EVSM, MSM): the bound below this is cut to 0
+    /// and the rest rescaled to [0, 1] (Lauritzen's linstep). In [0, 1).
+    #[arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps")]
+    pub bleeding_reduction: f32,
+    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (the map
+    /// stores d and filters in log space, so c is not limited by the format).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps")]
+    pub esm_exponent: f32,
+    /// EVSM positive exponent: 0 to 42 (5.54 for 16-bit).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_positive, help_heading = "Filterable maps")]
+    pub evsm_positive: f32,
+    /// EVSM negative exponent (evsm4): 0 to 42 (5.54 for 16-bit).
+    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps")]
+    pub evsm_negative: f32,
+    /// MSM moment bias α: the moments are blended toward those of a two-point
+    /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits, 6e-5 at 16).
+    /// In [0, 0.1].
+    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps")]
+    pub moment_bias: f32,
+    /// Fourier terms M of convolution shadow maps: 1 to 16 (2M channels).
+    #[arg(long, value_name = "M", default_value_t = MomentSettings::default().csm_terms, help_heading = "Filterable maps")]
+    pub csm_terms: u32,
+    /// Ringing attenuation α of convolution shadow maps: term k is weighted by
+    /// exp(−α (k/M)²); 0 is the raw truncated series. ≥ 0.
+    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps")]
+    pub csm_attenuation: f32,
+    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. > 0.
+    #[arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps")]
+    pub csm_scale: f32,
+    /// Offset o of the convolution reconstruction (see --csm-scale): in [−0.5, 0.5].
+    #[arg(long, value_name = "O", default_value_t = MomentSettings::default().csm_offset, help_heading = "Filterable maps")]
+    pub csm_offset: f32,
+}
+
+impl Default for MomentSettings {
+    fn default() -> Self {
+        Self {
+            blur_radius: 2,
+            mipmaps: false,
+            moment_format: MomentFormat::default(),
+            min_variance: 1e-6,
+            bleeding_reduction: 0.2,
+            esm_exponent: 80.0,
+            evsm_positive: 40.0,
+            evsm_negative: 5.0,
+            moment_bias: 3e-5,
+            csm_terms: 8,
+            csm_attenuation: 2.0,
+            csm_scale: 2.0,
+            csm_offset: 0.25,
+        }
+    }
+}
+
+impl MomentSettings {
+    pub(super) fn validate(&self, technique: Technique) -> Result<(), SettingsError> {
+        let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
+        check(self.blur_radius <= 16, "--blur-radius", self.blur_radius, "0 to 16 texels")?;
+        check(in_range(self.min_variance, 0.0, 1.0), "--min-variance", self.min_variance, "0 to 1")?;
+        check(
+            self.bleeding_reduction.is_finite() && (0.0..1.0).contains(&self.bleeding_reduction),
+            "--bleeding-reduction",
+            self.bleeding_reduction,
+            "in [0, 1)",
+        )?;
+        // Only EVSM stores exponentials, so only its exponents are bounded by the
+        // format (with `auto` on a 16-bit adapter the renderer clamps them).
+        let evsm = matches!(technique, Technique::Evsm2 | Technique::Evsm4);
+        let half = evsm && self.moment_format == MomentFormat::Rgba16float;
+        // ESM stores d itself and exponentiates in the shader, so only EVSM, which
+        // stores exp(c·d) and its square, is limited by the storage format's range.
+        let (esm_max, evsm_max) = (88.0, if half { 5.54 } else { 42.0 });
+        let precision = if half { "with --moment-format rgba16float" } else { "at 32 bits" };
+        check(
+            in_range(self.esm_exponent, 1.0, esm_max),
+            "--esm-exponent",
+            self.esm_exponent,
+            format!("1 to {esm_max} {precision}"),
+        )?;
+        check(
+            in_range(self.evsm_positive, 0.0, evsm_max),
+            "--evsm-positive",
+            self.evsm_positive,
+            format!("0 to {evsm_max} {precision}"),
+        )?;
+        check(
+            in_range(self.evsm_negative, 0.0, evsm_max),
+            "--evsm-negative",
+            self.evsm_negative,
+            format!("0 to {evsm_max} {precision}"),
+        )?;
+        check(in_range(self.moment_bias, 0.0, 0.1), "--moment-bias", self.moment_bias, "0 to 0.1")?;
+        check((1..=16).contains(&self.csm_terms), "--csm-terms", self.csm_terms, "1 to 16")?;
+        check(
+            in_range(self.csm_attenuation, 0.0, 1e3),
+            "--csm-attenuation",
+            self.csm_attenuation,
+            "0 to 1000",
+        )?;
+        check(self.csm_scale.is_finite() && self.csm_scale > 0.0, "--csm-scale", self.csm_scale, "> 0")?;
+        check(in_range(self.csm_offset, -0.5, 0.5), "--csm-offset", self.csm_offset, "-0.5 to 0.5")?;
+        Ok(())
+    }
+}

@@ -1,0 +1,244 @@
+//! Which light casts the shadows, its overrides of the scene's light, and how the
+//! lights of a render are resolved with their own shadow settings.
+
+use super::*;
+
+/// Which of the scene's lights is rendered.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightKind {
+    /// The scene's directional light (sun), with an orthographic shadow map fitted to the scene.
+    #[default]
+    Sun,
+    /// The scene's spot light, with a perspective shadow map covering its cone.
+    Spot,
+    /// The scene's point light, with a cube shadow map (six 90° faces).
+    Point,
+    /// Every light of the scene's light list at once (scene files' [[light]],
+    /// glTF KHR_lights_punctual, the built-in `lamps`), each with its own shadow map
+    /// and shadow settings.
+    All,
+}
+
+/// The light, and overrides of the scene's light parameters.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct LightSettings {
+    /// Which light casts the shadows.
+    #[arg(long = "light", value_enum, default_value_t, help_heading = "Light")]
+    pub kind: LightKind,
+    /// Sun elevation above the horizon in degrees, in (0, 90] [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_elevation: Option<f32>,
+    /// Sun azimuth in degrees, measured from +z toward +x [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_azimuth: Option<f32>,
+    /// Spot light position, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub spot_position: Option<Vec3>,
+    /// Point the spot light aims at, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub spot_target: Option<Vec3>,
+    /// Spot cone outer half-angle in degrees, in (0, 89]: no light outside it [default: the scene's].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub spot_outer_angle: Option<f32>,
+    /// Spot cone inner half-angle in degrees, in [0, outer]: full light inside it [default: 80% of outer].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub spot_inner_angle: Option<f32>,
+    /// Spot light range in world units, > 0; also the shadow map's far plane [default: the scene's].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub spot_range: Option<f32>,
+    /// Radius of the spot light's emitting disk in world units, ≥ 0; 0 is a point
+    /// light with hard shadows [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub spot_radius: Option<f32>,
+    /// Angular diameter of the sun's disk in degrees, in [0, 30]; 0 gives hard
+    /// shadows, the real sun is about 0.53 [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    pub sun_angular_diameter: Option<f32>,
+    /// Point light position, as X,Y,Z [default: the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    pub point_position: Option<Vec3>,
+    /// Point light range in world units, > 0; also the cube faces' far plane [default: the scene's].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub point_range: Option<f32>,
+    /// Radius of the point light's emitting sphere in world units, ≥ 0; 0 gives hard
+    /// shadows [default: the scene's, 0 for the built-ins].
+    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    pub point_radius: Option<f32>,
+    /// With --light all: the light whose visibility the frame outputs and the
+    /// reference traces, as an index into the scene's light list.
+    #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Light")]
+    pub light_index: usize,
+}
+
+/// One light of a render, with the shadow settings it is drawn with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResolvedLight {
+    /// The light's name in the scene's list, or its type for a single light.
+    pub name: String,
+    pub light: Light,
+    /// The render's shadow settings with the light's own laid over them.
+    pub shadow: ShadowSettings,
+}
+
+impl Settings {
+    /// The light whose visibility a frame outputs and the reference traces: the
+    /// scene's light of the chosen kind with these settings' overrides, or with
+    /// --light all the one at --light-index.
+    pub fn resolve_light(&self, scene: &Scene) -> Result<Light, SettingsError> {
+        let l = &self.light;
+        Ok(match l.kind {
+            LightKind::All => {
+                let lights = self.scene_light_list(scene)?;
+                check(
+                    l.light_index < lights.len(),
+                    "--light-index",
+                    l.light_index,
+                    format!("below {}, the number of lights scene `{}` lists", lights.len(), scene.name),
+                )?;
+                lights[l.light_index].light
+            }
+            LightKind::Point => {
+                let mut point = scene.point;
+                point.position = l.point_position.unwrap_or(point.position);
+                point.range = l.point_range.unwrap_or(point.range);
+                point.radius = l.point_radius.unwrap_or(point.radius);
+                Light::Point(point)
+            }
+            LightKind::Sun => {
+                let mut sun = scene.sun;
+                if l.sun_elevation.is_some() || l.sun_azimuth.is_some() {
+                    let to_sun = -sun.direction;
+                    let elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
+                    let azimuth = to_sun.x.atan2(to_sun.z).to_degrees();
+                    sun.direction = -sun_direction(
+                        l.sun_elevation.unwrap_or(elevation),
+                        l.sun_azimuth.unwrap_or(azimuth),
+                    );
+                }
+                sun.angular_diameter_degrees = l.sun_angular_diameter.unwrap_or(sun.angular_diameter_degrees);
+                Light::Directional(sun)
+            }
+            LightKind::Spot => {
+                let mut spot = scene.spot;
+                let target = spot.position + spot.direction;
+                spot.position = l.spot_position.unwrap_or(spot.position);
+                if l.spot_position.is_some() || l.spot_target.is_some() {
+                    let aim = l.spot_target.unwrap_or(target) - spot.position;
+                    check(
+                        aim.length() > 1e-6,
+                        "--spot-target",
+                        "the spot position",
+                        "a point different from the spot light's position",
+                    )?;
+                    spot.direction = aim.normalize();
+                }
+                if let Some(outer) = l.spot_outer_angle {
+                    spot.outer_angle_degrees = outer;
+                    spot.inner_angle_degrees = 0.8 * outer;
+                }
+                if let Some(inner) = l.spot_inner_angle {
+                    spot.inner_angle_degrees = inner;
+                }
+                check(
+                    spot.inner_angle_degrees <= spot.outer_angle_degrees,
+                    "--spot-inner-angle",
+                    spot.inner_angle_degrees,
+                    format!("at most the outer angle {}", spot.outer_angle_degrees),
+                )?;
+                spot.range = l.spot_range.unwrap_or(spot.range);
+                spot.radius = l.spot_radius.unwrap_or(spot.radius);
+                Light::Spot(spot)
+            }
+        })
+    }
+
+    /// Every light of the render, each with its shadow settings: the one light of
+    /// --light sun, spot or point with these shadow settings, or with --light all the
+    /// scene's list, each light's own settings laid over these.
+    pub fn resolve_lights(&self, scene: &Scene) -> Result<Vec<ResolvedLight>, SettingsError> {
+        if self.light.kind != LightKind::All {
+            let light = self.resolve_light(scene)?;
+            check_light_type(&light, &self.shadow, light.type_name())?;
+            return Ok(vec![ResolvedLight {
+                name: light.type_name().into(),
+                light,
+                shadow: self.shadow.clone(),
+            }]);
+        }
+        self.resolve_light(scene)?;
+        self.scene_light_list(scene)?
+            .iter()
+            .map(|entry| {
+                let shadow = match &entry.shadow {
+                    None => self.shadow.clone(),
+                    Some(table) => self.shadow_with(table).map_err(|problem| SettingsError {
+                        flag: "[light.shadow]",
+                        value: entry.name.clone(),
+                        valid: problem,
+                    })?,
+                };
+                check_light_type(&entry.light, &shadow, &entry.name)?;
+                Ok(ResolvedLight { name: entry.name.clone(), light: entry.light, shadow })
+            })
+            .collect()
+    }
+
+    /// These shadow settings with `table` laid over them.
+    fn shadow_with(&self, table: &toml::Table) -> Result<ShadowSettings, String> {
+        let mut merged = toml::Value::try_from(&self.shadow).map_err(|e| e.to_string())?;
+        overlay(&mut merged, &toml::Value::Table(table.clone()));
+        let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
+        shadow.validate().map_err(|e| e.to_string())?;
+        Ok(shadow)
+    }
+
+    fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<&'s [crate::SceneLight], SettingsError> {
+        check(
+            !scene.lights.is_empty(),
+            "--light",
+            "all",
+            format!(
+                "a scene with a light list; `{}` has none (scene files list [[light]], glTF files KHR_lights_punctual lights, and the built-in `lamps` has eight)",
+                scene.name
+            ),
+        )?;
+        check(
+            scene.lights.len() <= MAX_LIGHTS,
+            "--light",
+            "all",
+            format!("at most {MAX_LIGHTS} lights; `{}` lists {}", scene.name, scene.lights.len()),
+        )?;
+        Ok(&scene.lights)
+    }
+}
+
+/// The most lights one render draws.
+pub const MAX_LIGHTS: usize = 32;
+
+/// Checks that a light's type and its shadow settings go together: a point light's
+/// cube map takes the depth-comparison techniques and a single map.
+fn check_light_type(light: &Light, shadow: &ShadowSettings, name: &str) -> Result<(), SettingsError> {
+    if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
+        check(
+            shadow.filter.technique.supports_point_lights() && shadow.filter.technique != Technique::Pcss,
+            "--technique",
+            shadow.filter.technique.name(),
+            format!(
+                "for point light `{name}` with --omni paraboloid: hard, pcf2x2, pcf, pcf-tent or pcf-poisson"
+            ),
+        )?;
+    }
+    if let Light::Point(_) = light {
+        check(
+            shadow.filter.technique.supports_point_lights(),
+            "--technique",
+            shadow.filter.technique.name(),
+            format!(
+                "for point light `{name}` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
+            ),
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,272 @@
+//! The one typed settings structure for a render: image size, camera, light and
+//! shadows. The command-line flags (clap) and the file format (serde/TOML) are both
+//! derived from these definitions, so their names, defaults and help text agree.
+//!
+//! Camera and light fields are optional overrides of the scene's own defaults. The
+//! shadow settings are orthogonal axes: the filter (technique), the bias, the map,
+//! and the partition of the light's view.
+
+use clap::{Args, ValueEnum};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::{Camera, Light, Scene, sun_direction};
+
+mod error;
+mod filter;
+mod light;
+mod screen;
+mod shadow;
+#[cfg(test)]
+mod tests;
+
+pub use error::SettingsError;
+use error::{check, check_opt, check_vec};
+pub use filter::*;
+pub use light::*;
+pub use screen::*;
+pub use shadow::*;
+
+/// Everything that configures one render besides the scene itself.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Settings {
+    #[command(flatten)]
+    pub scene: SceneOptions,
+    #[command(flatten)]
+    pub image: ImageSettings,
+    #[command(flatten)]
+    pub camera: CameraSettings,
+    #[command(flatten)]
+    pub light: LightSettings,
+    #[command(flatten)]
+    pub shadow: ShadowSettings,
+    #[command(flatten)]
+    pub screen: ScreenSpaceSettings,
+    #[command(flatten)]
+    pub reference: ReferenceSettings,
+}
+
+/// Changes to the scene itself.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct SceneOptions {
+    /// Add a ground plane under the scene: at its lowest point, three times its
+    /// width, for models that come without a floor to receive their shadows (the
+    /// built-in scenes have one already).
+    #[arg(long, help_heading = "Scene")]
+    pub ground: bool,
+}
+
+/// The ray-traced reference.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReferenceSettings {
+    /// Shadow rays per pixel for an area light (a spot with --spot-radius > 0 or a sun
+    /// with --sun-angular-diameter > 0): 8 to 65536, stratified. A point light needs one.
+    #[arg(long, value_name = "N", default_value_t = ReferenceSettings::default().samples, help_heading = "Reference")]
+    pub samples: u32,
+}
+
+impl Default for ReferenceSettings {
+    fn default() -> Self {
+        Self { samples: 256 }
+    }
+}
+
+/// A diagnostic view drawn over the lit image.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DebugView {
+    /// The lit image alone.
+    #[default]
+    None,
+    /// Tint each pixel by the cascade that shades it: red, green, blue, yellow,
+    /// magenta, cyan, orange, violet for cascades 0 to 7.
+    Cascades,
+}
+
+/// The output image.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ImageSettings {
+    /// Image width in pixels (1 to 16384).
+    #[arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image")]
+    pub width: u32,
+    /// Image height in pixels (1 to 16384).
+    #[arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image")]
+    pub height: u32,
+    /// A diagnostic view over the image.
+    #[arg(long, value_enum, default_value_t, help_heading = "Image")]
+    pub debug_view: DebugView,
+}
+
+impl Default for ImageSettings {
+    fn default() -> Self {
+        Self { width: 1280, height: 720, debug_view: DebugView::None }
+    }
+}
+
+/// Overrides of the scene's camera. An absent field keeps the scene's value.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraSettings {
+    /// Camera position in world units, as X,Y,Z [default: the scene's].
+    #[arg(long = "camera-eye", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at, as X,Y,Z [default: the scene's].
+    #[arg(long = "camera-target", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    pub target: Option<Vec3>,
+    /// Full vertical field of view in degrees, in (0, 180) [default: the scene's].
+    #[arg(long = "fov", value_name = "DEGREES", help_heading = "Camera")]
+    pub fov_y_degrees: Option<f32>,
+    /// Near clip distance in world units, > 0 [default: the scene's].
+    #[arg(long = "camera-near", value_name = "DISTANCE", help_heading = "Camera")]
+    pub near: Option<f32>,
+    /// Far clip distance in world units, > near [default: the scene's].
+    #[arg(long = "camera-far", value_name = "DISTANCE", help_heading = "Camera")]
+    pub far: Option<f32>,
+}
+
+/// The largest shadow map Gnomon allows, whatever the device.
+pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
+
+/// The most cascades a light may have: the renderer sizes its uniforms by it.
+pub const MAX_CASCADES: u32 = 8;
+
+/// The widest PCF kernel, in texels (a world-unit kernel is clamped to it too).
+pub const MAX_KERNEL_TEXELS: f32 = 32.0;
+/// The smallest shadow map Gnomon allows.
+pub const MIN_SHADOW_RESOLUTION: u32 = 256;
+
+impl Settings {
+    /// Checks every value against its documented range. Device-dependent limits (the
+    /// largest texture) are checked by the renderer, which knows the device.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let i = &self.image;
+        check((1..=16384).contains(&i.width), "--width", i.width, "1 to 16384 pixels")?;
+        check((1..=16384).contains(&i.height), "--height", i.height, "1 to 16384 pixels")?;
+        let c = &self.camera;
+        check_vec(c.eye, "--camera-eye")?;
+        check_vec(c.target, "--camera-target")?;
+        check_opt(
+            c.fov_y_degrees,
+            "--fov",
+            |x| x > 0.0 && x < 180.0,
+            "between 0 and 180 degrees, exclusive",
+        )?;
+        check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
+        check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
+        let l = &self.light;
+        check_opt(l.sun_elevation, "--sun-elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
+        check_opt(l.sun_azimuth, "--sun-azimuth", |_| true, "a finite angle in degrees")?;
+        check_vec(l.spot_position, "--spot-position")?;
+        check_vec(l.spot_target, "--spot-target")?;
+        check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
+        check_opt(
+            l.spot_inner_angle,
+            "--spot-inner-angle",
+            |x| (0.0..=89.0).contains(&x),
+            "in [0, outer angle] degrees",
+        )?;
+        check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.spot_radius, "--spot-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_vec(l.point_position, "--point-position")?;
+        check_opt(l.point_range, "--point-range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.point_radius, "--point-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_opt(
+            l.sun_angular_diameter,
+            "--sun-angular-diameter",
+            |x| (0.0..=30.0).contains(&x),
+            "in [0, 30] degrees",
+        )?;
+        self.shadow.validate()?;
+        let n = self.reference.samples;
+        check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
+        Ok(())
+    }
+
+    /// Whether a frame with these lights resolves its shadows in a screen-space mask:
+    /// as --shadow-path says, and with `auto` when any light marches contact shadows.
+    /// Contact shadows with --shadow-path forward are refused: they need the prepass.
+    pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
+        let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
+        match (self.screen.shadow_path, contact) {
+            (ShadowPath::Forward, Some(light)) => Err(SettingsError {
+                flag: "--contact-shadows",
+                value: format!("on for light `{}`", light.name),
+                valid: "only with --shadow-path auto or mask: contact shadows march through the mask path's depth prepass"
+                    .into(),
+            }),
+            (ShadowPath::Forward, None) => Ok(false),
+            (ShadowPath::Mask, _) => Ok(true),
+            (ShadowPath::Auto, contact) => Ok(contact.is_some()),
+        }
+    }
+
+    /// The camera: the scene's, with these settings' overrides applied.
+    pub fn resolve_camera(&self, scene: &Scene) -> Result<Camera, SettingsError> {
+        let c = &self.camera;
+        let mut cam = scene.camera;
+        cam.eye = c.eye.unwrap_or(cam.eye);
+        cam.target = c.target.unwrap_or(cam.target);
+        cam.fov_y_degrees = c.fov_y_degrees.unwrap_or(cam.fov_y_degrees);
+        if c.eye.is_some() || c.target.is_some() {
+            // The scene's planes were chosen for its own viewpoint; from a new one,
+            // fit them to the scene's bounds: far past the farthest corner, near a
+            // small fraction of that (Depth32Float keeps ample precision at 1e4).
+            let bounds = scene.bounds();
+            let farthest = bounds.corners().iter().map(|p| p.distance(cam.eye)).fold(0.0f32, f32::max);
+            cam.far = 1.01 * farthest.max(1e-3);
+            cam.near = cam.far * 1e-4;
+        }
+        cam.near = c.near.unwrap_or(cam.near);
+        cam.far = c.far.unwrap_or(cam.far);
+        check(
+            cam.far > cam.near,
+            "--camera-far",
+            cam.far,
+            format!("greater than the near distance {}", cam.near),
+        )?;
+        check(
+            (cam.target - cam.eye).length() > 1e-6,
+            "--camera-target",
+            "the eye position",
+            "a point different from the camera position",
+        )?;
+        Ok(cam)
+    }
+}
+
+/// Parses `X,Y,Z` into a vector.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three comma-separated numbers X,Y,Z, got `{s}`"));
+    }
+    let mut v = [0.0f32; 3];
+    for (slot, part) in v.iter_mut().zip(&parts) {
+        *slot = part.parse().map_err(|_| format!("`{part}` in `{s}` is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("`{part}` in `{s}` is not finite"));
+        }
+    }
+    Ok(Vec3::from_array(v))
+}
+
+/// Copies every value of `from` into `into`, recursing into tables.
+pub(crate) fn overlay(into: &mut toml::Value, from: &toml::Value) {
+    match (into, from) {
+        (toml::Value::Table(a), toml::Value::Table(b)) => {
+            for (k, v) in b {
+                match a.get_mut(k) {
+                    Some(slot) => overlay(slot, v),
+                    None => {
+                        a.insert(k.clone(), v.clone());
+                    }
+                }
+            }
+        }
+        (slot, v) => *slot = v.clone(),
+    }
+}

@@ -1,0 +1,109 @@
+//! Screen-space settings: where each pixel's shadow is resolved (forward or the
+//! shadow mask), and contact shadows.
+
+use super::*;
+
+/// Where each pixel's shadow is resolved.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowPath {
+    /// The mask when any light has contact shadows (which march through its depth),
+    /// forward otherwise.
+    #[default]
+    Auto,
+    /// In the lighting pass, once per fragment drawn.
+    Forward,
+    /// Screen-space shadows, as in Unity URP: a depth-and-normal prepass, then one
+    /// full-screen pass per light that reconstructs each pixel's position from depth,
+    /// looks its shadow up once and stores it in a mask the lighting pass reads.
+    Mask,
+}
+
+/// How shadows are resolved on screen: the frame-wide choice of path (contact
+/// shadows, per light, are in the shadow settings).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScreenSpaceSettings {
+    /// Where each pixel's shadow lookup runs: forward, in the lighting pass, or once
+    /// per pixel into a screen-space shadow mask.
+    #[arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")]
+    pub shadow_path: ShadowPath,
+}
+
+/// Contact shadows: a short ray marched in screen space from each pixel toward the
+/// light through the depth prepass, to restore the shadows that a shadow map's bias
+/// and resolution lose where objects meet (after Sousa, Kasyan & Schulz, "Secrets of
+/// CryENGINE 3 graphics technology", 2011, and Unreal's screen-space shadows). The
+/// result multiplies in as min(map, contact).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ContactSettings {
+    /// March contact shadows for this light (needs --shadow-path auto or mask).
+    #[arg(long, help_heading = "Contact shadows")]
+    pub contact_shadows: bool,
+    /// Length of the ray toward the light, in world units (> 0, at most 10).
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_length, help_heading = "Contact shadows")]
+    pub contact_length: f32,
+    /// Depth-buffer samples along the ray, 1 to 64; the start is jittered per pixel by
+    /// interleaved gradient noise.
+    #[arg(long, value_name = "N", default_value_t = ContactSettings::default().contact_steps, help_heading = "Contact shadows")]
+    pub contact_steps: u32,
+    /// Assumed thickness of what the depth buffer holds, as a fraction of its view
+    /// depth: a sample behind the depth buffer by less than this occludes the ray,
+    /// one farther behind passes behind the surface. 0 to 1.
+    #[arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows")]
+    pub contact_thickness: f32,
+    /// The ray starts this far along the surface's normal, in world units, so that its
+    /// first samples clear the receiver's own depth. ≥ 0.
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_bias, help_heading = "Contact shadows")]
+    pub contact_bias: f32,
+    /// View depth beyond which contact shadows are off; they fade out over its last
+    /// quarter. > 0.
+    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_distance, help_heading = "Contact shadows")]
+    pub contact_distance: f32,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            contact_shadows: false,
+            contact_length: 0.3,
+            contact_steps: 16,
+            contact_thickness: 0.02,
+            contact_bias: 0.02,
+            contact_distance: 50.0,
+        }
+    }
+}
+
+impl ContactSettings {
+    pub(super) fn validate(&self) -> Result<(), SettingsError> {
+        let finite = |x: f32| x.is_finite();
+        check(
+            finite(self.contact_length) && self.contact_length > 0.0 && self.contact_length <= 10.0,
+            "--contact-length",
+            self.contact_length,
+            "a distance in (0, 10]",
+        )?;
+        check((1..=64).contains(&self.contact_steps), "--contact-steps", self.contact_steps, "1 to 64")?;
+        check(
+            finite(self.contact_thickness) && self.contact_thickness > 0.0 && self.contact_thickness <= 1.0,
+            "--contact-thickness",
+            self.contact_thickness,
+            "a fraction of the view depth in (0, 1]",
+        )?;
+        check(
+            finite(self.contact_bias) && self.contact_bias >= 0.0,
+            "--contact-bias",
+            self.contact_bias,
+            "a distance ≥ 0",
+        )?;
+        check(
+            finite(self.contact_distance) && self.contact_distance > 0.0,
+            "--contact-distance",
+            self.contact_distance,
+            "a distance > 0",
+        )?;
+        Ok(())
+    }
+}

@@ -1,0 +1,400 @@
+//! The shadow map and its partition: bias and culling, the map's resolution,
+//! format, fit and warp, the point lights' map, cascades, and the checks that tie
+//! them together.
+
+use super::*;
+
+/// Which faces the shadow pass culls.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CullMode {
+    /// Cull faces turned away from the light: the usual choice.
+    #[default]
+    Back,
+    /// Cull faces turned toward the light, so closed meshes store their back faces:
+    /// the classic anti-acne trick, which can leak where meshes are open or thin.
+    Front,
+    /// Draw both sides.
+    None,
+}
+
+/// The bias axis: offsets that keep a surface from shadowing itself (acne) without
+/// detaching shadows from their casters (peter-panning).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BiasSettings {
+    /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
+    /// For Depth32Float one unit is 2^(e−23) for a primitive whose largest depth has
+    /// exponent e: about 6e-8 at depth 0.5.
+    #[arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias")]
+    pub depth_bias: i32,
+    /// Rasterizer slope-scaled depth bias (D3D `SlopeScaledDepthBias`): multiplies the
+    /// caster's depth slope per shadow texel, so 1 pushes a surface back by the depth
+    /// it spans across one texel. Must be finite and ≥ 0.
+    #[arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias")]
+    pub slope_bias: f32,
+    /// Normal-offset bias: the receiver is pushed along its surface normal by this many
+    /// shadow texels (world size of a texel at the receiver) times 1 − N·L before the
+    /// lookup, so surfaces facing the light are hardly moved and grazing ones fully
+    /// (Holbert, "Normal offset shadows", 2011). ≥ 0.
+    #[arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias")]
+    pub normal_offset: f32,
+    /// Faces culled when drawing casters into the shadow map.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow bias")]
+    pub cull: CullMode,
+}
+
+impl BiasSettings {
+    /// No bias at all, for demonstrating acne.
+    pub fn none() -> Self {
+        Self { depth_bias: 0, slope_bias: 0.0, normal_offset: 0.0, cull: CullMode::Back }
+    }
+}
+
+impl Default for BiasSettings {
+    fn default() -> Self {
+        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.6, cull: CullMode::Back }
+    }
+}
+
+/// The storage format of the shadow map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MapFormat {
+    /// 32-bit float depth: exact enough for every technique here, and filterable by comparison.
+    #[default]
+    Depth32float,
+}
+
+/// What a directional light's map is fitted to.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Fit {
+    /// The whole scene's bounds, whatever the camera sees: stable, but texels are
+    /// spent on ground the camera never shows.
+    Scene,
+    /// The potential receivers: the intersection of the camera's view frustum with the
+    /// scene's bounds in x and y, extended toward the light to every caster in z.
+    #[default]
+    Receivers,
+}
+
+/// The map axis: the shadow map's size and format.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MapSettings {
+    /// Shadow map width and height in texels: 256 to 8192, and at most the device's
+    /// maximum 2D texture size.
+    #[arg(long = "shadow-res", value_name = "TEXELS", default_value_t = MapSettings::default().resolution, help_heading = "Shadow map")]
+    pub resolution: u32,
+    /// Shadow map texel format.
+    #[arg(long = "shadow-format", value_enum, default_value_t, help_heading = "Shadow map")]
+    pub format: MapFormat,
+    /// What a sun's map covers (a spot's map always covers its cone).
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub fit: Fit,
+    /// Perspective warp of a sun's single map, fitted to the receivers. Warped maps store
+    /// depth that is monotonic along each light ray but not linear in distance, so they
+    /// take the depth-comparison techniques (hard and the PCF family) with kernels in
+    /// texels; a spot's map is perspective already and ignores this.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub warp: WarpKind,
+    /// Depth clamping ("pancaking") where the device supports it (unclipped depth): a
+    /// sun's map fitted to the receivers (--fit receivers, tight cascades) starts its
+    /// depth range at the nearest receiver, and casters nearer the sun are clamped onto
+    /// that plane, so the range, and the depth error, shrink. Never for PCSS, stable
+    /// cascades or warps.
+    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set, help_heading = "Shadow map")]
+    pub depth_clamp: bool,
+    /// How a point light's map covers every direction.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub omni: OmniMap,
+}
+
+impl Default for MapSettings {
+    fn default() -> Self {
+        Self {
+            resolution: 2048,
+            format: MapFormat::default(),
+            fit: Fit::default(),
+            warp: WarpKind::default(),
+            depth_clamp: true,
+            omni: OmniMap::default(),
+        }
+    }
+}
+
+/// The parametrization of a point light's map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum OmniMap {
+    /// A cube: six 90° faces, sampled by direction; uniform texels within a factor
+    /// of 3 in solid angle, six passes.
+    #[default]
+    Cube,
+    /// Dual paraboloids (Brabec, Annen & Seidel 2002): two hemispheres, the lower
+    /// one around the light's −y axis, in two passes. Cheaper to draw, but the
+    /// parabolic mapping bends straight edges that the rasterizer draws straight,
+    /// and texels grow 4× from the axis to the rim. Hard and PCF lookups only.
+    Paraboloid,
+}
+
+/// Perspective warps of a sun's map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum WarpKind {
+    /// No warp: an orthographic map.
+    #[default]
+    None,
+    /// Perspective shadow maps (Stamminger & Drettakis 2002): the map drawn in the
+    /// camera's post-perspective space, the camera slid back to take in every caster.
+    Psm,
+    /// Light-space perspective shadow maps (Wimmer, Scherzer & Purgathofer 2004), with
+    /// n_opt = (z_n + √(z_n·z_f)) / sin γ.
+    Lispsm,
+    /// Trapezoidal shadow maps (Martin & Tan 2004), with the 80 % rule.
+    Tsm,
+}
+
+/// How the light's view is split into shadow maps.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Partition {
+    /// One map covering what the light must see (see --fit).
+    #[default]
+    Single,
+    /// Cascaded shadow maps for a sun: the view frustum split along its depth, one
+    /// --shadow-res map per slice, in a depth texture array (a spot keeps one map).
+    Cascades,
+}
+
+/// How the view depth range is divided among cascades.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum SplitScheme {
+    /// Equal depth ranges.
+    Uniform,
+    /// Equal depth ratios, matching perspective texel density.
+    Log,
+    /// Parallel-split shadow maps: λ·log + (1 − λ)·uniform (λ = 1 is fully log).
+    #[default]
+    Practical,
+}
+
+/// How each cascade's map is placed over its slice.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CascadeFit {
+    /// The slice's potential receivers exactly: the most texels on screen, but the
+    /// map's size and position change as the camera moves, so edges shimmer.
+    Tight,
+    /// The slice's bounding sphere, snapped to whole texels: a fixed size whatever the
+    /// camera's orientation, moving in texel steps, so edges hold still.
+    #[default]
+    Stable,
+}
+
+/// How a pixel picks its cascade.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CascadeSelection {
+    /// By the pixel's view depth against the split distances.
+    #[default]
+    Depth,
+    /// The first cascade whose map contains the pixel's projection: uses the finer
+    /// maps wherever their (stable, larger) windows reach.
+    Projection,
+}
+
+/// Cascaded shadow maps (--partition cascades).
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CascadeSettings {
+    /// Number of cascades: 1 to 8.
+    #[arg(long = "cascades", value_name = "N", default_value_t = CascadeSettings::default().count, help_heading = "Cascades")]
+    pub count: u32,
+    /// Split scheme of the view depth range.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub split: SplitScheme,
+    /// λ of the practical split scheme, in [0, 1]: 1 is fully logarithmic.
+    #[arg(long, value_name = "LAMBDA", default_value_t = CascadeSettings::default().split_lambda, help_heading = "Cascades")]
+    pub split_lambda: f32,
+    /// Farthest view depth the cascades cover, in world units, > 0 [default: the
+    /// camera's far plane]. Beyond it a sun casts no shadow.
+    #[arg(long, value_name = "DISTANCE", help_heading = "Cascades")]
+    pub shadow_distance: Option<f32>,
+    /// How each cascade's map is fitted to its slice.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub cascade_fit: CascadeFit,
+    /// How a pixel chooses its cascade.
+    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    pub cascade_selection: CascadeSelection,
+    /// Width of the band at the far end of each cascade over which it blends into the
+    /// next, as a fraction of the cascade's depth range: 0 to 0.5.
+    #[arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades")]
+    pub cascade_blend: f32,
+    /// Keep the cascades fitted to the first frame while the camera moves (along
+    /// `compare --camera-path`, or in the viewer), to see what refitting buys.
+    #[arg(long = "freeze-cascades", help_heading = "Cascades")]
+    pub freeze: bool,
+    /// Sample-distribution shadow maps (Lauritzen, Salvi & Lefohn 2011): split the view
+    /// depths the camera actually sees, reduced on the GPU from a depth prepass of the
+    /// shadow casters, instead of the depths where the view frustum meets the scene's
+    /// bounds. Costs a prepass and a read back of two numbers before the shadow pass.
+    #[arg(long, help_heading = "Cascades")]
+    pub sdsm: bool,
+    /// With --sdsm, also fit each tight cascade in x and y to the light-space bounds of
+    /// the samples it serves (a second reduction of the same depth buffer), instead of
+    /// to its whole slice of the view frustum.
+    #[arg(long, help_heading = "Cascades")]
+    pub sdsm_bounds: bool,
+}
+
+impl Default for CascadeSettings {
+    fn default() -> Self {
+        Self {
+            count: 4,
+            split: SplitScheme::default(),
+            split_lambda: 0.8,
+            shadow_distance: None,
+            cascade_fit: CascadeFit::default(),
+            cascade_selection: CascadeSelection::default(),
+            cascade_blend: 0.1,
+            freeze: false,
+            sdsm: false,
+            sdsm_bounds: false,
+        }
+    }
+}
+
+/// Shadow settings, one field per orthogonal axis.
+#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct ShadowSettings {
+    #[command(flatten)]
+    pub filter: FilterSettings,
+    #[command(flatten)]
+    pub bias: BiasSettings,
+    #[command(flatten)]
+    pub map: MapSettings,
+    /// Partition of the light's view into maps.
+    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    pub partition: Partition,
+    #[command(flatten)]
+    pub cascades: CascadeSettings,
+    #[command(flatten)]
+    pub contact: ContactSettings,
+}
+
+impl ShadowSettings {
+    /// Checks every shadow value against its documented range.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let s = self;
+        let f = &s.filter;
+        match f.kernel_unit {
+            KernelUnit::Texels => check(
+                f.pcf_kernel.is_finite() && (1.0..=MAX_KERNEL_TEXELS).contains(&f.pcf_kernel),
+                "--pcf-kernel",
+                f.pcf_kernel,
+                format!("1 to {MAX_KERNEL_TEXELS} texels (or a world width with --kernel-unit world)"),
+            )?,
+            KernelUnit::World => check(
+                f.pcf_kernel.is_finite() && f.pcf_kernel > 0.0,
+                "--pcf-kernel",
+                f.pcf_kernel,
+                "a world width > 0",
+            )?,
+        }
+        check((8..=64).contains(&f.poisson_samples), "--poisson-samples", f.poisson_samples, "8 to 64")?;
+        check(
+            (8..=64).contains(&f.pcss.blocker_samples),
+            "--blocker-samples",
+            f.pcss.blocker_samples,
+            "8 to 64",
+        )?;
+        check(
+            f.pcss.max_radius.is_finite() && (1.0..=64.0).contains(&f.pcss.max_radius),
+            "--max-radius",
+            f.pcss.max_radius,
+            "1 to 64 texels",
+        )?;
+        f.moments.validate(f.technique)?;
+        if s.map.warp != WarpKind::None {
+            let warp = s.map.warp.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default();
+            check(
+                s.partition == Partition::Single,
+                "--warp",
+                &warp,
+                "a warp of a single map: with --partition cascades use --warp none",
+            )?;
+            check(
+                matches!(
+                    f.technique,
+                    Technique::Hard
+                        | Technique::Pcf2x2
+                        | Technique::Pcf
+                        | Technique::PcfTent
+                        | Technique::PcfPoisson
+                ),
+                "--warp",
+                &warp,
+                format!(
+                    "with --technique {}: a warped map takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson (its depth is not linear in distance)",
+                    f.technique.name()
+                ),
+            )?;
+            check(
+                f.kernel_unit == KernelUnit::Texels,
+                "--warp",
+                &warp,
+                "with --kernel-unit world: a warped map's kernels are in texels",
+            )?;
+        }
+        let c = &s.cascades;
+        check((1..=MAX_CASCADES).contains(&c.count), "--cascades", c.count, format!("1 to {MAX_CASCADES}"))?;
+        check(
+            c.split_lambda.is_finite() && (0.0..=1.0).contains(&c.split_lambda),
+            "--split-lambda",
+            c.split_lambda,
+            "0 to 1",
+        )?;
+        check(
+            c.cascade_blend.is_finite() && (0.0..=0.5).contains(&c.cascade_blend),
+            "--cascade-blend",
+            c.cascade_blend,
+            "0 to 0.5",
+        )?;
+        check_opt(c.shadow_distance, "--shadow-distance", |x| x > 0.0, "a distance > 0")?;
+        if c.sdsm_bounds {
+            check(c.sdsm, "--sdsm-bounds", "set", "only with --sdsm, whose depth prepass it reduces")?;
+            check(
+                c.cascade_fit == CascadeFit::Tight,
+                "--sdsm-bounds",
+                "set",
+                "only with --cascade-fit tight: bounds that follow every pixel cannot keep a stable cascade still",
+            )?;
+        }
+        let b = &s.bias;
+        check(
+            b.slope_bias.is_finite() && b.slope_bias >= 0.0,
+            "--slope-bias",
+            b.slope_bias,
+            "a finite factor ≥ 0",
+        )?;
+        check(
+            b.normal_offset.is_finite() && b.normal_offset >= 0.0,
+            "--normal-offset",
+            b.normal_offset,
+            "a finite number of texels ≥ 0",
+        )?;
+        let r = s.map.resolution;
+        check(
+            (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
+            "--shadow-res",
+            r,
+            format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
+        )?;
+        s.contact.validate()?;
+        Ok(())
+    }
+}

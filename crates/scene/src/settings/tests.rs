@@ -1,0 +1,287 @@
+//! Settings tests: flags, defaults and TOML agree; invalid values name their
+//! setting and range; lights resolve with their own shadow settings.
+
+use super::*;
+use clap::Parser;
+
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    settings: Settings,
+}
+
+#[test]
+fn flag_defaults_equal_struct_defaults() {
+    let parsed = Cli::try_parse_from(["gnomon"]).unwrap().settings;
+    assert_eq!(parsed, Settings::default());
+    parsed.validate().unwrap();
+}
+
+#[test]
+fn flags_and_toml_agree() {
+    let parsed = Cli::try_parse_from([
+        "gnomon",
+        "--technique",
+        "pcf",
+        "--pcf-kernel",
+        "5",
+        "--shadow-res",
+        "1024",
+        "--slope-bias",
+        "2.5",
+        "--cull",
+        "front",
+        "--light",
+        "spot",
+        "--camera-eye",
+        "1,2,3",
+        "--kernel-unit",
+        "world",
+        "--receiver-plane-bias",
+        "false",
+        "--blur-radius",
+        "4",
+        "--mipmaps",
+        "--moment-format",
+        "rgba16float",
+        "--csm-terms",
+        "12",
+        "--shadow-path",
+        "mask",
+        "--contact-shadows",
+        "--contact-length",
+        "0.5",
+        "--contact-steps",
+        "24",
+    ])
+    .unwrap()
+    .settings;
+    let text = r#"
+        [camera]
+        eye = [1.0, 2.0, 3.0]
+        [light]
+        kind = "spot"
+        [shadow.filter]
+        technique = "pcf"
+        pcf_kernel = 5
+        kernel_unit = "world"
+        receiver_plane_bias = false
+        [shadow.filter.moments]
+        blur_radius = 4
+        mipmaps = true
+        moment_format = "rgba16float"
+        csm_terms = 12
+        [shadow.bias]
+        slope_bias = 2.5
+        cull = "front"
+        [shadow.map]
+        resolution = 1024
+        [shadow.contact]
+        contact_shadows = true
+        contact_length = 0.5
+        contact_steps = 24
+        [screen]
+        shadow_path = "mask"
+    "#;
+    let from_file: Settings = toml::from_str(text).unwrap();
+    assert_eq!(parsed, from_file);
+    // And a round trip through TOML keeps everything.
+    let again: Settings = toml::from_str(&toml::to_string(&parsed).unwrap()).unwrap();
+    assert_eq!(again, parsed);
+}
+
+#[test]
+fn invalid_values_name_the_flag_and_the_range() {
+    let mut s = Settings::default();
+    s.shadow.map.resolution = 100;
+    let e = s.validate().unwrap_err();
+    assert_eq!(e.flag, "--shadow-res");
+    assert!(e.to_string().contains("256 to 8192"), "{e}");
+    let mut s = Settings::default();
+    s.shadow.filter.pcf_kernel = 40.0;
+    assert_eq!(s.validate().unwrap_err().flag, "--pcf-kernel");
+    let mut s = Settings::default();
+    s.camera.fov_y_degrees = Some(180.0);
+    assert_eq!(s.validate().unwrap_err().flag, "--fov");
+    assert!(parse_vec3("1,2").is_err() && parse_vec3("1,x,3").is_err() && parse_vec3("1,inf,2").is_err());
+    assert_eq!(parse_vec3(" 1, 2.5,-3").unwrap(), Vec3::new(1.0, 2.5, -3.0));
+}
+
+#[test]
+fn warps_take_a_single_map_and_a_depth_comparison() {
+    let mut s = Settings::default();
+    s.shadow.map.warp = WarpKind::Lispsm;
+    s.validate().unwrap();
+    s.shadow.partition = Partition::Cascades;
+    let e = s.validate().unwrap_err();
+    assert_eq!(e.flag, "--warp");
+    assert!(e.to_string().contains("--warp none"), "{e}");
+    let mut s = Settings::default();
+    s.shadow.map.warp = WarpKind::Tsm;
+    s.shadow.filter.technique = Technique::Vsm;
+    let e = s.validate().unwrap_err();
+    assert!(e.to_string().contains("with --technique vsm"), "{e}");
+    s.shadow.filter.technique = Technique::PcfPoisson;
+    s.validate().unwrap();
+    s.shadow.filter.kernel_unit = KernelUnit::World;
+    assert!(s.validate().unwrap_err().to_string().contains("--kernel-unit world"));
+}
+
+#[test]
+fn sdsm_bounds_need_sdsm_and_tight_cascades() {
+    let mut s = Settings::default();
+    s.shadow.partition = Partition::Cascades;
+    s.shadow.cascades.sdsm_bounds = true;
+    let e = s.validate().unwrap_err();
+    assert!(e.flag == "--sdsm-bounds" && e.to_string().contains("only with --sdsm"), "{e}");
+    s.shadow.cascades.sdsm = true;
+    s.shadow.cascades.cascade_fit = CascadeFit::Stable;
+    assert!(s.validate().unwrap_err().to_string().contains("--cascade-fit tight"));
+    s.shadow.cascades.cascade_fit = CascadeFit::Tight;
+    s.validate().unwrap();
+}
+
+#[test]
+fn technique_names_are_the_flag_values() {
+    let names: Vec<_> = Technique::all().iter().map(|t| t.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "hard",
+            "pcf2x2",
+            "pcf",
+            "pcf-tent",
+            "pcf-poisson",
+            "pcss",
+            "vsm",
+            "esm",
+            "evsm2",
+            "evsm4",
+            "msm-hamburger",
+            "msm-hausdorff",
+            "convolution"
+        ]
+    );
+    for t in Technique::all() {
+        let parsed = <Technique as ValueEnum>::from_str(t.name(), false).unwrap();
+        assert_eq!(parsed, *t);
+        let toml_name: toml::Value = toml::Value::try_from(t).unwrap();
+        assert_eq!(toml_name.as_str(), Some(t.name()), "serde and clap agree");
+    }
+}
+
+#[test]
+fn sun_overrides_keep_the_other_angle() {
+    let scene = crate::builtin::spheres();
+    let mut s = Settings::default();
+    s.light.sun_elevation = Some(30.0);
+    let Light::Directional(sun) = s.resolve_light(&scene).unwrap() else { panic!() };
+    assert!(((-sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
+    let (a0, a1) =
+        (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
+    assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
+}
+
+#[test]
+fn point_light_flags_override_the_scenes_and_are_checked() {
+    let scene = crate::builtin::spheres();
+    let parsed = Cli::try_parse_from([
+        "gnomon",
+        "--light",
+        "point",
+        "--point-position",
+        "1,2,3",
+        "--point-range",
+        "7",
+        "--point-radius",
+        "0.2",
+    ])
+    .unwrap()
+    .settings;
+    parsed.validate().unwrap();
+    let Light::Point(p) = parsed.resolve_light(&scene).unwrap() else { panic!("a point light") };
+    assert_eq!((p.position, p.range, p.radius), (Vec3::new(1.0, 2.0, 3.0), 7.0, 0.2));
+    assert_eq!(p.color, scene.point.color, "what no flag names stays the scene's");
+    let lights = parsed.resolve_lights(&scene).unwrap();
+    assert_eq!((lights.len(), lights[0].name.as_str()), (1, "point"));
+
+    let mut bad = parsed.clone();
+    bad.light.point_range = Some(0.0);
+    assert_eq!(bad.validate().unwrap_err().flag, "--point-range");
+    bad.light.point_range = None;
+    bad.light.point_radius = Some(-1.0);
+    assert_eq!(bad.validate().unwrap_err().flag, "--point-radius");
+    // A cube map is compared by direction: the moment techniques are refused.
+    let mut vsm = parsed;
+    vsm.shadow.filter.technique = Technique::Vsm;
+    let e = vsm.resolve_lights(&scene).unwrap_err();
+    assert_eq!(e.flag, "--technique");
+    assert!(e.valid.contains("pcf-poisson or pcss"), "{e}");
+    // Dual paraboloids take the 2D lookups, without PCSS.
+    let mut paraboloid = vsm;
+    paraboloid.shadow.map.omni = OmniMap::Paraboloid;
+    paraboloid.shadow.filter.technique = Technique::Pcss;
+    let e = paraboloid.resolve_lights(&scene).unwrap_err();
+    assert!(e.valid.contains("--omni paraboloid"), "{e}");
+    paraboloid.shadow.filter.technique = Technique::PcfPoisson;
+    paraboloid.resolve_lights(&scene).unwrap();
+}
+
+#[test]
+fn light_all_takes_each_lights_own_shadow_settings() {
+    let scene = crate::builtin::lamps();
+    let mut s = Settings::default();
+    s.light.kind = LightKind::All;
+    s.shadow.bias.slope_bias = 2.5;
+    let lights = s.resolve_lights(&scene).unwrap();
+    assert_eq!(lights.len(), 8);
+    assert_eq!(lights[0].shadow.partition, Partition::Cascades);
+    assert_eq!(lights[2].shadow.filter.technique, Technique::Pcss);
+    assert!(
+        lights.iter().all(|l| l.shadow.bias.slope_bias == 2.5),
+        "the render's, where a light says nothing"
+    );
+    // A light whose own table is invalid over these settings is named.
+    let mut broken = scene.clone();
+    broken.lights[3].shadow = Some("[map]\nresolution = 100".parse().unwrap());
+    let e = s.resolve_lights(&broken).unwrap_err();
+    assert!(e.to_string().contains("spot 2") && e.to_string().contains("--shadow-res"), "{e}");
+    // No list: a clear error naming where lists come from.
+    let e = s.resolve_lights(&crate::builtin::spheres()).unwrap_err();
+    assert!(e.valid.contains("[[light]]") && e.valid.contains("lamps"), "{e}");
+}
+
+#[test]
+fn contact_shadows_choose_the_mask_path_and_are_checked() {
+    let scene = crate::builtin::lamps();
+    let mut s = Settings::default();
+    let lights = s.resolve_lights(&scene).unwrap();
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto without contact shadows is forward");
+    s.screen.shadow_path = ShadowPath::Mask;
+    assert!(s.uses_shadow_mask(&lights).unwrap());
+    // One light with contact shadows is enough for auto to take the mask...
+    s.screen.shadow_path = ShadowPath::Auto;
+    s.light.kind = LightKind::All;
+    let mut lit = scene.clone();
+    lit.lights[5].shadow = Some("[contact]\ncontact_shadows = true".parse().unwrap());
+    let lights = s.resolve_lights(&lit).unwrap();
+    assert!(lights[5].shadow.contact.contact_shadows && !lights[4].shadow.contact.contact_shadows);
+    assert!(s.uses_shadow_mask(&lights).unwrap());
+    // ...and forward refuses it, naming the light.
+    s.screen.shadow_path = ShadowPath::Forward;
+    let e = s.uses_shadow_mask(&lights).unwrap_err();
+    assert!(e.flag == "--contact-shadows" && e.to_string().contains(&lit.lights[5].name), "{e}");
+    // Each parameter's range is checked, naming the flag.
+    for (flag, set) in [
+        ("--contact-length", (|c: &mut ContactSettings| c.contact_length = 0.0) as fn(&mut ContactSettings)),
+        ("--contact-steps", |c| c.contact_steps = 0),
+        ("--contact-steps", |c| c.contact_steps = 65),
+        ("--contact-thickness", |c| c.contact_thickness = f32::NAN),
+        ("--contact-bias", |c| c.contact_bias = -0.1),
+        ("--contact-distance", |c| c.contact_distance = 0.0),
+    ] {
+        let mut s = Settings::default();
+        set(&mut s.shadow.contact);
+        assert_eq!(s.validate().unwrap_err().flag, flag);
+    }
+}
