@@ -5,7 +5,9 @@ use glam::{Mat4, Vec3};
 /// An axis-aligned box. An empty box has `min > max` on every axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// Corner with the smallest coordinate on every axis, in the box's space (usually world space).
     pub min: Vec3,
+    /// Corner with the largest coordinate on every axis, in the same space as `min`.
     pub max: Vec3,
 }
 
@@ -13,6 +15,7 @@ impl Aabb {
     /// The empty box: the identity of [`Aabb::union`].
     pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
 
+    /// The box with corners `min` and `max`, taken as given: a `min` above `max` on any axis makes it empty.
     pub fn new(min: Vec3, max: Vec3) -> Self {
         Self { min, max }
     }
@@ -22,22 +25,27 @@ impl Aabb {
         points.into_iter().fold(Self::EMPTY, |b, p| b.including(p))
     }
 
+    /// Whether the box holds no point at all: `min > max` on at least one axis.
     pub fn is_empty(&self) -> bool {
         self.min.cmpgt(self.max).any()
     }
 
+    /// This box grown just enough to hold the point `p`.
     pub fn including(self, p: Vec3) -> Self {
         Self { min: self.min.min(p), max: self.max.max(p) }
     }
 
+    /// The smallest box holding both this box and `other`.
     pub fn union(self, other: Aabb) -> Self {
         Self { min: self.min.min(other.min), max: self.max.max(other.max) }
     }
 
+    /// The box's midpoint, `(min + max) / 2`; meaningless (NaN for [`Aabb::EMPTY`]) for an empty box.
     pub fn center(&self) -> Vec3 {
         0.5 * (self.min + self.max)
     }
 
+    /// Size along each axis, `max − min`; negative on some axis for an empty box.
     pub fn extent(&self) -> Vec3 {
         self.max - self.min
     }
@@ -66,6 +74,7 @@ impl Aabb {
         Aabb::from_points(self.corners().map(|c| to_from_this.transform_point3(c)))
     }
 
+    /// Whether `p` lies inside the box, boundary included.
     pub fn contains(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }

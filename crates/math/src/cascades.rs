@@ -19,7 +19,10 @@ pub enum SplitScheme {
     Logarithmic,
     /// Parallel-split shadow maps (Zhang, Sun, Xu & Lo 2006): z_i = λ·log_i +
     /// (1 − λ)·uniform_i. λ = 1 is fully logarithmic, λ = 0 uniform.
-    Practical { lambda: f32 },
+    Practical {
+        /// Weight of the logarithmic split against the uniform one, in [0, 1].
+        lambda: f32,
+    },
 }
 
 /// The N + 1 view depths bounding N cascades, from `near` to `far` inclusive.

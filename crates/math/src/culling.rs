@@ -63,8 +63,12 @@ impl Frustum {
 /// Where a box lies against a [`Frustum`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Containment {
+    /// Wholly outside at least one plane: nothing in the box can be visible, so it is skipped.
     Outside,
+    /// Neither provably outside nor wholly inside: the box straddles the boundary (or lies just
+    /// outside near a corner, which the plane test cannot tell apart), so its contents need testing.
     Partial,
+    /// Every corner inside every plane: everything in the box is in the volume, without further tests.
     Inside,
 }
 
@@ -146,6 +150,7 @@ impl CullTree {
         self.bounds.len()
     }
 
+    /// Whether the tree holds no instances.
     pub fn is_empty(&self) -> bool {
         self.bounds.is_empty()
     }

@@ -12,6 +12,9 @@ use crate::{Aabb, LightProjection, projection::view_from_world_look_at};
 /// the index as [`Aabb::corners`] are: the view frustum or a box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hexahedron {
+    /// The corners in world space. Bit 0 of the index picks low or high x (NDC −1 or +1 for a
+    /// frustum), bit 1 low or high y, bit 2 low or high z: for a frustum, the near (depth 0) or far
+    /// (depth 1) face.
     pub corners: [Vec3; 8],
 }
 
@@ -32,6 +35,7 @@ impl Hexahedron {
         }
     }
 
+    /// The box `bounds` as a hexahedron, with its corners in [`Aabb::corners`] order.
     pub fn from_aabb(bounds: &Aabb) -> Self {
         Self { corners: bounds.corners() }
     }

@@ -12,6 +12,8 @@
 //!   top-left of the image. The y flip lives in [`texture_from_ndc`] and nowhere else.
 //! - Matrices are named `to_from_from`: `clip_from_world` maps world points to clip space.
 
+#![warn(missing_docs)]
+
 mod aabb;
 pub mod cascades;
 pub mod culling;

@@ -9,21 +9,39 @@ use crate::{Aabb, projection::view_from_world_look_at};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ProjectionKind {
     /// Parallel rays; `width` × `height` world units are covered by the map.
-    Orthographic { width: f32, height: f32 },
+    Orthographic {
+        /// Width of the window in light view space (along its x), in world units.
+        width: f32,
+        /// Height of the window in light view space (along its y), in world units.
+        height: f32,
+    },
     /// Rays from a point; `fov` is the full (square) field of view in radians.
-    Perspective { fov: f32 },
+    Perspective {
+        /// Full field of view, the same horizontally and vertically, in radians.
+        fov: f32,
+    },
     /// Parallel rays through a perspective warp of the light's view plane
     /// ([`crate::warping`]): texels vary in size across the map. `width` × `height` is
     /// the world extent of the warped window's far edge and its depth along the warp's
     /// axis; the true size of a texel is local (see [`LightProjection::texel_world_size`]).
-    Warped { width: f32, height: f32 },
+    Warped {
+        /// World width of the warped window at its far edge, where its texels are largest.
+        width: f32,
+        /// World depth of the warped window along the warp's axis.
+        height: f32,
+    },
 }
 
 /// Everything a renderer needs to draw and sample one shadow map.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightProjection {
+    /// World space to the light's view space, which looks down −z. The transform is rigid (a
+    /// cube face's is mirrored), so light-space distances are world units.
     pub light_from_world: Mat4,
+    /// The light's view space to the map's clip space (WebGPU depth in [0, 1]): the
+    /// orthographic, perspective or warped projection that `kind` describes.
     pub clip_from_light: Mat4,
+    /// The projection's shape and size, which give a texel's size in world units.
     pub kind: ProjectionKind,
     /// Distance along the light's view axis of the depth-0 plane.
     pub near: f32,
@@ -51,6 +69,8 @@ impl LightProjection {
         }
     }
 
+    /// World space to the map's clip space, `clip_from_light · light_from_world`: the matrix a
+    /// shadow pass draws casters with, and the lighting pass projects receivers with.
     pub fn clip_from_world(&self) -> Mat4 {
         self.clip_from_light * self.light_from_world
     }

@@ -18,15 +18,22 @@ use crate::{LightProjection, ProjectionKind};
 /// The six faces in WebGPU's layer order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CubeFace {
+    /// The face the +x axis passes through (layer 0).
     PositiveX,
+    /// The face the −x axis passes through (layer 1).
     NegativeX,
+    /// The face the +y axis (up) passes through (layer 2).
     PositiveY,
+    /// The face the −y axis (down) passes through (layer 3).
     NegativeY,
+    /// The face the +z axis passes through (layer 4).
     PositiveZ,
+    /// The face the −z axis passes through (layer 5).
     NegativeZ,
 }
 
 impl CubeFace {
+    /// Every face, in layer order: `ALL[i].layer() == i`.
     pub const ALL: [CubeFace; 6] = [
         CubeFace::PositiveX,
         CubeFace::NegativeX,

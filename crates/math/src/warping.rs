@@ -1,5 +1,5 @@
 //! Perspective warps of a directional light's map: perspective shadow maps (PSM;
-//! Stamminger & Drettakis 2002, in [`psm`]), light-space perspective shadow maps
+//! Stamminger & Drettakis 2002, in `psm`), light-space perspective shadow maps
 //! (LiSPSM; Wimmer, Scherzer & Purgathofer, EGSR 2004) and trapezoidal shadow maps
 //! (TSM; Martin & Tan, EGSR 2004).
 //!
@@ -44,11 +44,13 @@ pub enum Warp {
 /// The camera as the warps see it.
 #[derive(Clone, Copy, Debug)]
 pub struct WarpView {
+    /// Camera position, in world space.
     pub eye: Vec3,
     /// Unit view direction.
     pub forward: Vec3,
     /// View depths bounding the receivers (z_n, z_f), 0 < near < far.
     pub near: f32,
+    /// See `near`: the far view depth of the receivers (z_f), in world units along `forward`.
     pub far: f32,
 }
 

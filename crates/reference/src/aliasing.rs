@@ -19,7 +19,9 @@ use gnomon_scene::{Camera, Light};
 /// A frame's geometry and shadow layout, as the aliasing measure needs them.
 #[derive(Clone, Copy)]
 pub struct AliasingInput<'a> {
+    /// Image width in pixels; every per-pixel slice is `width × height` long, row-major, top row first.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// World position of the visible surface; NaN for background.
     pub position: &'a [Vec3],
@@ -27,6 +29,7 @@ pub struct AliasingInput<'a> {
     pub normal: &'a [Vec3],
     /// View depth of the visible surface; NaN for background.
     pub depth: &'a [f32],
+    /// The camera the frame was rendered with, for the world size of a pixel at each surface.
     pub camera: &'a Camera,
     /// The light, for the direction of its rays.
     pub light: &'a Light,
@@ -43,7 +46,9 @@ pub struct AliasingInput<'a> {
 /// m per pixel, and its summary over the pixels where it is defined.
 #[derive(Clone, Debug)]
 pub struct AliasingImage {
+    /// Image width in pixels, as in the input.
     pub width: u32,
+    /// Image height in pixels, as in the input.
     pub height: u32,
     /// Pixels spanned by one shadow texel in its longest direction (the perspective
     /// term); NaN for background and outside every layer.

@@ -38,9 +38,15 @@ pub fn shadow_states(visibility: &[f32], classes: &[PixelClass]) -> Vec<Option<b
 /// reference's shadow states ([`shadow_states`]).
 #[derive(Clone, Debug)]
 pub struct PathFrame {
+    /// Image width in pixels; every per-pixel vector is `width × height` long, row-major, top row first.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// The frame's camera, world space to clip space: reprojects the next frame's surface points
+    /// into this frame's pixels.
     pub clip_from_world: Mat4,
+    /// The frame's camera, world space to view space: gives a reprojected point's view depth, to
+    /// tell the same surface from one in front of it.
     pub view_from_world: Mat4,
     /// World position of the visible surface; NaN for background.
     pub position: Vec<Vec3>,
@@ -48,7 +54,10 @@ pub struct PathFrame {
     pub object_id: Vec<u32>,
     /// View depth; NaN for background.
     pub depth: Vec<f32>,
+    /// The technique's shadow state per pixel ([`shadow_states`]): `Some(true)` shadowed,
+    /// `Some(false)` lit, `None` where the pixel is not compared.
     pub technique: Vec<Option<bool>>,
+    /// The reference's shadow state per pixel, over the same pixels as `technique`.
     pub reference: Vec<Option<bool>>,
 }
 
@@ -153,6 +162,7 @@ impl FlickerCounter {
         }
     }
 
+    /// The flicker measured over the pairs added so far; a rate with nothing to measure is 0.
     pub fn result(&self) -> Flicker {
         let rate = |n: u64, of: u64| n as f64 / of.max(1) as f64;
         let technique_flip_rate = rate(self.technique_flips, self.compared);

@@ -4,13 +4,21 @@
 use crate::{ReferenceImage, metrics::PixelClass};
 
 /// Hard-shadow heat-map colours, with their legend labels.
+///
+/// This one: a compared pixel that the technique shadows but the reference lights (red).
 pub const FALSE_SHADOW: [u8; 3] = [235, 60, 50];
+/// Compared pixel that the technique lights but the reference shadows (blue).
 pub const FALSE_LIT: [u8; 3] = [40, 140, 255];
+/// Pixel where the two images see different surfaces, never compared (yellow).
 pub const SILHOUETTE: [u8; 3] = [230, 190, 30];
+/// Pixel where neither image sees a surface (near-black).
 pub const BACKGROUND: [u8; 3] = [28, 28, 34];
+/// Compared pixel lit in both images (light grey).
 pub const CORRECT_LIT: [u8; 3] = [190, 190, 190];
+/// Compared pixel shadowed in both images (dark grey).
 pub const CORRECT_SHADOW: [u8; 3] = [85, 85, 85];
 
+/// The legend of [`hard`]'s picture: each label with its colour (the background is left out).
 pub const HARD_LEGEND: &[(&str, [u8; 3])] = &[
     ("false shadow", FALSE_SHADOW),
     ("false lit", FALSE_LIT),

@@ -3,6 +3,8 @@
 //! the light at the surface points the rasterizer shades, and the metrics that turn
 //! a technique's difference from it into numbers and pictures.
 
+#![warn(missing_docs)]
+
 pub mod aliasing;
 pub mod flicker;
 pub mod heatmap;

@@ -16,7 +16,9 @@ use crate::texture::sample_alpha;
 /// The closest surface along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Distance from the ray's origin to the hit, in world units (the direction is unit length).
     pub t: f32,
+    /// World-space hit point, from the triangle's barycentrics (more exact than origin + t·direction).
     pub position: Vec3,
     /// The triangle's geometric normal, unit length, facing the ray's origin.
     pub normal: Vec3,
@@ -50,6 +52,9 @@ pub struct TracedScene {
 }
 
 impl TracedScene {
+    /// Gathers every instance's triangles into world space and builds the BVH over them; the
+    /// triangles of alpha-masked materials keep their UVs and texture for the alpha test. The
+    /// scene must be valid ([`Scene::validate`]): its indices are trusted.
     pub fn build(scene: &Scene) -> Self {
         let mut triangles = Vec::with_capacity(scene.triangle_count());
         let mut owners = Vec::with_capacity(scene.triangle_count());
@@ -119,6 +124,7 @@ impl TracedScene {
         t
     }
 
+    /// Number of triangles traced: every instance's, casters or not.
     pub fn triangle_count(&self) -> usize {
         self.triangle_count
     }

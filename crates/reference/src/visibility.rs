@@ -15,7 +15,9 @@ use crate::{
 /// How the reference is computed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceOptions {
+    /// Image width in pixels; matches the rasterizer's frame.
     pub width: u32,
+    /// Image height in pixels; matches the rasterizer's frame.
     pub height: u32,
     /// Shadow rays per pixel for an area light (ignored for point lights, which need one).
     pub samples: u32,
@@ -24,7 +26,9 @@ pub struct ReferenceOptions {
 /// The reference, per pixel, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceImage {
+    /// Image width in pixels; every per-pixel vector is `width × height` long.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel actually used: 1 for a point or directional light.
     pub samples: u32,
@@ -47,6 +51,7 @@ pub struct ReferenceImage {
 }
 
 impl ReferenceImage {
+    /// Number of pixels, `width × height`.
     pub fn pixel_count(&self) -> usize {
         (self.width * self.height) as usize
     }

@@ -6,10 +6,16 @@ use crate::RenderError;
 /// What was picked, for `--verbose` and for reports.
 #[derive(Clone, Debug)]
 pub struct GpuInfo {
+    /// The adapter's name, as the driver reports it (`llvmpipe (LLVM 15.0.6, 256 bits)`, say).
     pub adapter: String,
+    /// The graphics API wgpu drives it through (`Vulkan`, `Metal`, `Dx12`, `Gl`).
     pub backend: String,
+    /// The kind of device (`DiscreteGpu`, `IntegratedGpu`, `Cpu`, …); `Cpu` for a software
+    /// rasterizer such as lavapipe.
     pub device_type: String,
+    /// The driver's name.
     pub driver: String,
+    /// The driver's version and build details, free-form.
     pub driver_info: String,
 }
 
@@ -40,9 +46,14 @@ impl std::fmt::Display for GpuInfo {
 /// Cloning shares the device (wgpu's handles are reference-counted).
 #[derive(Clone, Debug)]
 pub struct Gpu {
+    /// The wgpu device every resource is created on.
     pub device: wgpu::Device,
+    /// The queue every frame's commands are submitted to.
     pub queue: wgpu::Queue,
+    /// Which adapter and driver the device runs on, for logs and reports.
     pub info: GpuInfo,
+    /// The limits the device was opened with; settings are checked against them
+    /// ([`crate::Renderer::check_limits`]).
     pub limits: wgpu::Limits,
     /// Nanoseconds per timestamp tick, when the device can time passes.
     pub timestamp_period_ns: Option<f32>,

@@ -34,6 +34,8 @@ pub struct SampleDistribution {
 /// that bound them when they are cascades.
 #[derive(Clone, Debug)]
 pub struct ShadowLayout {
+    /// One projection per layer: the cascades in order near to far, a cube's six faces in
+    /// WebGPU's order, a paraboloid map's two hemispheres, or the single map.
     pub projections: Vec<LightProjection>,
     /// One more than the projections: cascade i covers view depths `splits[i]` to
     /// `splits[i + 1]`. A single map covers 0 to infinity.

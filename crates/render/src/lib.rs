@@ -12,6 +12,8 @@
 //! # Ok(()) }
 //! ```
 
+#![warn(missing_docs)]
+
 mod device;
 mod frame;
 mod gpu_scene;
@@ -41,45 +43,105 @@ use gnomon_scene::{SceneError, settings::SettingsError};
 /// fault and what would be valid.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// No GPU adapter is available (for the backends `WGPU_BACKEND` allows, if set).
     #[error(
         "no GPU adapter found{backends}. Gnomon needs a Vulkan, Metal, DX12 or GL driver. \
          On Debian or Ubuntu without a GPU, install the CPU Vulkan driver lavapipe: \
          `sudo apt-get install mesa-vulkan-drivers`"
     )]
-    NoAdapter { backends: String },
+    NoAdapter {
+        /// The message's mention of `WGPU_BACKEND` when that variable narrowed the search; empty when unset.
+        backends: String,
+    },
+    /// The adapter was found but refused to open a device with the limits and features asked for.
     #[error("could not open the GPU device on adapter `{adapter}`: {reason}")]
-    DeviceRequest { adapter: String, reason: String },
+    DeviceRequest {
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+        /// wgpu's reason for refusing the device.
+        reason: String,
+    },
+    /// The shadow map resolution exceeds the device's largest 2D texture.
     #[error(
         "a shadow map of {requested}² texels (`shadow.map.resolution`) is larger than this device \
          allows: adapter `{adapter}` supports 2D textures up to {max} texels (and Gnomon up to {})",
         gnomon_scene::settings::MAX_SHADOW_RESOLUTION
     )]
-    ShadowMapTooLarge { requested: u32, max: u32, adapter: String },
+    ShadowMapTooLarge {
+        /// The requested map resolution, in texels a side.
+        requested: u32,
+        /// The device's largest 2D texture, in texels a side.
+        max: u32,
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
+    /// The image width or height exceeds the device's largest 2D texture.
     #[error(
         "an image of {width}×{height} is larger than adapter `{adapter}` allows: at most {max} pixels a side"
     )]
-    ImageTooLarge { width: u32, height: u32, max: u32, adapter: String },
+    ImageTooLarge {
+        /// The requested image width, in pixels.
+        width: u32,
+        /// The requested image height, in pixels.
+        height: u32,
+        /// The device's largest 2D texture, in texels a side.
+        max: u32,
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
+    /// The device cannot hold the lighting pass's colour targets: too few attachment bytes per pixel.
     #[error(
         "adapter `{adapter}` allows {available} bytes of colour attachments per pixel; the lighting \
          pass needs {needed}"
     )]
-    AttachmentsTooLarge { available: u32, needed: u32, adapter: String },
+    AttachmentsTooLarge {
+        /// The device's limit on colour attachment bytes per pixel (per sample).
+        available: u32,
+        /// The bytes per pixel the lighting pass's colour targets take together.
+        needed: u32,
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
+    /// rgba32float moment maps were asked for on a device without 32-bit float filtering.
     #[error(
         "the moment format rgba32float (`shadow.filter.moments.moment_format`) needs 32-bit float \
          filtering, which adapter `{adapter}` does not have; choose rgba16float or auto"
     )]
-    MomentFormatUnsupported { adapter: String },
+    MomentFormatUnsupported {
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
+    /// A setting is out of its valid range.
     #[error(transparent)]
     Settings(#[from] SettingsError),
+    /// The scene is not well formed (checked before upload).
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The scene (named by the field) has nothing to draw: no instances or triangles, or, for a
+    /// [`DepthBaselineScene`], no shadow casters.
     #[error("scene `{0}` has nothing to draw")]
     EmptyScene(String),
+    /// The scene's instance data does not fit in one storage buffer binding on this device.
     #[error(
         "scene `{scene}`: its {instances} instances need {bytes} bytes of instance data, but this \
          device binds at most {limit} bytes in one storage buffer; render fewer instances"
     )]
-    SceneTooLarge { scene: String, instances: usize, bytes: u64, limit: u64 },
+    SceneTooLarge {
+        /// Name of the scene.
+        scene: String,
+        /// Number of instances uploaded.
+        instances: usize,
+        /// Size of their per-instance data, in bytes.
+        bytes: u64,
+        /// The most bytes the device binds in one storage buffer.
+        limit: u64,
+    },
+    /// wgpu reported a validation, out-of-memory or internal error, or a wait or readback failed.
     #[error("the GPU reported an error while {during}: {message}")]
-    Gpu { during: &'static str, message: String },
+    Gpu {
+        /// What the renderer was doing, for the message ("reading back", say).
+        during: &'static str,
+        /// wgpu's description of the error.
+        message: String,
+    },
 }

@@ -19,10 +19,15 @@ pub(crate) const KEEP_FRAMES: u64 = 3;
 /// How many resources of each kind the pool has created: a steady frame adds none.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Creations {
+    /// Textures created.
     pub textures: u64,
+    /// Texture views created.
     pub views: u64,
+    /// Buffers created.
     pub buffers: u64,
+    /// Bind groups created.
     pub bind_groups: u64,
+    /// Timestamp query sets created.
     pub query_sets: u64,
 }
 

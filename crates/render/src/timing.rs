@@ -23,6 +23,7 @@ pub enum PassKind {
 }
 
 impl PassKind {
+    /// The kind's lower-case name, as reports and tables print it (`"shadow"`, `"lighting"`, …).
     pub fn name(self) -> &'static str {
         match self {
             PassKind::Prepass => "prepass",
@@ -57,11 +58,13 @@ pub enum ClockChoice {
 /// One pass's time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassTime {
+    /// Which kind of pass this is.
     pub kind: PassKind,
     /// The light's index in the frame, for per-light passes.
     pub light: Option<u32>,
     /// The map layer, for shadow passes.
     pub layer: Option<u32>,
+    /// The pass's time in milliseconds (GPU, or CPU wall clock: see [`TimingSource`]).
     pub ms: f64,
 }
 

@@ -25,12 +25,16 @@ pub const MAX_CASCADES: usize = SETTINGS_MAX_CASCADES as usize;
 #[repr(u32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightKindGpu {
+    /// A directional light (`LIGHT_SUN`).
     Sun = 0,
+    /// A spot light (`LIGHT_SPOT`).
     Spot = 1,
+    /// A point light (`LIGHT_POINT`).
     Point = 2,
 }
 
 impl LightKindGpu {
+    /// Every kind, for generating the WGSL constants.
     pub const ALL: [LightKindGpu; 3] = [LightKindGpu::Sun, LightKindGpu::Spot, LightKindGpu::Point];
 
     /// Its name in WGSL.
@@ -48,6 +52,7 @@ impl LightKindGpu {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TechniqueParams {
+    /// Real-valued parameters (an exponent, a bias, …), laid out by each technique.
     pub reals: Vec4,
     /// Counts, variants and switches (0 or 1).
     pub integers: UVec4,
@@ -63,13 +68,17 @@ pub struct CascadeGpu {
     /// The world step over which a warped layer's texel size is measured by finite
     /// differences (about a texel at its far edge).
     pub warp_step: f32,
-    /// The view depths where the cascade starts and ends.
+    /// View depth where the cascade starts, in world units.
     pub split_start: f32,
+    /// View depth where the cascade ends, in world units; `f32::MAX` for a map that covers every depth.
     pub split_end: f32,
     /// 1 for a warped layer (PSM, LiSPSM, TSM), whose texel size varies across it.
     pub warped: u32,
+    /// Padding to WGSL's 16-byte layout.
     pub _pad0: u32,
+    /// Padding to WGSL's 16-byte layout.
     pub _pad1: u32,
+    /// Padding to WGSL's 16-byte layout.
     pub _pad2: u32,
 }
 
@@ -80,6 +89,7 @@ pub struct CascadeGpu {
 pub struct LightGpu {
     /// The layer being drawn (shadow passes) or layer 0 (everything else).
     pub clip_from_world: Mat4,
+    /// World space to layer 0's light view space: the light's axes, and distances along its view axis.
     pub light_from_world: Mat4,
     /// Colour × intensity.
     pub radiance: Vec3,
@@ -99,13 +109,17 @@ pub struct LightGpu {
     pub moment_layers: u32,
     /// cos of the spot's inner and outer angles.
     pub cos_inner: f32,
+    /// cos of the spot's outer half-angle: no light outside it (−1, every direction, for other lights).
     pub cos_outer: f32,
     /// The map's near and far planes along the light's axis.
     pub map_near: f32,
+    /// The map's far plane along the light's axis, in world units.
     pub map_far: f32,
     /// Texel world size of an orthographic map, and per unit of distance for a
     /// perspective one.
     pub texel_ortho: f32,
+    /// Texel world size per unit of distance from the light, for a perspective map (0 for an
+    /// orthographic one; for a paraboloid map, radians per texel on its axis).
     pub texel_per_distance: f32,
     /// The normal offset, in texels.
     pub normal_offset: f32,
@@ -113,13 +127,18 @@ pub struct LightGpu {
     pub resolution: f32,
     /// The PCF kernel's width, in texels or world units (`kernel_in_world`).
     pub kernel_width: f32,
+    /// 1 when `kernel_width` is in world units, 0 when in texels.
     pub kernel_in_world: u32,
+    /// Taps of the Poisson-disk PCF and of PCSS's filtering step, at most the disk's size.
     pub poisson_taps: u32,
+    /// 1 to tilt the compared depth along the receiver's plane across the kernel, 0 not.
     pub receiver_plane_bias: u32,
     /// PCSS: the light's size (spot or point radius in world units, tan of the sun's
     /// angular radius), blocker-search taps, the largest radius in texels.
     pub light_size: f32,
+    /// PCSS: taps of the blocker search, at most the Poisson disk's size.
     pub blocker_taps: u32,
+    /// PCSS: the largest blocker-search and penumbra radius, in texels.
     pub max_penumbra_texels: f32,
     /// 1 to pick cascades by projection, 0 by view depth.
     pub select_by_projection: u32,
@@ -129,19 +148,26 @@ pub struct LightGpu {
     /// point light's distance cube): constant, in units of the last mantissa bit, and
     /// slope-scaled.
     pub depth_bias: f32,
+    /// Slope-scaled depth bias: multiplies the depth a surface spans across one texel.
     pub slope_bias: f32,
     /// Contact shadows: ray steps (0 when off), ray length in world units, thickness
     /// as a fraction of view depth, the ray's start offset along the normal, and the
     /// view depth where they end.
     pub contact_steps: u32,
+    /// Contact shadows: length of the ray toward the light, in world units.
     pub contact_length: f32,
+    /// Contact shadows: assumed thickness of the depth buffer's surfaces, as a fraction of view depth.
     pub contact_thickness: f32,
+    /// Contact shadows: the ray's start offset along the surface normal, in world units.
     pub contact_bias: f32,
+    /// Contact shadows: the view depth beyond which they are off (faded over its last quarter).
     pub contact_distance: f32,
+    /// The technique's own parameters ([`TechniqueParams`]).
     pub params: TechniqueParams,
     /// Each layer's clip_from_world (a paraboloid's: its hemisphere's frame);
     /// layer 0 equals `clip_from_world` outside the shadow passes.
     pub cascade_clip_from_world: [Mat4; MAX_CASCADES],
+    /// Each layer's texel size, view-depth span and warp flag; unused layers are zero.
     pub cascades: [CascadeGpu; MAX_CASCADES],
 }
 
@@ -160,25 +186,37 @@ impl Default for LightGpu {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct CameraGpu {
+    /// World space to the camera's clip space (WebGPU depth in [0, 1]).
     pub clip_from_world: Mat4,
+    /// World space to the camera's view space (right-handed, looking down −z).
     pub view_from_world: Mat4,
+    /// The camera's view space to world space: reconstructs positions from depth.
     pub world_from_view: Mat4,
+    /// Camera position in world space, for view vectors (specular highlights).
     pub eye: Vec3,
     /// 1 to tint pixels by their cascade.
     pub tint_cascades: u32,
     /// clip_from_view's x and y scales (a symmetric perspective).
     pub scale_x: f32,
+    /// clip_from_view's y scale, 1 / tan(fov_y / 2).
     pub scale_y: f32,
+    /// Near plane distance in world units (view depth at clip depth 0).
     pub near: f32,
+    /// Far plane distance in world units (view depth at clip depth 1).
     pub far: f32,
     /// The image's width and height in pixels, and their inverses.
     pub width: f32,
+    /// Image height in pixels.
     pub height: f32,
+    /// 1 / width, to turn pixel coordinates into NDC.
     pub inv_width: f32,
+    /// 1 / height, to turn pixel coordinates into NDC.
     pub inv_height: f32,
 }
 
 impl CameraGpu {
+    /// The uniform for `camera` drawing a `width` × `height` image; `debug_view` turns on
+    /// the cascade tint.
     pub fn new(camera: &Camera, width: u32, height: u32, debug_view: DebugView) -> Self {
         let aspect = width as f32 / height as f32;
         let clip_from_view = camera.clip_from_view(aspect);
@@ -215,12 +253,17 @@ pub fn wgsl_constants() -> String {
 
 /// What a light's uniform is made from.
 pub struct LightInputs<'a> {
+    /// The scene, for its ambient light.
     pub scene: &'a Scene,
+    /// The light the uniform describes.
     pub light: &'a Light,
+    /// The light's map layers: projections and cascade splits.
     pub layout: &'a ShadowLayout,
     /// The render's settings with this light's shadow settings.
     pub settings: &'a Settings,
+    /// The technique's own parameters ([`techniques::ShadowTechnique::params`]).
     pub params: TechniqueParams,
+    /// The filterable map the technique samples, if it has one (for its moment layer count).
     pub filterable_map: Option<techniques::FilterableMap>,
 }
 

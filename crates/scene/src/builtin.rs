@@ -10,8 +10,11 @@ use crate::{
 
 /// A built-in scene: its name, what it shows, and how to build it.
 pub struct Builtin {
+    /// The name that selects it on the command line and in scene files (`builtin = "NAME"`).
     pub name: &'static str,
+    /// One line on what the scene shows and what it tests, as the CLI's list of scenes prints it.
     pub description: &'static str,
+    /// Builds the scene, deterministically: the built-ins double as test fixtures.
     pub build: fn() -> Scene,
 }
 

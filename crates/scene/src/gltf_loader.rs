@@ -21,7 +21,9 @@ use crate::{
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {problem}", path.display())]
 pub struct LoadError {
+    /// The file that failed: the `.gltf` or `.glb` that was asked for.
     pub path: PathBuf,
+    /// What is wrong with it, in words, for the error message.
     pub problem: String,
 }
 

@@ -1,6 +1,8 @@
 //! Gnomon's scene model (meshes, materials, instances, camera, lights), the typed
 //! render settings, and the built-in procedural scenes. No GPU.
 
+#![warn(missing_docs)]
+
 pub mod builtin;
 pub mod camera_path;
 pub mod geometry;

@@ -7,18 +7,25 @@ use gnomon_math::Aabb;
 /// the side their normals point to.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
+    /// The mesh's name, for error messages (from the glTF mesh, or given by a built-in scene).
     pub name: String,
+    /// Vertex positions in object space.
     pub positions: Vec<Vec3>,
+    /// Vertex normals in object space, one per position.
     pub normals: Vec<Vec3>,
+    /// Vertex texture coordinates (u right, v down, as glTF), one per position.
     pub uvs: Vec<Vec2>,
+    /// Triangle list: three indices into the vertex arrays per triangle.
     pub indices: Vec<u32>,
 }
 
 impl Mesh {
+    /// Number of triangles, `indices.len() / 3`.
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
 
+    /// Object-space bounds of the positions; [`Aabb::EMPTY`] for a mesh without vertices.
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(self.positions.iter().copied())
     }
@@ -31,7 +38,10 @@ pub enum AlphaMode {
     Opaque,
     /// The surface exists where alpha ≥ the cutoff, and nowhere else: cut-out leaves,
     /// fences. Shadows are cut out the same way.
-    Mask { cutoff: f32 },
+    Mask {
+        /// The alpha threshold, in [0, 1] (glTF `alphaCutoff`, 0.5 when absent).
+        cutoff: f32,
+    },
     /// Partly transparent. Gnomon draws it solid in the image but it casts no
     /// shadow: a shadow map stores one depth, and no threshold is right for glass.
     Blend,
@@ -40,6 +50,7 @@ pub enum AlphaMode {
 /// A surface's appearance for the lighting pass (Lambert + Blinn-Phong).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// The material's name, for error messages.
     pub name: String,
     /// Linear RGB base colour (albedo), each channel in [0, 1].
     pub base_color: Vec3,
@@ -47,6 +58,7 @@ pub struct Material {
     pub alpha: f32,
     /// Base-colour texture: an index into [`Scene::textures`], multiplied with `base_color`.
     pub base_color_texture: Option<usize>,
+    /// How alpha decides where the surface exists, and whether it casts shadows.
     pub alpha_mode: AlphaMode,
     /// Whether both sides are meant to be seen (glTF `doubleSided`).
     pub double_sided: bool,
@@ -57,6 +69,8 @@ pub struct Material {
 }
 
 impl Material {
+    /// An opaque, single-sided, untextured material of colour `base_color` (linear RGB) with a
+    /// moderate highlight (specular 0.25, shininess 48).
     pub fn new(name: &str, base_color: Vec3) -> Self {
         Self {
             name: name.into(),
@@ -74,19 +88,29 @@ impl Material {
 /// How a texture coordinate outside [0, 1] wraps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Wrap {
+    /// Coordinates wrap around: the texture tiles (glTF `REPEAT`).
     Repeat,
+    /// The texture tiles, mirrored on every other repeat (glTF `MIRRORED_REPEAT`).
     MirroredRepeat,
+    /// Coordinates are clamped to [0, 1]: the edge texels stretch outward (glTF `CLAMP_TO_EDGE`).
     ClampToEdge,
 }
 
 /// An RGBA8 texture in memory (colour channels sRGB-encoded, alpha linear), with its sampler.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
+    /// The texture's name, for error messages.
     pub name: String,
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// Texels row by row from the top row (v = 0), four bytes each (R, G, B, A):
+    /// `4 · width · height` bytes in all.
     pub rgba8: Vec<u8>,
+    /// Wrapping along u (horizontally).
     pub wrap_u: Wrap,
+    /// Wrapping along v (vertically).
     pub wrap_v: Wrap,
     /// Nearest-texel magnification (glTF `NEAREST`); otherwise bilinear.
     pub nearest: bool,
@@ -95,9 +119,13 @@ pub struct Texture {
 /// One placed copy of a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Instance {
+    /// The instance's name, for error messages (the glTF node, or given by a built-in scene).
     pub name: String,
+    /// The mesh drawn: an index into [`Scene::meshes`].
     pub mesh: usize,
+    /// The material it is drawn with: an index into [`Scene::materials`].
     pub material: usize,
+    /// Object space to world space: where the instance is placed, turned and scaled.
     pub world_from_object: Mat4,
     /// Whether the instance is drawn into shadow maps. Every instance receives shadows.
     pub casts_shadow: bool,
@@ -106,24 +134,34 @@ pub struct Instance {
 /// A perspective camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Camera position in world space.
     pub eye: Vec3,
+    /// World-space point the camera looks at; the view direction is `target − eye`.
     pub target: Vec3,
+    /// World-space up hint that fixes the roll (+y everywhere in Gnomon); need not be
+    /// perpendicular to the view direction, but must not be parallel to it.
     pub up: Vec3,
     /// Full vertical field of view, in degrees.
     pub fov_y_degrees: f32,
+    /// Near plane distance along the view direction, in world units; depth 0 in clip space.
     pub near: f32,
+    /// Far plane distance along the view direction, in world units; depth 1 in clip space.
     pub far: f32,
 }
 
 impl Camera {
+    /// World space to the camera's view space (right-handed, looking down −z).
     pub fn view_from_world(&self) -> Mat4 {
         gnomon_math::view_from_world_look_at(self.eye, self.target, self.up)
     }
 
+    /// View space to clip space for an image of `aspect` = width / height: a perspective
+    /// projection with WebGPU depth in [0, 1] from `near` to `far`.
     pub fn clip_from_view(&self, aspect: f32) -> Mat4 {
         gnomon_math::camera_clip_from_view(self.fov_y_degrees.to_radians(), aspect, self.near, self.far)
     }
 
+    /// World space to clip space: `clip_from_view(aspect) · view_from_world()`.
     pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
         self.clip_from_view(aspect) * self.view_from_world()
     }
@@ -146,6 +184,7 @@ pub struct DirectionalLight {
 /// A point light restricted to a cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpotLight {
+    /// Position of the light (the apex of the cone) in world space.
     pub position: Vec3,
     /// The cone's axis, unit length, pointing away from the light.
     pub direction: Vec3,
@@ -155,7 +194,10 @@ pub struct SpotLight {
     pub outer_angle_degrees: f32,
     /// Distance in world units beyond which no light arrives; also the shadow map's far plane.
     pub range: f32,
+    /// Linear RGB colour.
     pub color: Vec3,
+    /// Brightness scale: lit surfaces receive `color · intensity`, with no falloff with distance
+    /// inside `range` (only the cone's edge fades).
     pub intensity: f32,
     /// Radius in world units of the light's emitting disk, facing along `direction`;
     /// 0 is a point light (hard shadows). The reference samples this disk for soft shadows.
@@ -174,11 +216,15 @@ impl SpotLight {
 /// Its shadow map is a cube: six 90° views.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointLight {
+    /// Position of the light (the centre of its sphere) in world space.
     pub position: Vec3,
     /// Distance in world units beyond which no light arrives; also the far plane of the
     /// cube's faces.
     pub range: f32,
+    /// Linear RGB colour.
     pub color: Vec3,
+    /// Brightness scale: lit surfaces receive `color · intensity`, with no falloff with distance
+    /// inside `range`.
     pub intensity: f32,
     /// Radius in world units of the emitting sphere; 0 is a point (hard shadows). The
     /// reference samples the sphere's solid angle for soft shadows.
@@ -195,8 +241,11 @@ impl PointLight {
 /// The light a render uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
+    /// A sun: parallel rays, drawn with an orthographic (or cascaded, or warped) shadow map.
     Directional(DirectionalLight),
+    /// A spot light: a cone from a point, drawn with a perspective shadow map.
     Spot(SpotLight),
+    /// A point light: every direction, drawn with a cube (or dual-paraboloid) shadow map.
     Point(PointLight),
 }
 
@@ -216,8 +265,12 @@ impl Light {
 /// [`crate::settings::ShadowSettings`], laid over them).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneLight {
+    /// The light's name, for reports and messages (from the scene file, glTF light or built-in).
     pub name: String,
+    /// The light itself.
     pub light: Light,
+    /// This light's own shadow settings, a partial [`crate::settings::ShadowSettings`] table laid
+    /// over the render's; `None` to draw it with the render's settings unchanged.
     pub shadow: Option<toml::Table>,
 }
 
@@ -231,10 +284,15 @@ pub fn sun_direction(elevation_degrees: f32, azimuth_degrees: f32) -> Vec3 {
 /// A complete scene with its default view and lights.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene's name: the built-in's, or taken from its file; shown in reports and error messages.
     pub name: String,
+    /// Every mesh, in object space; instances refer to them by index.
     pub meshes: Vec<Mesh>,
+    /// Every material; instances refer to them by index.
     pub materials: Vec<Material>,
+    /// The placed meshes: what is drawn and traced.
     pub instances: Vec<Instance>,
+    /// The default view, which the settings' camera overrides change.
     pub camera: Camera,
     /// The scene's default sun, used with `--light sun`.
     pub sun: DirectionalLight,
@@ -257,30 +315,100 @@ pub struct Scene {
 /// A scene that is not well formed.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SceneError {
+    /// An instance's mesh index is not below the number of meshes.
     #[error("scene `{scene}`: instance `{instance}` refers to mesh {mesh}, but there are {count} meshes")]
-    MeshOutOfRange { scene: String, instance: String, mesh: usize, count: usize },
+    MeshOutOfRange {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the instance with the bad index.
+        instance: String,
+        /// The mesh index it gives.
+        mesh: usize,
+        /// The number of meshes in the scene.
+        count: usize,
+    },
+    /// An instance's material index is not below the number of materials.
     #[error(
         "scene `{scene}`: instance `{instance}` refers to material {material}, but there are {count} materials"
     )]
-    MaterialOutOfRange { scene: String, instance: String, material: usize, count: usize },
+    MaterialOutOfRange {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the instance with the bad index.
+        instance: String,
+        /// The material index it gives.
+        material: usize,
+        /// The number of materials in the scene.
+        count: usize,
+    },
+    /// A mesh's positions, normals and texture coordinates differ in number.
     #[error(
         "scene `{scene}`: mesh `{mesh}` has {positions} positions, {normals} normals and {uvs} UVs; all three must match"
     )]
-    AttributeCountMismatch { scene: String, mesh: String, positions: usize, normals: usize, uvs: usize },
+    AttributeCountMismatch {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the mesh at fault.
+        mesh: String,
+        /// Its number of positions.
+        positions: usize,
+        /// Its number of normals.
+        normals: usize,
+        /// Its number of texture coordinates.
+        uvs: usize,
+    },
+    /// A mesh's index reaches past its vertices, or its index count is not a multiple of 3.
     #[error(
         "scene `{scene}`: mesh `{mesh}` has an index {index} beyond its {vertices} vertices, or an index count not a multiple of 3"
     )]
-    BadIndices { scene: String, mesh: String, index: u32, vertices: usize },
+    BadIndices {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the mesh at fault.
+        mesh: String,
+        /// The first index past the vertices (0 when only the index count is wrong).
+        index: u32,
+        /// The mesh's number of vertices.
+        vertices: usize,
+    },
+    /// A mesh has a position or normal with an infinite or NaN coordinate.
     #[error("scene `{scene}`: mesh `{mesh}` has a non-finite position or normal")]
-    NonFinite { scene: String, mesh: String },
+    NonFinite {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the mesh at fault.
+        mesh: String,
+    },
+    /// A material's base-colour texture index is not below the number of textures.
     #[error(
         "scene `{scene}`: material `{material}` refers to texture {texture}, but there are {count} textures"
     )]
-    TextureOutOfRange { scene: String, material: String, texture: usize, count: usize },
+    TextureOutOfRange {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the material with the bad index.
+        material: String,
+        /// The texture index it gives.
+        texture: usize,
+        /// The number of textures in the scene.
+        count: usize,
+    },
+    /// A texture is empty (zero width or height) or its bytes are not 4 per texel.
     #[error(
         "scene `{scene}`: texture `{texture}` is {width}×{height} but holds {bytes} bytes, not 4 per texel"
     )]
-    BadTexture { scene: String, texture: String, width: u32, height: u32, bytes: usize },
+    BadTexture {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the texture at fault.
+        texture: String,
+        /// Its width in texels.
+        width: u32,
+        /// Its height in texels.
+        height: u32,
+        /// The number of bytes it holds.
+        bytes: usize,
+    },
 }
 
 impl Scene {
@@ -295,6 +423,7 @@ impl Scene {
             .fold(Aabb::EMPTY, Aabb::union)
     }
 
+    /// Number of triangles drawn: each instance counts its mesh's triangles.
     pub fn triangle_count(&self) -> usize {
         self.instances.iter().map(|i| self.meshes[i.mesh].triangle_count()).sum()
     }

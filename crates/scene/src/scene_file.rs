@@ -62,7 +62,9 @@ use crate::{
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {problem}", path.display())]
 pub struct SceneFileError {
+    /// The scene file (a model it names that fails to load is reported against it too).
     pub path: PathBuf,
+    /// What is wrong with it, in words, for the error message.
     pub problem: String,
 }
 
@@ -244,8 +246,13 @@ struct ViewEntry {
 /// A loaded scene file: the scene, with the chosen view as its camera, and the
 /// file's default settings (a TOML table in the shape of [`Settings`]).
 pub struct LoadedSceneFile {
+    /// The scene: the built-in start, the models placed, the file's lights, and the chosen view
+    /// as its camera. Already validated.
     pub scene: Scene,
+    /// The names of the file's `[[view]]`s, in file order (for listing, and for `--view`).
     pub view_names: Vec<String>,
+    /// The file's `[settings]` table, already checked against [`Settings`]; the command line's
+    /// values are laid over it. `None` when the file has none.
     pub settings: Option<toml::Value>,
 }
 

@@ -84,6 +84,7 @@ impl Renderer {
         })
     }
 
+    /// The device the renderer draws with.
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
     }

@@ -30,6 +30,7 @@ pub struct OutputRequest {
 /// The light's depth map as rendered, with what is needed to interpret it.
 #[derive(Clone, Debug)]
 pub struct ShadowMapImage {
+    /// Texels per side of each (square) layer.
     pub resolution: u32,
     /// Array layers: cascades, cube faces (WebGPU's order) or paraboloids; 1 for a
     /// single map.
@@ -50,7 +51,9 @@ impl ShadowMapImage {
 /// Everything a frame produced. Images are row-major, top row first.
 #[derive(Clone, Debug)]
 pub struct Frame {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// RGBA8, sRGB-encoded.
     pub color: Vec<u8>,
@@ -65,6 +68,7 @@ pub struct Frame {
     pub depth: Vec<f32>,
     /// Instance index + 1 of the visible surface; 0 for background.
     pub object_id: Vec<u32>,
+    /// The camera the frame was drawn with: the scene's, with the settings' overrides.
     pub camera: Camera,
     /// The light whose visibility the frame reports: the one light, or with
     /// `--light all` the one at `--light-index`. The shadow-map fields below are its.
@@ -78,7 +82,9 @@ pub struct Frame {
     /// The shadow map was drawn with depth clamping: its near plane sits at the nearest
     /// receiver, and casters before it are clamped onto it.
     pub shadow_depth_clamp: bool,
+    /// Texels per side of each layer of the reported light's map.
     pub shadow_resolution: u32,
+    /// The reported light's map read back, when [`OutputRequest::shadow_map`] asked for it.
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
     pub timings: Option<PassTimings>,
@@ -102,7 +108,9 @@ pub struct LiveFrame {
     /// The reported light's shadow map: a Depth32Float 2D array, one layer per cascade
     /// (six for a cube), bindable as a texture.
     pub shadow_map: wgpu::Texture,
+    /// The camera the frame was drawn with: the scene's, with the settings' overrides.
     pub camera: Camera,
+    /// The light whose shadow map `shadow_map` is (as [`Frame::light`]).
     pub light: Light,
     /// The reported light's layers and cascade splits.
     pub layout: ShadowLayout,
@@ -111,9 +119,11 @@ pub struct LiveFrame {
     pub timings: Option<PassTimings>,
     /// How many frames before this one `timings` and `lights`' times were taken.
     pub timings_age: u32,
+    /// Draw calls and state changes of this frame, every light together.
     pub stats: DrawStats,
     /// What each light drew (this frame) and cost (`timings_age` frames ago).
     pub lights: Vec<LightStats>,
+    /// Shadows were resolved in a screen-space mask, not per fragment (as [`Frame::shadow_mask`]).
     pub shadow_mask: bool,
 }
 
@@ -124,6 +134,7 @@ pub struct LightStats {
     pub name: String,
     /// "sun", "spot" or "point".
     pub kind: &'static str,
+    /// The shadow technique the light was drawn with (its own settings, with `--light all`).
     pub technique: Technique,
     /// Texels per side of each of its layers.
     pub resolution: u32,
@@ -137,7 +148,9 @@ pub struct LightStats {
     /// Time of its shadow passes (every layer), moment pass and lighting pass, where
     /// the frame was timed.
     pub shadow_ms: Option<f64>,
+    /// GPU time of its moment pass (filterable techniques only), where the frame was timed.
     pub filter_ms: Option<f64>,
+    /// GPU time of its lighting pass, where the frame was timed.
     pub lighting_ms: Option<f64>,
     /// GPU time of its shadow-mask pass, on the mask path.
     pub mask_ms: Option<f64>,
@@ -186,14 +199,18 @@ impl DrawStats {
 /// the commands. `submit_ms` is the whole, from the call to the queue's submit.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CpuTimings {
+    /// Planning: resolving the camera and lights and fitting every light's projection.
     pub plan_ms: f64,
+    /// Culling every map layer and the camera against the instances.
     pub cull_ms: f64,
+    /// Recording the passes' commands, up to and including the submit.
     pub record_ms: f64,
+    /// The whole, from the call to the queue's submit: plan, cull and record together.
     pub submit_ms: f64,
 }
 
 /// What timing one frame measured: the summary, each pass, the draws and the CPU
-/// cost ([`Renderer::time_passes`]).
+/// cost ([`crate::Renderer::time_passes`]).
 #[derive(Clone, Debug)]
 pub struct FrameCost {
     /// None only when the frame was not timed.
@@ -201,8 +218,11 @@ pub struct FrameCost {
     /// Each pass's time: every layer of every light's map, filters, screen-space
     /// passes and lighting.
     pub passes: Vec<PassTime>,
+    /// Draw calls and state changes, every light together.
     pub stats: DrawStats,
+    /// What each light drew and cost, in the order they were drawn.
     pub lights: Vec<LightStats>,
+    /// The frame's CPU cost.
     pub cpu: CpuTimings,
 }
 
@@ -210,12 +230,15 @@ pub struct FrameCost {
 /// each kind of pass summed over the lights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassTimings {
+    /// The shadow passes: every layer of every light's map.
     pub shadow_ms: f64,
     /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
     pub filter_ms: Option<f64>,
+    /// The lighting passes, every light's.
     pub lighting_ms: f64,
     /// On the mask path: the depth-and-normal prepass, and the mask passes.
     pub prepass_ms: Option<f64>,
+    /// On the mask path: the shadow-mask passes, every light's.
     pub mask_ms: Option<f64>,
     /// The whole frame on the GPU, from the first shadow pass's start to the last
     /// lighting pass's end (SDSM's prepass not included).
@@ -225,6 +248,7 @@ pub struct PassTimings {
 }
 
 impl Frame {
+    /// Number of pixels, `width × height`: the length of every per-pixel vector.
     pub fn pixel_count(&self) -> usize {
         (self.width * self.height) as usize
     }

@@ -89,7 +89,9 @@ pub(crate) fn filter_wgsl(format: wgpu::TextureFormat) -> String {
 fn wgsl_format(format: wgpu::TextureFormat) -> &'static str {
     match format {
         wgpu::TextureFormat::Rgba16Float => "rgba16float",
-        _ => "rgba32float",
+        wgpu::TextureFormat::Rgba32Float => "rgba32float",
+        // `Renderer::moment_format` picks one of the two; wgpu's enum is open-ended.
+        other => unreachable!("a moment map is rgba16float or rgba32float, not {other:?}"),
     }
 }
 

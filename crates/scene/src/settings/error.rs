@@ -7,8 +7,11 @@ use super::*;
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error("{flag} = {value} is invalid: {valid}")]
 pub struct SettingsError {
+    /// The setting at fault: its command-line flag (`--blur-radius`) or scene-file key.
     pub flag: &'static str,
+    /// The value given, as text.
     pub value: String,
+    /// What would be valid, in words (a range, or a condition on other settings).
     pub valid: String,
 }
 

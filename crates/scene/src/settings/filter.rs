@@ -63,6 +63,7 @@ impl Technique {
         }
     }
 
+    /// Every technique, in declaration order (the order `--help` lists them).
     pub fn all() -> &'static [Technique] {
         Technique::value_variants()
     }
@@ -131,8 +132,10 @@ pub struct FilterSettings {
     /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
     #[arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter")]
     pub receiver_plane_bias: bool,
+    /// PCSS: blocker-search taps and the largest penumbra radius.
     #[command(flatten)]
     pub pcss: PcssSettings,
+    /// Parameters of the filterable (moment and exponential) maps.
     #[command(flatten)]
     pub moments: MomentSettings,
 }

@@ -14,7 +14,7 @@ pub enum LightKind {
     Spot,
     /// The scene's point light, with a cube shadow map (six 90° faces).
     Point,
-    /// Every light of the scene's light list at once (scene files' [[light]],
+    /// Every light of the scene's light list at once (scene files' `[[light]]`,
     /// glTF KHR_lights_punctual, the built-in `lamps`), each with its own shadow map
     /// and shadow settings.
     All,
@@ -77,6 +77,8 @@ pub struct LightSettings {
 pub struct ResolvedLight {
     /// The light's name in the scene's list, or its type for a single light.
     pub name: String,
+    /// The light itself, with the settings' overrides applied to a single light; a list light is
+    /// used as the scene defines it.
     pub light: Light,
     /// The render's shadow settings with the light's own laid over them.
     pub shadow: ShadowSettings,

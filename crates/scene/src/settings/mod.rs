@@ -31,18 +31,25 @@ pub use shadow::*;
 #[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
+    /// Changes to the scene itself (a ground plane).
     #[command(flatten)]
     pub scene: SceneOptions,
+    /// The output image: size and debug view.
     #[command(flatten)]
     pub image: ImageSettings,
+    /// Overrides of the scene's camera.
     #[command(flatten)]
     pub camera: CameraSettings,
+    /// Which light is rendered, and overrides of its parameters.
     #[command(flatten)]
     pub light: LightSettings,
+    /// How shadows are drawn: filter, bias, map, partition, cascades, contact shadows.
     #[command(flatten)]
     pub shadow: ShadowSettings,
+    /// Where shadows are resolved: in the lighting pass, or in a screen-space mask first.
     #[command(flatten)]
     pub screen: ScreenSpaceSettings,
+    /// The ray-traced reference the render is compared with.
     #[command(flatten)]
     pub reference: ReferenceSettings,
 }

@@ -271,17 +271,22 @@ impl Default for CascadeSettings {
 #[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
 pub struct ShadowSettings {
+    /// The filter: which technique samples the map, and its parameters.
     #[command(flatten)]
     pub filter: FilterSettings,
+    /// Biases against shadow acne (constant, slope-scaled, normal offset) and face culling.
     #[command(flatten)]
     pub bias: BiasSettings,
+    /// The map: resolution, storage format, fit, warp, depth clamping, point-light layout.
     #[command(flatten)]
     pub map: MapSettings,
     /// Partition of the light's view into maps.
     #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
     pub partition: Partition,
+    /// The cascades, used with `--partition cascades`.
     #[command(flatten)]
     pub cascades: CascadeSettings,
+    /// Contact shadows for this light.
     #[command(flatten)]
     pub contact: ContactSettings,
 }
