@@ -1,6 +1,8 @@
 //! The viewer's path: a live frame (left on the GPU) shows the same image as a read-back
 //! frame, and the shadow-map preview shows every layer's depth in grayscale.
 
+mod support;
+
 use gnomon_render::{Gpu, OutputRequest, Renderer, read_texture};
 use gnomon_scene::{Settings, builtin, settings::Partition};
 
@@ -66,7 +68,7 @@ fn the_map_preview_shows_every_cascade_in_gray_side_by_side() {
 fn live_frames_report_the_previous_frames_times() {
     let gpu = Gpu::new_headless().unwrap();
     if gpu.timestamp_period_ns.is_none() {
-        println!("skipped: live frame timings: the adapter has no timestamp queries");
+        support::figures::skipped("live frame timings", "the adapter has no timestamp queries");
         return;
     }
     let mut renderer = Renderer::new(&gpu).unwrap();

@@ -5,6 +5,8 @@
 //! through every entry point (read back, live, timed); and a changed setting creates
 //! only what depends on it.
 
+mod support;
+
 use gnomon_render::{Creations, Gpu, OutputRequest, Renderer, timing::ClockChoice};
 use gnomon_scene::{
     Scene, Settings, builtin,
@@ -78,19 +80,24 @@ fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
     let gpu = Gpu::new_headless().unwrap();
     let scene = builtin::spheres();
     let mut failures = Vec::new();
-    let mut checked = 0;
+    let (mut checked, mut total) = (0, 0);
     for &technique in Technique::all() {
         for (name, settings) in light_cases(technique) {
             // A fresh renderer per case, so that each case warms up alone.
             let mut renderer = Renderer::new(&gpu).unwrap();
             let created = created_in_steady_state(&mut renderer, &scene, &settings);
             checked += 1;
+            total += created.total();
             if created.total() != 0 {
                 failures.push(format!("{technique:?}, {name}: {created:?}"));
             }
         }
     }
-    println!("figure: persistence: {checked} cases × {STEADY_FRAMES} steady frames, creations 0 expected");
+    support::figures::figure(
+        &format!("persistence: resources created by {STEADY_FRAMES} steady frames, over {checked} cases"),
+        total,
+        0,
+    );
     assert!(failures.is_empty(), "steady frames created resources:\n{}", failures.join("\n"));
 }
 
