@@ -111,14 +111,9 @@ impl Renderer {
                     DepthTarget::Paraboloid => continue,
                     target @ (DepthTarget::Projected | DepthTarget::CubeFace) => target,
                 };
-                let resolution = light.settings.shadow.map.resolution;
                 let map = self.pool.texture(
                     "baseline depth",
-                    wgpu::Extent3d {
-                        width: resolution,
-                        height: resolution,
-                        depth_or_array_layers: light.layers(),
-                    },
+                    light.map_size(),
                     SHADOW_FORMAT,
                     wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                 );

@@ -71,6 +71,12 @@ impl LightPlan {
     pub fn layers(&self) -> u32 {
         self.layout.projections.len() as u32
     }
+
+    /// Its map's size: resolution² texels, one array layer per layout layer.
+    pub fn map_size(&self) -> wgpu::Extent3d {
+        let resolution = self.settings.shadow.map.resolution;
+        wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: self.layers() }
+    }
 }
 
 impl Renderer {

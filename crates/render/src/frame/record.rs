@@ -281,14 +281,10 @@ impl Renderer {
         layers: &[Visible],
         light_index: u32,
     ) -> wgpu::Texture {
-        let resolution = light.settings.shadow.map.resolution;
+        debug_assert_eq!(layers.len() as u32, light.layers(), "one culled set per layer");
         let map = self.pool.texture(
             "shadow map",
-            wgpu::Extent3d {
-                width: resolution,
-                height: resolution,
-                depth_or_array_layers: layers.len() as u32,
-            },
+            light.map_size(),
             SHADOW_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
