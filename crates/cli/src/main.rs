@@ -90,6 +90,7 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::DeviceRequest { .. }
         | RenderError::ImageTooLarge { .. }
         | RenderError::AttachmentsTooLarge { .. }
+        | RenderError::ReceiverNeedsMapPath
         | RenderError::Settings(_)
         | RenderError::Scene(_)
         | RenderError::EmptyScene(_)

@@ -28,11 +28,12 @@ pub mod uniforms;
 
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
-    CpuTimings, Creations, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
-    Renderer, ShadowMapImage,
+    CpuTimings, Creations, DrawStats, Frame, FrameCost, LightShadows, LightStats, LiveFrame, OutputRequest,
+    PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
 };
 pub use gpu_scene::GpuScene;
 pub use layout::{ShadowLayout, light_projection};
+pub use passes::blit::HostTarget;
 pub use passes::depth_baseline::DepthBaselineScene;
 pub use readback::read_texture;
 pub use wgpu;
@@ -111,6 +112,16 @@ pub enum RenderError {
         /// Name of the adapter, as wgpu reports it.
         adapter: String,
     },
+    /// A host's shader reads each light's own shadow map ([`Renderer::record_shadows`]);
+    /// the mask path (a screen-space mask, contact shadows) needs Gnomon's depth prepass.
+    #[error(
+        "the shadow receiver reads each light's shadow map, but these settings shade through \
+         Gnomon's screen-space mask (`screen.shadow_path = \"mask\"`, or \
+         `shadow.contact.contact_shadows` on for a light), which needs Gnomon's own depth \
+         prepass; set `screen.shadow_path` to forward or auto with contact shadows off, or \
+         let Gnomon draw the image"
+    )]
+    ReceiverNeedsMapPath,
     /// A setting is out of its valid range.
     #[error(transparent)]
     Settings(#[from] SettingsError),

@@ -105,6 +105,12 @@ impl PassClock {
         Self { mode, labels: Vec::new() }
     }
 
+    /// A clock that times nothing: for passes recorded into a host's encoder, which
+    /// Gnomon neither submits nor waits for.
+    pub fn off() -> Self {
+        Self { mode: Mode::Off, labels: Vec::new() }
+    }
+
     /// Starts timing a pass. On the CPU clock, everything recorded so far is
     /// submitted and waited for first, so the pass is timed alone.
     pub fn begin(

@@ -2,12 +2,12 @@
 //! warm-up frame, the same frame again creates no texture, view, buffer, query set or
 //! bind group, for every technique, every light kind (sun, spot, point through a cube
 //! and through paraboloids, all of `lamps` at once), on the forward and mask paths and
-//! through every entry point (read back, live, timed); and a changed setting creates
-//! only what depends on it.
+//! through every entry point (read back, live, timed, drawn into a host's target,
+//! shadows for a host's shader); and a changed setting creates only what depends on it.
 
 mod support;
 
-use gnomon_render::{Creations, Gpu, OutputRequest, Renderer, timing::ClockChoice};
+use gnomon_render::{Creations, Gpu, HostTarget, OutputRequest, Renderer, timing::ClockChoice, wgpu};
 use gnomon_scene::{
     Scene, Settings, builtin,
     settings::{LightKind, OmniMap, Partition, ShadowPath, Technique},
@@ -27,30 +27,89 @@ fn small(technique: Technique, light: LightKind) -> Settings {
 }
 
 /// Renders `settings` once to warm up, then [`STEADY_FRAMES`] times through each
-/// entry point, and returns what the steady frames created.
+/// entry point (read back, live, timed, into a host's target, and shadows for a
+/// host's shader where the settings allow it), and returns what the steady frames
+/// created.
 fn created_in_steady_state(renderer: &mut Renderer, scene: &Scene, settings: &Settings) -> Creations {
     let uploaded = renderer.upload(scene).unwrap();
     let request = OutputRequest { shadow_map: true, ..Default::default() };
-    // Warm up every entry point: each holds its own readbacks.
-    renderer.render_uploaded(&uploaded, scene, settings, &request).unwrap();
-    renderer.render_live(&uploaded, scene, settings).unwrap();
-    renderer.time_passes(&uploaded, scene, settings, ClockChoice::Auto).unwrap();
+    let gpu = renderer.gpu().clone();
+    let host_texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host target"),
+        size: wgpu::Extent3d {
+            width: settings.image.width,
+            height: settings.image.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Bgra8UnormSrgb,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let host_view = host_texture.create_view(&Default::default());
+    let target = HostTarget::new(&host_texture, &host_view);
+    let receives = settings.screen.shadow_path != ShadowPath::Mask;
+    let frame_through = |renderer: &mut Renderer, entry: Entry| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        match entry {
+            Entry::ReadBack => drop(renderer.render_uploaded(&uploaded, scene, settings, &request).unwrap()),
+            Entry::Live => drop(renderer.render_live(&uploaded, scene, settings).unwrap()),
+            Entry::Timed => {
+                drop(renderer.time_passes(&uploaded, scene, settings, ClockChoice::Auto).unwrap())
+            }
+            Entry::Into => {
+                renderer.render_into(&mut encoder, &target, &uploaded, scene, settings).unwrap();
+            }
+            Entry::Shadows => {
+                drop(renderer.record_shadows(&mut encoder, &uploaded, scene, settings).unwrap())
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+    };
+    // The viewer's entry points alternate: warm each up (each holds its own
+    // readbacks), then alternate them.
+    let alternating = [Entry::ReadBack, Entry::Live, Entry::Timed];
+    for entry in alternating {
+        frame_through(renderer, entry);
+    }
+    let mut created = Creations::default();
+    let mut count = |renderer: &Renderer, before: Creations| {
+        let after = renderer.creations();
+        created.textures += after.textures - before.textures;
+        created.views += after.views - before.views;
+        created.buffers += after.buffers - before.buffers;
+        created.bind_groups += after.bind_groups - before.bind_groups;
+        created.query_sets += after.query_sets - before.query_sets;
+    };
     let before = renderer.creations();
     for frame in 0..STEADY_FRAMES {
-        match frame % 3 {
-            0 => drop(renderer.render_uploaded(&uploaded, scene, settings, &request).unwrap()),
-            1 => drop(renderer.render_live(&uploaded, scene, settings).unwrap()),
-            _ => drop(renderer.time_passes(&uploaded, scene, settings, ClockChoice::Auto).unwrap()),
+        frame_through(renderer, alternating[frame % alternating.len()]);
+    }
+    count(renderer, before);
+    // A host's frames take one entry point each time: what only another entry point
+    // uses may have been dropped meanwhile, so each gets its own warm-up frame.
+    let embedded: &[Entry] = if receives { &[Entry::Into, Entry::Shadows] } else { &[Entry::Into] };
+    for &entry in embedded {
+        frame_through(renderer, entry);
+        let before = renderer.creations();
+        for _ in 0..STEADY_FRAMES / 2 {
+            frame_through(renderer, entry);
         }
+        count(renderer, before);
     }
-    let after = renderer.creations();
-    Creations {
-        textures: after.textures - before.textures,
-        views: after.views - before.views,
-        buffers: after.buffers - before.buffers,
-        bind_groups: after.bind_groups - before.bind_groups,
-        query_sets: after.query_sets - before.query_sets,
-    }
+    created
+}
+
+/// A renderer entry point.
+#[derive(Clone, Copy)]
+enum Entry {
+    ReadBack,
+    Live,
+    Timed,
+    Into,
+    Shadows,
 }
 
 /// Every light kind a technique can shadow, with its settings adjusted.
@@ -94,7 +153,11 @@ fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
         }
     }
     support::figures::figure(
-        &format!("persistence: resources created by {STEADY_FRAMES} steady frames, over {checked} cases"),
+        &format!(
+            "persistence: resources created by {STEADY_FRAMES} steady frames per entry point group \
+             (read back/live/timed alternating; into a host's target; shadows for a host's shader), \
+             over {checked} cases"
+        ),
         total,
         0,
     );

@@ -412,6 +412,51 @@ pub enum SceneError {
 }
 
 impl Scene {
+    /// An empty scene seen by `camera` and lit by `sun`, for a program that keeps its
+    /// own geometry to hand its shadow casters to Gnomon with [`Scene::place`]. Its
+    /// spot and point light (used only when settings pick them) hang 10 units above
+    /// the origin, the spot pointing down.
+    pub fn new(name: &str, camera: Camera, sun: DirectionalLight) -> Scene {
+        let above = Vec3::new(0.0, 10.0, 0.0);
+        let white = Vec3::ONE;
+        Scene {
+            name: name.into(),
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            instances: Vec::new(),
+            camera,
+            sun,
+            spot: SpotLight {
+                position: above,
+                direction: Vec3::NEG_Y,
+                inner_angle_degrees: 32.0,
+                outer_angle_degrees: 40.0,
+                range: 30.0,
+                color: white,
+                intensity: 1.0,
+                radius: 0.0,
+            },
+            point: PointLight { position: above, range: 30.0, color: white, intensity: 1.0, radius: 0.0 },
+            lights: Vec::new(),
+            ambient: Vec3::splat(0.12),
+            textures: Vec::new(),
+            has_ground: false,
+        }
+    }
+
+    /// Adds `mesh` with `material` at `world_from_object`, casting shadows.
+    pub fn place(&mut self, name: &str, mesh: Mesh, material: Material, world_from_object: Mat4) {
+        self.meshes.push(mesh);
+        self.materials.push(material);
+        self.instances.push(Instance {
+            name: name.into(),
+            mesh: self.meshes.len() - 1,
+            material: self.materials.len() - 1,
+            world_from_object,
+            casts_shadow: true,
+        });
+    }
+
     /// World-space bounds of all instances.
     pub fn bounds(&self) -> Aabb {
         // Each mesh's bounds once, not once per instance: a million instances of a

@@ -122,6 +122,40 @@ impl FixedBindings {
     }
 }
 
+impl FixedBindings {
+    /// The shadow receiver's group: the light's and camera's uniforms and the light's
+    /// maps, for a host's shader.
+    pub fn receiver_group(
+        &self,
+        pool: &mut Pool,
+        layouts: &Layouts,
+        uniforms: ReceiverUniforms,
+        views: ShadowViews,
+    ) -> wgpu::BindGroup {
+        pool.bind_group(
+            "shadow receiver",
+            &layouts.receiver,
+            &[
+                Binding::Buffer(uniforms.light.clone()),
+                Binding::Buffer(uniforms.camera.clone()),
+                Binding::View(views.map.clone()),
+                Binding::Sampler(self.compare_sampler.clone()),
+                Binding::View(views.moments.unwrap_or(&self.placeholder_moments).clone()),
+                Binding::Sampler(self.moment_sampler.clone()),
+                Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
+                Binding::Sampler(self.compare_nearest_sampler.clone()),
+                Binding::Sampler(self.gather_sampler.clone()),
+            ],
+        )
+    }
+}
+
+/// The uniforms of a receiver's group.
+pub(crate) struct ReceiverUniforms<'a> {
+    pub light: &'a wgpu::Buffer,
+    pub camera: &'a wgpu::Buffer,
+}
+
 /// Group 0 of the geometry passes: the instances and the light's uniform `light`.
 pub(crate) fn scene_group(
     pool: &mut Pool,

@@ -6,9 +6,11 @@
 
 mod baseline;
 mod bindings;
+mod host_target;
 mod late;
 mod outputs;
 mod plan;
+mod receiver;
 mod record;
 mod screen;
 
@@ -19,11 +21,12 @@ pub use outputs::{
     CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
     ShadowMapImage,
 };
+pub use receiver::{LightShadows, ReceiverVariant, Shadows};
 
 use crate::{
     Gpu, GpuScene, RenderError,
     passes::{
-        Layouts, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass, lighting,
+        Layouts, blit::BlitPass, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass, lighting,
         lighting::LightingPass, map_preview::MapPreviewPass, moments::MomentPass,
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
@@ -43,6 +46,7 @@ struct Passes {
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
     depth_baseline: DepthBaselinePass,
+    blit: BlitPass,
 }
 
 /// The renderer: everything a frame reuses. Create one per device and keep it; a
@@ -72,6 +76,7 @@ impl Renderer {
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
                 depth_baseline: DepthBaselinePass::new(device),
+                blit: BlitPass::new(device),
             };
             Self {
                 gpu: Gpu::clone(gpu),
@@ -113,8 +118,24 @@ impl Renderer {
         GpuScene::upload(&self.gpu, scene, &self.layouts)
     }
 
-    /// Checks `settings` against the device's limits.
+    /// Checks `settings` against the device's limits, for a frame Gnomon draws.
     pub fn check_limits(&self, settings: &Settings) -> Result<(), RenderError> {
+        self.check_map_limits(settings)?;
+        let limits = &self.gpu.limits;
+        let needed = lighting::target_bytes_per_pixel();
+        if limits.max_color_attachment_bytes_per_sample < needed {
+            return Err(RenderError::AttachmentsTooLarge {
+                available: limits.max_color_attachment_bytes_per_sample,
+                needed,
+                adapter: self.gpu.info.adapter.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks what the shadow maps of `settings` need of the device (all that a host
+    /// drawing its own image needs, [`Renderer::record_shadows`]).
+    pub fn check_map_limits(&self, settings: &Settings) -> Result<(), RenderError> {
         let limits = &self.gpu.limits;
         let adapter = self.gpu.info.adapter.clone();
         let max = limits.max_texture_dimension_2d;
@@ -127,14 +148,6 @@ impl Renderer {
             return Err(RenderError::ImageTooLarge { width, height, max, adapter });
         }
         self.moment_format(settings)?;
-        let needed = lighting::target_bytes_per_pixel();
-        if limits.max_color_attachment_bytes_per_sample < needed {
-            return Err(RenderError::AttachmentsTooLarge {
-                available: limits.max_color_attachment_bytes_per_sample,
-                needed,
-                adapter,
-            });
-        }
         Ok(())
     }
 

@@ -98,7 +98,7 @@ impl Renderer {
         let mut lights = Vec::with_capacity(resolved.len());
         for (index, r) in resolved.into_iter().enumerate() {
             let light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
-            self.check_limits(&light_settings)?;
+            self.check_map_limits(&light_settings)?;
             let layout = match fixed_layout {
                 Some(layout) if index == shown => layout.clone(),
                 _ => self.fit_layout(uploaded, &r.light, &light_settings, &camera, aspect)?,

@@ -65,9 +65,10 @@ pub(super) enum TimesWanted {
     Late,
 }
 
-/// What every recording step appends to: the encoder, the pass clock and the counts.
-pub(super) struct Recording {
-    pub encoder: wgpu::CommandEncoder,
+/// What every recording step appends to: the encoder (the renderer's own, or the
+/// host's), the pass clock and the counts.
+pub(super) struct Recording<'e> {
+    pub encoder: &'e mut wgpu::CommandEncoder,
     pub clock: PassClock,
     pub stats: DrawStats,
 }
@@ -88,6 +89,25 @@ pub(super) struct LightBindings {
     /// The mask pass's shadow group, on the mask path.
     pub mask: Option<wgpu::BindGroup>,
     pub lookup: Lookup,
+}
+
+/// A light's uniform and the views of its maps, for the passes from the camera.
+pub(super) struct LightMaps {
+    pub light_buffer: wgpu::Buffer,
+    /// The depth map, every layer.
+    pub map: wgpu::TextureView,
+    /// The filterable techniques' moment map.
+    pub moments: Option<wgpu::TextureView>,
+    /// A point light's map as a cube.
+    pub cube: Option<wgpu::TextureView>,
+    pub lookup: Lookup,
+}
+
+impl LightMaps {
+    /// The views of a shadow group, with the light's layer of the mask where it has one.
+    pub fn views<'a>(&'a self, mask: Option<&'a wgpu::TextureView>) -> ShadowViews<'a> {
+        ShadowViews { map: &self.map, moments: self.moments.as_ref(), cube: self.cube.as_ref(), mask }
+    }
 }
 
 /// One depth-only pass: a shadow-map layer, or SDSM's camera prepass.
@@ -169,14 +189,42 @@ impl Renderer {
         request: &SubmitRequest,
     ) -> Recorded {
         let gpu = self.gpu.clone();
-        let (width, height) = (settings.image.width, settings.image.height);
         // Every layer of every light, each light's filter, mask and lighting, and the prepass.
         let timed_passes = plan.lights.iter().map(|p| p.layers() + 3).sum::<u32>() + 1;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut rec = Recording {
-            encoder: gpu.device.create_command_encoder(&Default::default()),
+            encoder: &mut encoder,
             clock: PassClock::new(&gpu, &mut self.pool, timed_passes, request.clock),
             stats: DrawStats::default(),
         };
+        let drawn = self.record_passes(&mut rec, uploaded, settings, plan, culled, request.readback);
+        let Recording { clock, stats, .. } = rec;
+        let times = clock.resolve(&mut self.pool, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+        Recorded {
+            readbacks: drawn.readbacks,
+            times: Some(times),
+            stats,
+            color: drawn.color,
+            shadow_map: drawn.shadow_map,
+            submitted_at: Instant::now(),
+        }
+    }
+
+    /// Records every pass of a frame into `rec`: each light's shadow maps and moment
+    /// map, the screen-space passes on the mask path, each light's lighting, and the
+    /// copies `readback` asks for.
+    pub(super) fn record_passes(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        settings: &Settings,
+        plan: &FramePlan,
+        culled: &Culled,
+        readback: Readback,
+    ) -> Drawn {
+        let gpu = self.gpu.clone();
+        let (width, height) = (settings.image.width, settings.image.height);
         let camera_gpu = CameraGpu::new(&plan.camera, width, height, settings.image.debug_view);
         let camera_buffer = self.pool.uniform(&gpu.queue, "camera", &camera_gpu);
         let camera_group =
@@ -188,23 +236,15 @@ impl Renderer {
         let mut lit = Vec::with_capacity(plan.lights.len());
         let mut shown_map = None;
         for (index, light) in plan.lights.iter().enumerate() {
-            let map = self.record_shadow_maps(&mut rec, uploaded, light, &culled.layers[index], index as u32);
+            let map = self.record_shadow_maps(rec, uploaded, light, &culled.layers[index], index as u32);
             if index == plan.shown {
-                if request.readback.shadow_map {
+                if readback.shadow_map {
                     let aspect = wgpu::TextureAspect::DepthOnly;
-                    readbacks.shadow_map =
-                        Some(readback::record(&mut self.pool, &mut rec.encoder, &map, aspect));
+                    readbacks.shadow_map = Some(readback::record(&mut self.pool, rec.encoder, &map, aspect));
                 }
                 shown_map = Some(map.clone());
             }
-            lit.push(self.light_bindings(
-                &mut rec,
-                uploaded,
-                light,
-                index as u32,
-                &map,
-                mask_layers.get(index),
-            ));
+            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
         }
         let targets = self.lighting_targets(width, height);
         if plan.mask_path {
@@ -215,30 +255,24 @@ impl Renderer {
                 depth: &targets.depth,
                 mask_layers: &mask_layers,
             };
-            self.record_screen_space(&mut rec, uploaded, plan, &lit, &screen);
+            self.record_screen_space(rec, uploaded, plan, &lit, &screen);
         }
         let shared =
             SharedLighting { plan, camera_group: &camera_group, targets: &targets, visible: &culled.camera };
         for (index, bindings) in lit.iter().enumerate() {
-            self.record_lighting(&mut rec, uploaded, &shared, index, bindings);
+            self.record_lighting(rec, uploaded, &shared, index, bindings);
         }
-        if request.readback.images {
+        if readback.images {
             readbacks.targets = targets
                 .textures
                 .iter()
-                .map(|t| readback::record(&mut self.pool, &mut rec.encoder, t, wgpu::TextureAspect::All))
+                .map(|t| readback::record(&mut self.pool, rec.encoder, t, wgpu::TextureAspect::All))
                 .collect();
         }
-        let Recording { mut encoder, clock, stats } = rec;
-        let times = clock.resolve(&mut self.pool, &mut encoder);
-        gpu.queue.submit([encoder.finish()]);
-        Recorded {
+        Drawn {
             readbacks,
-            times: Some(times),
-            stats,
             color: targets.textures[0].clone(),
             shadow_map: shown_map.expect("the reported light is one of the lights"),
-            submitted_at: Instant::now(),
         }
     }
 
@@ -273,7 +307,7 @@ impl Renderer {
     /// Draws a light's shadow map, one depth pass per layer (cascade or cube face),
     /// each drawing the casters culled for that layer (`layers`), each timed alone.
     /// Returns the map.
-    fn record_shadow_maps(
+    pub(super) fn record_shadow_maps(
         &mut self,
         rec: &mut Recording,
         uploaded: &GpuScene,
@@ -303,17 +337,53 @@ impl Renderer {
             };
             let slot = rec.clock.begin(
                 &self.gpu,
-                &mut rec.encoder,
+                rec.encoder,
                 PassKind::Shadow,
                 Some(light_index),
                 Some(layer as u32),
             );
-            let drawn =
-                self.record_depth_pass(&mut rec.encoder, uploaded, &pass, rec.clock.render_writes(slot));
-            rec.clock.end(&self.gpu, &mut rec.encoder, slot);
+            let drawn = self.record_depth_pass(rec.encoder, uploaded, &pass, rec.clock.render_writes(slot));
+            rec.clock.end(&self.gpu, rec.encoder, slot);
             rec.stats.add(&drawn);
         }
         map
+    }
+
+    /// A light's uniform and its maps as the passes from the camera read them: the
+    /// depth map (drawn already), its moment map (recorded here) and its cube view.
+    pub(super) fn light_maps(
+        &mut self,
+        rec: &mut Recording,
+        light: &LightPlan,
+        index: u32,
+        map: &wgpu::Texture,
+    ) -> LightMaps {
+        let gpu = self.gpu.clone();
+        let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
+        let map_view = self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
+        let shadow = &light.settings.shadow;
+        let moments = light.filterable_map.map(|filterable| {
+            let input = MomentInput {
+                technique: shadow.filter.technique,
+                map: filterable,
+                settings: &shadow.filter.moments,
+                format: light.moment_format,
+                resolution: shadow.map.resolution,
+                cascades: light.layers(),
+                depth_view: &map_view,
+                light_buffer: &light_buffer,
+            };
+            let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
+            let writes = rec.clock.compute_writes(slot);
+            let moments =
+                self.passes.moments.record(&gpu.device, &mut self.pool, rec.encoder, &input, writes);
+            rec.clock.end(&gpu, rec.encoder, slot);
+            moments.view
+        });
+        let lookup = light.lookup();
+        let cube = (lookup == Lookup::Cube)
+            .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
+        LightMaps { light_buffer, map: map_view, moments, cube, lookup }
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes
@@ -327,42 +397,13 @@ impl Renderer {
         map: &wgpu::Texture,
         mask_layer: Option<&wgpu::TextureView>,
     ) -> LightBindings {
-        let gpu = self.gpu.clone();
-        let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
-        let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
-        let map_view = self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
-        let shadow = &light.settings.shadow;
-        let moment_map = light.filterable_map.map(|filterable| {
-            let input = MomentInput {
-                technique: shadow.filter.technique,
-                map: filterable,
-                settings: &shadow.filter.moments,
-                format: light.moment_format,
-                resolution: shadow.map.resolution,
-                cascades: light.layers(),
-                depth_view: &map_view,
-                light_buffer: &light_buffer,
-            };
-            let slot = rec.clock.begin(&gpu, &mut rec.encoder, PassKind::Filter, Some(index), None);
-            let writes = rec.clock.compute_writes(slot);
-            let moments =
-                self.passes.moments.record(&gpu.device, &mut self.pool, &mut rec.encoder, &input, writes);
-            rec.clock.end(&gpu, &mut rec.encoder, slot);
-            moments
-        });
-        let lookup = light.lookup();
-        let cube = (lookup == Lookup::Cube)
-            .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
-        let views = |mask| ShadowViews {
-            map: &map_view,
-            moments: moment_map.as_ref().map(|m| &m.view),
-            cube: cube.as_ref(),
-            mask,
-        };
+        let maps = self.light_maps(rec, light, index, map);
+        let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
-        let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, views(mask_layer));
-        let mask = mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, views(None)));
-        LightBindings { scene, lighting, mask, lookup }
+        let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(mask_layer));
+        let mask =
+            mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
+        LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
 
     /// One light's lighting pass, adding its light to the targets (the first light
@@ -399,7 +440,7 @@ impl Renderer {
             })
             .collect();
         let gpu = &self.gpu;
-        let slot = rec.clock.begin(gpu, &mut rec.encoder, PassKind::Lighting, Some(index as u32), None);
+        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Lighting, Some(index as u32), None);
         let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lighting"),
             color_attachments: &attachments,
@@ -440,7 +481,7 @@ impl Renderer {
         rec.stats.lighting_instances += camera_visible.instances();
         rec.stats.bind_group_changes += binds;
         drop(pass);
-        rec.clock.end(gpu, &mut rec.encoder, slot);
+        rec.clock.end(gpu, rec.encoder, slot);
     }
 
     /// Records a depth-only pass with the shadow pipelines, drawing the runs
@@ -501,6 +542,15 @@ impl Renderer {
     }
 }
 
+/// What a frame's passes drew.
+pub(super) struct Drawn {
+    pub readbacks: FrameReadbacks,
+    /// The colour image.
+    pub color: wgpu::Texture,
+    /// The reported light's shadow map.
+    pub shadow_map: wgpu::Texture,
+}
+
 /// What recording left for the frame to read.
 pub(super) struct Recorded {
     pub readbacks: FrameReadbacks,
@@ -513,7 +563,7 @@ pub(super) struct Recorded {
 }
 
 /// Culls for every layer of every light, and for the camera, in parallel.
-fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
+pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
     let camera_view = CullView {
         frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
         near: true,

@@ -70,7 +70,7 @@ impl Renderer {
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
         {
             let mask_group = bindings.mask.as_ref().expect("a mask pass group on the mask path");
-            let slot = rec.clock.begin(gpu, &mut rec.encoder, PassKind::Mask, Some(index as u32), None);
+            let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Mask, Some(index as u32), None);
             let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow mask"),
                 color_attachments: &[cleared(layer, wgpu::Color::WHITE)],
@@ -88,7 +88,7 @@ impl Renderer {
             rec.stats.bind_group_changes += 3;
             pass.draw(0..3, 0..1);
             drop(pass);
-            rec.clock.end(gpu, &mut rec.encoder, slot);
+            rec.clock.end(gpu, rec.encoder, slot);
         }
     }
 
@@ -102,7 +102,7 @@ impl Renderer {
         [normals, view_depth]: [&wgpu::TextureView; 2],
     ) {
         let gpu = &self.gpu;
-        let slot = rec.clock.begin(gpu, &mut rec.encoder, PassKind::Prepass, None, None);
+        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Prepass, None, None);
         // View depth 0 marks the background.
         let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("prepass"),
@@ -133,6 +133,6 @@ impl Renderer {
         rec.stats.prepass_draws += draws;
         rec.stats.bind_group_changes += binds;
         drop(pass);
-        rec.clock.end(gpu, &mut rec.encoder, slot);
+        rec.clock.end(gpu, rec.encoder, slot);
     }
 }

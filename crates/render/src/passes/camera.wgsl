@@ -1,5 +1,6 @@
-// The camera uniform (group 1, binding 0) of the passes that shade from the camera:
-// the lighting pass and the screen-space shadow mask. Mirrors `CameraGpu`.
+// The camera uniform of the passes that shade from the camera: the lighting pass and
+// the screen-space shadow mask (group 1, binding 0), and the host's shader through
+// the shadow receiver (receiver.wgsl). Mirrors `CameraGpu`.
 
 struct Camera {
     clip_from_world: mat4x4<f32>,
@@ -16,5 +17,3 @@ struct Camera {
     inv_width: f32,
     inv_height: f32,
 };
-
-@group(1) @binding(0) var<uniform> camera: Camera;

@@ -7,7 +7,7 @@
 // The lit fraction at `world` and the cube face its direction falls on, as
 // (visibility, face). The screen derivatives give the receiver's plane, for
 // receiver-plane depth bias (when it is on).
-fn shadow_visibility(
+fn lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,

@@ -10,9 +10,9 @@ use gnomon_scene::settings::Technique;
 use wgpu::naga;
 
 use super::{
-    depth_reduce, lighting,
+    blit, depth_reduce, lighting,
     lighting::{LightingKey, LightingRole, Lookup},
-    map_preview, moments, screen_space, shadow,
+    map_preview, moments, receiver, screen_space, shadow,
 };
 use crate::uniforms::{self, LightKindGpu, StructLayout};
 
@@ -28,6 +28,17 @@ fn lookups(technique: Technique) -> Vec<Lookup> {
     all
 }
 
+/// A host's fragment stage, as the receiver's documentation asks it to call
+/// `shadow_visibility`.
+const HOST_SHADER: &str = "
+@fragment
+fn host_main(@builtin(position) frag: vec4<f32>, @location(0) world: vec3<f32>, @location(1) normal: vec3<f32>) -> @location(0) vec4<f32> {
+    let v = shadow_visibility(world, normalize(normal), frag);
+    let l = shadow_light_direction(world);
+    return vec4<f32>(shadow_light_radiance() * v * l.w * max(dot(normal, l.xyz), 0.0), 1.0);
+}
+";
+
 /// Every composed shader, named.
 fn every_variant() -> Vec<(String, String)> {
     let mut out = Vec::new();
@@ -41,9 +52,13 @@ fn every_variant() -> Vec<(String, String)> {
                 let key = LightingKey { technique, lookup, role };
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
             }
-            if lookup != Lookup::Mask {
+            if let Some(map) = lighting::MapLookup::of(lookup) {
                 let key = screen_space::MaskKey { technique, lookup };
                 out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+                // The receiver with a host's fragment shader calling it, in the group
+                // a host might pick.
+                let source = receiver::receiver_wgsl(technique, map, 3) + HOST_SHADER;
+                out.push((format!("receiver {technique:?} {map:?}"), source));
             }
         }
         if technique.is_filterable() {
@@ -63,6 +78,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("depth reduce".into(), depth_reduce::reduce_wgsl()));
     out.push(("sample bounds".into(), depth_reduce::bounds_wgsl()));
     out.push(("map preview".into(), map_preview::preview_wgsl()));
+    out.push(("blit".into(), blit::blit_wgsl()));
     out
 }
 

@@ -64,11 +64,45 @@ pub(crate) enum Lookup {
 /// technique's shadow lookup and the rules of resolve_visibility.wgsl, or on the
 /// mask path the read of the mask. Shared by the lighting and shadow-mask passes.
 pub(crate) fn visibility_wgsl(technique: Technique, lookup: Lookup) -> Vec<String> {
-    let mut parts: Vec<String> = Vec::new();
+    let Some(map) = MapLookup::of(lookup) else {
+        return vec![include_str!("mask_lookup.wgsl").to_owned()];
+    };
+    let mut parts = vec![techniques::SHADOW_BINDINGS_WGSL.to_owned()];
+    parts.extend(resolved_lookup_wgsl(technique, map));
+    parts
+}
+
+/// How a light's own map is looked up: a [`Lookup`] other than the mask.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum MapLookup {
+    /// Projected into 2D layers.
+    Map,
+    /// By direction in a cube.
+    Cube,
+    /// Through dual paraboloids.
+    Paraboloid,
+}
+
+impl MapLookup {
+    /// The map lookup of `lookup`; None for the mask, which reads no map.
+    pub fn of(lookup: Lookup) -> Option<MapLookup> {
+        match lookup {
+            Lookup::Map => Some(MapLookup::Map),
+            Lookup::Cube => Some(MapLookup::Cube),
+            Lookup::Paraboloid => Some(MapLookup::Paraboloid),
+            Lookup::Mask => None,
+        }
+    }
+}
+
+/// `pixel_visibility` of a technique and map lookup, without the declarations of the
+/// shadow resources it reads (those of `SHADOW_BINDINGS_WGSL`, in whichever group
+/// the pass binds them): the technique's lookup, the light kind's visibility
+/// function and the rules of resolve_visibility.wgsl.
+pub(crate) fn resolved_lookup_wgsl(technique: Technique, lookup: MapLookup) -> Vec<String> {
+    let mut parts = techniques::helper_wgsl();
     let visibility = match lookup {
-        Lookup::Mask => return vec![include_str!("mask_lookup.wgsl").to_owned()],
-        Lookup::Cube => {
-            parts.extend(techniques::shared_wgsl());
+        MapLookup::Cube => {
             parts.push(techniques::CUBE_WGSL.to_owned());
             let cube = techniques::lookup(technique).cube_wgsl().unwrap_or_else(|| {
                 unreachable!("{technique:?} has no cube lookup; settings refuse it for point lights")
@@ -76,13 +110,11 @@ pub(crate) fn visibility_wgsl(technique: Technique, lookup: Lookup) -> Vec<Strin
             parts.extend(cube.iter().map(|s| s.to_string()));
             include_str!("cube_visibility.wgsl")
         }
-        Lookup::Map => {
-            parts.extend(techniques::shared_wgsl());
+        MapLookup::Map => {
             parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
             include_str!("map_visibility.wgsl")
         }
-        Lookup::Paraboloid => {
-            parts.extend(techniques::shared_wgsl());
+        MapLookup::Paraboloid => {
             parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
             include_str!("paraboloid_visibility.wgsl")
         }

@@ -104,7 +104,7 @@ fn shadow_lookup(
 
 // The lit fraction at `world` and the layer that shaded it (the cascade), as
 // (visibility, layer).
-fn shadow_visibility(
+fn lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,

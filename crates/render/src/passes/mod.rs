@@ -1,6 +1,7 @@
 //! The render passes and the resources they share: bind group layouts, the WGSL
 //! composition, and the pipeline caches.
 
+pub(crate) mod blit;
 pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
 pub(crate) mod lighting;
@@ -51,8 +52,15 @@ pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
 /// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
 
-/// The camera uniform of the passes that shade from the camera.
-pub(crate) const CAMERA_WGSL: &str = include_str!("camera.wgsl");
+/// The camera uniform's struct.
+pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
+
+/// The camera uniform of the passes that shade from the camera, bound at group 1.
+pub(crate) const CAMERA_WGSL: &str =
+    concat!(include_str!("camera.wgsl"), "\n@group(1) @binding(0) var<uniform> camera: Camera;\n");
+
+/// The shadow receiver: a host's shader reads a light's shadows through it.
+pub(crate) mod receiver;
 
 /// What the lighting and shadow-mask passes share about a point and its light.
 pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
@@ -71,6 +79,9 @@ pub(crate) struct Layouts {
     /// its nearest comparison and gathering samplers, and on the mask path the light's
     /// layer of the shadow mask.
     pub shadow: wgpu::BindGroupLayout,
+    /// The shadow receiver's one group, in the host's shader: the light's and the
+    /// camera's uniforms, then the shadow resources in the order of `shadow`.
+    pub receiver: wgpu::BindGroupLayout,
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
     pub material: wgpu::BindGroupLayout,
@@ -87,10 +98,10 @@ impl Layouts {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let depth = |dimension| texture(wgpu::TextureSampleType::Depth, dimension);
-        let filterable = |dimension| texture(wgpu::TextureSampleType::Float { filterable: true }, dimension);
-        let sampler = |kind| wgpu::BindingType::Sampler(kind);
-        use wgpu::{SamplerBindingType as S, TextureViewDimension as D};
+        let filterable =
+            texture(wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D2);
+        let filtering = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
+        let fragment = wgpu::ShaderStages::FRAGMENT;
         Self {
             scene: layout(
                 "scene",
@@ -100,33 +111,41 @@ impl Layouts {
                 ],
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
-            shadow: layout(
-                "shadow map",
-                &[
-                    fragment_entry(0, depth(D::D2Array)),
-                    fragment_entry(1, sampler(S::Comparison)),
-                    fragment_entry(2, filterable(D::D2Array)),
-                    fragment_entry(3, sampler(S::Filtering)),
-                    fragment_entry(4, depth(D::Cube)),
-                    fragment_entry(5, sampler(S::Comparison)),
-                    fragment_entry(6, sampler(S::NonFiltering)),
-                    unfilterable_texture_entry(7),
-                ],
+            shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(7)]].concat()),
+            receiver: layout(
+                "shadow receiver",
+                &[vec![uniform_entry(0, fragment), uniform_entry(1, fragment)], shadow_entries(2)].concat(),
             ),
             screen: layout(
                 "screen",
-                &[
-                    uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                    unfilterable_texture_entry(1),
-                    unfilterable_texture_entry(2),
-                ],
+                &[uniform_entry(0, fragment), unfilterable_texture_entry(1), unfilterable_texture_entry(2)],
             ),
-            material: layout(
-                "material",
-                &[fragment_entry(0, filterable(D::D2)), fragment_entry(1, sampler(S::Filtering))],
-            ),
+            material: layout("material", &[fragment_entry(0, filterable), fragment_entry(1, filtering)]),
         }
     }
+}
+
+/// The shadow resources a light's lookup reads, from binding `first` on: its depth
+/// map and comparison sampler, the moment map and its sampler, the cube with its
+/// nearest comparison and gathering samplers (the declarations of
+/// techniques/bindings.wgsl and receiver.wgsl).
+fn shadow_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+    use wgpu::{SamplerBindingType as S, TextureViewDimension as D};
+    let depth = |dimension| texture(wgpu::TextureSampleType::Depth, dimension);
+    let filterable = texture(wgpu::TextureSampleType::Float { filterable: true }, D::D2Array);
+    [
+        depth(D::D2Array),
+        wgpu::BindingType::Sampler(S::Comparison),
+        filterable,
+        wgpu::BindingType::Sampler(S::Filtering),
+        depth(D::Cube),
+        wgpu::BindingType::Sampler(S::Comparison),
+        wgpu::BindingType::Sampler(S::NonFiltering),
+    ]
+    .into_iter()
+    .zip(first..)
+    .map(|(ty, binding)| fragment_entry(binding, ty))
+    .collect()
 }
 
 /// A texture binding of one sample, read by fragment stages.

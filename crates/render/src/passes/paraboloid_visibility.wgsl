@@ -21,7 +21,7 @@ fn paraboloid_texel_world_size(layer: u32, world: vec3<f32>) -> f32 {
     return (len + d.z) * 2.0 / light.resolution;
 }
 
-fn shadow_visibility(
+fn lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,

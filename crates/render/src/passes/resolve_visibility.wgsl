@@ -1,5 +1,5 @@
 // A pixel's visibility of its light, resolved from the shadow map: the lookup of
-// `shadow_visibility` (map_visibility.wgsl, cube_visibility.wgsl or
+// `lookup_visibility` (map_visibility.wgsl, cube_visibility.wgsl or
 // paraboloid_visibility.wgsl), then the rules that hold whatever the map says. The
 // forward lighting pass calls it per fragment; the shadow-mask pass once per pixel.
 
@@ -17,7 +17,7 @@ fn pixel_visibility(
     pixel: vec2<f32>,
     view_depth: f32,
 ) -> vec2<f32> {
-    var shadow = shadow_visibility(world, n, l, world_dx, world_dy, pixel, view_depth);
+    var shadow = lookup_visibility(world, n, l, world_dx, world_dy, pixel, view_depth);
     if light.kind != LIGHT_SUN && cone <= 0.0 {
         // Outside a spot's cone or a light's range no light arrives: visibility 0 by
         // definition.

@@ -98,9 +98,22 @@ pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
 /// Taps in the shared Poisson disk, the most any technique may ask for.
 pub const POISSON_DISK_SIZE: usize = 64;
 
+/// The shadow resources a technique may read, as the lighting, mask and moment passes
+/// bind them (group 2). The shadow receiver declares the same names in the host's
+/// group (`passes/receiver.wgsl`).
+pub(crate) const SHADOW_BINDINGS_WGSL: &str = include_str!("bindings.wgsl");
+
 /// The WGSL every technique is composed with, before its own: the shadow bindings,
 /// the generated kernels, the lookup contract and its helpers.
 pub(crate) fn shared_wgsl() -> Vec<String> {
+    let mut parts = vec![SHADOW_BINDINGS_WGSL.to_owned()];
+    parts.extend(helper_wgsl());
+    parts
+}
+
+/// [`shared_wgsl`] without the bindings: the generated kernels, the lookup contract
+/// and its helpers.
+pub(crate) fn helper_wgsl() -> Vec<String> {
     let disk: Vec<String> = gnomon_math::kernels::poisson_disk(POISSON_DISK_SIZE)
         .iter()
         .map(|p| format!("vec2<f32>({:.6}, {:.6})", p.x, p.y))
@@ -111,12 +124,7 @@ pub(crate) fn shared_wgsl() -> Vec<String> {
          var<private> POISSON_DISK: array<vec2<f32>, {POISSON_DISK_SIZE}> = array<vec2<f32>, {POISSON_DISK_SIZE}>(\n    {}\n);\n",
         disk.join(",\n    ")
     );
-    vec![
-        include_str!("bindings.wgsl").to_owned(),
-        kernels,
-        include_str!("common.wgsl").to_owned(),
-        include_str!("filterable.wgsl").to_owned(),
-    ]
+    vec![kernels, include_str!("common.wgsl").to_owned(), include_str!("filterable.wgsl").to_owned()]
 }
 
 #[cfg(test)]

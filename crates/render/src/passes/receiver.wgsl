@@ -1,0 +1,56 @@
+// Gnomon's shadow receiver: the shadows of one light, for a host's own fragment
+// shader. Composed after the light and camera structs, the technique's lookup and
+// the rules of resolve_visibility.wgsl; the host's shader follows it in one module.
+//
+// Every resource sits in one bind group, at the index the host chose
+// (RECEIVER_GROUP is replaced by it), in the order of `Layouts::receiver`.
+
+@group(RECEIVER_GROUP) @binding(0) var<uniform> light: Light;
+@group(RECEIVER_GROUP) @binding(1) var<uniform> camera: Camera;
+@group(RECEIVER_GROUP) @binding(2) var shadow_map: texture_depth_2d_array;
+@group(RECEIVER_GROUP) @binding(3) var shadow_compare: sampler_comparison;
+@group(RECEIVER_GROUP) @binding(4) var moment_map: texture_2d_array<f32>;
+@group(RECEIVER_GROUP) @binding(5) var moment_sampler: sampler;
+@group(RECEIVER_GROUP) @binding(6) var shadow_cube: texture_depth_cube;
+@group(RECEIVER_GROUP) @binding(7) var shadow_compare_nearest: sampler_comparison;
+@group(RECEIVER_GROUP) @binding(8) var shadow_gather: sampler;
+
+// The fraction of this light that reaches the surface point `world` (world space), in
+// [0, 1]: 0 in shadow, on a surface turned away from the light, or outside a spot's
+// cone or a light's range; 1 fully lit. Exactly what Gnomon's own lighting pass
+// computes for the same point.
+//
+// `normal`: the unit shading normal on the side the camera sees (flip it on back
+// faces, as `@builtin(front_facing)` tells). `frag_coord`: the fragment's
+// `@builtin(position)`, for the per-pixel rotation of the filter taps.
+//
+// Call it from a fragment shader in uniform control flow, before any `discard`: it
+// takes the screen derivatives of `world` (the receiver's plane, the geometric normal).
+fn shadow_visibility(world: vec3<f32>, normal: vec3<f32>, frag_coord: vec4<f32>) -> f32 {
+    let world_dx = dpdx(world);
+    let world_dy = dpdy(world);
+    // The triangle's plane normal, facing the camera (as surface.wgsl derives it).
+    var geometric_n = normalize(cross(world_dx, world_dy));
+    if dot(geometric_n, camera.eye - world) < 0.0 {
+        geometric_n = -geometric_n;
+    }
+    let geometry = light_geometry(world);
+    let view_depth = -(camera.view_from_world * vec4<f32>(world, 1.0)).z;
+    let shadow = pixel_visibility(
+        world, normal, geometric_n, geometry.xyz, geometry.w, world_dx, world_dy, frag_coord.xy, view_depth
+    );
+    return shadow.x;
+}
+
+// The light as seen from `world`, before shadowing: the unit direction towards the
+// light (xyz) and the fraction that arrives there (w: 1 for a sun, a spot's cone
+// falloff, 0 beyond a light's range). Its colour times intensity is
+// `shadow_light_radiance()`.
+fn shadow_light_direction(world: vec3<f32>) -> vec4<f32> {
+    return light_geometry(world);
+}
+
+// The light's colour times its intensity (linear RGB).
+fn shadow_light_radiance() -> vec3<f32> {
+    return light.radiance;
+}
