@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 use crate::Camera;
 
 /// How the camera moves along a path.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum CameraPathKind {
     /// Eye and target move together along the view direction, toward the target.

@@ -4,14 +4,15 @@
 use super::*;
 
 /// How the shadow map is sampled and filtered.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Technique {
     /// One point-sampled depth comparison: Williams (1978), the textbook algorithm.
     Hard,
     /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
     #[default]
-    #[value(name = "pcf2x2")]
+    #[cfg_attr(feature = "cli", value(name = "pcf2x2"))]
     #[serde(rename = "pcf2x2")]
     Pcf2x2,
     /// Box PCF of width --pcf-kernel, from bilinear comparison taps with exact area
@@ -65,7 +66,21 @@ impl Technique {
 
     /// Every technique, in declaration order (the order `--help` lists them).
     pub fn all() -> &'static [Technique] {
-        Technique::value_variants()
+        &[
+            Technique::Hard,
+            Technique::Pcf2x2,
+            Technique::Pcf,
+            Technique::PcfTent,
+            Technique::PcfPoisson,
+            Technique::Pcss,
+            Technique::Vsm,
+            Technique::Esm,
+            Technique::Evsm2,
+            Technique::Evsm4,
+            Technique::MsmHamburger,
+            Technique::MsmHausdorff,
+            Technique::Convolution,
+        ]
     }
 
     /// Whether the technique can shadow a point light, from its cube map: the
@@ -99,7 +114,8 @@ impl Technique {
 }
 
 /// The unit of a PCF kernel's width.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelUnit {
     /// Shadow-map texels: the same blur everywhere in the map.
@@ -111,32 +127,33 @@ pub enum KernelUnit {
 }
 
 /// The filter axis: which technique, and its parameters.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct FilterSettings {
     /// Shadow filtering technique.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
     pub technique: Technique,
     /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
     /// 1 to 32 texels, or a world width > 0.
-    #[arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter"))]
     pub pcf_kernel: f32,
     /// Unit of --pcf-kernel.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow filter")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
     pub kernel_unit: KernelUnit,
     /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64.
-    #[arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter"))]
     pub poisson_samples: u32,
     /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
     /// across the kernel along the receiver's plane, from the screen-space derivatives
     /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
-    #[arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter"))]
     pub receiver_plane_bias: bool,
     /// PCSS: blocker-search taps and the largest penumbra radius.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub pcss: PcssSettings,
     /// Parameters of the filterable (moment and exponential) maps.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub moments: MomentSettings,
 }
 
@@ -156,15 +173,16 @@ impl Default for FilterSettings {
 
 /// PCSS: the light's size comes from the light (--spot-radius or
 /// --sun-angular-diameter), the same parameter the reference's area light uses.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct PcssSettings {
     /// Depth taps of PCSS's blocker search: 8 to 64.
-    #[arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS"))]
     pub blocker_samples: u32,
     /// Largest blocker-search and penumbra radius, in texels: 1 to 64. Wider
     /// penumbrae are clipped to it.
-    #[arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS"))]
     pub max_radius: f32,
 }
 
@@ -175,7 +193,8 @@ impl Default for PcssSettings {
 }
 
 /// Storage format of a filterable moment map.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum MomentFormat {
     /// 32-bit float where the adapter can filter it, else 16-bit (the GL backend).
@@ -190,55 +209,56 @@ pub enum MomentFormat {
 }
 
 /// Parameters of the filterable techniques: VSM, ESM, EVSM, MSM and convolution.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct MomentSettings {
     /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):
     /// 0 (no blur) to 16.
-    #[arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps"))]
     pub blur_radius: u32,
     /// Build mipmaps of the moment map and sample them trilinearly (VSM, EVSM, MSM,
     /// convolution), against aliasing when the map is minified on screen.
-    #[arg(long, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, help_heading = "Filterable maps"))]
     pub mipmaps: bool,
     /// Texel format of the moment map.
-    #[arg(long, value_enum, default_value_t, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Filterable maps"))]
     pub moment_format: MomentFormat,
     /// Smallest variance Chebyshev's bound may use (VSM, EVSM), in units of the
     /// normalised light depth squared: ≥ 0. Hides acne from quantisation.
-    #[arg(long, value_name = "VARIANCE", default_value_t = MomentSettings::default().min_variance, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "VARIANCE", default_value_t = MomentSettings::default().min_variance, help_heading = "Filterable maps"))]
     pub min_variance: f32,
     /// Light-bleeding reduction (VSM, EVSM, MSM): the bound below this is cut to 0
     /// and the rest rescaled to [0, 1] (Lauritzen's linstep). In [0, 1).
-    #[arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps"))]
     pub bleeding_reduction: f32,
     /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (the map
     /// stores d and filters in log space, so c is not limited by the format).
-    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps"))]
     pub esm_exponent: f32,
     /// EVSM positive exponent: 0 to 42 (5.54 for 16-bit).
-    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_positive, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_positive, help_heading = "Filterable maps"))]
     pub evsm_positive: f32,
     /// EVSM negative exponent (evsm4): 0 to 42 (5.54 for 16-bit).
-    #[arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps"))]
     pub evsm_negative: f32,
     /// MSM moment bias α: the moments are blended toward those of a two-point
     /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits, 6e-5 at 16).
     /// In [0, 0.1].
-    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps"))]
     pub moment_bias: f32,
     /// Fourier terms M of convolution shadow maps: 1 to 16 (2M channels).
-    #[arg(long, value_name = "M", default_value_t = MomentSettings::default().csm_terms, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "M", default_value_t = MomentSettings::default().csm_terms, help_heading = "Filterable maps"))]
     pub csm_terms: u32,
     /// Ringing attenuation α of convolution shadow maps: term k is weighted by
     /// exp(−α (k/M)²); 0 is the raw truncated series. ≥ 0.
-    #[arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps"))]
     pub csm_attenuation: f32,
     /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. > 0.
-    #[arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps"))]
     pub csm_scale: f32,
     /// Offset o of the convolution reconstruction (see --csm-scale): in [−0.5, 0.5].
-    #[arg(long, value_name = "O", default_value_t = MomentSettings::default().csm_offset, help_heading = "Filterable maps")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "O", default_value_t = MomentSettings::default().csm_offset, help_heading = "Filterable maps"))]
     pub csm_offset: f32,
 }
 

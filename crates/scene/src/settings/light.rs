@@ -4,7 +4,8 @@
 use super::*;
 
 /// Which of the scene's lights is rendered.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum LightKind {
     /// The scene's directional light (sun), with an orthographic shadow map fitted to the scene.
@@ -21,54 +22,55 @@ pub enum LightKind {
 }
 
 /// The light, and overrides of the scene's light parameters.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct LightSettings {
     /// Which light casts the shadows.
-    #[arg(long = "light", value_enum, default_value_t, help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long = "light", value_enum, default_value_t, help_heading = "Light"))]
     pub kind: LightKind,
     /// Sun elevation above the horizon in degrees, in (0, 90] [default: the scene's].
-    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DEGREES", help_heading = "Light"))]
     pub sun_elevation: Option<f32>,
     /// Sun azimuth in degrees, measured from +z toward +x [default: the scene's].
-    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DEGREES", help_heading = "Light"))]
     pub sun_azimuth: Option<f32>,
     /// Spot light position, as X,Y,Z [default: the scene's].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light"))]
     pub spot_position: Option<Vec3>,
     /// Point the spot light aims at, as X,Y,Z [default: the scene's].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light"))]
     pub spot_target: Option<Vec3>,
     /// Spot cone outer half-angle in degrees, in (0, 89]: no light outside it [default: the scene's].
-    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DEGREES", help_heading = "Light"))]
     pub spot_outer_angle: Option<f32>,
     /// Spot cone inner half-angle in degrees, in [0, outer]: full light inside it [default: 80% of outer].
-    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DEGREES", help_heading = "Light"))]
     pub spot_inner_angle: Option<f32>,
     /// Spot light range in world units, > 0; also the shadow map's far plane [default: the scene's].
-    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", help_heading = "Light"))]
     pub spot_range: Option<f32>,
     /// Radius of the spot light's emitting disk in world units, ≥ 0; 0 is a point
     /// light with hard shadows [default: the scene's, 0 for the built-ins].
-    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", help_heading = "Light"))]
     pub spot_radius: Option<f32>,
     /// Angular diameter of the sun's disk in degrees, in [0, 30]; 0 gives hard
     /// shadows, the real sun is about 0.53 [default: the scene's, 0 for the built-ins].
-    #[arg(long, value_name = "DEGREES", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DEGREES", help_heading = "Light"))]
     pub sun_angular_diameter: Option<f32>,
     /// Point light position, as X,Y,Z [default: the scene's].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Light"))]
     pub point_position: Option<Vec3>,
     /// Point light range in world units, > 0; also the cube faces' far plane [default: the scene's].
-    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", help_heading = "Light"))]
     pub point_range: Option<f32>,
     /// Radius of the point light's emitting sphere in world units, ≥ 0; 0 gives hard
     /// shadows [default: the scene's, 0 for the built-ins].
-    #[arg(long, value_name = "DISTANCE", help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", help_heading = "Light"))]
     pub point_radius: Option<f32>,
     /// With --light all: the light whose visibility the frame outputs and the
     /// reference traces, as an index into the scene's light list.
-    #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Light")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = 0, help_heading = "Light"))]
     pub light_index: usize,
 }
 

@@ -6,7 +6,6 @@
 //! shadow settings are orthogonal axes: the filter (technique), the bias, the map,
 //! and the partition of the light's view.
 
-use clap::{Args, ValueEnum};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -17,7 +16,9 @@ mod filter;
 mod light;
 mod screen;
 mod shadow;
-#[cfg(test)]
+// The tests parse flags: they need the `cli` feature, which `cargo test --workspace`
+// turns on (the `gnomon` binary asks for it).
+#[cfg(all(test, feature = "cli"))]
 mod tests;
 
 pub use error::SettingsError;
@@ -28,50 +29,53 @@ pub use screen::*;
 pub use shadow::*;
 
 /// Everything that configures one render besides the scene itself.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// Changes to the scene itself (a ground plane).
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub scene: SceneOptions,
     /// The output image: size and debug view.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub image: ImageSettings,
     /// Overrides of the scene's camera.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub camera: CameraSettings,
     /// Which light is rendered, and overrides of its parameters.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub light: LightSettings,
     /// How shadows are drawn: filter, bias, map, partition, cascades, contact shadows.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub shadow: ShadowSettings,
     /// Where shadows are resolved: in the lighting pass, or in a screen-space mask first.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub screen: ScreenSpaceSettings,
     /// The ray-traced reference the render is compared with.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub reference: ReferenceSettings,
 }
 
 /// Changes to the scene itself.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct SceneOptions {
     /// Add a ground plane under the scene: at its lowest point, three times its
     /// width, for models that come without a floor to receive their shadows (the
     /// built-in scenes have one already).
-    #[arg(long, help_heading = "Scene")]
+    #[cfg_attr(feature = "cli", arg(long, help_heading = "Scene"))]
     pub ground: bool,
 }
 
 /// The ray-traced reference.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ReferenceSettings {
     /// Shadow rays per pixel for an area light (a spot with --spot-radius > 0 or a sun
     /// with --sun-angular-diameter > 0): 8 to 65536, stratified. A point light needs one.
-    #[arg(long, value_name = "N", default_value_t = ReferenceSettings::default().samples, help_heading = "Reference")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = ReferenceSettings::default().samples, help_heading = "Reference"))]
     pub samples: u32,
 }
 
@@ -82,7 +86,8 @@ impl Default for ReferenceSettings {
 }
 
 /// A diagnostic view drawn over the lit image.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum DebugView {
     /// The lit image alone.
@@ -94,17 +99,18 @@ pub enum DebugView {
 }
 
 /// The output image.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ImageSettings {
     /// Image width in pixels (1 to 16384).
-    #[arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image")]
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image"))]
     pub width: u32,
     /// Image height in pixels (1 to 16384).
-    #[arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image")]
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image"))]
     pub height: u32,
     /// A diagnostic view over the image.
-    #[arg(long, value_enum, default_value_t, help_heading = "Image")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Image"))]
     pub debug_view: DebugView,
 }
 
@@ -115,23 +121,24 @@ impl Default for ImageSettings {
 }
 
 /// Overrides of the scene's camera. An absent field keeps the scene's value.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct CameraSettings {
     /// Camera position in world units, as X,Y,Z [default: the scene's].
-    #[arg(long = "camera-eye", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    #[cfg_attr(feature = "cli", arg(long = "camera-eye", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera"))]
     pub eye: Option<Vec3>,
     /// Point the camera looks at, as X,Y,Z [default: the scene's].
-    #[arg(long = "camera-target", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera")]
+    #[cfg_attr(feature = "cli", arg(long = "camera-target", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera"))]
     pub target: Option<Vec3>,
     /// Full vertical field of view in degrees, in (0, 180) [default: the scene's].
-    #[arg(long = "fov", value_name = "DEGREES", help_heading = "Camera")]
+    #[cfg_attr(feature = "cli", arg(long = "fov", value_name = "DEGREES", help_heading = "Camera"))]
     pub fov_y_degrees: Option<f32>,
     /// Near clip distance in world units, > 0 [default: the scene's].
-    #[arg(long = "camera-near", value_name = "DISTANCE", help_heading = "Camera")]
+    #[cfg_attr(feature = "cli", arg(long = "camera-near", value_name = "DISTANCE", help_heading = "Camera"))]
     pub near: Option<f32>,
     /// Far clip distance in world units, > near [default: the scene's].
-    #[arg(long = "camera-far", value_name = "DISTANCE", help_heading = "Camera")]
+    #[cfg_attr(feature = "cli", arg(long = "camera-far", value_name = "DISTANCE", help_heading = "Camera"))]
     pub far: Option<f32>,
 }
 

@@ -4,7 +4,8 @@
 use super::*;
 
 /// Where each pixel's shadow is resolved.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowPath {
     /// The mask when any light has contact shadows (which march through its depth),
@@ -21,12 +22,16 @@ pub enum ShadowPath {
 
 /// How shadows are resolved on screen: the frame-wide choice of path (contact
 /// shadows, per light, are in the shadow settings).
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ScreenSpaceSettings {
     /// Where each pixel's shadow lookup runs: forward, in the lighting pass, or once
     /// per pixel into a screen-space shadow mask.
-    #[arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")]
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
+    )]
     pub shadow_path: ShadowPath,
 }
 
@@ -35,31 +40,32 @@ pub struct ScreenSpaceSettings {
 /// and resolution lose where objects meet (after Sousa, Kasyan & Schulz, "Secrets of
 /// CryENGINE 3 graphics technology", 2011, and Unreal's screen-space shadows). The
 /// result multiplies in as min(map, contact).
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactSettings {
     /// March contact shadows for this light (needs --shadow-path auto or mask).
-    #[arg(long, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, help_heading = "Contact shadows"))]
     pub contact_shadows: bool,
     /// Length of the ray toward the light, in world units (> 0, at most 10).
-    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_length, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_length, help_heading = "Contact shadows"))]
     pub contact_length: f32,
     /// Depth-buffer samples along the ray, 1 to 64; the start is jittered per pixel by
     /// interleaved gradient noise.
-    #[arg(long, value_name = "N", default_value_t = ContactSettings::default().contact_steps, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = ContactSettings::default().contact_steps, help_heading = "Contact shadows"))]
     pub contact_steps: u32,
     /// Assumed thickness of what the depth buffer holds, as a fraction of its view
     /// depth: a sample behind the depth buffer by less than this occludes the ray,
     /// one farther behind passes behind the surface. 0 to 1.
-    #[arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows"))]
     pub contact_thickness: f32,
     /// The ray starts this far along the surface's normal, in world units, so that its
     /// first samples clear the receiver's own depth. ≥ 0.
-    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_bias, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_bias, help_heading = "Contact shadows"))]
     pub contact_bias: f32,
     /// View depth beyond which contact shadows are off; they fade out over its last
     /// quarter. > 0.
-    #[arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_distance, help_heading = "Contact shadows")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_distance, help_heading = "Contact shadows"))]
     pub contact_distance: f32,
 }
 

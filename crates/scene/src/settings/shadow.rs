@@ -5,7 +5,8 @@
 use super::*;
 
 /// Which faces the shadow pass culls.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum CullMode {
     /// Cull faces turned away from the light: the usual choice.
@@ -20,27 +21,28 @@ pub enum CullMode {
 
 /// The bias axis: offsets that keep a surface from shadowing itself (acne) without
 /// detaching shadows from their casters (peter-panning).
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct BiasSettings {
     /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
     /// For Depth32Float one unit is 2^(e−23) for a primitive whose largest depth has
     /// exponent e: about 6e-8 at depth 0.5.
-    #[arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias"))]
     pub depth_bias: i32,
     /// Rasterizer slope-scaled depth bias (D3D `SlopeScaledDepthBias`): multiplies the
     /// caster's depth slope per shadow texel, so 1 pushes a surface back by the depth
     /// it spans across one texel. Must be finite and ≥ 0.
-    #[arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias"))]
     pub slope_bias: f32,
     /// Normal-offset bias: the receiver is pushed along its surface normal by this many
     /// shadow texels (world size of a texel at the receiver) times 1 − N·L before the
     /// lookup, so surfaces facing the light are hardly moved and grazing ones fully
     /// (Holbert, "Normal offset shadows", 2011). ≥ 0.
-    #[arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias"))]
     pub normal_offset: f32,
     /// Faces culled when drawing casters into the shadow map.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow bias")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow bias"))]
     pub cull: CullMode,
 }
 
@@ -58,7 +60,8 @@ impl Default for BiasSettings {
 }
 
 /// The storage format of the shadow map.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum MapFormat {
     /// 32-bit float depth: exact enough for every technique here, and filterable by comparison.
@@ -67,7 +70,8 @@ pub enum MapFormat {
 }
 
 /// What a directional light's map is fitted to.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Fit {
     /// The whole scene's bounds, whatever the camera sees: stable, but texels are
@@ -80,34 +84,38 @@ pub enum Fit {
 }
 
 /// The map axis: the shadow map's size and format.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct MapSettings {
     /// Shadow map width and height in texels: 256 to 8192, and at most the device's
     /// maximum 2D texture size.
-    #[arg(long = "shadow-res", value_name = "TEXELS", default_value_t = MapSettings::default().resolution, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long = "shadow-res", value_name = "TEXELS", default_value_t = MapSettings::default().resolution, help_heading = "Shadow map"))]
     pub resolution: u32,
     /// Shadow map texel format.
-    #[arg(long = "shadow-format", value_enum, default_value_t, help_heading = "Shadow map")]
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "shadow-format", value_enum, default_value_t, help_heading = "Shadow map")
+    )]
     pub format: MapFormat,
     /// What a sun's map covers (a spot's map always covers its cone).
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub fit: Fit,
     /// Perspective warp of a sun's single map, fitted to the receivers. Warped maps store
     /// depth that is monotonic along each light ray but not linear in distance, so they
     /// take the depth-comparison techniques (hard and the PCF family) with kernels in
     /// texels; a spot's map is perspective already and ignores this.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub warp: WarpKind,
     /// Depth clamping ("pancaking") where the device supports it (unclipped depth): a
     /// sun's map fitted to the receivers (--fit receivers, tight cascades) starts its
     /// depth range at the nearest receiver, and casters nearer the sun are clamped onto
     /// that plane, so the range, and the depth error, shrink. Never for PCSS, stable
     /// cascades or warps.
-    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set, help_heading = "Shadow map"))]
     pub depth_clamp: bool,
     /// How a point light's map covers every direction.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub omni: OmniMap,
 }
 
@@ -125,7 +133,8 @@ impl Default for MapSettings {
 }
 
 /// The parametrization of a point light's map.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum OmniMap {
     /// A cube: six 90° faces, sampled by direction; uniform texels within a factor
@@ -140,7 +149,8 @@ pub enum OmniMap {
 }
 
 /// Perspective warps of a sun's map.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum WarpKind {
     /// No warp: an orthographic map.
@@ -157,7 +167,8 @@ pub enum WarpKind {
 }
 
 /// How the light's view is split into shadow maps.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Partition {
     /// One map covering what the light must see (see --fit).
@@ -169,7 +180,8 @@ pub enum Partition {
 }
 
 /// How the view depth range is divided among cascades.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum SplitScheme {
     /// Equal depth ranges.
@@ -182,7 +194,8 @@ pub enum SplitScheme {
 }
 
 /// How each cascade's map is placed over its slice.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum CascadeFit {
     /// The slice's potential receivers exactly: the most texels on screen, but the
@@ -195,7 +208,8 @@ pub enum CascadeFit {
 }
 
 /// How a pixel picks its cascade.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum CascadeSelection {
     /// By the pixel's view depth against the split distances.
@@ -207,46 +221,47 @@ pub enum CascadeSelection {
 }
 
 /// Cascaded shadow maps (--partition cascades).
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct CascadeSettings {
     /// Number of cascades: 1 to 8.
-    #[arg(long = "cascades", value_name = "N", default_value_t = CascadeSettings::default().count, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long = "cascades", value_name = "N", default_value_t = CascadeSettings::default().count, help_heading = "Cascades"))]
     pub count: u32,
     /// Split scheme of the view depth range.
-    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Cascades"))]
     pub split: SplitScheme,
     /// λ of the practical split scheme, in [0, 1]: 1 is fully logarithmic.
-    #[arg(long, value_name = "LAMBDA", default_value_t = CascadeSettings::default().split_lambda, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "LAMBDA", default_value_t = CascadeSettings::default().split_lambda, help_heading = "Cascades"))]
     pub split_lambda: f32,
     /// Farthest view depth the cascades cover, in world units, > 0 [default: the
     /// camera's far plane]. Beyond it a sun casts no shadow.
-    #[arg(long, value_name = "DISTANCE", help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", help_heading = "Cascades"))]
     pub shadow_distance: Option<f32>,
     /// How each cascade's map is fitted to its slice.
-    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Cascades"))]
     pub cascade_fit: CascadeFit,
     /// How a pixel chooses its cascade.
-    #[arg(long, value_enum, default_value_t, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Cascades"))]
     pub cascade_selection: CascadeSelection,
     /// Width of the band at the far end of each cascade over which it blends into the
     /// next, as a fraction of the cascade's depth range: 0 to 0.5.
-    #[arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades"))]
     pub cascade_blend: f32,
     /// Keep the cascades fitted to the first frame while the camera moves (along
     /// `compare --camera-path`, or in the viewer), to see what refitting buys.
-    #[arg(long = "freeze-cascades", help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long = "freeze-cascades", help_heading = "Cascades"))]
     pub freeze: bool,
     /// Sample-distribution shadow maps (Lauritzen, Salvi & Lefohn 2011): split the view
     /// depths the camera actually sees, reduced on the GPU from a depth prepass of the
     /// shadow casters, instead of the depths where the view frustum meets the scene's
     /// bounds. Costs a prepass and a read back of two numbers before the shadow pass.
-    #[arg(long, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, help_heading = "Cascades"))]
     pub sdsm: bool,
     /// With --sdsm, also fit each tight cascade in x and y to the light-space bounds of
     /// the samples it serves (a second reduction of the same depth buffer), instead of
     /// to its whole slice of the view frustum.
-    #[arg(long, help_heading = "Cascades")]
+    #[cfg_attr(feature = "cli", arg(long, help_heading = "Cascades"))]
     pub sdsm_bounds: bool,
 }
 
@@ -268,26 +283,27 @@ impl Default for CascadeSettings {
 }
 
 /// Shadow settings, one field per orthogonal axis.
-#[derive(Args, Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ShadowSettings {
     /// The filter: which technique samples the map, and its parameters.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub filter: FilterSettings,
     /// Biases against shadow acne (constant, slope-scaled, normal offset) and face culling.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub bias: BiasSettings,
     /// The map: resolution, storage format, fit, warp, depth clamping, point-light layout.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub map: MapSettings,
     /// Partition of the light's view into maps.
-    #[arg(long, value_enum, default_value_t, help_heading = "Shadow map")]
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub partition: Partition,
     /// The cascades, used with `--partition cascades`.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub cascades: CascadeSettings,
     /// Contact shadows for this light.
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub contact: ContactSettings,
 }
 
@@ -325,7 +341,9 @@ impl ShadowSettings {
         )?;
         f.moments.validate(f.technique)?;
         if s.map.warp != WarpKind::None {
-            let warp = s.map.warp.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default();
+            // Its name as flags and scene files write it (serde's kebab case).
+            let warp = toml::Value::try_from(s.map.warp).ok().and_then(|v| v.as_str().map(str::to_owned));
+            let warp = warp.unwrap_or_default();
             check(
                 s.partition == Partition::Single,
                 "--warp",

@@ -2,7 +2,7 @@
 //! setting and range; lights resolve with their own shadow settings.
 
 use super::*;
-use clap::Parser;
+use clap::{Parser, ValueEnum};
 
 #[derive(Parser)]
 struct Cli {
@@ -139,6 +139,11 @@ fn sdsm_bounds_need_sdsm_and_tight_cascades() {
     assert!(s.validate().unwrap_err().to_string().contains("--cascade-fit tight"));
     s.shadow.cascades.cascade_fit = CascadeFit::Tight;
     s.validate().unwrap();
+}
+
+#[test]
+fn every_technique_is_listed_in_declaration_order() {
+    assert_eq!(Technique::all(), Technique::value_variants());
 }
 
 #[test]
