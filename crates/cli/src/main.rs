@@ -72,7 +72,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("gnomon: error: {}{e:#}", flag_of(&e).unwrap_or_default());
+            let message = format!("{}{e:#}", flag_of(&e).unwrap_or_default());
+            eprintln!("gnomon: error: {}", gnomon_scene::settings::in_flags(&message));
             ExitCode::FAILURE
         }
     }

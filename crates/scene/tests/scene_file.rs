@@ -157,7 +157,7 @@ fn point_lights_and_the_light_list_come_from_the_file() {
     assert!(matches!(s.resolve_light(&scene).unwrap(), Light::Spot(_)));
     s.light.light_index = 3;
     let e = s.resolve_light(&scene).unwrap_err().to_string();
-    assert!(e.contains("--light-index") && e.contains("below 3"), "{e}");
+    assert!(e.contains("`light.light_index`") && e.contains("below 3"), "{e}");
 }
 
 #[test]
@@ -185,7 +185,7 @@ fn bad_light_entries_name_the_light_and_the_field() {
     );
     check(
         "type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = 5.0\n[light.shadow]\nmap.resolution = 3\n",
-        "--shadow-res",
+        "`shadow.map.resolution`",
     );
 }
 
@@ -224,5 +224,5 @@ shadow_path = "mask"
         Ok(scene) => s.resolve_lights(scene).unwrap_err().to_string(),
         Err(e) => e.to_string(),
     };
-    assert!(e.contains("--contact-length"), "{e}");
+    assert!(e.contains("`shadow.contact.contact_length`"), "{e}");
 }

@@ -144,7 +144,8 @@ impl SettingsForm {
             None => return Err(format!("--{} needs a value", field.long)),
         };
         let parsed = self.parse(&values)?;
-        parsed.validate().map_err(|e| e.to_string())?;
+        // The panel speaks in flags, as the command line does.
+        parsed.validate().map_err(|e| gnomon_scene::settings::in_flags(&e.to_string()))?;
         Ok(parsed)
     }
 

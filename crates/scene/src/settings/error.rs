@@ -3,42 +3,80 @@
 
 use super::*;
 
-/// A setting outside its valid range. The message names the flag and what is valid.
+/// A setting outside its valid range. The message names the setting as scene files
+/// write it (`shadow.filter.moments.blur_radius`), never a command-line flag: the
+/// `gnomon` binary maps each setting in it to the flag its user typed.
 #[derive(Debug, thiserror::Error, PartialEq)]
-#[error("{flag} = {value} is invalid: {valid}")]
+#[error("`{setting}` = {value} is invalid: {valid}")]
 pub struct SettingsError {
-    /// The setting at fault: its command-line flag (`--blur-radius`) or scene-file key.
-    pub flag: &'static str,
+    /// The setting at fault: its path in the settings' TOML (`shadow.map.resolution`),
+    /// or a scene file's table (`[light.shadow]`).
+    pub setting: &'static str,
     /// The value given, as text.
     pub value: String,
-    /// What would be valid, in words (a range, or a condition on other settings).
+    /// What would be valid, in words (a range, or a condition on other settings, each
+    /// named in backticks by its path).
     pub valid: String,
 }
 
 pub(super) fn check(
     ok: bool,
-    flag: &'static str,
+    setting: &'static str,
     value: impl ToString,
     valid: impl Into<String>,
 ) -> Result<(), SettingsError> {
-    if ok { Ok(()) } else { Err(SettingsError { flag, value: value.to_string(), valid: valid.into() }) }
+    if ok { Ok(()) } else { Err(SettingsError { setting, value: value.to_string(), valid: valid.into() }) }
 }
 
 pub(super) fn check_opt(
     v: Option<f32>,
-    flag: &'static str,
+    setting: &'static str,
     ok: impl Fn(f32) -> bool,
     valid: &str,
 ) -> Result<(), SettingsError> {
     match v {
-        Some(x) => check(x.is_finite() && ok(x), flag, x, valid),
+        Some(x) => check(x.is_finite() && ok(x), setting, x, valid),
         None => Ok(()),
     }
 }
 
-pub(super) fn check_vec(v: Option<Vec3>, flag: &'static str) -> Result<(), SettingsError> {
+pub(super) fn check_vec(v: Option<Vec3>, setting: &'static str) -> Result<(), SettingsError> {
     match v {
-        Some(p) => check(p.is_finite(), flag, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
+        Some(p) => check(p.is_finite(), setting, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
         None => Ok(()),
     }
+}
+
+#[cfg(feature = "cli")]
+/// The library names a setting by its path in scene files, in backticks
+/// (`` `shadow.map.resolution` ``); on the command line it is the flag its user typed.
+/// Rewrites every such path in `message` into its flag, through clap's definition of
+/// the settings: an argument's id is its field's name, the path's last segment, and
+/// the path's first segment is a group of [`Settings`].
+pub fn in_flags(message: &str) -> String {
+    use clap::Args as _;
+    let command = Settings::augment_args(clap::Command::new("gnomon"));
+    let groups = toml::Table::try_from(Settings::default()).unwrap_or_default();
+    let flag_of_setting = |path: &str| -> Option<String> {
+        let (group, field) = (path.split_once('.')?.0, path.rsplit('.').next()?);
+        if !groups.contains_key(group) {
+            return None;
+        }
+        let argument = command.get_arguments().find(|a| a.get_id() == field)?;
+        argument.get_long().map(|long| format!("--{long}"))
+    };
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(start) = rest.find('`') {
+        let Some(length) = rest[start + 1..].find('`') else { break };
+        let token = &rest[start + 1..start + 1 + length];
+        out.push_str(&rest[..start]);
+        match flag_of_setting(token) {
+            Some(flag) => out.push_str(&flag),
+            None => out.push_str(&rest[start..start + 2 + length]),
+        }
+        rest = &rest[start + 2 + length..];
+    }
+    out.push_str(rest);
+    out
 }

@@ -285,11 +285,21 @@ impl Default for MomentSettings {
 impl MomentSettings {
     pub(super) fn validate(&self, technique: Technique) -> Result<(), SettingsError> {
         let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
-        check(self.blur_radius <= 16, "--blur-radius", self.blur_radius, "0 to 16 texels")?;
-        check(in_range(self.min_variance, 0.0, 1.0), "--min-variance", self.min_variance, "0 to 1")?;
+        check(
+            self.blur_radius <= 16,
+            "shadow.filter.moments.blur_radius",
+            self.blur_radius,
+            "0 to 16 texels",
+        )?;
+        check(
+            in_range(self.min_variance, 0.0, 1.0),
+            "shadow.filter.moments.min_variance",
+            self.min_variance,
+            "0 to 1",
+        )?;
         check(
             self.bleeding_reduction.is_finite() && (0.0..1.0).contains(&self.bleeding_reduction),
-            "--bleeding-reduction",
+            "shadow.filter.moments.bleeding_reduction",
             self.bleeding_reduction,
             "in [0, 1)",
         )?;
@@ -300,35 +310,56 @@ impl MomentSettings {
         // ESM stores d itself and exponentiates in the shader, so only EVSM, which
         // stores exp(c·d) and its square, is limited by the storage format's range.
         let (esm_max, evsm_max) = (88.0, if half { 5.54 } else { 42.0 });
-        let precision = if half { "with --moment-format rgba16float" } else { "at 32 bits" };
+        let precision =
+            if half { "with `shadow.filter.moments.moment_format` rgba16float" } else { "at 32 bits" };
         check(
             in_range(self.esm_exponent, 1.0, esm_max),
-            "--esm-exponent",
+            "shadow.filter.moments.esm_exponent",
             self.esm_exponent,
             format!("1 to {esm_max} {precision}"),
         )?;
         check(
             in_range(self.evsm_positive, 0.0, evsm_max),
-            "--evsm-positive",
+            "shadow.filter.moments.evsm_positive",
             self.evsm_positive,
             format!("0 to {evsm_max} {precision}"),
         )?;
         check(
             in_range(self.evsm_negative, 0.0, evsm_max),
-            "--evsm-negative",
+            "shadow.filter.moments.evsm_negative",
             self.evsm_negative,
             format!("0 to {evsm_max} {precision}"),
         )?;
-        check(in_range(self.moment_bias, 0.0, 0.1), "--moment-bias", self.moment_bias, "0 to 0.1")?;
-        check((1..=16).contains(&self.csm_terms), "--csm-terms", self.csm_terms, "1 to 16")?;
+        check(
+            in_range(self.moment_bias, 0.0, 0.1),
+            "shadow.filter.moments.moment_bias",
+            self.moment_bias,
+            "0 to 0.1",
+        )?;
+        check(
+            (1..=16).contains(&self.csm_terms),
+            "shadow.filter.moments.csm_terms",
+            self.csm_terms,
+            "1 to 16",
+        )?;
         check(
             in_range(self.csm_attenuation, 0.0, 1e3),
-            "--csm-attenuation",
+            "shadow.filter.moments.csm_attenuation",
             self.csm_attenuation,
             "0 to 1000",
         )?;
-        check(self.csm_scale.is_finite() && self.csm_scale > 0.0, "--csm-scale", self.csm_scale, "> 0")?;
-        check(in_range(self.csm_offset, -0.5, 0.5), "--csm-offset", self.csm_offset, "-0.5 to 0.5")?;
+        check(
+            self.csm_scale.is_finite() && self.csm_scale > 0.0,
+            "shadow.filter.moments.csm_scale",
+            self.csm_scale,
+            "> 0",
+        )?;
+        check(
+            in_range(self.csm_offset, -0.5, 0.5),
+            "shadow.filter.moments.csm_offset",
+            self.csm_offset,
+            "-0.5 to 0.5",
+        )?;
         Ok(())
     }
 }

@@ -97,7 +97,7 @@ impl Settings {
                 let lights = self.scene_light_list(scene)?;
                 check(
                     l.light_index < lights.len(),
-                    "--light-index",
+                    "light.light_index",
                     l.light_index,
                     format!("below {}, the number of lights scene `{}` lists", lights.len(), scene.name),
                 )?;
@@ -132,7 +132,7 @@ impl Settings {
                     let aim = l.spot_target.unwrap_or(target) - spot.position;
                     check(
                         aim.length() > 1e-6,
-                        "--spot-target",
+                        "light.spot_target",
                         "the spot position",
                         "a point different from the spot light's position",
                     )?;
@@ -147,7 +147,7 @@ impl Settings {
                 }
                 check(
                     spot.inner_angle_degrees <= spot.outer_angle_degrees,
-                    "--spot-inner-angle",
+                    "light.spot_inner_angle",
                     spot.inner_angle_degrees,
                     format!("at most the outer angle {}", spot.outer_angle_degrees),
                 )?;
@@ -178,7 +178,7 @@ impl Settings {
                 let shadow = match &entry.shadow {
                     None => self.shadow.clone(),
                     Some(table) => self.shadow_with(table).map_err(|problem| SettingsError {
-                        flag: "[light.shadow]",
+                        setting: "[light.shadow]",
                         value: entry.name.clone(),
                         valid: problem,
                     })?,
@@ -201,7 +201,7 @@ impl Settings {
     fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<&'s [crate::SceneLight], SettingsError> {
         check(
             !scene.lights.is_empty(),
-            "--light",
+            "light.kind",
             "all",
             format!(
                 "a scene with a light list; `{}` has none (scene files list [[light]], glTF files KHR_lights_punctual lights, and the built-in `lamps` has eight)",
@@ -210,7 +210,7 @@ impl Settings {
         )?;
         check(
             scene.lights.len() <= MAX_LIGHTS,
-            "--light",
+            "light.kind",
             "all",
             format!("at most {MAX_LIGHTS} lights; `{}` lists {}", scene.name, scene.lights.len()),
         )?;
@@ -227,17 +227,17 @@ fn check_light_type(light: &Light, shadow: &ShadowSettings, name: &str) -> Resul
     if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
         check(
             shadow.filter.technique.supports_point_lights() && shadow.filter.technique != Technique::Pcss,
-            "--technique",
+            "shadow.filter.technique",
             shadow.filter.technique.name(),
             format!(
-                "for point light `{name}` with --omni paraboloid: hard, pcf2x2, pcf, pcf-tent or pcf-poisson"
+                "for point light `{name}` with `shadow.map.omni` paraboloid: hard, pcf2x2, pcf, pcf-tent or pcf-poisson"
             ),
         )?;
     }
     if let Light::Point(_) = light {
         check(
             shadow.filter.technique.supports_point_lights(),
-            "--technique",
+            "shadow.filter.technique",
             shadow.filter.technique.name(),
             format!(
                 "for point light `{name}` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"

@@ -22,6 +22,8 @@ mod shadow;
 mod tests;
 
 pub use error::SettingsError;
+#[cfg(feature = "cli")]
+pub use error::in_flags;
 use error::{check, check_opt, check_vec};
 pub use filter::*;
 pub use light::*;
@@ -158,45 +160,50 @@ impl Settings {
     /// largest texture) are checked by the renderer, which knows the device.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let i = &self.image;
-        check((1..=16384).contains(&i.width), "--width", i.width, "1 to 16384 pixels")?;
-        check((1..=16384).contains(&i.height), "--height", i.height, "1 to 16384 pixels")?;
+        check((1..=16384).contains(&i.width), "image.width", i.width, "1 to 16384 pixels")?;
+        check((1..=16384).contains(&i.height), "image.height", i.height, "1 to 16384 pixels")?;
         let c = &self.camera;
-        check_vec(c.eye, "--camera-eye")?;
-        check_vec(c.target, "--camera-target")?;
+        check_vec(c.eye, "camera.eye")?;
+        check_vec(c.target, "camera.target")?;
         check_opt(
             c.fov_y_degrees,
-            "--fov",
+            "camera.fov_y_degrees",
             |x| x > 0.0 && x < 180.0,
             "between 0 and 180 degrees, exclusive",
         )?;
-        check_opt(c.near, "--camera-near", |x| x > 0.0, "a distance > 0")?;
-        check_opt(c.far, "--camera-far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
+        check_opt(c.near, "camera.near", |x| x > 0.0, "a distance > 0")?;
+        check_opt(c.far, "camera.far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
         let l = &self.light;
-        check_opt(l.sun_elevation, "--sun-elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
-        check_opt(l.sun_azimuth, "--sun-azimuth", |_| true, "a finite angle in degrees")?;
-        check_vec(l.spot_position, "--spot-position")?;
-        check_vec(l.spot_target, "--spot-target")?;
-        check_opt(l.spot_outer_angle, "--spot-outer-angle", |x| x > 0.0 && x <= 89.0, "in (0, 89] degrees")?;
+        check_opt(l.sun_elevation, "light.sun_elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
+        check_opt(l.sun_azimuth, "light.sun_azimuth", |_| true, "a finite angle in degrees")?;
+        check_vec(l.spot_position, "light.spot_position")?;
+        check_vec(l.spot_target, "light.spot_target")?;
+        check_opt(
+            l.spot_outer_angle,
+            "light.spot_outer_angle",
+            |x| x > 0.0 && x <= 89.0,
+            "in (0, 89] degrees",
+        )?;
         check_opt(
             l.spot_inner_angle,
-            "--spot-inner-angle",
+            "light.spot_inner_angle",
             |x| (0.0..=89.0).contains(&x),
             "in [0, outer angle] degrees",
         )?;
-        check_opt(l.spot_range, "--spot-range", |x| x > 0.0, "a distance > 0")?;
-        check_opt(l.spot_radius, "--spot-radius", |x| x >= 0.0, "a distance ≥ 0")?;
-        check_vec(l.point_position, "--point-position")?;
-        check_opt(l.point_range, "--point-range", |x| x > 0.0, "a distance > 0")?;
-        check_opt(l.point_radius, "--point-radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_opt(l.spot_range, "light.spot_range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.spot_radius, "light.spot_radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_vec(l.point_position, "light.point_position")?;
+        check_opt(l.point_range, "light.point_range", |x| x > 0.0, "a distance > 0")?;
+        check_opt(l.point_radius, "light.point_radius", |x| x >= 0.0, "a distance ≥ 0")?;
         check_opt(
             l.sun_angular_diameter,
-            "--sun-angular-diameter",
+            "light.sun_angular_diameter",
             |x| (0.0..=30.0).contains(&x),
             "in [0, 30] degrees",
         )?;
         self.shadow.validate()?;
         let n = self.reference.samples;
-        check((8..=65536).contains(&n), "--samples", n, "8 to 65536 shadow rays per pixel")?;
+        check((8..=65536).contains(&n), "reference.samples", n, "8 to 65536 shadow rays per pixel")?;
         Ok(())
     }
 
@@ -207,7 +214,7 @@ impl Settings {
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {
             (ShadowPath::Forward, Some(light)) => Err(SettingsError {
-                flag: "--contact-shadows",
+                setting: "shadow.contact.contact_shadows",
                 value: format!("on for light `{}`", light.name),
                 valid: "only with --shadow-path auto or mask: contact shadows march through the mask path's depth prepass"
                     .into(),
@@ -238,13 +245,13 @@ impl Settings {
         cam.far = c.far.unwrap_or(cam.far);
         check(
             cam.far > cam.near,
-            "--camera-far",
+            "camera.far",
             cam.far,
             format!("greater than the near distance {}", cam.near),
         )?;
         check(
             (cam.target - cam.eye).length() > 1e-6,
-            "--camera-target",
+            "camera.target",
             "the eye position",
             "a point different from the camera position",
         )?;

@@ -87,26 +87,31 @@ impl ContactSettings {
         let finite = |x: f32| x.is_finite();
         check(
             finite(self.contact_length) && self.contact_length > 0.0 && self.contact_length <= 10.0,
-            "--contact-length",
+            "shadow.contact.contact_length",
             self.contact_length,
             "a distance in (0, 10]",
         )?;
-        check((1..=64).contains(&self.contact_steps), "--contact-steps", self.contact_steps, "1 to 64")?;
+        check(
+            (1..=64).contains(&self.contact_steps),
+            "shadow.contact.contact_steps",
+            self.contact_steps,
+            "1 to 64",
+        )?;
         check(
             finite(self.contact_thickness) && self.contact_thickness > 0.0 && self.contact_thickness <= 1.0,
-            "--contact-thickness",
+            "shadow.contact.contact_thickness",
             self.contact_thickness,
             "a fraction of the view depth in (0, 1]",
         )?;
         check(
             finite(self.contact_bias) && self.contact_bias >= 0.0,
-            "--contact-bias",
+            "shadow.contact.contact_bias",
             self.contact_bias,
             "a distance ≥ 0",
         )?;
         check(
             finite(self.contact_distance) && self.contact_distance > 0.0,
-            "--contact-distance",
+            "shadow.contact.contact_distance",
             self.contact_distance,
             "a distance > 0",
         )?;

@@ -315,27 +315,34 @@ impl ShadowSettings {
         match f.kernel_unit {
             KernelUnit::Texels => check(
                 f.pcf_kernel.is_finite() && (1.0..=MAX_KERNEL_TEXELS).contains(&f.pcf_kernel),
-                "--pcf-kernel",
+                "shadow.filter.pcf_kernel",
                 f.pcf_kernel,
-                format!("1 to {MAX_KERNEL_TEXELS} texels (or a world width with --kernel-unit world)"),
+                format!(
+                    "1 to {MAX_KERNEL_TEXELS} texels (or a world width with `shadow.filter.kernel_unit` world)"
+                ),
             )?,
             KernelUnit::World => check(
                 f.pcf_kernel.is_finite() && f.pcf_kernel > 0.0,
-                "--pcf-kernel",
+                "shadow.filter.pcf_kernel",
                 f.pcf_kernel,
                 "a world width > 0",
             )?,
         }
-        check((8..=64).contains(&f.poisson_samples), "--poisson-samples", f.poisson_samples, "8 to 64")?;
+        check(
+            (8..=64).contains(&f.poisson_samples),
+            "shadow.filter.poisson_samples",
+            f.poisson_samples,
+            "8 to 64",
+        )?;
         check(
             (8..=64).contains(&f.pcss.blocker_samples),
-            "--blocker-samples",
+            "shadow.filter.pcss.blocker_samples",
             f.pcss.blocker_samples,
             "8 to 64",
         )?;
         check(
             f.pcss.max_radius.is_finite() && (1.0..=64.0).contains(&f.pcss.max_radius),
-            "--max-radius",
+            "shadow.filter.pcss.max_radius",
             f.pcss.max_radius,
             "1 to 64 texels",
         )?;
@@ -346,9 +353,9 @@ impl ShadowSettings {
             let warp = warp.unwrap_or_default();
             check(
                 s.partition == Partition::Single,
-                "--warp",
+                "shadow.map.warp",
                 &warp,
-                "a warp of a single map: with --partition cascades use --warp none",
+                "a warp of a single map: with `shadow.partition` cascades use `shadow.map.warp` none",
             )?;
             check(
                 matches!(
@@ -359,61 +366,71 @@ impl ShadowSettings {
                         | Technique::PcfTent
                         | Technique::PcfPoisson
                 ),
-                "--warp",
+                "shadow.map.warp",
                 &warp,
                 format!(
-                    "with --technique {}: a warped map takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson (its depth is not linear in distance)",
+                    "with `shadow.filter.technique` {}: a warped map takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson (its depth is not linear in distance)",
                     f.technique.name()
                 ),
             )?;
             check(
                 f.kernel_unit == KernelUnit::Texels,
-                "--warp",
+                "shadow.map.warp",
                 &warp,
-                "with --kernel-unit world: a warped map's kernels are in texels",
+                "with `shadow.filter.kernel_unit` world: a warped map's kernels are in texels",
             )?;
         }
         let c = &s.cascades;
-        check((1..=MAX_CASCADES).contains(&c.count), "--cascades", c.count, format!("1 to {MAX_CASCADES}"))?;
+        check(
+            (1..=MAX_CASCADES).contains(&c.count),
+            "shadow.cascades.count",
+            c.count,
+            format!("1 to {MAX_CASCADES}"),
+        )?;
         check(
             c.split_lambda.is_finite() && (0.0..=1.0).contains(&c.split_lambda),
-            "--split-lambda",
+            "shadow.cascades.split_lambda",
             c.split_lambda,
             "0 to 1",
         )?;
         check(
             c.cascade_blend.is_finite() && (0.0..=0.5).contains(&c.cascade_blend),
-            "--cascade-blend",
+            "shadow.cascades.cascade_blend",
             c.cascade_blend,
             "0 to 0.5",
         )?;
-        check_opt(c.shadow_distance, "--shadow-distance", |x| x > 0.0, "a distance > 0")?;
+        check_opt(c.shadow_distance, "shadow.cascades.shadow_distance", |x| x > 0.0, "a distance > 0")?;
         if c.sdsm_bounds {
-            check(c.sdsm, "--sdsm-bounds", "set", "only with --sdsm, whose depth prepass it reduces")?;
+            check(
+                c.sdsm,
+                "shadow.cascades.sdsm_bounds",
+                "set",
+                "only with `shadow.cascades.sdsm`, whose depth prepass it reduces",
+            )?;
             check(
                 c.cascade_fit == CascadeFit::Tight,
-                "--sdsm-bounds",
+                "shadow.cascades.sdsm_bounds",
                 "set",
-                "only with --cascade-fit tight: bounds that follow every pixel cannot keep a stable cascade still",
+                "only with `shadow.cascades.cascade_fit` tight: bounds that follow every pixel cannot keep a stable cascade still",
             )?;
         }
         let b = &s.bias;
         check(
             b.slope_bias.is_finite() && b.slope_bias >= 0.0,
-            "--slope-bias",
+            "shadow.bias.slope_bias",
             b.slope_bias,
             "a finite factor ≥ 0",
         )?;
         check(
             b.normal_offset.is_finite() && b.normal_offset >= 0.0,
-            "--normal-offset",
+            "shadow.bias.normal_offset",
             b.normal_offset,
             "a finite number of texels ≥ 0",
         )?;
         let r = s.map.resolution;
         check(
             (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
-            "--shadow-res",
+            "shadow.map.resolution",
             r,
             format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
         )?;

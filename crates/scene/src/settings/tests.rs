@@ -91,18 +91,18 @@ fn flags_and_toml_agree() {
 }
 
 #[test]
-fn invalid_values_name_the_flag_and_the_range() {
+fn invalid_values_name_the_setting_and_the_range() {
     let mut s = Settings::default();
     s.shadow.map.resolution = 100;
     let e = s.validate().unwrap_err();
-    assert_eq!(e.flag, "--shadow-res");
+    assert_eq!(e.setting, "shadow.map.resolution");
     assert!(e.to_string().contains("256 to 8192"), "{e}");
     let mut s = Settings::default();
     s.shadow.filter.pcf_kernel = 40.0;
-    assert_eq!(s.validate().unwrap_err().flag, "--pcf-kernel");
+    assert_eq!(s.validate().unwrap_err().setting, "shadow.filter.pcf_kernel");
     let mut s = Settings::default();
     s.camera.fov_y_degrees = Some(180.0);
-    assert_eq!(s.validate().unwrap_err().flag, "--fov");
+    assert_eq!(s.validate().unwrap_err().setting, "camera.fov_y_degrees");
     assert!(parse_vec3("1,2").is_err() && parse_vec3("1,x,3").is_err() && parse_vec3("1,inf,2").is_err());
     assert_eq!(parse_vec3(" 1, 2.5,-3").unwrap(), Vec3::new(1.0, 2.5, -3.0));
 }
@@ -114,17 +114,17 @@ fn warps_take_a_single_map_and_a_depth_comparison() {
     s.validate().unwrap();
     s.shadow.partition = Partition::Cascades;
     let e = s.validate().unwrap_err();
-    assert_eq!(e.flag, "--warp");
-    assert!(e.to_string().contains("--warp none"), "{e}");
+    assert_eq!(e.setting, "shadow.map.warp");
+    assert!(e.to_string().contains("`shadow.map.warp` none"), "{e}");
     let mut s = Settings::default();
     s.shadow.map.warp = WarpKind::Tsm;
     s.shadow.filter.technique = Technique::Vsm;
     let e = s.validate().unwrap_err();
-    assert!(e.to_string().contains("with --technique vsm"), "{e}");
+    assert!(e.to_string().contains("with `shadow.filter.technique` vsm"), "{e}");
     s.shadow.filter.technique = Technique::PcfPoisson;
     s.validate().unwrap();
     s.shadow.filter.kernel_unit = KernelUnit::World;
-    assert!(s.validate().unwrap_err().to_string().contains("--kernel-unit world"));
+    assert!(s.validate().unwrap_err().to_string().contains("`shadow.filter.kernel_unit` world"));
 }
 
 #[test]
@@ -133,12 +133,36 @@ fn sdsm_bounds_need_sdsm_and_tight_cascades() {
     s.shadow.partition = Partition::Cascades;
     s.shadow.cascades.sdsm_bounds = true;
     let e = s.validate().unwrap_err();
-    assert!(e.flag == "--sdsm-bounds" && e.to_string().contains("only with --sdsm"), "{e}");
+    assert!(
+        e.setting == "shadow.cascades.sdsm_bounds"
+            && e.to_string().contains("only with `shadow.cascades.sdsm`"),
+        "{e}"
+    );
     s.shadow.cascades.sdsm = true;
     s.shadow.cascades.cascade_fit = CascadeFit::Stable;
-    assert!(s.validate().unwrap_err().to_string().contains("--cascade-fit tight"));
+    assert!(s.validate().unwrap_err().to_string().contains("`shadow.cascades.cascade_fit` tight"));
     s.shadow.cascades.cascade_fit = CascadeFit::Tight;
     s.validate().unwrap();
+}
+
+#[test]
+fn errors_speak_in_settings_not_flags() {
+    let mut cases = Vec::new();
+    let mut s = Settings::default();
+    s.shadow.map.resolution = 100;
+    cases.push(s);
+    let mut s = Settings::default();
+    s.shadow.partition = Partition::Cascades;
+    s.shadow.cascades.sdsm_bounds = true;
+    cases.push(s);
+    let mut s = Settings::default();
+    s.shadow.map.warp = WarpKind::Lispsm;
+    s.shadow.partition = Partition::Cascades;
+    cases.push(s);
+    for s in cases {
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.starts_with('`') && !e.contains("--"), "{e}");
+    }
 }
 
 #[test]
@@ -212,22 +236,22 @@ fn point_light_flags_override_the_scenes_and_are_checked() {
 
     let mut bad = parsed.clone();
     bad.light.point_range = Some(0.0);
-    assert_eq!(bad.validate().unwrap_err().flag, "--point-range");
+    assert_eq!(bad.validate().unwrap_err().setting, "light.point_range");
     bad.light.point_range = None;
     bad.light.point_radius = Some(-1.0);
-    assert_eq!(bad.validate().unwrap_err().flag, "--point-radius");
+    assert_eq!(bad.validate().unwrap_err().setting, "light.point_radius");
     // A cube map is compared by direction: the moment techniques are refused.
     let mut vsm = parsed;
     vsm.shadow.filter.technique = Technique::Vsm;
     let e = vsm.resolve_lights(&scene).unwrap_err();
-    assert_eq!(e.flag, "--technique");
+    assert_eq!(e.setting, "shadow.filter.technique");
     assert!(e.valid.contains("pcf-poisson or pcss"), "{e}");
     // Dual paraboloids take the 2D lookups, without PCSS.
     let mut paraboloid = vsm;
     paraboloid.shadow.map.omni = OmniMap::Paraboloid;
     paraboloid.shadow.filter.technique = Technique::Pcss;
     let e = paraboloid.resolve_lights(&scene).unwrap_err();
-    assert!(e.valid.contains("--omni paraboloid"), "{e}");
+    assert!(e.valid.contains("`shadow.map.omni` paraboloid"), "{e}");
     paraboloid.shadow.filter.technique = Technique::PcfPoisson;
     paraboloid.resolve_lights(&scene).unwrap();
 }
@@ -250,7 +274,7 @@ fn light_all_takes_each_lights_own_shadow_settings() {
     let mut broken = scene.clone();
     broken.lights[3].shadow = Some("[map]\nresolution = 100".parse().unwrap());
     let e = s.resolve_lights(&broken).unwrap_err();
-    assert!(e.to_string().contains("spot 2") && e.to_string().contains("--shadow-res"), "{e}");
+    assert!(e.to_string().contains("spot 2") && e.to_string().contains("`shadow.map.resolution`"), "{e}");
     // No list: a clear error naming where lists come from.
     let e = s.resolve_lights(&crate::builtin::spheres()).unwrap_err();
     assert!(e.valid.contains("[[light]]") && e.valid.contains("lamps"), "{e}");
@@ -275,18 +299,37 @@ fn contact_shadows_choose_the_mask_path_and_are_checked() {
     // ...and forward refuses it, naming the light.
     s.screen.shadow_path = ShadowPath::Forward;
     let e = s.uses_shadow_mask(&lights).unwrap_err();
-    assert!(e.flag == "--contact-shadows" && e.to_string().contains(&lit.lights[5].name), "{e}");
+    assert!(
+        e.setting == "shadow.contact.contact_shadows" && e.to_string().contains(&lit.lights[5].name),
+        "{e}"
+    );
     // Each parameter's range is checked, naming the flag.
-    for (flag, set) in [
-        ("--contact-length", (|c: &mut ContactSettings| c.contact_length = 0.0) as fn(&mut ContactSettings)),
-        ("--contact-steps", |c| c.contact_steps = 0),
-        ("--contact-steps", |c| c.contact_steps = 65),
-        ("--contact-thickness", |c| c.contact_thickness = f32::NAN),
-        ("--contact-bias", |c| c.contact_bias = -0.1),
-        ("--contact-distance", |c| c.contact_distance = 0.0),
+    for (setting, set) in [
+        (
+            "shadow.contact.contact_length",
+            (|c: &mut ContactSettings| c.contact_length = 0.0) as fn(&mut ContactSettings),
+        ),
+        ("shadow.contact.contact_steps", |c| c.contact_steps = 0),
+        ("shadow.contact.contact_steps", |c| c.contact_steps = 65),
+        ("shadow.contact.contact_thickness", |c| c.contact_thickness = f32::NAN),
+        ("shadow.contact.contact_bias", |c| c.contact_bias = -0.1),
+        ("shadow.contact.contact_distance", |c| c.contact_distance = 0.0),
     ] {
         let mut s = Settings::default();
         set(&mut s.shadow.contact);
-        assert_eq!(s.validate().unwrap_err().flag, flag);
+        assert_eq!(s.validate().unwrap_err().setting, setting);
     }
+}
+
+/// Settings named by the library become the flags of the command line; other
+/// quoted names stay as they are.
+#[test]
+fn settings_in_messages_become_flags() {
+    let library = "`shadow.contact.contact_shadows` = on for light `lamp` is invalid: only with \
+                   `screen.shadow_path` auto or mask; `shadow.map.resolution` too; model `box.width`";
+    assert_eq!(
+        in_flags(library),
+        "--contact-shadows = on for light `lamp` is invalid: only with --shadow-path auto or mask; \
+         --shadow-res too; model `box.width`"
+    );
 }
