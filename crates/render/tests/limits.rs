@@ -35,7 +35,7 @@ fn settings_outside_their_ranges_are_refused_before_rendering() {
     s.camera.near = Some(10.0);
     s.camera.far = Some(5.0);
     let err = renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap_err();
-    assert!(err.to_string().contains("--camera-far"), "{err}");
+    assert!(err.to_string().contains("`camera.far`") && !err.to_string().contains("--"), "{err}");
 }
 
 #[test]
