@@ -105,24 +105,11 @@ impl FixedBindings {
 
     /// Group 2 of the lighting and mask passes: a light's maps and their samplers.
     pub fn shadow_group(&self, pool: &mut Pool, layouts: &Layouts, views: ShadowViews) -> wgpu::BindGroup {
-        pool.bind_group(
-            "shadow map",
-            &layouts.shadow,
-            &[
-                Binding::View(views.map.clone()),
-                Binding::Sampler(self.compare_sampler.clone()),
-                Binding::View(views.moments.unwrap_or(&self.placeholder_moments).clone()),
-                Binding::Sampler(self.moment_sampler.clone()),
-                Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
-                Binding::Sampler(self.compare_nearest_sampler.clone()),
-                Binding::Sampler(self.gather_sampler.clone()),
-                Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone()),
-            ],
-        )
+        let mask = Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone());
+        let bindings = [self.map_bindings(&views), vec![mask]].concat();
+        pool.bind_group("shadow map", &layouts.shadow, &bindings)
     }
-}
 
-impl FixedBindings {
     /// The shadow receiver's group: the light's and camera's uniforms and the light's
     /// maps, for a host's shader.
     pub fn receiver_group(
@@ -132,21 +119,23 @@ impl FixedBindings {
         uniforms: ReceiverUniforms,
         views: ShadowViews,
     ) -> wgpu::BindGroup {
-        pool.bind_group(
-            "shadow receiver",
-            &layouts.receiver,
-            &[
-                Binding::Buffer(uniforms.light.clone()),
-                Binding::Buffer(uniforms.camera.clone()),
-                Binding::View(views.map.clone()),
-                Binding::Sampler(self.compare_sampler.clone()),
-                Binding::View(views.moments.unwrap_or(&self.placeholder_moments).clone()),
-                Binding::Sampler(self.moment_sampler.clone()),
-                Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
-                Binding::Sampler(self.compare_nearest_sampler.clone()),
-                Binding::Sampler(self.gather_sampler.clone()),
-            ],
-        )
+        let buffers = vec![Binding::Buffer(uniforms.light.clone()), Binding::Buffer(uniforms.camera.clone())];
+        let bindings = [buffers, self.map_bindings(&views)].concat();
+        pool.bind_group("shadow receiver", &layouts.receiver, &bindings)
+    }
+
+    /// A light's maps and their samplers, in the order of `passes::shadow_entries`,
+    /// with the placeholders where the light has no moment map or cube.
+    fn map_bindings(&self, views: &ShadowViews) -> Vec<Binding> {
+        vec![
+            Binding::View(views.map.clone()),
+            Binding::Sampler(self.compare_sampler.clone()),
+            Binding::View(views.moments.unwrap_or(&self.placeholder_moments).clone()),
+            Binding::Sampler(self.moment_sampler.clone()),
+            Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
+            Binding::Sampler(self.compare_nearest_sampler.clone()),
+            Binding::Sampler(self.gather_sampler.clone()),
+        ]
     }
 }
 

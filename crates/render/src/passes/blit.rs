@@ -9,7 +9,7 @@ use crate::pool::{Binding, Pool, ViewKey};
 
 /// The blit's WGSL, composed.
 pub(crate) fn blit_wgsl() -> String {
-    compose_wgsl(&[include_str!("blit.wgsl")])
+    compose_wgsl(&[super::FULLSCREEN_WGSL, include_str!("blit.wgsl")])
 }
 
 /// A host's colour target for [`crate::Renderer::render_into`]: a view, its format
@@ -45,16 +45,7 @@ impl BlitPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blit"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
+            entries: &[super::unfilterable_texture_entry(0)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("blit"),

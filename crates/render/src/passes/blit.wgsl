@@ -4,13 +4,6 @@
 
 @group(0) @binding(0) var image: texture_2d<f32>;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    // One triangle that covers the target.
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 @fragment
 fn fs_blit(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     return textureLoad(image, vec2<i32>(frag.xy), 0);

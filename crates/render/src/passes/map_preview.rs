@@ -164,5 +164,5 @@ impl MapPreviewPass {
 
 /// `map_preview.wgsl`, composed.
 pub(crate) fn preview_wgsl() -> String {
-    super::compose_wgsl(&[include_str!("map_preview.wgsl")])
+    super::compose_wgsl(&[super::FULLSCREEN_WGSL, include_str!("map_preview.wgsl")])
 }

@@ -46,6 +46,9 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     all.join("\n")
 }
 
+/// The vertex stage of the passes that cover their whole target.
+pub(crate) const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
+
 /// The light uniform's struct and depth conventions, shared by every pass.
 pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
 
