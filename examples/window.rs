@@ -117,6 +117,44 @@ struct Live {
     uploaded: GpuScene,
     mesh: HostMesh,
     host: HostRenderer,
+    /// The host's visibility and depth targets, made again when the window resizes.
+    targets: Targets,
+}
+
+/// The targets the host draws beside the window's colour.
+struct Targets {
+    visibility: wgpu::Texture,
+    visibility_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, size: [u32; 2]) -> Self {
+        let visibility = target_texture(device, host::VISIBILITY_FORMAT, wgpu::TextureUsages::COPY_SRC, size);
+        let depth = target_texture(device, host::DEPTH_FORMAT, wgpu::TextureUsages::empty(), size);
+        let (visibility_view, depth_view) =
+            (visibility.create_view(&Default::default()), depth.create_view(&Default::default()));
+        Self { visibility, visibility_view, depth_view }
+    }
+}
+
+/// A render target of the window's size.
+fn target_texture(
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    [width, height]: [u32; 2],
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("window example target"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
+        view_formats: &[],
+    })
 }
 
 struct App {
@@ -176,7 +214,8 @@ impl App {
         let uploaded = gnomon.upload(&scene)?;
         let host = HostRenderer::new(&device, &gnomon, config.format);
         let mesh = HostMesh::new(&device, &vertices);
-        Ok(Live { window, surface, config, gpu, gnomon, scene, uploaded, mesh, host })
+        let targets = Targets::new(&device, [config.width, config.height]);
+        Ok(Live { window, surface, config, gpu, gnomon, scene, uploaded, mesh, host, targets })
     }
 
     /// Draws one frame into the window; on the last frame of `--frames`, also into a
@@ -195,22 +234,7 @@ impl App {
         let shadows =
             live.gnomon.record_shadows(&mut encoder, &live.uploaded, &live.scene, &self.settings)?;
         let sun_shadows = &shadows.lights[0];
-        let texture = |format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("window example target"),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
-                view_formats: &[],
-            })
-        };
-        let visibility = texture(host::VISIBILITY_FORMAT, wgpu::TextureUsages::COPY_SRC);
-        let depth = texture(host::DEPTH_FORMAT, wgpu::TextureUsages::empty());
-        let (visibility_view, depth_view) =
-            (visibility.create_view(&Default::default()), depth.create_view(&Default::default()));
+        let Targets { visibility, visibility_view, depth_view } = &live.targets;
         // ...and the host draws with its own pipeline, reading them.
         let surface_texture = match live.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Some(t),
@@ -221,13 +245,15 @@ impl App {
         };
         if let Some(surface_texture) = &surface_texture {
             let view = surface_texture.texture.create_view(&Default::default());
-            let targets = HostTargets { color: &view, visibility: &visibility_view, depth: &depth_view };
+            let targets = HostTargets { color: &view, visibility: visibility_view, depth: depth_view };
             live.host.draw(device, &mut encoder, &targets, sun_shadows, &live.mesh);
         }
-        let shot = last.then(|| texture(live.config.format, wgpu::TextureUsages::COPY_SRC));
+        let shot = last.then(|| {
+            target_texture(device, live.config.format, wgpu::TextureUsages::COPY_SRC, [width, height])
+        });
         if let Some(shot) = &shot {
             let view = shot.create_view(&Default::default());
-            let targets = HostTargets { color: &view, visibility: &visibility_view, depth: &depth_view };
+            let targets = HostTargets { color: &view, visibility: visibility_view, depth: depth_view };
             live.host.draw(device, &mut encoder, &targets, sun_shadows, &live.mesh);
         }
         live.gpu.queue.submit([encoder.finish()]);
@@ -237,7 +263,7 @@ impl App {
         }
         self.frame += 1;
         if let Some(shot) = shot {
-            let visibility: Vec<f32> = read_texture(&live.gpu, &visibility)?;
+            let visibility: Vec<f32> = read_texture(&live.gpu, visibility)?;
             save_screenshot(&live.gpu, &shot, self.args.screenshot.as_ref(), &visibility)?;
             event_loop.exit();
         }
@@ -293,6 +319,7 @@ impl ApplicationHandler for App {
                 live.config.width = size.width.max(1);
                 live.config.height = size.height.max(1);
                 live.surface.configure(&live.gpu.device, &live.config);
+                live.targets = Targets::new(&live.gpu.device, [live.config.width, live.config.height]);
             }
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.redraw(event_loop) {

@@ -17,7 +17,7 @@ use crate::{
     passes::{
         SHADOW_FORMAT,
         depth_reduce::{BoundsRequest, Planes},
-        lighting::Lookup,
+        lighting::MapLookup,
         shadow::DepthTarget,
     },
     pool::ViewKey,
@@ -59,11 +59,11 @@ impl LightPlan {
     }
 
     /// How the lighting pass looks its map up.
-    pub fn lookup(&self) -> Lookup {
+    pub fn lookup(&self) -> MapLookup {
         match self.depth_target() {
-            DepthTarget::CubeFace => Lookup::Cube,
-            DepthTarget::Paraboloid => Lookup::Paraboloid,
-            DepthTarget::Projected => Lookup::Map,
+            DepthTarget::CubeFace => MapLookup::Cube,
+            DepthTarget::Paraboloid => MapLookup::Paraboloid,
+            DepthTarget::Projected => MapLookup::Map,
         }
     }
 

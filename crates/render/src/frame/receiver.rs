@@ -111,8 +111,10 @@ impl Renderer {
                 let uniforms = ReceiverUniforms { light: &maps.light_buffer, camera: &camera };
                 let bind_group =
                     self.fixed.receiver_group(&mut self.pool, &self.layouts, uniforms, maps.views(None));
-                let lookup = MapLookup::of(maps.lookup).expect("a light's own lookup is never the mask");
-                let variant = ReceiverVariant { technique: light.settings.shadow.filter.technique, lookup };
+                let variant = ReceiverVariant {
+                    technique: light.settings.shadow.filter.technique,
+                    lookup: maps.lookup,
+                };
                 lights.push(LightShadows { light: light.light, bind_group, variant });
             }
             Shadows { lights, stats: rec.stats }

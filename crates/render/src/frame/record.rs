@@ -21,7 +21,7 @@ use crate::{
     layout::ShadowLayout,
     passes::{
         SHADOW_FORMAT, begin_depth_pass,
-        lighting::{self, LightingKey, LightingRole, Lookup},
+        lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
         moments::MomentInput,
         screen_space,
         shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape, Sides},
@@ -88,7 +88,7 @@ pub(super) struct LightBindings {
     pub lighting: wgpu::BindGroup,
     /// The mask pass's shadow group, on the mask path.
     pub mask: Option<wgpu::BindGroup>,
-    pub lookup: Lookup,
+    pub lookup: MapLookup,
 }
 
 /// A light's uniform and the views of its maps, for the passes from the camera.
@@ -100,7 +100,7 @@ pub(super) struct LightMaps {
     pub moments: Option<wgpu::TextureView>,
     /// A point light's map as a cube.
     pub cube: Option<wgpu::TextureView>,
-    pub lookup: Lookup,
+    pub lookup: MapLookup,
 }
 
 impl LightMaps {
@@ -381,7 +381,7 @@ impl Renderer {
             moments.view
         });
         let lookup = light.lookup();
-        let cube = (lookup == Lookup::Cube)
+        let cube = (lookup == MapLookup::Cube)
             .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
         LightMaps { light_buffer, map: map_view, moments, cube, lookup }
     }
@@ -463,7 +463,7 @@ impl Renderer {
         });
         let key = LightingKey {
             technique: light.settings.shadow.filter.technique,
-            lookup: if plan.mask_path { Lookup::Mask } else { bindings.lookup },
+            lookup: if plan.mask_path { Lookup::Mask } else { Lookup::Own(bindings.lookup) },
             role: if first {
                 LightingRole::First
             } else {

@@ -11,18 +11,18 @@ use wgpu::naga;
 
 use super::{
     blit, depth_reduce, lighting,
-    lighting::{LightingKey, LightingRole, Lookup},
+    lighting::{LightingKey, LightingRole, Lookup, MapLookup},
     map_preview, moments, receiver, screen_space, shadow,
 };
 use crate::uniforms::{self, LightKindGpu, StructLayout};
 
 /// The lookups a technique's map can be read through.
 fn lookups(technique: Technique) -> Vec<Lookup> {
-    let mut all = vec![Lookup::Map, Lookup::Mask];
+    let mut all = vec![Lookup::Own(MapLookup::Map), Lookup::Mask];
     if technique.supports_point_lights() {
-        all.push(Lookup::Cube);
+        all.push(Lookup::Own(MapLookup::Cube));
         if technique != Technique::Pcss {
-            all.push(Lookup::Paraboloid);
+            all.push(Lookup::Own(MapLookup::Paraboloid));
         }
     }
     all
@@ -52,8 +52,8 @@ fn every_variant() -> Vec<(String, String)> {
                 let key = LightingKey { technique, lookup, role };
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
             }
-            if let Some(map) = lighting::MapLookup::of(lookup) {
-                let key = screen_space::MaskKey { technique, lookup };
+            if let Lookup::Own(map) = lookup {
+                let key = screen_space::MaskKey { technique, lookup: map };
                 out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
                 // The receiver with a host's fragment shader calling it, in the group
                 // a host might pick.

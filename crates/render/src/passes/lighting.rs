@@ -46,17 +46,13 @@ pub(crate) struct LightingKey {
     pub role: LightingRole,
 }
 
-/// How the lighting pass finds a receiver in its light's map.
+/// How the lighting pass finds a receiver's visibility.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum Lookup {
-    /// Projected into 2D layers: a sun's map or cascades, a spot's map.
-    Map,
-    /// By direction in a point light's cube.
-    Cube,
-    /// Through a point light's dual paraboloids, into two 2D layers.
-    Paraboloid,
+    /// In the light's own map.
+    Own(MapLookup),
     /// Not at all: the screen-space shadow mask holds it (the mask pass made the
-    /// lookup, with the light's own lookup kind).
+    /// lookup, in the light's own map).
     Mask,
 }
 
@@ -64,35 +60,24 @@ pub(crate) enum Lookup {
 /// technique's shadow lookup and the rules of resolve_visibility.wgsl, or on the
 /// mask path the read of the mask. Shared by the lighting and shadow-mask passes.
 pub(crate) fn visibility_wgsl(technique: Technique, lookup: Lookup) -> Vec<String> {
-    let Some(map) = MapLookup::of(lookup) else {
-        return vec![include_str!("mask_lookup.wgsl").to_owned()];
+    let map = match lookup {
+        Lookup::Own(map) => map,
+        Lookup::Mask => return vec![include_str!("mask_lookup.wgsl").to_owned()],
     };
     let mut parts = vec![techniques::SHADOW_BINDINGS_WGSL.to_owned()];
     parts.extend(resolved_lookup_wgsl(technique, map));
     parts
 }
 
-/// How a light's own map is looked up: a [`Lookup`] other than the mask.
+/// How a receiver is found in its light's own map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum MapLookup {
-    /// Projected into 2D layers.
+    /// Projected into 2D layers: a sun's map or cascades, a spot's map.
     Map,
-    /// By direction in a cube.
+    /// By direction in a point light's cube.
     Cube,
-    /// Through dual paraboloids.
+    /// Through a point light's dual paraboloids, into two 2D layers.
     Paraboloid,
-}
-
-impl MapLookup {
-    /// The map lookup of `lookup`; None for the mask, which reads no map.
-    pub fn of(lookup: Lookup) -> Option<MapLookup> {
-        match lookup {
-            Lookup::Map => Some(MapLookup::Map),
-            Lookup::Cube => Some(MapLookup::Cube),
-            Lookup::Paraboloid => Some(MapLookup::Paraboloid),
-            Lookup::Mask => None,
-        }
-    }
 }
 
 /// `pixel_visibility` of a technique and map lookup, without the declarations of the

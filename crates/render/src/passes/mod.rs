@@ -37,6 +37,36 @@ pub(crate) fn begin_depth_pass<'e>(
     })
 }
 
+/// Draws the full-screen triangle (`FULLSCREEN_WGSL`) with `pipeline` and its one
+/// bind group into `target`, cleared to black first.
+pub(crate) fn draw_fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.draw(0..3, 0..1);
+}
+
 /// Concatenates WGSL sources into one module, after the constants generated from
 /// Rust ([`crate::uniforms::wgsl_constants`]). WGSL allows module-scope declarations
 /// in any order, so the shared declarations, the technique and the pass compose freely.

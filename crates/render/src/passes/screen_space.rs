@@ -9,7 +9,7 @@ use gnomon_scene::settings::Technique;
 
 use super::{
     Layouts, compose_wgsl,
-    lighting::{self, Lookup},
+    lighting::{self, Lookup, MapLookup},
 };
 use crate::gpu_types::VertexStream;
 
@@ -26,8 +26,8 @@ pub(crate) const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Floa
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct MaskKey {
     pub technique: Technique,
-    /// How the light's map is looked up (never [`Lookup::Mask`]).
-    pub lookup: Lookup,
+    /// How the light's map is looked up.
+    pub lookup: MapLookup,
 }
 
 /// The prepass's WGSL, composed: the lighting pass's vertex stage (`vs_surface`) and
@@ -44,7 +44,7 @@ pub(crate) fn prepass_wgsl() -> String {
 /// The shadow-mask pass's WGSL for `key`, composed.
 pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     let mut parts = lighting::camera_shading_wgsl();
-    parts.extend(lighting::visibility_wgsl(key.technique, key.lookup));
+    parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
     parts.push(include_str!("octahedron.wgsl").to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(include_str!("shadow_mask.wgsl").to_owned());

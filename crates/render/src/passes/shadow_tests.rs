@@ -14,7 +14,7 @@ use super::*;
 use crate::{
     gpu_types::INSTANCE_SLOT,
     passes::{
-        lighting::{self, LightingKey, LightingRole, Lookup},
+        lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
         screen_space,
     },
 };
@@ -153,7 +153,7 @@ fn no_geometry_vertex_stage_reads_a_storage_buffer() {
     let mut modules = vec![("shadow", Reflected::new(&shadow_wgsl()))];
     modules.push(("prepass", Reflected::new(&screen_space::prepass_wgsl())));
     for technique in [Technique::Hard, Technique::Pcss, Technique::Vsm] {
-        for lookup in [Lookup::Map, Lookup::Mask] {
+        for lookup in [Lookup::Own(MapLookup::Map), Lookup::Mask] {
             let key = LightingKey { technique, lookup, role: LightingRole::First };
             modules.push(("lighting", Reflected::new(&lighting::lighting_wgsl(key))));
         }
