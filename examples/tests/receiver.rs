@@ -70,17 +70,18 @@ fn a_hosts_shader_sees_gnomons_shadows_for_every_technique_and_light() {
     let mut renderer = Renderer::new(&gpu).unwrap();
     let scene = builtin::spheres();
     let (mut worst, mut cases) = (0.0f64, 0);
-    for &technique in Technique::all() {
+    let registered: Vec<_> = renderer.techniques().iter().collect();
+    for technique in registered {
         let mut lights = vec![(LightKind::Sun, OmniMap::Cube), (LightKind::Spot, OmniMap::Cube)];
-        if technique.supports_point_lights() {
+        if technique.cube_wgsl().is_some() {
             lights.push((LightKind::Point, OmniMap::Cube));
-            if technique != Technique::Pcss {
-                lights.push((LightKind::Point, OmniMap::Paraboloid));
-            }
+        }
+        if technique.maps().paraboloid {
+            lights.push((LightKind::Point, OmniMap::Paraboloid));
         }
         for (light, omni) in lights {
             let case = format!("{technique:?}, {light:?} light, {omni:?}");
-            let settings = settings(technique, light, omni);
+            let settings = settings(technique.technique(), light, omni);
             let frame = renderer.render(&scene, &settings, &OutputRequest::default()).unwrap();
             let hosted = host_visibility(&gpu, &mut renderer, &scene, &settings);
             assert_eq!(hosted.len(), frame.visibility.len());
@@ -115,7 +116,7 @@ fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
     let mut renderer = Renderer::new(&gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
-    let mut settings = settings(Technique::Pcf, LightKind::Sun, OmniMap::Cube);
+    let mut settings = settings(Technique::PCF, LightKind::Sun, OmniMap::Cube);
     settings.screen.shadow_path = ShadowPath::Mask;
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();

@@ -296,17 +296,20 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
 
 /// The techniques × sweep values to time, each with its settings checked.
 fn configurations(args: &BenchArgs, base: &Settings) -> anyhow::Result<Vec<Config>> {
-    let techniques =
-        if args.techniques.is_empty() { vec![base.shadow.filter.technique] } else { args.techniques.clone() };
+    let techniques = if args.techniques.is_empty() {
+        vec![base.shadow.filter.technique.clone()]
+    } else {
+        args.techniques.clone()
+    };
     let sweep = match &args.sweep {
         None => None,
         Some(text) => Some(parse_sweep(text)?),
     };
     let form = SettingsForm::new();
     let mut configs = Vec::new();
-    for &technique in &techniques {
+    for technique in techniques {
         let mut settings = base.clone();
-        settings.shadow.filter.technique = technique;
+        settings.shadow.filter.technique = technique.clone();
         match &sweep {
             None => configs.push(Config { technique, sweep_value: None, settings }),
             Some((flag, values)) => {
@@ -321,7 +324,11 @@ fn configurations(args: &BenchArgs, base: &Settings) -> anyhow::Result<Vec<Confi
                     let swept = form
                         .set(&settings, &field.id, Some(value))
                         .map_err(|e| anyhow::anyhow!("--sweep {flag}={value}: {e}"))?;
-                    configs.push(Config { technique, sweep_value: Some(value.clone()), settings: swept });
+                    configs.push(Config {
+                        technique: technique.clone(),
+                        sweep_value: Some(value.clone()),
+                        settings: swept,
+                    });
                 }
             }
         }

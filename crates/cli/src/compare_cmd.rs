@@ -75,7 +75,7 @@ struct Rendered {
 /// One technique's row of the report.
 #[derive(Serialize)]
 struct Row {
-    technique: &'static str,
+    technique: String,
     #[serde(flatten)]
     metrics: Metrics,
     /// Median GPU milliseconds of the shadow pass, where the adapter has timestamps.
@@ -161,9 +161,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let uploaded = renderer.upload(&scene)?;
 
     let mut frames: Vec<Rendered> = Vec::new();
-    for &technique in &args.techniques {
+    for technique in &args.techniques {
         let mut s = settings.clone();
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         let frame = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
         let (mut shadow, mut filter, mut lighting) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.timing_frames {
@@ -177,7 +177,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             let filter = (!filter.is_empty()).then(|| median(&mut filter));
             (median(&mut shadow), filter, median(&mut lighting))
         });
-        frames.push(Rendered { technique, frame, timing });
+        frames.push(Rendered { technique: technique.clone(), frame, timing });
     }
 
     let flicker = match args.camera_path {
@@ -245,7 +245,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             },
         ]);
         rows.push(Row {
-            technique: name,
+            technique: name.to_owned(),
             metrics: m,
             shadow_ms: timing.map(|t| t.0),
             filter_ms: timing.and_then(|t| t.1),
@@ -328,8 +328,8 @@ fn measure_flicker(
             far: Some(camera.far),
         };
         let reference = bar.suspend(|| lab::reference(scene, &s, !args.no_cache))?.image;
-        for (t, &technique) in args.techniques.iter().enumerate() {
-            s.shadow.filter.technique = technique;
+        for (t, technique) in args.techniques.iter().enumerate() {
+            s.shadow.filter.technique = technique.clone();
             let request = OutputRequest { fixed_layout: frozen.clone(), ..Default::default() };
             let frame = renderer.render_uploaded(uploaded, scene, &s, &request)?;
             if settings.shadow.cascades.freeze && frozen.is_none() {

@@ -42,8 +42,18 @@ enum Command {
     Techniques,
 }
 
+/// The command line, with the registry's techniques as the choices of every
+/// `--technique` and `--techniques` (the settings crate does not know them).
+fn parse_cli(techniques: &gnomon_render::techniques::TechniqueRegistry) -> Cli {
+    use clap::{CommandFactory, FromArgMatches};
+    let command = gnomon_scene::settings::offer_techniques(Cli::command(), &techniques.choices());
+    let matches = command.get_matches();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
+    let cli = parse_cli(&techniques);
     let result = match cli.command {
         None => render_cmd::run(&render_cmd::RenderArgs::default_from_cli()),
         Some(Command::Render(args)) => render_cmd::run(&args),
@@ -58,13 +68,8 @@ fn main() -> ExitCode {
             Ok(())
         }
         Some(Command::Techniques) => {
-            use clap::ValueEnum;
-            for t in gnomon_scene::settings::Technique::all() {
-                let help = t
-                    .to_possible_value()
-                    .and_then(|v| v.get_help().map(|h| h.to_string()))
-                    .unwrap_or_default();
-                println!("{:<8} {help}", t.name());
+            for (name, summary) in techniques.choices() {
+                println!("{name:<14} {summary}");
             }
             Ok(())
         }

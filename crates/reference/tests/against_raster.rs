@@ -37,7 +37,7 @@ fn settings(width: u32, height: u32, technique: Technique) -> Settings {
 #[test]
 fn raising_the_bias_on_contact_raises_the_false_lit_rate() {
     let scene = builtin::contact();
-    let s = settings(640, 360, Technique::Hard);
+    let s = settings(640, 360, Technique::HARD);
     let truth = reference(&scene, &s);
     let default = measure(&scene, &s, &truth);
     let mut biased = s.clone();
@@ -60,7 +60,7 @@ fn raising_the_bias_on_contact_raises_the_false_lit_rate() {
 #[test]
 fn dropping_the_bias_on_grazing_raises_the_false_shadow_rate() {
     let scene = builtin::grazing();
-    let s = settings(640, 360, Technique::Hard);
+    let s = settings(640, 360, Technique::HARD);
     let truth = reference(&scene, &s);
     let default = measure(&scene, &s, &truth);
     let mut unbiased = s.clone();
@@ -83,10 +83,10 @@ fn dropping_the_bias_on_grazing_raises_the_false_shadow_rate() {
 #[test]
 fn foundation_techniques_mismatch_under_a_twentieth_of_a_percent_on_spheres() {
     let scene = builtin::spheres();
-    let s = settings(1280, 720, Technique::Hard);
+    let s = settings(1280, 720, Technique::HARD);
     let truth = reference(&scene, &s);
-    for technique in [Technique::Hard, Technique::Pcf2x2, Technique::Pcf] {
-        let m = measure(&scene, &settings(1280, 720, technique), &truth);
+    for technique in [Technique::HARD, Technique::PCF2X2, Technique::PCF] {
+        let m = measure(&scene, &settings(1280, 720, technique.clone()), &truth);
         eprintln!(
             "spheres 1280×720, 2048², {}: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} compared, {} silhouette",
             technique.name(),

@@ -132,7 +132,7 @@ fn stable_cascades_shimmer_five_times_less_than_tight_ones() {
         let mut s = pssm(fit);
         s.image.width = 1280;
         s.image.height = 720;
-        s.shadow.filter.technique = Technique::Hard;
+        s.shadow.filter.technique = Technique::HARD;
         let f = flicker_along_truck(&scene, &traced, &s, 12);
         eprintln!("{fit:?}: {f:?}");
         assert!(f.reprojected > 100_000, "{f:?}");
@@ -149,7 +149,7 @@ fn single_map(warp: WarpKind) -> Settings {
     s.image.height = 360;
     s.shadow.map.resolution = 2048;
     s.shadow.map.warp = warp;
-    s.shadow.filter.technique = Technique::Pcf2x2;
+    s.shadow.filter.technique = Technique::PCF2X2;
     s
 }
 

@@ -114,8 +114,8 @@ fn pixel_size(position: &[Vec3], ids: &[u32], w: usize, i: usize) -> f32 {
 fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
     let scene = checker_scene();
     let direction = scene.sun.direction;
-    for technique in [Technique::Hard, Technique::Pcf2x2] {
-        let s = settings(technique);
+    for technique in [Technique::HARD, Technique::PCF2X2] {
+        let s = settings(technique.clone());
         let frame = render(&scene, &s);
         let texel = frame.light_projection.texel_world_size(2048, 0.0);
         let w = frame.width as usize;
@@ -142,7 +142,7 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
         );
     }
     // The reference: exact to a pixel, with the same alpha lookup.
-    let s = settings(Technique::Hard);
+    let s = settings(Technique::HARD);
     let r = reference(&scene, &s);
     let w = r.width as usize;
     let mut worst = f32::NEG_INFINITY;
@@ -190,7 +190,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let (mut scene, extras) = gnomon_scene::gltf_loader::load(&path).unwrap();
     assert!(!extras.has_camera, "the tree ships without a camera: the loader fits one");
     scene.sun.direction = -gnomon_scene::sun_direction(55.0, 200.0);
-    let mut s = settings(Technique::Pcf2x2);
+    let mut s = settings(Technique::PCF2X2);
     s.image.width = 1280;
     s.image.height = 720;
     let measure = |scene: &Scene, s: &Settings, what: &str| {
@@ -238,7 +238,7 @@ fn the_mask_paths_prepass_cuts_the_same_holes() {
     // The prepass applies the alpha cut too: through the quad's holes the mask path
     // sees, and shades, the same ground as the forward path.
     let scene = checker_scene();
-    let mut s = settings(Technique::Pcf2x2);
+    let mut s = settings(Technique::PCF2X2);
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Forward;
     let forward = render(&scene, &s);
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Mask;

@@ -42,7 +42,7 @@ fn eight_mixed_lights_each_match_the_reference() {
             assert_eq!((l.layer_draws.len(), l.resolution), (6, 512), "{l:?}");
         }
         assert_eq!(frame.lights[1].resolution, 1024);
-        assert_eq!(frame.lights[2].technique, Technique::Pcss);
+        assert_eq!(frame.lights[2].technique, Technique::PCSS);
         assert!(frame.lights.iter().all(|l| l.shadow_draws() > 0), "{:?}", frame.lights);
         assert_eq!(frame.light, scene.lights[index].light, "the frame reports the light asked for");
 

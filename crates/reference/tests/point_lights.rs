@@ -23,7 +23,7 @@ use gnomon_scene::{
 fn point_settings(technique: Technique, resolution: u32, width: u32, height: u32) -> Settings {
     let mut s = Settings::default();
     s.light.kind = LightKind::Point;
-    s.shadow.filter.technique = technique;
+    s.shadow.filter.technique = technique.clone();
     s.shadow.map.resolution = resolution;
     s.image.width = width;
     s.image.height = height;
@@ -36,7 +36,7 @@ fn point_settings(technique: Technique, resolution: u32, width: u32, height: u32
 #[test]
 fn point_light_in_spheres_mismatches_under_half_a_percent() {
     let scene = builtin::spheres();
-    let s = point_settings(Technique::Pcf2x2, 1024, 1280, 720);
+    let s = point_settings(Technique::PCF2X2, 1024, 1280, 720);
     let truth = reference(&scene, &s);
     let frame = render(&scene, &s);
     let m = compare(&frame, &truth);
@@ -64,7 +64,7 @@ fn point_light_in_spheres_mismatches_under_half_a_percent() {
 #[test]
 fn dual_paraboloids_trade_accuracy_for_two_views() {
     let scene = builtin::spheres();
-    let cube = point_settings(Technique::Pcf2x2, 1024, 1280, 720);
+    let cube = point_settings(Technique::PCF2X2, 1024, 1280, 720);
     let mut paraboloid = cube.clone();
     paraboloid.shadow.map.omni = gnomon_scene::settings::OmniMap::Paraboloid;
     let truth = reference(&scene, &cube);
@@ -177,14 +177,14 @@ fn no_band_of_mismatch_along_cube_face_seams() {
     let scene = seam_scene();
     let band = 3.0;
     for technique in [
-        Technique::Hard,
-        Technique::Pcf2x2,
-        Technique::Pcf,
-        Technique::PcfTent,
-        Technique::PcfPoisson,
-        Technique::Pcss,
+        Technique::HARD,
+        Technique::PCF2X2,
+        Technique::PCF,
+        Technique::PCF_TENT,
+        Technique::PCF_POISSON,
+        Technique::PCSS,
     ] {
-        let mut s = point_settings(technique, 512, 960, 640);
+        let mut s = point_settings(technique.clone(), 512, 960, 640);
         s.shadow.filter.pcf_kernel = 3.0;
         let truth = reference(&scene, &s);
         let frame = render(&scene, &s);
@@ -252,7 +252,7 @@ fn casters_outside_a_face_are_not_drawn_into_it() {
         world_from_object: Mat4::from_translation(Vec3::new(4.0, 2.0, 0.0)),
         casts_shadow: true,
     });
-    let s = point_settings(Technique::Pcf2x2, 512, 480, 320);
+    let s = point_settings(Technique::PCF2X2, 512, 480, 320);
     let frame = render(&scene, &s);
     // Layers in WebGPU's order: +x, −x, +y, −y, +z, −z.
     assert_eq!(frame.lights[0].layer_draws, vec![2, 1, 0, 1, 1, 1], "{:?}", frame.lights[0]);
@@ -285,13 +285,13 @@ const SPHERE_PCSS_OVER_HARD: f64 = 0.7;
 #[test]
 fn sphere_light_pcss_follows_the_monte_carlo_penumbra() {
     let scene = builtin::spheres();
-    let mut s = point_settings(Technique::Pcss, 1024, 480, 270);
+    let mut s = point_settings(Technique::PCSS, 1024, 480, 270);
     s.light.point_radius = Some(0.25);
     s.reference.samples = 128;
     let truth = reference(&scene, &s);
     let pcss = compare(&render(&scene, &s), &truth);
     let mut hard = s.clone();
-    hard.shadow.filter.technique = Technique::Hard;
+    hard.shadow.filter.technique = Technique::HARD;
     let hard = compare(&render(&scene, &hard), &truth);
     eprintln!("sphere light r = 0.25: MAE pcss {:.4}, hard {:.4}", pcss.mae, hard.mae);
     figure(

@@ -57,16 +57,16 @@ type Configure = Box<dyn Fn(&mut Settings)>;
 #[test]
 fn the_mask_path_gives_the_forward_visibility() {
     let cases: Vec<(&str, Scene, Configure)> = vec![
-        ("spheres, hard", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::Hard)),
-        ("spheres, pcf", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::Pcf)),
-        ("spheres, pcss", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::Pcss)),
-        ("spheres, vsm", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::Vsm)),
+        ("spheres, hard", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::HARD)),
+        ("spheres, pcf", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::PCF)),
+        ("spheres, pcss", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::PCSS)),
+        ("spheres, vsm", builtin::spheres(), Box::new(|s| s.shadow.filter.technique = Technique::VSM)),
         (
             "columns, cascades, pcf-poisson",
             builtin::columns(),
             Box::new(|s| {
                 s.shadow.partition = Partition::Cascades;
-                s.shadow.filter.technique = Technique::PcfPoisson;
+                s.shadow.filter.technique = Technique::PCF_POISSON;
             }),
         ),
         (
@@ -74,7 +74,7 @@ fn the_mask_path_gives_the_forward_visibility() {
             builtin::contact(),
             Box::new(|s| {
                 s.light.kind = LightKind::Spot;
-                s.shadow.filter.technique = Technique::Pcf;
+                s.shadow.filter.technique = Technique::PCF;
             }),
         ),
         (
@@ -82,7 +82,7 @@ fn the_mask_path_gives_the_forward_visibility() {
             builtin::spheres(),
             Box::new(|s| {
                 s.light.kind = LightKind::Point;
-                s.shadow.filter.technique = Technique::Pcf;
+                s.shadow.filter.technique = Technique::PCF;
             }),
         ),
         (
@@ -107,7 +107,7 @@ fn the_mask_path_gives_the_forward_visibility() {
             Box::new(|s| {
                 s.light.kind = LightKind::Point;
                 s.shadow.map.omni = OmniMap::Paraboloid;
-                s.shadow.filter.technique = Technique::Pcf2x2;
+                s.shadow.filter.technique = Technique::PCF2X2;
             }),
         ),
     ];
@@ -262,8 +262,8 @@ fn contact_shadows_reattach_peter_panned_shadows() {
     let mut s = settings(640, 360);
     s.shadow.bias.slope_bias = PETER_PANNING_SLOPE_BIAS;
     let truth = reference(&scene, &s);
-    for technique in [Technique::Hard, Technique::Pcf2x2, Technique::Pcf, Technique::Pcss] {
-        s.shadow.filter.technique = technique;
+    for technique in [Technique::HARD, Technique::PCF2X2, Technique::PCF, Technique::PCSS] {
+        s.shadow.filter.technique = technique.clone();
         let [(near_without, all_without), (near_with, all_with)] =
             with_and_without_contact(&scene, &s, &truth);
         eprintln!(

@@ -35,13 +35,13 @@ fn pcss_beats_every_fixed_pcf_kernel_on_contact() {
     let (scene, mut s, truth) = contact_under_a_disk_light();
     let mut renderer = Renderer::new(gpu()).unwrap();
 
-    s.shadow.filter.technique = Technique::Pcss;
+    s.shadow.filter.technique = Technique::PCSS;
     let pcss = measure(&mut renderer, &scene, &s, &truth);
     let mut best_fixed = (f64::INFINITY, String::new());
-    for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
+    for technique in [Technique::PCF, Technique::PCF_TENT, Technique::PCF_POISSON] {
         for width in [1.0, 2.0, 3.0, 5.0, 9.0, 15.0, 25.0, 32.0] {
             for receiver_plane_bias in [false, true] {
-                s.shadow.filter.technique = technique;
+                s.shadow.filter.technique = technique.clone();
                 s.shadow.filter.pcf_kernel = width;
                 s.shadow.filter.receiver_plane_bias = receiver_plane_bias;
                 let m = measure(&mut renderer, &scene, &s, &truth);
@@ -80,7 +80,7 @@ fn pcss_beats_every_fixed_pcf_kernel_on_contact() {
 #[test]
 fn vsm_stays_close_to_the_monte_carlo_reference_on_contact() {
     let (scene, mut s, truth) = contact_under_a_disk_light();
-    s.shadow.filter.technique = Technique::Vsm;
+    s.shadow.filter.technique = Technique::VSM;
     let mut renderer = Renderer::new(gpu()).unwrap();
     let vsm = measure(&mut renderer, &scene, &s, &truth);
     figure("contact, spot r = 0.5: VSM MAE", format!("{:.4}", vsm.mae), VSM_MAE_BOUND);

@@ -13,10 +13,10 @@ use gnomon_math::{
 };
 use gnomon_scene::{
     Camera, Light, Settings,
-    settings::{
-        CascadeFit, CascadeSelection, Fit, KernelUnit, OmniMap, Partition, SplitScheme, Technique, WarpKind,
-    },
+    settings::{CascadeFit, CascadeSelection, Fit, KernelUnit, OmniMap, Partition, SplitScheme, WarpKind},
 };
+
+use crate::techniques::TechniqueRef;
 
 /// What SDSM measured of the camera's samples (Lauritzen, Salvi & Lefohn 2011).
 #[derive(Clone, Debug, PartialEq)]
@@ -45,6 +45,17 @@ pub struct ShadowLayout {
     pub depth_clamp: bool,
 }
 
+/// What the device and the light's technique allow its map.
+#[derive(Clone, Copy, Debug)]
+pub struct MapDrawing {
+    /// The light's technique: its filter's reach is the margin a sample-fitted
+    /// cascade keeps, and [`crate::techniques::MapSupport::clamped_depth`] says
+    /// whether its map may be drawn with depth clamping.
+    pub technique: TechniqueRef,
+    /// The device can draw with unclipped depth (`DEPTH_CLIP_CONTROL`).
+    pub unclipped_depth: bool,
+}
+
 /// The shadow layout of `light` under `settings`: one map, or for a sun with
 /// `--partition cascades`, one per slice of the view frustum, all sharing one depth
 /// range so that every layer stores depth the same way; for a point light, the six
@@ -55,12 +66,13 @@ pub struct ShadowLayout {
 /// where the view frustum meets the scene's bounds, and with --sdsm-bounds each tight
 /// cascade narrows to the light-space bounds of its own samples.
 ///
-/// `depth_clamp` says the device can draw with unclipped depth; with it, and
-/// `--depth-clamp true` (the default), where a sun's map
-/// follows the receivers (--fit receivers, tight cascades) its near plane then moves up
-/// to the nearest receiver ([`LightProjection::pancaked`]). Not for PCSS, whose blocker
-/// search reads the true distance to each blocker, nor for stable cascades, whose depth
-/// range must not follow the camera, nor for warps, which rely on clipping.
+/// Where the device can draw with unclipped depth (`drawing`), with
+/// `shadow.map.depth_clamp` (the default) and a technique that reads clamped depth
+/// (not PCSS, whose blocker search reads the true distance to each blocker), a sun's
+/// map that follows the receivers (`fit` receivers, tight cascades) moves its near
+/// plane up to the nearest receiver ([`LightProjection::pancaked`]). Not for stable
+/// cascades, whose depth range must not follow the camera, nor for warps, which rely
+/// on clipping.
 pub fn shadow_layout(
     scene_bounds: &Aabb,
     light: &Light,
@@ -68,7 +80,7 @@ pub fn shadow_layout(
     aspect: f32,
     settings: &Settings,
     sampled: Option<&SampleDistribution>,
-    depth_clamp: bool,
+    drawing: MapDrawing,
 ) -> ShadowLayout {
     if let Light::Point(point) = light {
         // Six 90° faces from the light's position, or two paraboloids; near and far
@@ -84,7 +96,7 @@ pub fn shadow_layout(
         };
     }
     let pancake =
-        depth_clamp && settings.shadow.map.depth_clamp && settings.shadow.filter.technique != Technique::Pcss;
+        drawing.unclipped_depth && settings.shadow.map.depth_clamp && drawing.technique.maps().clamped_depth;
     let single = || {
         let fit = settings.shadow.map.fit;
         let clamped = pancake && fit == Fit::Receivers && matches!(light, Light::Directional(_));
@@ -129,7 +141,7 @@ pub fn shadow_layout(
                         Some(window) => cascades::fit_cascade_to_samples(
                             &tight,
                             window,
-                            filter_margin_texels(settings, &tight),
+                            filter_margin_texels(settings, drawing.technique, &tight),
                             resolution,
                         ),
                         None => tight,
@@ -192,7 +204,7 @@ pub(crate) fn cascade_splits(
 /// Texels a sample-fitted cascade keeps around its samples: the technique's filter
 /// reach and the normal offset, plus two for the bilinear footprint and the pixel's
 /// own extent.
-fn filter_margin_texels(settings: &Settings, tight: &LightProjection) -> f32 {
+fn filter_margin_texels(settings: &Settings, technique: TechniqueRef, tight: &LightProjection) -> f32 {
     let f = &settings.shadow.filter;
     let texel = tight.texel_world_size(settings.shadow.map.resolution, 0.0).max(1e-9);
     let kernel = match f.kernel_unit {
@@ -200,7 +212,7 @@ fn filter_margin_texels(settings: &Settings, tight: &LightProjection) -> f32 {
         KernelUnit::World => f.pcf_kernel / texel,
     };
     // Each technique states its own reach (`ShadowTechnique::filter_reach_texels`).
-    let reach = crate::techniques::lookup(f.technique).filter_reach_texels(f, kernel);
+    let reach = technique.filter_reach_texels(f, kernel);
     2.0 + reach + settings.shadow.bias.normal_offset
 }
 

@@ -45,7 +45,7 @@ fn check_boundary(
 }
 
 fn techniques() -> Vec<(Technique, u32)> {
-    vec![(Technique::Hard, 3), (Technique::Pcf2x2, 3), (Technique::Pcf, 3), (Technique::Pcf, 7)]
+    vec![(Technique::HARD, 3), (Technique::PCF2X2, 3), (Technique::PCF, 3), (Technique::PCF, 7)]
 }
 
 #[test]
@@ -53,7 +53,7 @@ fn square_occluder_under_a_sun_matches_the_analytic_projection() {
     let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
     for (technique, kernel) in techniques() {
         let mut s = settings(640, 480, 1024);
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         s.shadow.filter.pcf_kernel = kernel as f32;
         let frame = render(&scene, &s);
         let texel = frame.light_projection.texel_world_size(1024, 0.0);
@@ -81,7 +81,7 @@ fn spot_light_cone_and_shadow_match_the_perspective_projection() {
     for (technique, kernel) in techniques() {
         let mut s = settings(640, 480, 1024);
         s.light.kind = gnomon_scene::settings::LightKind::Spot;
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         s.shadow.filter.pcf_kernel = kernel as f32;
         let frame = render(&scene, &s);
         let Light::Spot(spot) = frame.light else { panic!("spot expected") };

@@ -5,6 +5,7 @@
 mod support;
 
 use glam::{Vec2, Vec3};
+use gnomon_render::techniques::TechniqueRegistry;
 use gnomon_scene::{
     builtin,
     settings::{BiasSettings, Technique},
@@ -62,13 +63,11 @@ fn acne_fraction_with(s: &gnomon_scene::Settings, threshold: f32) -> (f64, f64, 
         let (p, n) = (frame.position[i], frame.normal[i]);
         if frame.visibility[i] < threshold && ray_traced_lit(&scene, &frame.light, p, n) {
             let texel = frame.light_projection.texel_world_size(2048, 0.0);
-            // A kernel of width W legitimately greys pixels within W/2 of an edge.
-            let reach = match s.shadow.filter.technique {
-                Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => {
-                    0.5 * s.shadow.filter.pcf_kernel
-                }
-                _ => 0.0,
-            };
+            // A filter legitimately greys pixels within its reach of an edge (W/2 for
+            // a PCF kernel of width W), as the technique states it.
+            let f = &s.shadow.filter;
+            let technique = TechniqueRegistry::builtin().get(&f.technique).expect("a built-in technique");
+            let reach = technique.filter_reach_texels(f, f.pcf_kernel);
             if !near_shadow_edge(&scene, &frame.light, p, n, (1.5 + reach) * texel) {
                 wrong += 1;
             } else {
@@ -81,14 +80,14 @@ fn acne_fraction_with(s: &gnomon_scene::Settings, threshold: f32) -> (f64, f64, 
 
 #[test]
 fn grazing_without_bias_has_acne_and_the_default_bias_removes_it() {
-    let (unbiased, _, facing) = acne_fraction(Technique::Hard, BiasSettings::none());
+    let (unbiased, _, facing) = acne_fraction(Technique::HARD, BiasSettings::none());
     assert!(facing > 100_000, "the plane fills most of the view ({facing} lit-facing pixels)");
     assert!(
         unbiased > 0.05,
         "zero bias: only {:.3}% wrongly shadowed, expected acne above 5%",
         100.0 * unbiased
     );
-    let (biased, edge, _) = acne_fraction(Technique::Hard, BiasSettings::default());
+    let (biased, edge, _) = acne_fraction(Technique::HARD, BiasSettings::default());
     assert!(biased < 0.001, "default bias: {:.4}% wrongly shadowed, expected under 0.1%", 100.0 * biased);
     // Edge aliasing is excluded above; it must stay a thin band, not a hiding place.
     assert!(edge < 0.005, "default bias: {:.3}% wrongly shadowed along shadow edges", 100.0 * edge);
@@ -102,8 +101,8 @@ fn grazing_without_bias_has_acne_and_the_default_bias_removes_it() {
 
 #[test]
 fn default_bias_removes_acne_for_filtered_techniques_too() {
-    for technique in [Technique::Pcf2x2, Technique::Pcf] {
-        let (biased, edge, _) = acne_fraction(technique, BiasSettings::default());
+    for technique in [Technique::PCF2X2, Technique::PCF] {
+        let (biased, edge, _) = acne_fraction(technique.clone(), BiasSettings::default());
         assert!(
             biased < 0.001,
             "{technique:?}: {:.4}% wrongly shadowed with the default bias",
@@ -119,9 +118,9 @@ fn receiver_plane_bias_keeps_wide_kernels_off_their_own_receiver() {
     // plane's depth differs by far more than the slope bias allows for one texel:
     // the outer taps shadow the receiver itself, and lit ground greys. Any pixel of
     // truly lit ground below 0.9 counts.
-    for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
+    for technique in [Technique::PCF, Technique::PCF_TENT, Technique::PCF_POISSON] {
         let mut s = settings(640, 360, 2048);
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         s.shadow.filter.pcf_kernel = 25.0;
         s.shadow.filter.receiver_plane_bias = false;
         let (flat, _, _) = acne_fraction_with(&s, 0.9);
@@ -194,8 +193,8 @@ fn contact_detachment(technique: Technique, bias: BiasSettings) -> (f32, usize) 
 
 #[test]
 fn default_bias_keeps_the_contact_shadow_attached() {
-    for technique in [Technique::Hard, Technique::Pcf2x2, Technique::Pcf] {
-        let (detached, on_line) = contact_detachment(technique, BiasSettings::default());
+    for technique in [Technique::HARD, Technique::PCF2X2, Technique::PCF] {
+        let (detached, on_line) = contact_detachment(technique.clone(), BiasSettings::default());
         eprintln!("contact wall, {}, default bias: detached by {detached:.2} texels", technique.name());
         assert!(on_line > 20, "{technique:?}: only {on_line} pixels on the shadow's centre line");
         assert!(detached <= 2.0, "{technique:?}: shadow detached by {detached:.2} texels at the contact");
@@ -205,7 +204,7 @@ fn default_bias_keeps_the_contact_shadow_attached() {
     let mut previous = 0.0;
     for slope_bias in [20.0, 40.0, 80.0] {
         let (detached, _) =
-            contact_detachment(Technique::Hard, BiasSettings { slope_bias, ..Default::default() });
+            contact_detachment(Technique::HARD, BiasSettings { slope_bias, ..Default::default() });
         eprintln!("contact wall, hard, slope bias {slope_bias}: detached by {detached:.2} texels");
         assert!(detached >= previous, "more bias, no less detachment ({detached:.2} < {previous:.2})");
         if slope_bias == 40.0 {

@@ -82,7 +82,7 @@ fn bleeding_reduction_reduces_vsm_light_bleeding() {
     let umbra = |p: Vec2| p.x > -1.54 + 0.25 && p.x < 0.46 - 0.25 && p.y.abs() < 1.75;
     let bleeding = |amount: f32| {
         let mut s = settings(640, 480, RESOLUTION);
-        s.shadow.filter.technique = Technique::Vsm;
+        s.shadow.filter.technique = Technique::VSM;
         s.shadow.filter.moments.blur_radius = 6;
         s.shadow.filter.moments.bleeding_reduction = amount;
         let v = visibilities(&scene, &s, umbra);
@@ -145,7 +145,7 @@ fn attenuation_reduces_convolution_ringing() {
     const BINS: usize = 24;
     let profile = |alpha: f32| {
         let mut s = settings(640, 480, RESOLUTION);
-        s.shadow.filter.technique = Technique::Convolution;
+        s.shadow.filter.technique = Technique::CONVOLUTION;
         s.shadow.filter.moments.csm_terms = 16;
         s.shadow.filter.moments.csm_attenuation = alpha;
         s.shadow.filter.moments.csm_scale = 1.0;

@@ -7,7 +7,12 @@
 
 mod support;
 
-use gnomon_render::{Creations, Gpu, HostTarget, OutputRequest, Renderer, timing::ClockChoice, wgpu};
+use gnomon_render::{
+    Creations, Gpu, HostTarget, OutputRequest, Renderer,
+    techniques::{TechniqueRef, TechniqueRegistry},
+    timing::ClockChoice,
+    wgpu,
+};
 use gnomon_scene::{
     Scene, Settings, builtin,
     settings::{LightKind, OmniMap, Partition, ShadowPath, Technique},
@@ -113,23 +118,23 @@ enum Entry {
 }
 
 /// Every light kind a technique can shadow, with its settings adjusted.
-fn light_cases(technique: Technique) -> Vec<(&'static str, Settings)> {
-    let mut cases =
-        vec![("sun", small(technique, LightKind::Sun)), ("spot", small(technique, LightKind::Spot))];
-    let mut cascades = small(technique, LightKind::Sun);
+fn light_cases(technique: TechniqueRef) -> Vec<(&'static str, Settings)> {
+    let small = |light| small(technique.technique(), light);
+    let mut cases = vec![("sun", small(LightKind::Sun)), ("spot", small(LightKind::Spot))];
+    let mut cascades = small(LightKind::Sun);
     cascades.shadow.partition = Partition::Cascades;
     cascades.shadow.cascades.count = 3;
     cases.push(("sun, 3 cascades", cascades));
-    let mut mask = small(technique, LightKind::Sun);
+    let mut mask = small(LightKind::Sun);
     mask.screen.shadow_path = ShadowPath::Mask;
     cases.push(("sun, mask path", mask));
-    if technique.supports_point_lights() {
-        cases.push(("point, cube", small(technique, LightKind::Point)));
-        if technique != Technique::Pcss {
-            let mut paraboloid = small(technique, LightKind::Point);
-            paraboloid.shadow.map.omni = OmniMap::Paraboloid;
-            cases.push(("point, paraboloids", paraboloid));
-        }
+    if technique.cube_wgsl().is_some() {
+        cases.push(("point, cube", small(LightKind::Point)));
+    }
+    if technique.maps().paraboloid {
+        let mut paraboloid = small(LightKind::Point);
+        paraboloid.shadow.map.omni = OmniMap::Paraboloid;
+        cases.push(("point, paraboloids", paraboloid));
     }
     cases
 }
@@ -140,7 +145,7 @@ fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
     let scene = builtin::spheres();
     let mut failures = Vec::new();
     let (mut checked, mut total) = (0, 0);
-    for &technique in Technique::all() {
+    for technique in TechniqueRegistry::builtin().iter() {
         for (name, settings) in light_cases(technique) {
             // A fresh renderer per case, so that each case warms up alone.
             let mut renderer = Renderer::new(&gpu).unwrap();
@@ -169,7 +174,7 @@ fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
     let gpu = Gpu::new_headless().unwrap();
     let scene = builtin::lamps();
     for path in [ShadowPath::Forward, ShadowPath::Mask] {
-        let mut settings = small(Technique::Pcf, LightKind::All);
+        let mut settings = small(Technique::PCF, LightKind::All);
         settings.screen.shadow_path = path;
         let mut renderer = Renderer::new(&gpu).unwrap();
         let created = created_in_steady_state(&mut renderer, &scene, &settings);
@@ -186,7 +191,7 @@ fn a_changed_setting_creates_only_what_depends_on_it() {
     let scene = builtin::spheres();
     let mut renderer = Renderer::new(&gpu).unwrap();
     let uploaded = renderer.upload(&scene).unwrap();
-    let small_map = small(Technique::Pcf, LightKind::Sun);
+    let small_map = small(Technique::PCF, LightKind::Sun);
     let mut large_map = small_map.clone();
     large_map.shadow.map.resolution = 512;
     renderer.render_live(&uploaded, &scene, &small_map).unwrap();

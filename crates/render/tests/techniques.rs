@@ -6,6 +6,7 @@
 mod support;
 
 use glam::{Vec2, Vec3};
+use gnomon_render::techniques::TechniqueRegistry;
 use gnomon_scene::{
     Scene,
     settings::{LightKind, Settings, Technique},
@@ -18,14 +19,15 @@ const RESOLUTION: u32 = 1024;
 /// kernel half-width, the bilinear tap, and the texel itself, in texels.
 fn footprint_texels(s: &Settings) -> f32 {
     let f = &s.shadow.filter;
-    match f.technique {
-        Technique::Hard | Technique::Pcf2x2 => 1.5,
-        Technique::Pcf | Technique::PcfTent | Technique::PcfPoisson => 0.5 * f.pcf_kernel + 1.5,
-        // The penumbra estimate is analytic, but its blocker search and taps add noise.
-        Technique::Pcss => 2.5,
-        // Gaussian blur of σ = radius/2 truncated at the radius, then bilinear.
-        _ => f.moments.blur_radius as f32 + 1.5,
+    if f.technique == Technique::PCSS {
+        // Its reach is the widest penumbra it may filter; its estimate of this one is
+        // analytic, but its blocker search and taps add noise.
+        return 2.5;
     }
+    // The reach each technique states (a PCF kernel's half-width, a moment map's
+    // blur radius), plus the bilinear tap and the texel itself.
+    let technique = TechniqueRegistry::builtin().get(&f.technique).expect("a built-in technique");
+    technique.filter_reach_texels(f, f.pcf_kernel) + 1.5
 }
 
 struct Outcome {
@@ -101,9 +103,9 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() 
     let slant = -scene.sun.direction.normalize().y;
     let penumbra_half = height / slant * (0.5 * angular_diameter).to_radians().tan() / slant;
 
-    for technique in Technique::all() {
+    for technique in TechniqueRegistry::builtin().iter().map(|t| t.technique()) {
         let mut s = settings(640, 480, RESOLUTION);
-        s.shadow.filter.technique = *technique;
+        s.shadow.filter.technique = technique.clone();
         let o = classify(
             &scene,
             &s,
@@ -123,10 +125,10 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot()
     // Similar triangles: the disk's radius scaled by h / (H − h) on the ground.
     let penumbra_half = radius * height / (SPOT_HEIGHT - height);
 
-    for technique in Technique::all() {
+    for technique in TechniqueRegistry::builtin().iter().map(|t| t.technique()) {
         let mut s = settings(640, 480, RESOLUTION);
         s.light.kind = LightKind::Spot;
-        s.shadow.filter.technique = *technique;
+        s.shadow.filter.technique = technique.clone();
         let o = classify(
             &scene,
             &s,
@@ -146,9 +148,11 @@ fn filterable_techniques_also_work_with_16_bit_moment_maps() {
     // The portable format, where 32-bit float is not filterable (the GL backend):
     // exponents and the moment bias are set for half precision, as documented.
     let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
-    for technique in Technique::all().iter().filter(|t| t.is_filterable()) {
+    let registry = TechniqueRegistry::builtin();
+    let filterable = registry.iter().filter(|t| t.filterable_map(&Default::default()).is_some());
+    for technique in filterable.map(|t| t.technique()) {
         let mut s = settings(640, 480, RESOLUTION);
-        s.shadow.filter.technique = *technique;
+        s.shadow.filter.technique = technique.clone();
         let m = &mut s.shadow.filter.moments;
         m.moment_format = gnomon_scene::settings::MomentFormat::Rgba16float;
         m.evsm_positive = 5.54;
@@ -191,10 +195,10 @@ fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
     // comes from the scene's geometry, not from the renderer's own texel size.
     let scene = square_under_sun().scene;
     let texel = analytic_sun_texel(&scene, RESOLUTION);
-    for technique in [Technique::Pcf, Technique::PcfTent, Technique::PcfPoisson] {
+    for technique in [Technique::PCF, Technique::PCF_TENT, Technique::PCF_POISSON] {
         let mut s = settings(320, 240, RESOLUTION);
         s.shadow.map.fit = gnomon_scene::settings::Fit::Scene;
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         s.shadow.filter.pcf_kernel = 5.0;
         let in_texels = render(&scene, &s);
         // The fit pads the window by a thousandth of the scene's radius a side.
@@ -227,9 +231,9 @@ fn a_kernel_in_world_units_equals_the_same_width_in_texels() {
 #[test]
 fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
     let SquareOccluder { scene, shadow_center, shadow_half: half, .. } = square_under_sun();
-    for technique in [Technique::Vsm, Technique::Evsm4, Technique::MsmHamburger, Technique::Convolution] {
+    for technique in [Technique::VSM, Technique::EVSM4, Technique::MSM_HAMBURGER, Technique::CONVOLUTION] {
         let mut s = settings(640, 480, RESOLUTION);
-        s.shadow.filter.technique = technique;
+        s.shadow.filter.technique = technique.clone();
         s.shadow.filter.moments.mipmaps = true;
         let o =
             classify(&scene, &s, |p| Some(square_distance(Vec2::new(p.x, p.z), shadow_center, half)), 0.0);
@@ -240,7 +244,7 @@ fn mipmapped_moment_maps_keep_the_umbra_dark_and_the_lit_ground_lit() {
     let mut low = scene.clone();
     low.camera.eye = Vec3::new(0.0, 1.2, 6.0);
     let mut s = settings(320, 240, 2048);
-    s.shadow.filter.technique = Technique::Vsm;
+    s.shadow.filter.technique = Technique::VSM;
     let top = render(&low, &s);
     s.shadow.filter.moments.mipmaps = true;
     let mipped = render(&low, &s);
@@ -256,16 +260,16 @@ fn techniques_stay_correct_with_cascades() {
     for fit in [CascadeFit::Tight, CascadeFit::Stable] {
         for selection in [CascadeSelection::Depth, CascadeSelection::Projection] {
             for technique in [
-                Technique::Hard,
-                Technique::Pcf2x2,
-                Technique::PcfTent,
-                Technique::Pcss,
-                Technique::Vsm,
-                Technique::Esm,
-                Technique::MsmHamburger,
+                Technique::HARD,
+                Technique::PCF2X2,
+                Technique::PCF_TENT,
+                Technique::PCSS,
+                Technique::VSM,
+                Technique::ESM,
+                Technique::MSM_HAMBURGER,
             ] {
                 let mut s = settings(640, 480, RESOLUTION);
-                s.shadow.filter.technique = technique;
+                s.shadow.filter.technique = technique.clone();
                 s.shadow.partition = Partition::Cascades;
                 s.shadow.cascades.cascade_fit = fit;
                 s.shadow.cascades.cascade_selection = selection;

@@ -70,12 +70,12 @@ fn models_lights_views_and_settings_come_from_the_file() {
     // File settings apply; a command-line value that differs from its default wins.
     let table = loaded.settings.unwrap();
     let merged = scene_file::merge_settings(&table, &Settings::default()).unwrap();
-    assert_eq!((merged.shadow.filter.technique, merged.shadow.filter.pcf_kernel), (Technique::Pcf, 5.0));
+    assert_eq!((merged.shadow.filter.technique, merged.shadow.filter.pcf_kernel), (Technique::PCF, 5.0));
     let mut cli = Settings::default();
     cli.shadow.filter.pcf_kernel = 7.0;
     cli.shadow.map.resolution = 1024;
     let merged = scene_file::merge_settings(&table, &cli).unwrap();
-    assert_eq!(merged.shadow.filter.technique, Technique::Pcf, "kept from the file");
+    assert_eq!(merged.shadow.filter.technique, Technique::PCF, "kept from the file");
     assert_eq!(merged.shadow.filter.pcf_kernel, 7.0, "the command line wins");
     assert_eq!(merged.shadow.map.resolution, 1024);
 }
@@ -151,7 +151,10 @@ fn point_lights_and_the_light_list_come_from_the_file() {
     let lights = s.resolve_lights(&scene).unwrap();
     assert_eq!(lights.len(), 3);
     assert_eq!(lights[0].shadow, s.shadow, "no table: the render's settings");
-    assert_eq!((lights[1].shadow.filter.technique, lights[1].shadow.map.resolution), (Technique::Pcss, 512));
+    assert_eq!(
+        (lights[1].shadow.filter.technique.clone(), lights[1].shadow.map.resolution),
+        (Technique::PCSS, 512)
+    );
     assert_eq!(lights[1].shadow.bias.normal_offset, 1.25, "the rest stays the render's");
     s.light.light_index = 2;
     assert!(matches!(s.resolve_light(&scene).unwrap(), Light::Spot(_)));

@@ -49,8 +49,11 @@ pub struct SettingsForm {
     fields: Vec<Field>,
 }
 
+/// The settings' flags, with the built-in techniques as `--technique`'s choices.
 fn settings_command() -> clap::Command {
-    Settings::augment_args(clap::Command::new("gnomon").no_binary_name(true))
+    let command = Settings::augment_args(clap::Command::new("gnomon").no_binary_name(true));
+    let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
+    gnomon_scene::settings::offer_techniques(command, &techniques.choices())
 }
 
 impl Default for SettingsForm {
@@ -275,7 +278,7 @@ mod tests {
         let s = form.set(&s, "eye", Some("1,2.5,-3")).unwrap();
         assert_eq!(s.camera.eye, Some(glam::Vec3::new(1.0, 2.5, -3.0)));
         let s = form.set(&s, "technique", Some("pcss")).unwrap();
-        assert_eq!(s.shadow.filter.technique, Technique::Pcss);
+        assert_eq!(s.shadow.filter.technique, Technique::PCSS);
         let s = form.set(&s, "debug_view", Some("cascades")).unwrap();
         assert_eq!(s.image.debug_view, DebugView::Cascades);
         // Unsetting an optional field gives it back to the scene.

@@ -87,7 +87,7 @@ fn window_test() -> anyhow::Result<()> {
     anyhow::ensure!(report.frames == 14, "drew {} frames, not 14", report.frames);
     anyhow::ensure!(report.screenshots.len() == 4, "screenshots: {:?}", report.screenshots);
     anyhow::ensure!(
-        report.settings.shadow.filter.technique == Technique::Pcss,
+        report.settings.shadow.filter.technique == Technique::PCSS,
         "the technique action left {:?}",
         report.settings.shadow.filter.technique
     );
@@ -124,7 +124,7 @@ fn window_test() -> anyhow::Result<()> {
     let table = saved.settings.expect("settings in the saved file");
     let reloaded =
         gnomon_scene::scene_file::merge_settings(&table, &Settings::default()).map_err(anyhow::Error::msg)?;
-    anyhow::ensure!(reloaded.shadow.filter.technique == Technique::Pcss);
+    anyhow::ensure!(reloaded.shadow.filter.technique == Technique::PCSS);
     anyhow::ensure!(reloaded.light.sun_angular_diameter == Some(6.0));
     anyhow::ensure!(reloaded.camera.eye.is_some() && reloaded.camera.target.is_some(), "no camera saved");
     if std::env::var_os("GNOMON_TEST_KEEP").is_none() {

@@ -31,6 +31,7 @@ use crate::{
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
+    techniques::TechniqueRegistry,
     timing::ClockChoice,
 };
 use bindings::FixedBindings;
@@ -60,11 +61,20 @@ pub struct Renderer {
     pool: Pool,
     /// Live frames' pass times, read when they arrive.
     late_times: LateTimes,
+    /// The techniques its settings may name.
+    techniques: TechniqueRegistry,
 }
 
 impl Renderer {
-    /// A renderer on `gpu`'s device (which it shares, not copies).
+    /// A renderer on `gpu`'s device (which it shares, not copies), with the built-in
+    /// techniques.
     pub fn new(gpu: &Gpu) -> Result<Self, RenderError> {
+        Self::with_techniques(gpu, TechniqueRegistry::builtin())
+    }
+
+    /// A renderer that knows `techniques`: the built-in ones and any the host
+    /// registered ([`TechniqueRegistry::with`]).
+    pub fn with_techniques(gpu: &Gpu, techniques: TechniqueRegistry) -> Result<Self, RenderError> {
         gpu.checked("creating the renderer", || {
             let device = &gpu.device;
             let layouts = Layouts::new(device);
@@ -83,10 +93,16 @@ impl Renderer {
                 fixed: FixedBindings::new(device),
                 pool: Pool::new(device),
                 late_times: LateTimes::default(),
+                techniques,
                 layouts,
                 passes,
             }
         })
+    }
+
+    /// The techniques its settings may name.
+    pub fn techniques(&self) -> &TechniqueRegistry {
+        &self.techniques
     }
 
     /// The device the renderer draws with.
@@ -118,7 +134,8 @@ impl Renderer {
         GpuScene::upload(&self.gpu, scene, &self.layouts)
     }
 
-    /// Checks `settings` against the device's limits, for a frame Gnomon draws.
+    /// Checks `settings` against the device's limits and the registered techniques,
+    /// for a frame Gnomon draws.
     pub fn check_limits(&self, settings: &Settings) -> Result<(), RenderError> {
         self.check_map_limits(settings)?;
         let limits = &self.gpu.limits;
@@ -133,9 +150,12 @@ impl Renderer {
         Ok(())
     }
 
-    /// Checks what the shadow maps of `settings` need of the device (all that a host
-    /// drawing its own image needs, [`Renderer::record_shadows`]).
+    /// Checks what the shadow maps of `settings` need of the device, and that a
+    /// registered technique can draw them ([`TechniqueRegistry::check`]): all that a
+    /// host drawing its own image needs, [`Renderer::record_shadows`]. Each light's
+    /// kind is checked against its technique when a frame is planned.
     pub fn check_map_limits(&self, settings: &Settings) -> Result<(), RenderError> {
+        self.techniques.check(&settings.shadow)?;
         let limits = &self.gpu.limits;
         let adapter = self.gpu.info.adapter.clone();
         let max = limits.max_texture_dimension_2d;

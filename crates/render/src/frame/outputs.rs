@@ -452,7 +452,7 @@ impl TimedLights {
             .map(|(light, layers)| LightStats {
                 name: light.name.clone(),
                 kind: light.light.type_name(),
-                technique: light.settings.shadow.filter.technique,
+                technique: light.technique.technique(),
                 resolution: light.settings.shadow.map.resolution,
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
                 layer_instances: layers.iter().map(Visible::instances).collect(),

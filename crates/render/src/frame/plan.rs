@@ -13,7 +13,7 @@ use super::Renderer;
 use crate::{
     GpuScene, RenderError,
     gpu_scene::CullView,
-    layout::{SampleDistribution, ShadowLayout, cascade_splits, shadow_layout},
+    layout::{MapDrawing, SampleDistribution, ShadowLayout, cascade_splits, shadow_layout},
     passes::{
         SHADOW_FORMAT,
         depth_reduce::{BoundsRequest, Planes},
@@ -21,7 +21,7 @@ use crate::{
         shadow::DepthTarget,
     },
     pool::ViewKey,
-    techniques,
+    techniques::{self, TechniqueRef},
     uniforms::{LightGpu, LightInputs},
 };
 
@@ -43,6 +43,8 @@ pub(super) struct LightPlan {
     /// The render's settings with this light's shadow settings.
     pub settings: Settings,
     pub layout: ShadowLayout,
+    /// Its technique, checked against the light and its map.
+    pub technique: TechniqueRef,
     pub filterable_map: Option<techniques::FilterableMap>,
     pub moment_format: wgpu::TextureFormat,
     pub light_gpu: LightGpu,
@@ -99,12 +101,12 @@ impl Renderer {
         for (index, r) in resolved.into_iter().enumerate() {
             let light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
             self.check_map_limits(&light_settings)?;
+            let technique = self.techniques.check_light(&r.shadow, &r.light, &r.name)?;
             let layout = match fixed_layout {
                 Some(layout) if index == shown => layout.clone(),
-                _ => self.fit_layout(uploaded, &r.light, &light_settings, &camera, aspect)?,
+                _ => self.fit_layout(uploaded, &r.light, &light_settings, technique, &camera, aspect)?,
             };
             let shadow = &light_settings.shadow;
-            let technique = techniques::lookup(shadow.filter.technique);
             let filterable_map = technique.filterable_map(&shadow.filter);
             let moment_format = self.moment_format(&light_settings)?;
             let precision = match moment_format {
@@ -128,6 +130,7 @@ impl Renderer {
                 light: r.light,
                 settings: light_settings,
                 layout,
+                technique,
                 filterable_map,
                 moment_format,
                 light_gpu,
@@ -143,6 +146,7 @@ impl Renderer {
         uploaded: &GpuScene,
         light: &Light,
         settings: &Settings,
+        technique: TechniqueRef,
         camera: &Camera,
         aspect: f32,
     ) -> Result<ShadowLayout, RenderError> {
@@ -153,8 +157,9 @@ impl Renderer {
             }
             _ => None,
         };
-        let depth_clamp = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-        Ok(shadow_layout(&uploaded.bounds, light, camera, aspect, settings, sampled.as_ref(), depth_clamp))
+        let unclipped_depth = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+        let drawing = MapDrawing { technique, unclipped_depth };
+        Ok(shadow_layout(&uploaded.bounds, light, camera, aspect, settings, sampled.as_ref(), drawing))
     }
 
     /// SDSM's sample distribution: draws the scene's depth from the camera and

@@ -14,6 +14,7 @@ use crate::{
     GpuScene, RenderError,
     frame::DrawStats,
     passes::{lighting::MapLookup, receiver},
+    techniques::TechniqueRef,
     timing::PassClock,
     uniforms::CameraGpu,
 };
@@ -45,14 +46,14 @@ pub struct LightShadows {
 /// a host pipeline; cache the host's pipelines by it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ReceiverVariant {
-    technique: Technique,
+    technique: TechniqueRef,
     lookup: MapLookup,
 }
 
 impl ReceiverVariant {
     /// The technique whose lookup it composes.
     pub fn technique(&self) -> Technique {
-        self.technique
+        self.technique.technique()
     }
 
     /// The receiver module, with its bind group at index `group` of the host's
@@ -111,10 +112,7 @@ impl Renderer {
                 let uniforms = ReceiverUniforms { light: &maps.light_buffer, camera: &camera };
                 let bind_group =
                     self.fixed.receiver_group(&mut self.pool, &self.layouts, uniforms, maps.views(None));
-                let variant = ReceiverVariant {
-                    technique: light.settings.shadow.filter.technique,
-                    lookup: maps.lookup,
-                };
+                let variant = ReceiverVariant { technique: light.technique, lookup: maps.lookup };
                 lights.push(LightShadows { light: light.light, bind_group, variant });
             }
             Shadows { lights, stats: rec.stats }

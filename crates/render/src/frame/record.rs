@@ -364,7 +364,7 @@ impl Renderer {
         let shadow = &light.settings.shadow;
         let moments = light.filterable_map.map(|filterable| {
             let input = MomentInput {
-                technique: shadow.filter.technique,
+                technique: light.technique,
                 map: filterable,
                 settings: &shadow.filter.moments,
                 format: light.moment_format,
@@ -462,7 +462,7 @@ impl Renderer {
             multiview_mask: None,
         });
         let key = LightingKey {
-            technique: light.settings.shadow.filter.technique,
+            technique: light.technique,
             lookup: if plan.mask_path { Lookup::Mask } else { Lookup::Own(bindings.lookup) },
             role: if first {
                 LightingRole::First

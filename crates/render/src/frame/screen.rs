@@ -79,7 +79,7 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            let key = MaskKey { technique: light.settings.shadow.filter.technique, lookup: bindings.lookup };
+            let key = MaskKey { technique: light.technique, lookup: bindings.lookup };
             pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
             pass.set_bind_group(0, &bindings.scene, &[]);
             pass.set_bind_group(1, &screen_group, &[]);

@@ -6,7 +6,6 @@
 
 use std::collections::BTreeMap;
 
-use gnomon_scene::settings::Technique;
 use wgpu::naga;
 
 use super::{
@@ -14,16 +13,19 @@ use super::{
     lighting::{LightingKey, LightingRole, Lookup, MapLookup},
     map_preview, moments, receiver, screen_space, shadow,
 };
-use crate::uniforms::{self, LightKindGpu, StructLayout};
+use crate::{
+    techniques::{TechniqueRef, TechniqueRegistry},
+    uniforms::{self, LightKindGpu, StructLayout},
+};
 
-/// The lookups a technique's map can be read through.
-fn lookups(technique: Technique) -> Vec<Lookup> {
+/// The lookups a technique's map can be read through, from its stated facts.
+fn lookups(technique: TechniqueRef) -> Vec<Lookup> {
     let mut all = vec![Lookup::Own(MapLookup::Map), Lookup::Mask];
-    if technique.supports_point_lights() {
+    if technique.cube_wgsl().is_some() {
         all.push(Lookup::Own(MapLookup::Cube));
-        if technique != Technique::Pcss {
-            all.push(Lookup::Own(MapLookup::Paraboloid));
-        }
+    }
+    if technique.maps().paraboloid {
+        all.push(Lookup::Own(MapLookup::Paraboloid));
     }
     all
 }
@@ -42,7 +44,8 @@ fn host_main(@builtin(position) frag: vec4<f32>, @location(0) world: vec3<f32>, 
 /// Every composed shader, named.
 fn every_variant() -> Vec<(String, String)> {
     let mut out = Vec::new();
-    for &technique in Technique::all() {
+    let registry = TechniqueRegistry::builtin();
+    for technique in registry.iter() {
         for lookup in lookups(technique) {
             for role in [
                 LightingRole::First,
@@ -61,7 +64,7 @@ fn every_variant() -> Vec<(String, String)> {
                 out.push((format!("receiver {technique:?} {map:?}"), source));
             }
         }
-        if technique.is_filterable() {
+        if technique.filterable_map(&Default::default()).is_some() {
             for format in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba32Float] {
                 out.push((
                     format!("moments encode {technique:?} {format:?}"),
@@ -114,7 +117,8 @@ fn check_layout(variant: &str, module: &naga::Module, layout: &StructLayout) -> 
 fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
     let variants = every_variant();
     // Every technique reaches the lighting pass on the forward and mask paths.
-    assert!(variants.len() > 3 * 2 * Technique::all().len(), "{} variants", variants.len());
+    let techniques = TechniqueRegistry::builtin().iter().count();
+    assert!(variants.len() > 3 * 2 * techniques, "{} variants", variants.len());
     let layouts = uniforms::struct_layouts();
     let mut found: BTreeMap<&str, usize> = layouts.iter().map(|l| (l.wgsl_name, 0)).collect();
     for (name, source) in &variants {

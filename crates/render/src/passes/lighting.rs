@@ -7,10 +7,11 @@
 
 use std::collections::HashMap;
 
-use gnomon_scene::settings::Technique;
-
 use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
-use crate::{gpu_types::VertexStream, techniques};
+use crate::{
+    gpu_types::VertexStream,
+    techniques::{self, TechniqueRef},
+};
 
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub(crate) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
@@ -41,7 +42,7 @@ pub(crate) enum LightingRole {
 /// What makes two lighting pipelines differ.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct LightingKey {
-    pub technique: Technique,
+    pub technique: TechniqueRef,
     pub lookup: Lookup,
     pub role: LightingRole,
 }
@@ -59,7 +60,7 @@ pub(crate) enum Lookup {
 /// The WGSL that defines `pixel_visibility` for a technique and lookup: the
 /// technique's shadow lookup and the rules of resolve_visibility.wgsl, or on the
 /// mask path the read of the mask. Shared by the lighting and shadow-mask passes.
-pub(crate) fn visibility_wgsl(technique: Technique, lookup: Lookup) -> Vec<String> {
+pub(crate) fn visibility_wgsl(technique: TechniqueRef, lookup: Lookup) -> Vec<String> {
     let map = match lookup {
         Lookup::Own(map) => map,
         Lookup::Mask => return vec![include_str!("mask_lookup.wgsl").to_owned()],
@@ -84,23 +85,23 @@ pub(crate) enum MapLookup {
 /// shadow resources it reads (those of `SHADOW_BINDINGS_WGSL`, in whichever group
 /// the pass binds them): the technique's lookup, the light kind's visibility
 /// function and the rules of resolve_visibility.wgsl.
-pub(crate) fn resolved_lookup_wgsl(technique: Technique, lookup: MapLookup) -> Vec<String> {
+pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -> Vec<String> {
     let mut parts = techniques::helper_wgsl();
     let visibility = match lookup {
         MapLookup::Cube => {
             parts.push(techniques::CUBE_WGSL.to_owned());
-            let cube = techniques::lookup(technique).cube_wgsl().unwrap_or_else(|| {
-                unreachable!("{technique:?} has no cube lookup; settings refuse it for point lights")
+            let cube = technique.cube_wgsl().unwrap_or_else(|| {
+                unreachable!("{technique:?} has no cube lookup; the registry refuses it for point lights")
             });
             parts.extend(cube.iter().map(|s| s.to_string()));
             include_str!("cube_visibility.wgsl")
         }
         MapLookup::Map => {
-            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
             include_str!("map_visibility.wgsl")
         }
         MapLookup::Paraboloid => {
-            parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+            parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
             include_str!("paraboloid_visibility.wgsl")
         }
     };
@@ -154,14 +155,15 @@ impl LightingPass {
         // Reading the mask is the same shader whatever technique filled it: one
         // pipeline serves them all.
         let key = match key.lookup {
-            Lookup::Mask => LightingKey { technique: Technique::default(), ..key },
+            Lookup::Mask => LightingKey { technique: TechniqueRef::any_builtin(), ..key },
             _ => key,
         };
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
             let source = lighting_wgsl(key);
+            let label = key.technique.technique().to_string();
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(key.technique.name()),
+                label: Some(&label),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             });
             let targets: Vec<Option<wgpu::ColorTargetState>> = TARGETS

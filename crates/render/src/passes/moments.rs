@@ -5,12 +5,12 @@
 use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
-use gnomon_scene::settings::{MomentSettings, Technique};
+use gnomon_scene::settings::MomentSettings;
 
 use super::{LIGHT_WGSL, compose_wgsl};
 use crate::{
     pool::{Binding, Pool, ViewKey},
-    techniques::{self, FilterableMap},
+    techniques::{self, FilterableMap, TechniqueRef},
 };
 
 const WORKGROUP: u32 = 8;
@@ -40,7 +40,7 @@ struct FormatPipelines {
     filter_layout: wgpu::BindGroupLayout,
     blur: wgpu::ComputePipeline,
     downsample: wgpu::ComputePipeline,
-    encode: HashMap<Technique, wgpu::ComputePipeline>,
+    encode: HashMap<TechniqueRef, wgpu::ComputePipeline>,
 }
 
 /// The moment pass's pipelines, built on first use per format and technique.
@@ -54,7 +54,7 @@ pub(crate) struct MomentPass {
 
 /// What the moment pass filters: a light's depth map and the technique's map.
 pub(crate) struct MomentInput<'a> {
-    pub technique: Technique,
+    pub technique: TechniqueRef,
     pub map: FilterableMap,
     pub settings: &'a MomentSettings,
     pub format: wgpu::TextureFormat,
@@ -72,10 +72,10 @@ pub(crate) struct MomentMap {
 }
 
 /// The moment pass's encoding WGSL for a technique and storage format, composed.
-pub(crate) fn encode_wgsl(technique: Technique, format: wgpu::TextureFormat) -> String {
+pub(crate) fn encode_wgsl(technique: TechniqueRef, format: wgpu::TextureFormat) -> String {
     let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned()];
     parts.extend(techniques::shared_wgsl());
-    parts.extend(techniques::lookup(technique).wgsl().iter().map(|s| s.to_string()));
+    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
     parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -201,7 +201,7 @@ impl MomentPass {
     fn encode_pipeline(
         &mut self,
         device: &wgpu::Device,
-        technique: Technique,
+        technique: TechniqueRef,
         format: wgpu::TextureFormat,
     ) -> &wgpu::ComputePipeline {
         let (light_layout, depth_layout) = (&self.light_layout, &self.depth_layout);

@@ -2,16 +2,15 @@
 //! the documented `shadow_visibility` entry of `receiver.wgsl`, with every resource
 //! in one bind group at the index the host's shader chose.
 
-use gnomon_scene::settings::Technique;
-
 use super::{
     CAMERA_STRUCT_WGSL, LIGHT_WGSL, SHADING_WGSL, compose_wgsl,
     lighting::{MapLookup, resolved_lookup_wgsl},
 };
+use crate::techniques::TechniqueRef;
 
 /// The receiver's module for `technique` looked up through `lookup`, its group at
 /// index `group`. A host's shader is appended to it.
-pub(crate) fn receiver_wgsl(technique: Technique, lookup: MapLookup, group: u32) -> String {
+pub(crate) fn receiver_wgsl(technique: TechniqueRef, lookup: MapLookup, group: u32) -> String {
     let mut parts: Vec<String> = [LIGHT_WGSL, CAMERA_STRUCT_WGSL, SHADING_WGSL].map(str::to_owned).to_vec();
     parts.extend(resolved_lookup_wgsl(technique, lookup));
     parts.push(include_str!("receiver.wgsl").replace("RECEIVER_GROUP", &group.to_string()));

@@ -5,13 +5,11 @@
 
 use std::collections::HashMap;
 
-use gnomon_scene::settings::Technique;
-
 use super::{
     Layouts, compose_wgsl,
     lighting::{self, Lookup, MapLookup},
 };
-use crate::gpu_types::VertexStream;
+use crate::{gpu_types::VertexStream, techniques::TechniqueRef};
 
 /// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
 pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -25,7 +23,7 @@ pub(crate) const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Floa
 /// A mask pipeline per technique and lookup kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct MaskKey {
-    pub technique: Technique,
+    pub technique: TechniqueRef,
     /// How the light's map is looked up.
     pub lookup: MapLookup,
 }

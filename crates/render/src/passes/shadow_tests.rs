@@ -8,6 +8,8 @@
 use std::collections::BTreeSet;
 
 use gnomon_scene::settings::{BiasSettings, CullMode, Technique};
+
+use crate::techniques::TechniqueRegistry;
 use wgpu::naga;
 
 use super::*;
@@ -152,7 +154,9 @@ fn opaque_casters_into_a_projected_map_take_the_depth_only_path() {
 fn no_geometry_vertex_stage_reads_a_storage_buffer() {
     let mut modules = vec![("shadow", Reflected::new(&shadow_wgsl()))];
     modules.push(("prepass", Reflected::new(&screen_space::prepass_wgsl())));
-    for technique in [Technique::Hard, Technique::Pcss, Technique::Vsm] {
+    let registry = TechniqueRegistry::builtin();
+    for technique in [Technique::HARD, Technique::PCSS, Technique::VSM] {
+        let technique = registry.get(&technique).expect("built in");
         for lookup in [Lookup::Own(MapLookup::Map), Lookup::Mask] {
             let key = LightingKey { technique, lookup, role: LightingRole::First };
             modules.push(("lighting", Reflected::new(&lighting::lighting_wgsl(key))));

@@ -4,14 +4,22 @@
 use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
 use crate::uniforms::TechniqueParams;
 
 pub struct Convolution;
 
 impl ShadowTechnique for Convolution {
     fn technique(&self) -> Technique {
-        Technique::Convolution
+        Technique::CONVOLUTION
+    }
+
+    fn summary(&self) -> &'static str {
+        "Convolution shadow maps (Annen et al. 2007): a Fourier series of the depth test."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::LINEAR_DEPTH
     }
 
     /// The moment map's blur radius.

@@ -3,14 +3,22 @@
 use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
 use crate::uniforms::TechniqueParams;
 
 pub struct Esm;
 
 impl ShadowTechnique for Esm {
     fn technique(&self) -> Technique {
-        Technique::Esm
+        Technique::ESM
+    }
+
+    fn summary(&self) -> &'static str {
+        "Exponential shadow maps (Annen et al. 2008): exp(c·d), filtered in log space."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::LINEAR_DEPTH
     }
 
     /// The moment map's blur radius.

@@ -3,13 +3,21 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::ShadowTechnique;
+use super::{MapSupport, ShadowTechnique};
 
 pub struct Hard;
 
 impl ShadowTechnique for Hard {
     fn technique(&self) -> Technique {
-        Technique::Hard
+        Technique::HARD
+    }
+
+    fn summary(&self) -> &'static str {
+        "One point-sampled depth comparison: Williams (1978), the textbook algorithm."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::ANY
     }
 
     /// One point sample: no reach.

@@ -1,6 +1,9 @@
-//! The shadow techniques. Each family is a module with its WGSL beside it, and is
-//! registered once in [`REGISTRY`]; the passes ask the registry for the WGSL, the
-//! parameters and the map of the selected [`Technique`] and know nothing else about it.
+//! The shadow techniques. Each family is a module with its WGSL beside it, and each
+//! technique is one line of [`BUILTIN`]. A technique states every fact about itself
+//! through [`ShadowTechnique`]: its name and summary, its WGSL and parameters, the
+//! maps it can read and how far its filter reaches. The passes, the layout and the
+//! settings' checks ask a [`TechniqueRegistry`] and know nothing else about it: a host
+//! registers a technique of its own with [`TechniqueRegistry::with`].
 //!
 //! A technique's WGSL defines `fn sample_shadow(q: ShadowQuery) -> f32` (the lookup,
 //! see `common.wgsl`), returning the lit fraction in [0, 1]. It may read the shadow
@@ -15,11 +18,31 @@ mod hard;
 mod msm;
 mod pcf;
 mod pcss;
+mod registry;
 mod variance;
 
-use gnomon_scene::settings::{FilterSettings, Technique};
+use gnomon_scene::settings::{FilterSettings, SettingsError, Technique};
 
 use crate::uniforms::TechniqueParams;
+pub use registry::{RegistryError, TechniqueRef, TechniqueRegistry};
+
+/// Every built-in technique, in the order the command line lists them. Adding one
+/// is its module, its WGSL and one line here.
+pub static BUILTIN: &[&dyn ShadowTechnique] = &[
+    &hard::Hard,
+    &pcf::Pcf2x2,
+    &pcf::PcfBox,
+    &pcf::PcfTent,
+    &pcf::PcfPoisson,
+    &pcss::Pcss,
+    &variance::VSM,
+    &esm::Esm,
+    &variance::EVSM2,
+    &variance::EVSM4,
+    &msm::HAMBURGER,
+    &msm::HAUSDORFF,
+    &convolution::Convolution,
+];
 
 /// A map of functions of depth that a filterable technique samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,10 +64,39 @@ pub enum MapPrecision {
     Half,
 }
 
-/// A shadow technique as the renderer sees it.
+/// Which maps a technique can read besides a plain 2D map of a sun or a spot, which
+/// every technique reads. (A point light's cube map takes the techniques that have a
+/// cube lookup, [`ShadowTechnique::cube_wgsl`].)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MapSupport {
+    /// A point light's dual paraboloids, read through the 2D lookup in each
+    /// hemisphere's projection (`shadow.map.omni` paraboloid).
+    pub paraboloid: bool,
+    /// A perspective-warped map (`shadow.map.warp`: PSM, LiSPSM, TSM), whose depth is
+    /// not linear in distance and whose texels change size across the map.
+    pub warped: bool,
+    /// A sun's map drawn with depth clamping ("pancaking", `shadow.map.depth_clamp`),
+    /// where casters before the near plane are flattened onto it.
+    pub clamped_depth: bool,
+}
+
+impl MapSupport {
+    /// A technique that only compares the receiver's depth with the stored depths
+    /// around its own texel reads any map: the comparison holds in any monotonic
+    /// depth, and a flattened caster still lies in front.
+    pub const ANY: MapSupport = MapSupport { paraboloid: true, warped: true, clamped_depth: true };
+    /// A technique that filters functions of depth needs depth linear in distance
+    /// (no warp), and has no paraboloid lookup; clamping keeps depth linear.
+    pub const LINEAR_DEPTH: MapSupport = MapSupport { paraboloid: false, warped: false, clamped_depth: true };
+}
+
+/// A shadow technique as the renderer sees it: every fact about it, in one place.
 pub trait ShadowTechnique: Sync {
-    /// The settings value that selects this technique.
+    /// The name that selects this technique (`shadow.filter.technique`).
     fn technique(&self) -> Technique;
+    /// What it does, in a line, with its reference: `gnomon techniques`, `--help` and
+    /// the viewer show it.
+    fn summary(&self) -> &'static str;
     /// WGSL sources, concatenated after the shared ones, defining `sample_shadow`.
     fn wgsl(&self) -> &'static [&'static str];
     /// The technique's parameters, passed to the shader as `light.params`; the
@@ -53,11 +105,14 @@ pub trait ShadowTechnique: Sync {
         TechniqueParams::default()
     }
     /// WGSL sources defining `fn sample_shadow_cube(q: CubeQuery) -> f32`, the lookup
-    /// in a point light's cube map (see `cube.wgsl`), for the techniques that have one
-    /// ([`Technique::supports_point_lights`]).
+    /// in a point light's cube map (see `cube.wgsl`), for the techniques that can
+    /// shadow a point light; `None` for the others, which the settings' checks then
+    /// refuse for point lights.
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         None
     }
+    /// The maps it can read besides a plain 2D map.
+    fn maps(&self) -> MapSupport;
     /// How far, in texels, the technique's lookup reaches from the receiver's texel
     /// (beyond the bilinear footprint): a sample-fitted cascade keeps this margin
     /// around its samples. `kernel_texels` is the PCF kernel's width in texels.
@@ -66,30 +121,11 @@ pub trait ShadowTechnique: Sync {
     fn filterable_map(&self, _settings: &FilterSettings) -> Option<FilterableMap> {
         None
     }
-}
-
-/// Every technique, in the order the command line lists them.
-pub static REGISTRY: &[&dyn ShadowTechnique] = &[
-    &hard::Hard,
-    &pcf::Pcf2x2,
-    &pcf::PcfBox,
-    &pcf::PcfTent,
-    &pcf::PcfPoisson,
-    &pcss::Pcss,
-    &variance::VSM,
-    &esm::Esm,
-    &variance::EVSM2,
-    &variance::EVSM4,
-    &msm::HAMBURGER,
-    &msm::HAUSDORFF,
-    &convolution::Convolution,
-];
-
-/// The registered implementation of `technique`.
-pub fn lookup(technique: Technique) -> &'static dyn ShadowTechnique {
-    REGISTRY.iter().copied().find(|t| t.technique() == technique).unwrap_or_else(|| {
-        unreachable!("technique {technique:?} is not registered; see `every_technique_is_registered_once`")
-    })
+    /// Checks the filter settings against what this technique needs beyond their
+    /// own ranges (which [`gnomon_scene::Settings::validate`] checks).
+    fn validate(&self, _settings: &FilterSettings) -> Result<(), SettingsError> {
+        Ok(())
+    }
 }
 
 /// The helpers every cube lookup shares, composed before a technique's cube WGSL.
@@ -125,46 +161,4 @@ pub(crate) fn helper_wgsl() -> Vec<String> {
         disk.join(",\n    ")
     );
     vec![kernels, include_str!("common.wgsl").to_owned(), include_str!("filterable.wgsl").to_owned()]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn every_technique_is_registered_once() {
-        for t in Technique::all() {
-            let n = REGISTRY.iter().filter(|r| r.technique() == *t).count();
-            assert_eq!(n, 1, "{t:?} is registered {n} times");
-        }
-        assert_eq!(REGISTRY.len(), Technique::all().len());
-    }
-
-    #[test]
-    fn point_light_techniques_have_a_cube_lookup() {
-        for t in REGISTRY {
-            let cube = t.cube_wgsl();
-            assert_eq!(cube.is_some(), t.technique().supports_point_lights(), "{:?}", t.technique());
-            if let Some(sources) = cube {
-                assert!(sources.concat().contains("fn sample_shadow_cube(q: CubeQuery) -> f32"));
-            }
-        }
-    }
-
-    #[test]
-    fn every_technique_defines_its_entry_points() {
-        let settings = FilterSettings::default();
-        for t in REGISTRY {
-            let source = t.wgsl().concat();
-            assert!(source.contains("fn sample_shadow(q: ShadowQuery) -> f32"), "{:?}", t.technique());
-            let filterable = t.filterable_map(&settings).is_some();
-            assert_eq!(filterable, t.technique().is_filterable(), "{:?}", t.technique());
-            assert_eq!(
-                source.contains("fn encode_moments(d: f32, layer: u32) -> vec4<f32>"),
-                filterable,
-                "{:?}: a filterable technique encodes its map, and only it",
-                t.technique()
-            );
-        }
-    }
 }

@@ -4,21 +4,38 @@
 use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
 use crate::uniforms::TechniqueParams;
 
 /// One moment-map technique: the two differ only in the bound they reconstruct.
 pub struct Msm {
     technique: Technique,
+    summary: &'static str,
     hausdorff: bool,
 }
 
-pub static HAMBURGER: Msm = Msm { technique: Technique::MsmHamburger, hausdorff: false };
-pub static HAUSDORFF: Msm = Msm { technique: Technique::MsmHausdorff, hausdorff: true };
+pub static HAMBURGER: Msm = Msm {
+    technique: Technique::MSM_HAMBURGER,
+    summary: "Moment shadow maps (Peters & Klein 2015), four moments, Hamburger bound.",
+    hausdorff: false,
+};
+pub static HAUSDORFF: Msm = Msm {
+    technique: Technique::MSM_HAUSDORFF,
+    summary: "Moment shadow maps, four moments, Hausdorff bound (depths in [0, 1]).",
+    hausdorff: true,
+};
 
 impl ShadowTechnique for Msm {
     fn technique(&self) -> Technique {
-        self.technique
+        self.technique.clone()
+    }
+
+    fn summary(&self) -> &'static str {
+        self.summary
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::LINEAR_DEPTH
     }
 
     /// The moment map's blur radius.

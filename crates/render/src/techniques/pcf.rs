@@ -6,7 +6,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::ShadowTechnique;
+use super::{MapSupport, ShadowTechnique};
 
 /// `pcf2x2`: one hardware bilinear comparison tap.
 pub struct Pcf2x2;
@@ -21,7 +21,15 @@ const PCF_WGSL: &str = include_str!("pcf.wgsl");
 
 impl ShadowTechnique for Pcf2x2 {
     fn technique(&self) -> Technique {
-        Technique::Pcf2x2
+        Technique::PCF2X2
+    }
+
+    fn summary(&self) -> &'static str {
+        "The hardware comparison sampler with linear filtering: 2×2 bilinear PCF."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::ANY
     }
 
     /// One bilinear tap: no reach beyond its footprint.
@@ -43,7 +51,15 @@ impl ShadowTechnique for Pcf2x2 {
 
 impl ShadowTechnique for PcfBox {
     fn technique(&self) -> Technique {
-        Technique::Pcf
+        Technique::PCF
+    }
+
+    fn summary(&self) -> &'static str {
+        "Box PCF of the kernel's width, from bilinear comparison taps with exact area weights (Castaño 2013): a W×W box in ⌈(W+1)/2⌉² taps."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::ANY
     }
 
     /// Half the kernel's width each side.
@@ -67,7 +83,15 @@ impl ShadowTechnique for PcfBox {
 
 impl ShadowTechnique for PcfTent {
     fn technique(&self) -> Technique {
-        Technique::PcfTent
+        Technique::PCF_TENT
+    }
+
+    fn summary(&self) -> &'static str {
+        "Tent PCF of the kernel's width from bilinear comparison taps (Castaño 2013): smoother edges than the box at the same cost."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::ANY
     }
 
     /// Half the kernel's width each side.
@@ -91,7 +115,15 @@ impl ShadowTechnique for PcfTent {
 
 impl ShadowTechnique for PcfPoisson {
     fn technique(&self) -> Technique {
-        Technique::PcfPoisson
+        Technique::PCF_POISSON
+    }
+
+    fn summary(&self) -> &'static str {
+        "PCF over a Poisson disk of the kernel's diameter, rotated per pixel by interleaved gradient noise (Jimenez 2014): noise instead of banding."
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::ANY
     }
 
     /// The disk's radius, half the kernel's width.

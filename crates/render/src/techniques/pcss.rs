@@ -4,13 +4,23 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::ShadowTechnique;
+use super::{MapSupport, ShadowTechnique};
 
 pub struct Pcss;
 
 impl ShadowTechnique for Pcss {
     fn technique(&self) -> Technique {
-        Technique::Pcss
+        Technique::PCSS
+    }
+
+    fn summary(&self) -> &'static str {
+        "Percentage-closer soft shadows (Fernando 2005): a blocker search, then PCF whose width follows the light's size and the blocker distance."
+    }
+
+    /// The blocker search turns stored depths into distances to the light: it needs
+    /// the true, unwarped and unclamped depth of a planar projection.
+    fn maps(&self) -> MapSupport {
+        MapSupport { paraboloid: false, warped: false, clamped_depth: false }
     }
 
     /// The largest penumbra radius it may filter with.

@@ -3,9 +3,9 @@
 //! McCool 2008).
 
 use glam::{UVec4, Vec4};
-use gnomon_scene::settings::{FilterSettings, Technique};
+use gnomon_scene::settings::{FilterSettings, MomentFormat, SettingsError, Technique};
 
-use super::{FilterableMap, MapPrecision, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
 use crate::uniforms::TechniqueParams;
 
 /// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
@@ -16,16 +16,62 @@ pub const HALF_MAX_EXPONENT: f32 = 5.54;
 /// `variance.wgsl`: 0 none (VSM), 2 positive (EVSM2), 4 positive and negative (EVSM4).
 pub struct Chebyshev {
     technique: Technique,
+    summary: &'static str,
     variant: u32,
 }
 
-pub static VSM: Chebyshev = Chebyshev { technique: Technique::Vsm, variant: 0 };
-pub static EVSM2: Chebyshev = Chebyshev { technique: Technique::Evsm2, variant: 2 };
-pub static EVSM4: Chebyshev = Chebyshev { technique: Technique::Evsm4, variant: 4 };
+pub static VSM: Chebyshev = Chebyshev {
+    technique: Technique::VSM,
+    summary: "Variance shadow maps (Donnelly & Lauritzen 2006): blurred (d, d²) and Chebyshev's bound.",
+    variant: 0,
+};
+pub static EVSM2: Chebyshev = Chebyshev {
+    technique: Technique::EVSM2,
+    summary: "Exponential variance shadow maps, positive exponent only (Lauritzen & McCool 2008).",
+    variant: 2,
+};
+pub static EVSM4: Chebyshev = Chebyshev {
+    technique: Technique::EVSM4,
+    summary: "Exponential variance shadow maps with positive and negative exponents.",
+    variant: 4,
+};
 
 impl ShadowTechnique for Chebyshev {
     fn technique(&self) -> Technique {
-        self.technique
+        self.technique.clone()
+    }
+
+    fn summary(&self) -> &'static str {
+        self.summary
+    }
+
+    fn maps(&self) -> MapSupport {
+        MapSupport::LINEAR_DEPTH
+    }
+
+    /// EVSM stores exp(c·d) and its square: in a 16-bit map the exponents must keep
+    /// exp(2c) below 65504 ([`HALF_MAX_EXPONENT`]). (With `auto` on a 16-bit adapter
+    /// the renderer clamps them instead, in [`Chebyshev::params`].)
+    fn validate(&self, s: &FilterSettings) -> Result<(), SettingsError> {
+        if self.variant == 0 || s.moments.moment_format != MomentFormat::Rgba16float {
+            return Ok(());
+        }
+        let bounded = |setting: &'static str, value: f32| {
+            if value <= HALF_MAX_EXPONENT {
+                Ok(())
+            } else {
+                Err(SettingsError {
+                    setting,
+                    value: value.to_string(),
+                    valid: format!(
+                        "0 to {HALF_MAX_EXPONENT} with `shadow.filter.technique` {} and `shadow.filter.moments.moment_format` rgba16float",
+                        self.technique
+                    ),
+                })
+            }
+        };
+        bounded("shadow.filter.moments.evsm_positive", s.moments.evsm_positive)?;
+        bounded("shadow.filter.moments.evsm_negative", s.moments.evsm_negative)
     }
 
     /// The moment map's blur radius.

@@ -19,6 +19,16 @@ pub struct SettingsError {
     pub valid: String,
 }
 
+/// A setting's value as scene files (and flags) write it: serde's name for a choice
+/// (`lispsm`, `pcf-tent`), the number or the list otherwise.
+pub fn value_name(value: &impl Serialize) -> String {
+    match toml::Value::try_from(value) {
+        Ok(toml::Value::String(name)) => name,
+        Ok(other) => other.to_string(),
+        Err(e) => format!("<{e}>"),
+    }
+}
+
 pub(super) fn check(
     ok: bool,
     setting: &'static str,

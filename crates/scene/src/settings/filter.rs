@@ -1,116 +1,128 @@
 //! The shadow filter: the technique and its parameters (PCF kernel, PCSS, the
 //! moment maps of the filterable techniques), with their checks.
 
+use std::borrow::Cow;
+
 use super::*;
 
-/// How the shadow map is sampled and filtered.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum Technique {
-    /// One point-sampled depth comparison: Williams (1978), the textbook algorithm.
-    Hard,
-    /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
-    #[default]
-    #[cfg_attr(feature = "cli", value(name = "pcf2x2"))]
-    #[serde(rename = "pcf2x2")]
-    Pcf2x2,
-    /// Box PCF of width --pcf-kernel, from bilinear comparison taps with exact area
-    /// weights (Castaño 2013): a W×W box in ⌈(W+1)/2⌉² taps.
-    Pcf,
-    /// Tent PCF of width --pcf-kernel from bilinear comparison taps (Castaño 2013):
-    /// smoother edges than the box at the same cost.
-    PcfTent,
-    /// PCF over a Poisson disk of diameter --pcf-kernel, rotated per pixel by
-    /// interleaved gradient noise (Jimenez 2014): noise instead of banding.
-    PcfPoisson,
-    /// Percentage-closer soft shadows (Fernando 2005): a blocker search, then PCF
-    /// whose width follows the light's size and the blocker distance.
-    Pcss,
-    /// Variance shadow maps (Donnelly & Lauritzen 2006): blurred (d, d²) and
-    /// Chebyshev's bound.
-    Vsm,
-    /// Exponential shadow maps (Annen et al. 2008): exp(c·d), filtered in log space.
-    Esm,
-    /// Exponential variance shadow maps, positive exponent only (Lauritzen 2008).
-    Evsm2,
-    /// Exponential variance shadow maps with positive and negative exponents.
-    Evsm4,
-    /// Moment shadow maps (Peters & Klein 2015), four moments, Hamburger bound.
-    MsmHamburger,
-    /// Moment shadow maps, four moments, Hausdorff bound (depths in [0, 1]).
-    MsmHausdorff,
-    /// Convolution shadow maps (Annen et al. 2007): a Fourier series of the depth test.
-    Convolution,
-}
+/// A shadow technique, by the name the command line and files use (`pcf2x2`, `vsm`).
+///
+/// What a name means (its WGSL, its parameters, which lights and maps it can take) is
+/// the renderer's technique registry's business (`gnomon_render::techniques`); this
+/// crate only checks that a name is well formed, and names the built-in techniques so
+/// settings can be written in code. A host registers its own technique under a name
+/// of its own and selects it with [`Technique::named`].
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct Technique(Cow<'static, str>);
 
 impl Technique {
+    /// One point-sampled depth comparison: Williams (1978).
+    pub const HARD: Technique = Technique::named("hard");
+    /// The hardware comparison sampler with linear filtering: 2×2 bilinear PCF.
+    pub const PCF2X2: Technique = Technique::named("pcf2x2");
+    /// Box PCF from bilinear comparison taps (Castaño 2013).
+    pub const PCF: Technique = Technique::named("pcf");
+    /// Tent PCF from bilinear comparison taps (Castaño 2013).
+    pub const PCF_TENT: Technique = Technique::named("pcf-tent");
+    /// PCF over a rotated Poisson disk.
+    pub const PCF_POISSON: Technique = Technique::named("pcf-poisson");
+    /// Percentage-closer soft shadows (Fernando 2005).
+    pub const PCSS: Technique = Technique::named("pcss");
+    /// Variance shadow maps (Donnelly & Lauritzen 2006).
+    pub const VSM: Technique = Technique::named("vsm");
+    /// Exponential shadow maps (Annen et al. 2008).
+    pub const ESM: Technique = Technique::named("esm");
+    /// Exponential variance shadow maps, positive exponent (Lauritzen & McCool 2008).
+    pub const EVSM2: Technique = Technique::named("evsm2");
+    /// Exponential variance shadow maps, both exponents.
+    pub const EVSM4: Technique = Technique::named("evsm4");
+    /// Moment shadow maps, Hamburger bound (Peters & Klein 2015).
+    pub const MSM_HAMBURGER: Technique = Technique::named("msm-hamburger");
+    /// Moment shadow maps, Hausdorff bound.
+    pub const MSM_HAUSDORFF: Technique = Technique::named("msm-hausdorff");
+    /// Convolution shadow maps (Annen et al. 2007).
+    pub const CONVOLUTION: Technique = Technique::named("convolution");
+
+    /// The most characters a technique's name has.
+    pub const MAX_NAME_LENGTH: usize = 32;
+
+    /// The technique registered under `name`. A name is checked when it is parsed
+    /// ([`str::parse`], a flag or a file); one written in code is trusted, and the
+    /// renderer refuses it if nothing is registered under it.
+    pub const fn named(name: &'static str) -> Technique {
+        Technique(Cow::Borrowed(name))
+    }
+
     /// The name used on the command line and in files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Technique::Hard => "hard",
-            Technique::Pcf2x2 => "pcf2x2",
-            Technique::Pcf => "pcf",
-            Technique::PcfTent => "pcf-tent",
-            Technique::PcfPoisson => "pcf-poisson",
-            Technique::Pcss => "pcss",
-            Technique::Vsm => "vsm",
-            Technique::Esm => "esm",
-            Technique::Evsm2 => "evsm2",
-            Technique::Evsm4 => "evsm4",
-            Technique::MsmHamburger => "msm-hamburger",
-            Technique::MsmHausdorff => "msm-hausdorff",
-            Technique::Convolution => "convolution",
+    pub fn name(&self) -> &str {
+        &self.0
+    }
+}
+
+impl Default for Technique {
+    fn default() -> Self {
+        Technique::PCF2X2
+    }
+}
+
+impl std::fmt::Display for Technique {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl TryFrom<String> for Technique {
+    type Error = SettingsError;
+    /// A well-formed name: 1 to [`Technique::MAX_NAME_LENGTH`] lowercase ASCII
+    /// letters, digits and `-`, starting with a letter. Whether a technique is
+    /// registered under it is for the renderer to say.
+    fn try_from(name: String) -> Result<Self, SettingsError> {
+        let well_formed = name.len() <= Technique::MAX_NAME_LENGTH
+            && name.starts_with(|c: char| c.is_ascii_lowercase())
+            && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-');
+        check(
+            well_formed,
+            "shadow.filter.technique",
+            &name,
+            format!(
+                "a technique's name: 1 to {} lowercase letters, digits and `-`, starting with a letter",
+                Technique::MAX_NAME_LENGTH
+            ),
+        )?;
+        Ok(Technique(Cow::Owned(name)))
+    }
+}
+
+impl std::str::FromStr for Technique {
+    type Err = SettingsError;
+    fn from_str(name: &str) -> Result<Self, SettingsError> {
+        Technique::try_from(name.to_owned())
+    }
+}
+
+impl From<Technique> for String {
+    fn from(t: Technique) -> String {
+        t.0.into_owned()
+    }
+}
+
+#[cfg(feature = "cli")]
+/// Lists `choices`, each a technique's name and one line of help, as the possible
+/// values of every `technique` and `techniques` argument of `command` and of its
+/// subcommands, so that `--help`, the parser's errors and the viewer's panel offer the
+/// renderer's registered techniques (this crate does not know them).
+pub fn offer_techniques(command: clap::Command, choices: &[(String, String)]) -> clap::Command {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values: Vec<PossibleValue> =
+        choices.iter().map(|(name, help)| PossibleValue::new(name.clone()).help(help.clone())).collect();
+    let command = command.mut_args(|arg| match arg.get_id().as_str() {
+        "technique" | "techniques" => {
+            arg.value_parser(PossibleValuesParser::new(values.clone()).try_map(Technique::try_from))
         }
-    }
-
-    /// Every technique, in declaration order (the order `--help` lists them).
-    pub fn all() -> &'static [Technique] {
-        &[
-            Technique::Hard,
-            Technique::Pcf2x2,
-            Technique::Pcf,
-            Technique::PcfTent,
-            Technique::PcfPoisson,
-            Technique::Pcss,
-            Technique::Vsm,
-            Technique::Esm,
-            Technique::Evsm2,
-            Technique::Evsm4,
-            Technique::MsmHamburger,
-            Technique::MsmHausdorff,
-            Technique::Convolution,
-        ]
-    }
-
-    /// Whether the technique can shadow a point light, from its cube map: the
-    /// depth-comparison techniques, which sample the cube by direction.
-    pub fn supports_point_lights(self) -> bool {
-        matches!(
-            self,
-            Technique::Hard
-                | Technique::Pcf2x2
-                | Technique::Pcf
-                | Technique::PcfTent
-                | Technique::PcfPoisson
-                | Technique::Pcss
-        )
-    }
-
-    /// Whether the technique filters a map of moments (or other functions of depth)
-    /// instead of comparing depths.
-    pub fn is_filterable(self) -> bool {
-        matches!(
-            self,
-            Technique::Vsm
-                | Technique::Esm
-                | Technique::Evsm2
-                | Technique::Evsm4
-                | Technique::MsmHamburger
-                | Technique::MsmHausdorff
-                | Technique::Convolution
-        )
-    }
+        _ => arg,
+    });
+    command.mut_subcommands(|sub| offer_techniques(sub, choices))
 }
 
 /// The unit of a PCF kernel's width.
@@ -132,7 +144,10 @@ pub enum KernelUnit {
 #[serde(default, deny_unknown_fields)]
 pub struct FilterSettings {
     /// Shadow filtering technique.
-    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_name = "NAME", default_value_t, help_heading = "Shadow filter")
+    )]
     pub technique: Technique,
     /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
     /// 1 to 32 texels, or a world width > 0.
@@ -283,7 +298,7 @@ impl Default for MomentSettings {
 }
 
 impl MomentSettings {
-    pub(super) fn validate(&self, technique: Technique) -> Result<(), SettingsError> {
+    pub(super) fn validate(&self) -> Result<(), SettingsError> {
         let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
         check(
             self.blur_radius <= 16,
@@ -303,32 +318,26 @@ impl MomentSettings {
             self.bleeding_reduction,
             "in [0, 1)",
         )?;
-        // Only EVSM stores exponentials, so only its exponents are bounded by the
-        // format (with `auto` on a 16-bit adapter the renderer clamps them).
-        let evsm = matches!(technique, Technique::Evsm2 | Technique::Evsm4);
-        let half = evsm && self.moment_format == MomentFormat::Rgba16float;
-        // ESM stores d itself and exponentiates in the shader, so only EVSM, which
-        // stores exp(c·d) and its square, is limited by the storage format's range.
-        let (esm_max, evsm_max) = (88.0, if half { 5.54 } else { 42.0 });
-        let precision =
-            if half { "with `shadow.filter.moments.moment_format` rgba16float" } else { "at 32 bits" };
+        // ESM stores d itself and exponentiates in the shader; EVSM stores exp(c·d) and
+        // its square, so at 32 bits its exponents stay below ln(f32::MAX) / 2. A 16-bit
+        // format bounds them further: EVSM's own check (`techniques::variance`) says so.
         check(
-            in_range(self.esm_exponent, 1.0, esm_max),
+            in_range(self.esm_exponent, 1.0, 88.0),
             "shadow.filter.moments.esm_exponent",
             self.esm_exponent,
-            format!("1 to {esm_max} {precision}"),
+            "1 to 88",
         )?;
         check(
-            in_range(self.evsm_positive, 0.0, evsm_max),
+            in_range(self.evsm_positive, 0.0, 42.0),
             "shadow.filter.moments.evsm_positive",
             self.evsm_positive,
-            format!("0 to {evsm_max} {precision}"),
+            "0 to 42",
         )?;
         check(
-            in_range(self.evsm_negative, 0.0, evsm_max),
+            in_range(self.evsm_negative, 0.0, 42.0),
             "shadow.filter.moments.evsm_negative",
             self.evsm_negative,
-            format!("0 to {evsm_max} {precision}"),
+            "0 to 42",
         )?;
         check(
             in_range(self.moment_bias, 0.0, 0.1),

@@ -160,11 +160,12 @@ impl Settings {
 
     /// Every light of the render, each with its shadow settings: the one light of
     /// --light sun, spot or point with these shadow settings, or with --light all the
-    /// scene's list, each light's own settings laid over these.
+    /// scene's list, each light's own settings laid over these. Whether a light's
+    /// technique can shadow it (a cube map, a paraboloid, a warped map) is the
+    /// renderer's technique registry's to say.
     pub fn resolve_lights(&self, scene: &Scene) -> Result<Vec<ResolvedLight>, SettingsError> {
         if self.light.kind != LightKind::All {
             let light = self.resolve_light(scene)?;
-            check_light_type(&light, &self.shadow, light.type_name())?;
             return Ok(vec![ResolvedLight {
                 name: light.type_name().into(),
                 light,
@@ -183,7 +184,6 @@ impl Settings {
                         valid: problem,
                     })?,
                 };
-                check_light_type(&entry.light, &shadow, &entry.name)?;
                 Ok(ResolvedLight { name: entry.name.clone(), light: entry.light, shadow })
             })
             .collect()
@@ -220,29 +220,3 @@ impl Settings {
 
 /// The most lights one render draws.
 pub const MAX_LIGHTS: usize = 32;
-
-/// Checks that a light's type and its shadow settings go together: a point light's
-/// cube map takes the depth-comparison techniques and a single map.
-fn check_light_type(light: &Light, shadow: &ShadowSettings, name: &str) -> Result<(), SettingsError> {
-    if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
-        check(
-            shadow.filter.technique.supports_point_lights() && shadow.filter.technique != Technique::Pcss,
-            "shadow.filter.technique",
-            shadow.filter.technique.name(),
-            format!(
-                "for point light `{name}` with `shadow.map.omni` paraboloid: hard, pcf2x2, pcf, pcf-tent or pcf-poisson"
-            ),
-        )?;
-    }
-    if let Light::Point(_) = light {
-        check(
-            shadow.filter.technique.supports_point_lights(),
-            "shadow.filter.technique",
-            shadow.filter.technique.name(),
-            format!(
-                "for point light `{name}` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
-            ),
-        )?;
-    }
-    Ok(())
-}

@@ -21,9 +21,9 @@ mod shadow;
 #[cfg(all(test, feature = "cli"))]
 mod tests;
 
-pub use error::SettingsError;
 #[cfg(feature = "cli")]
 pub use error::in_flags;
+pub use error::{SettingsError, value_name};
 use error::{check, check_opt, check_vec};
 pub use filter::*;
 pub use light::*;

@@ -346,32 +346,14 @@ impl ShadowSettings {
             f.pcss.max_radius,
             "1 to 64 texels",
         )?;
-        f.moments.validate(f.technique)?;
+        f.moments.validate()?;
         if s.map.warp != WarpKind::None {
-            // Its name as flags and scene files write it (serde's kebab case).
-            let warp = toml::Value::try_from(s.map.warp).ok().and_then(|v| v.as_str().map(str::to_owned));
-            let warp = warp.unwrap_or_default();
+            let warp = value_name(&s.map.warp);
             check(
                 s.partition == Partition::Single,
                 "shadow.map.warp",
                 &warp,
                 "a warp of a single map: with `shadow.partition` cascades use `shadow.map.warp` none",
-            )?;
-            check(
-                matches!(
-                    f.technique,
-                    Technique::Hard
-                        | Technique::Pcf2x2
-                        | Technique::Pcf
-                        | Technique::PcfTent
-                        | Technique::PcfPoisson
-                ),
-                "shadow.map.warp",
-                &warp,
-                format!(
-                    "with `shadow.filter.technique` {}: a warped map takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson (its depth is not linear in distance)",
-                    f.technique.name()
-                ),
             )?;
             check(
                 f.kernel_unit == KernelUnit::Texels,

@@ -1,0 +1,293 @@
+//! The technique registry: the techniques a renderer knows by name, and the checks
+//! that tie a technique to the light and the map it shadows. Every check and every
+//! message is generated from the facts each technique states
+//! ([`ShadowTechnique::cube_wgsl`], [`ShadowTechnique::maps`],
+//! [`ShadowTechnique::validate`]), so a new technique is checked like the built-in ones.
+
+use std::hash::{Hash, Hasher};
+
+use gnomon_scene::{
+    Light,
+    settings::{OmniMap, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
+};
+
+use super::{BUILTIN, ShadowTechnique};
+
+/// A registered technique: a cheap handle that compares and hashes by name (names
+/// are unique within a registry), for the pipeline caches' keys.
+#[derive(Clone, Copy)]
+pub struct TechniqueRef(&'static dyn ShadowTechnique);
+
+impl TechniqueRef {
+    /// The technique this handle refers to.
+    pub fn get(self) -> &'static dyn ShadowTechnique {
+        self.0
+    }
+
+    /// A built-in technique, for the keys of pipelines that do not depend on the
+    /// technique (reading a screen-space mask): any one would do.
+    pub(crate) fn any_builtin() -> Self {
+        TechniqueRef(BUILTIN[0])
+    }
+}
+
+impl std::ops::Deref for TechniqueRef {
+    type Target = dyn ShadowTechnique;
+    fn deref(&self) -> &Self::Target {
+        self.0
+    }
+}
+
+impl PartialEq for TechniqueRef {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.technique() == other.0.technique()
+    }
+}
+
+impl Eq for TechniqueRef {}
+
+impl Hash for TechniqueRef {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.0.technique().hash(state);
+    }
+}
+
+impl std::fmt::Debug for TechniqueRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0.technique())
+    }
+}
+
+/// A technique that cannot be registered.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum RegistryError {
+    /// Another technique is registered under the same name.
+    #[error("a technique named `{0}` is registered already")]
+    Duplicate(String),
+    /// The name is not one the settings could select.
+    #[error("cannot register technique: {0}")]
+    Name(SettingsError),
+}
+
+/// The techniques a renderer knows, by name, in the order they are listed.
+#[derive(Clone)]
+pub struct TechniqueRegistry {
+    techniques: Vec<TechniqueRef>,
+}
+
+impl Default for TechniqueRegistry {
+    fn default() -> Self {
+        Self::builtin()
+    }
+}
+
+impl TechniqueRegistry {
+    /// The built-in techniques ([`BUILTIN`]).
+    pub fn builtin() -> Self {
+        Self { techniques: BUILTIN.iter().map(|t| TechniqueRef(*t)).collect() }
+    }
+
+    /// This registry and `technique`, listed last. Its name must be well formed
+    /// ([`Technique`]'s rules) and not taken.
+    pub fn with(mut self, technique: &'static dyn ShadowTechnique) -> Result<Self, RegistryError> {
+        let name = technique.technique();
+        Technique::try_from(name.name().to_owned()).map_err(RegistryError::Name)?;
+        if self.techniques.iter().any(|t| t.technique() == name) {
+            return Err(RegistryError::Duplicate(name.to_string()));
+        }
+        self.techniques.push(TechniqueRef(technique));
+        Ok(self)
+    }
+
+    /// Every registered technique, in order.
+    pub fn iter(&self) -> impl Iterator<Item = TechniqueRef> + '_ {
+        self.techniques.iter().copied()
+    }
+
+    /// Each technique's name and summary, for a command line's possible values
+    /// (`gnomon_scene::settings::offer_techniques`).
+    pub fn choices(&self) -> Vec<(String, String)> {
+        self.iter().map(|t| (t.technique().to_string(), t.summary().to_owned())).collect()
+    }
+
+    /// The technique registered as `technique`.
+    pub fn get(&self, technique: &Technique) -> Result<TechniqueRef, SettingsError> {
+        self.iter().find(|t| t.technique() == *technique).ok_or_else(|| SettingsError {
+            setting: "shadow.filter.technique",
+            value: technique.to_string(),
+            valid: format!("one of the registered techniques: {}", self.names(|_| true)),
+        })
+    }
+
+    /// The technique `shadow` selects, checked against the map `shadow` asks for and
+    /// the technique's own needs. The light's kind is checked by
+    /// [`TechniqueRegistry::check_light`].
+    pub fn check(&self, shadow: &ShadowSettings) -> Result<TechniqueRef, SettingsError> {
+        let technique = self.get(&shadow.filter.technique)?;
+        if shadow.map.warp != WarpKind::None && !technique.maps().warped {
+            return Err(SettingsError {
+                setting: "shadow.map.warp",
+                value: value_name(&shadow.map.warp),
+                valid: format!(
+                    "with `shadow.filter.technique` {}: a warped map takes {} (its depth is not linear in distance)",
+                    technique.technique(),
+                    self.names(|t| t.maps().warped)
+                ),
+            });
+        }
+        technique.validate(&shadow.filter)?;
+        Ok(technique)
+    }
+
+    /// [`TechniqueRegistry::check`], and that the technique can shadow `light`
+    /// (called `name` in messages): a point light's cube map takes the techniques
+    /// with a cube lookup, its paraboloids those that read [`MapSupport::paraboloid`].
+    pub fn check_light(
+        &self,
+        shadow: &ShadowSettings,
+        light: &Light,
+        name: &str,
+    ) -> Result<TechniqueRef, SettingsError> {
+        let technique = self.check(shadow)?;
+        let refuse = |map: &str, fits: &dyn Fn(&TechniqueRef) -> bool| SettingsError {
+            setting: "shadow.filter.technique",
+            value: technique.technique().to_string(),
+            valid: format!("for point light `{name}` {map}: {}", self.names(fits)),
+        };
+        match (light, shadow.map.omni) {
+            (Light::Point(_), OmniMap::Cube) if technique.cube_wgsl().is_none() => {
+                Err(refuse("(a cube map)", &|t| t.cube_wgsl().is_some()))
+            }
+            (Light::Point(_), OmniMap::Paraboloid) if !technique.maps().paraboloid => {
+                Err(refuse("with `shadow.map.omni` paraboloid", &|t| t.maps().paraboloid))
+            }
+            (
+                Light::Point(_) | Light::Spot(_) | Light::Directional(_),
+                OmniMap::Cube | OmniMap::Paraboloid,
+            ) => Ok(technique),
+        }
+    }
+
+    /// The names of the techniques that `fits`, as a list for a message.
+    fn names(&self, fits: impl Fn(&TechniqueRef) -> bool) -> String {
+        let names: Vec<String> = self.iter().filter(|t| fits(t)).map(|t| t.technique().to_string()).collect();
+        match names.as_slice() {
+            [] => "none".to_owned(),
+            [one] => one.clone(),
+            [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use gnomon_scene::{PointLight, settings::FilterSettings};
+
+    use super::*;
+    use crate::techniques::MapSupport;
+
+    #[test]
+    fn every_builtin_is_registered_once_under_a_well_formed_name() {
+        let registry = TechniqueRegistry::builtin();
+        for t in registry.iter() {
+            let n = registry.iter().filter(|r| r.technique() == t.technique()).count();
+            assert_eq!(n, 1, "{t:?} is registered {n} times");
+            assert_eq!(t.technique().name().parse::<Technique>(), Ok(t.technique()));
+            assert!(!t.summary().is_empty(), "{t:?} has a summary");
+        }
+        assert_eq!(registry.get(&Technique::default()).map(|t| t.technique()), Ok(Technique::default()));
+    }
+
+    #[test]
+    fn a_name_is_registered_once() {
+        let again = TechniqueRegistry::builtin().with(BUILTIN[0]);
+        assert_eq!(again.err(), Some(RegistryError::Duplicate("hard".into())));
+    }
+
+    #[test]
+    fn an_unknown_name_lists_the_registered_ones() {
+        let e = TechniqueRegistry::builtin().get(&Technique::named("nope")).unwrap_err();
+        assert_eq!(e.setting, "shadow.filter.technique");
+        assert!(e.valid.contains("hard, pcf2x2") && e.valid.ends_with("or convolution"), "{e}");
+    }
+
+    fn point() -> Light {
+        Light::Point(PointLight {
+            position: glam::Vec3::Y,
+            range: 5.0,
+            color: glam::Vec3::ONE,
+            intensity: 1.0,
+            radius: 0.0,
+        })
+    }
+
+    fn shadow(technique: Technique) -> ShadowSettings {
+        ShadowSettings {
+            filter: FilterSettings { technique, ..FilterSettings::default() },
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn messages_list_the_techniques_whose_facts_fit() {
+        let registry = TechniqueRegistry::builtin();
+        let cube = registry.check_light(&shadow(Technique::VSM), &point(), "lamp").unwrap_err();
+        assert_eq!(
+            cube.valid,
+            "for point light `lamp` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
+        );
+        let mut paraboloid = shadow(Technique::PCSS);
+        paraboloid.map.omni = OmniMap::Paraboloid;
+        let e = registry.check_light(&paraboloid, &point(), "lamp").unwrap_err();
+        assert!(e.valid.ends_with(": hard, pcf2x2, pcf, pcf-tent or pcf-poisson"), "{e}");
+        paraboloid.filter.technique = Technique::PCF_POISSON;
+        registry.check_light(&paraboloid, &point(), "lamp").unwrap();
+
+        let mut warped = shadow(Technique::VSM);
+        warped.map.warp = WarpKind::Lispsm;
+        let e = registry.check(&warped).unwrap_err();
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.map.warp", "lispsm"));
+        assert!(e.valid.contains("takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson"), "{e}");
+    }
+
+    #[test]
+    fn a_technique_checks_its_own_settings() {
+        let mut evsm = shadow(Technique::EVSM4);
+        evsm.filter.moments.moment_format = gnomon_scene::settings::MomentFormat::Rgba16float;
+        evsm.filter.moments.evsm_positive = 20.0;
+        let e = TechniqueRegistry::builtin().check(&evsm).unwrap_err();
+        assert_eq!(e.setting, "shadow.filter.moments.evsm_positive");
+        evsm.filter.technique = Technique::VSM;
+        TechniqueRegistry::builtin().check(&evsm).unwrap();
+    }
+
+    #[test]
+    fn point_lights_take_the_techniques_with_a_cube_lookup() {
+        let registry = TechniqueRegistry::builtin();
+        for t in registry.iter() {
+            let cube = t.cube_wgsl();
+            assert_eq!(registry.check_light(&shadow(t.technique()), &point(), "p").is_ok(), cube.is_some());
+            if let Some(sources) = cube {
+                assert!(sources.concat().contains("fn sample_shadow_cube(q: CubeQuery) -> f32"));
+            }
+        }
+    }
+
+    #[test]
+    fn every_technique_defines_its_entry_points() {
+        let settings = FilterSettings::default();
+        for t in TechniqueRegistry::builtin().iter() {
+            let source = t.wgsl().concat();
+            assert!(source.contains("fn sample_shadow(q: ShadowQuery) -> f32"), "{t:?}");
+            let filterable = t.filterable_map(&settings).is_some();
+            assert_eq!(
+                source.contains("fn encode_moments(d: f32, layer: u32) -> vec4<f32>"),
+                filterable,
+                "{t:?}: a filterable technique encodes its map, and only it"
+            );
+            if filterable {
+                assert_eq!(t.maps(), MapSupport::LINEAR_DEPTH, "{t:?}: a filtered map needs linear depth");
+            }
+        }
+    }
+}
