@@ -466,8 +466,8 @@ fn single_out_light(
 ) -> anyhow::Result<()> {
     settings.resolve_light(scene)?;
     let mut light = scene.lights.swap_remove(settings.light.light_index);
-    if let Some(toml::Value::Table(filter)) = light.shadow.as_mut().and_then(|t| t.get_mut("filter")) {
-        filter.remove("technique");
+    if let Some(overrides) = light.shadow.as_mut() {
+        overrides.filter.technique = None;
     }
     eprintln!(
         "gnomon: comparing light {} `{}` ({})",

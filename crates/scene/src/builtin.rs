@@ -5,7 +5,9 @@ use glam::{Mat4, Vec3};
 
 use crate::{
     Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight, SpotLight,
-    geometry, sun_direction,
+    geometry,
+    settings::{FilterSettingsPatch, MapSettingsPatch, Partition, ShadowOverrides, Technique},
+    sun_direction,
 };
 
 /// A built-in scene: its name, what it shows, and how to build it.
@@ -419,7 +421,12 @@ pub fn lamps() -> Scene {
         l.intensity = 0.35;
         l
     };
-    let settings = |text: &str| Some(text.parse::<toml::Table>().expect("built-in light settings parse"));
+    // Each light's own technique, and map resolution when it has one.
+    let own = |technique: Technique, resolution: Option<u32>| ShadowOverrides {
+        filter: FilterSettingsPatch { technique: Some(technique), ..Default::default() },
+        map: MapSettingsPatch { resolution, ..Default::default() },
+        ..Default::default()
+    };
     let mut sun_light = sun(25.0, 140.0);
     sun_light.intensity = 0.35;
     let spots = [
@@ -436,36 +443,39 @@ pub fn lamps() -> Scene {
     let mut lights = vec![SceneLight {
         name: "sun".into(),
         light: Light::Directional(sun_light),
-        shadow: settings("partition = \"cascades\"\n[filter]\ntechnique = \"pcf-poisson\""),
+        shadow: Some(ShadowOverrides {
+            partition: Some(Partition::Cascades),
+            ..own(Technique::PCF_POISSON, None)
+        }),
     }];
     for (i, (position, target, color)) in spots.into_iter().enumerate() {
         let mut s = spot(position, target, 38.0, 25.0);
         s.color = color;
         s.intensity = 0.5;
-        let technique = ["pcf", "pcss", "hard"][i];
-        let shadow = match technique {
-            "pcss" => "[filter]\ntechnique = \"pcss\"\n".to_string(),
-            _ => format!("[filter]\ntechnique = \"{technique}\"\n[map]\nresolution = 1024"),
-        };
-        if technique == "pcss" {
+        let technique = [Technique::PCF, Technique::PCSS, Technique::HARD][i].clone();
+        let resolution = if technique == Technique::PCSS {
             s.radius = 0.3;
-        }
+            None
+        } else {
+            Some(1024)
+        };
         lights.push(SceneLight {
             name: format!("spot {i}"),
             light: Light::Spot(s),
-            shadow: settings(&shadow),
+            shadow: Some(own(technique, resolution)),
         });
     }
     for (i, (position, color)) in points.into_iter().enumerate() {
-        let technique = ["pcf2x2", "pcf-poisson", "pcf", "pcss"][i];
+        let technique =
+            [Technique::PCF2X2, Technique::PCF_POISSON, Technique::PCF, Technique::PCSS][i].clone();
         let mut p = dim(point(position, 22.0), color);
-        if technique == "pcss" {
+        if technique == Technique::PCSS {
             p.radius = 0.15;
         }
         lights.push(SceneLight {
             name: format!("lamp {i}"),
             light: Light::Point(p),
-            shadow: settings(&format!("[filter]\ntechnique = \"{technique}\"\n[map]\nresolution = 512")),
+            shadow: Some(own(technique, Some(512))),
         });
     }
     let mut scene = b.finish(

@@ -269,9 +269,9 @@ pub struct SceneLight {
     pub name: String,
     /// The light itself.
     pub light: Light,
-    /// This light's own shadow settings, a partial [`crate::settings::ShadowSettings`] table laid
-    /// over the render's; `None` to draw it with the render's settings unchanged.
-    pub shadow: Option<toml::Table>,
+    /// This light's own shadow settings, laid over the render's; `None` to draw it with the
+    /// render's settings unchanged.
+    pub shadow: Option<crate::settings::ShadowOverrides>,
 }
 
 /// Direction *toward* the sun for an elevation above the horizon and an azimuth

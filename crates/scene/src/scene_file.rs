@@ -55,7 +55,8 @@ use serde::Deserialize;
 
 use crate::{
     Camera, DirectionalLight, Light, PointLight, Scene, SceneLight, Settings, SpotLight, gltf_loader,
-    settings::ShadowSettings, sun_direction,
+    settings::{ShadowOverrides, ShadowSettings},
+    sun_direction,
 };
 
 /// A scene file that could not be used.
@@ -158,7 +159,7 @@ struct LightEntry {
     radius: Option<f32>,
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
-    shadow: Option<toml::Table>,
+    shadow: Option<ShadowOverrides>,
 }
 
 impl LightEntry {
@@ -220,16 +221,6 @@ impl LightEntry {
             other => Err(format!("`type` = \"{other}\" is invalid: sun, spot or point")),
         }
     }
-}
-
-/// Checks that a light's `[light.shadow]` table lays over the render's shadow
-/// settings as valid shadow settings.
-pub fn check_light_shadow(table: &toml::Table) -> Result<ShadowSettings, String> {
-    let mut merged = toml::Value::try_from(ShadowSettings::default()).map_err(|e| e.to_string())?;
-    crate::settings::overlay(&mut merged, &toml::Value::Table(table.clone()));
-    let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
-    shadow.validate().map_err(|e| e.to_string())?;
-    Ok(shadow)
 }
 
 #[derive(Deserialize)]
@@ -366,8 +357,11 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
     for (i, entry) in file.light.iter().enumerate() {
         let name = entry.name.clone().unwrap_or_else(|| format!("light {i}"));
         let light = entry.to_light(&scene).map_err(|e| fail(format!("[[light]] `{name}`: {e}")))?;
-        if let Some(table) = &entry.shadow {
-            check_light_shadow(table).map_err(|e| fail(format!("[[light]] `{name}` shadow: {e}")))?;
+        if let Some(overrides) = &entry.shadow {
+            // Checked over the defaults here; over the render's settings when resolved.
+            ShadowSettings::default()
+                .with_overrides(overrides)
+                .map_err(|e| fail(format!("[[light]] `{name}` shadow: {e}")))?;
         }
         scene.lights.push(SceneLight { name, light, shadow: entry.shadow.clone() });
     }

@@ -91,7 +91,13 @@ fn bad_scene_files_name_the_file_and_the_problem() {
     check("[[model]]\nfile = \"missing.glb\"\n", "missing.glb");
     check("[[model]]\nfile = \"tri.glb\"\nsclae = 2.0\n", "unknown field `sclae`");
     check("ground = true\n", "lists no models");
-    check("[[model]]\nfile = \"tri.glb\"\n[settings.shadow.filter]\ntechnique = \"nope\"\n", "[settings]");
+    // A malformed technique name is refused here; whether a well-formed one is
+    // registered is the renderer's to say (`gnomon-render`'s custom_technique test).
+    check("[[model]]\nfile = \"tri.glb\"\n[settings.shadow.filter]\ntechnique = \"No pe\"\n", "[settings]");
+    check(
+        "[[model]]\nfile = \"tri.glb\"\n[[light]]\ntype = \"sun\"\nelevation = 40.0\nazimuth = 0.0\n[light.shadow]\nmap.resolutoin = 512\n",
+        "unknown field `resolutoin`",
+    );
     let path = write_scene(&dir, SCENE);
     let e = scene_file::load(&path, Some("side")).err().unwrap().to_string();
     assert!(e.contains("no view `side`") && e.contains("front, top"), "{e}");

@@ -141,6 +141,13 @@ pub enum KernelUnit {
 /// The filter axis: which technique, and its parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`FilterSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct FilterSettings {
     /// Shadow filtering technique.
@@ -166,9 +173,11 @@ pub struct FilterSettings {
     pub receiver_plane_bias: bool,
     /// PCSS: blocker-search taps and the largest penumbra radius.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub pcss: PcssSettings,
     /// Parameters of the filterable (moment and exponential) maps.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub moments: MomentSettings,
 }
 
@@ -190,6 +199,13 @@ impl Default for FilterSettings {
 /// --sun-angular-diameter), the same parameter the reference's area light uses.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`PcssSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct PcssSettings {
     /// Depth taps of PCSS's blocker search: 8 to 64.
@@ -226,6 +242,13 @@ pub enum MomentFormat {
 /// Parameters of the filterable techniques: VSM, ESM, EVSM, MSM and convolution.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`MomentSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct MomentSettings {
     /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):

@@ -178,24 +178,17 @@ impl Settings {
             .map(|entry| {
                 let shadow = match &entry.shadow {
                     None => self.shadow.clone(),
-                    Some(table) => self.shadow_with(table).map_err(|problem| SettingsError {
-                        setting: "[light.shadow]",
-                        value: entry.name.clone(),
-                        valid: problem,
-                    })?,
+                    Some(overrides) => {
+                        self.shadow.with_overrides(overrides).map_err(|problem| SettingsError {
+                            setting: "[light.shadow]",
+                            value: entry.name.clone(),
+                            valid: problem.to_string(),
+                        })?
+                    }
                 };
                 Ok(ResolvedLight { name: entry.name.clone(), light: entry.light, shadow })
             })
             .collect()
-    }
-
-    /// These shadow settings with `table` laid over them.
-    fn shadow_with(&self, table: &toml::Table) -> Result<ShadowSettings, String> {
-        let mut merged = toml::Value::try_from(&self.shadow).map_err(|e| e.to_string())?;
-        overlay(&mut merged, &toml::Value::Table(table.clone()));
-        let shadow: ShadowSettings = merged.try_into().map_err(|e: toml::de::Error| e.to_string())?;
-        shadow.validate().map_err(|e| e.to_string())?;
-        Ok(shadow)
     }
 
     fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<&'s [crate::SceneLight], SettingsError> {

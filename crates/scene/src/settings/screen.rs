@@ -42,6 +42,13 @@ pub struct ScreenSpaceSettings {
 /// result multiplies in as min(map, contact).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`ContactSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactSettings {
     /// March contact shadows for this light (needs --shadow-path auto or mask).

@@ -23,6 +23,13 @@ pub enum CullMode {
 /// detaching shadows from their casters (peter-panning).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`BiasSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct BiasSettings {
     /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
@@ -86,6 +93,13 @@ pub enum Fit {
 /// The map axis: the shadow map's size and format.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`MapSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct MapSettings {
     /// Shadow map width and height in texels: 256 to 8192, and at most the device's
@@ -223,6 +237,13 @@ pub enum CascadeSelection {
 /// Cascaded shadow maps (--partition cascades).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`CascadeSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct CascadeSettings {
     /// Number of cascades: 1 to 8.
@@ -282,32 +303,58 @@ impl Default for CascadeSettings {
     }
 }
 
+/// A light's own shadow settings: any of [`ShadowSettings`]' fields, each laid over
+/// the render's ([`ShadowSettings::with_overrides`]). A scene file's `[light.shadow]`
+/// table is one, and so is a built-in scene's light list entry.
+pub type ShadowOverrides = ShadowSettingsPatch;
+
 /// Shadow settings, one field per orthogonal axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`ShadowSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
 #[serde(default, deny_unknown_fields)]
 pub struct ShadowSettings {
     /// The filter: which technique samples the map, and its parameters.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub filter: FilterSettings,
     /// Biases against shadow acne (constant, slope-scaled, normal offset) and face culling.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub bias: BiasSettings,
     /// The map: resolution, storage format, fit, warp, depth clamping, point-light layout.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub map: MapSettings,
     /// Partition of the light's view into maps.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub partition: Partition,
     /// The cascades, used with `--partition cascades`.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub cascades: CascadeSettings,
     /// Contact shadows for this light.
     #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
     pub contact: ContactSettings,
 }
 
 impl ShadowSettings {
+    /// These settings with `overrides` laid over them, checked.
+    pub fn with_overrides(&self, overrides: &ShadowOverrides) -> Result<ShadowSettings, SettingsError> {
+        use struct_patch::Patch as _;
+        let mut shadow = self.clone();
+        shadow.apply(overrides.clone());
+        shadow.validate()?;
+        Ok(shadow)
+    }
+
     /// Checks every shadow value against its documented range.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let s = self;

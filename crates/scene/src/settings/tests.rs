@@ -254,7 +254,10 @@ fn light_all_takes_each_lights_own_shadow_settings() {
     );
     // A light whose own table is invalid over these settings is named.
     let mut broken = scene.clone();
-    broken.lights[3].shadow = Some("[map]\nresolution = 100".parse().unwrap());
+    broken.lights[3].shadow = Some(ShadowOverrides {
+        map: MapSettingsPatch { resolution: Some(100), ..Default::default() },
+        ..Default::default()
+    });
     let e = s.resolve_lights(&broken).unwrap_err();
     assert!(e.to_string().contains("spot 2") && e.to_string().contains("`shadow.map.resolution`"), "{e}");
     // No list: a clear error naming where lists come from.
@@ -274,7 +277,10 @@ fn contact_shadows_choose_the_mask_path_and_are_checked() {
     s.screen.shadow_path = ShadowPath::Auto;
     s.light.kind = LightKind::All;
     let mut lit = scene.clone();
-    lit.lights[5].shadow = Some("[contact]\ncontact_shadows = true".parse().unwrap());
+    lit.lights[5].shadow = Some(ShadowOverrides {
+        contact: ContactSettingsPatch { contact_shadows: Some(true), ..Default::default() },
+        ..Default::default()
+    });
     let lights = s.resolve_lights(&lit).unwrap();
     assert!(lights[5].shadow.contact.contact_shadows && !lights[4].shadow.contact.contact_shadows);
     assert!(s.uses_shadow_mask(&lights).unwrap());
@@ -314,4 +320,28 @@ fn settings_in_messages_become_flags() {
         "--contact-shadows = on for light `lamp` is invalid: only with --shadow-path auto or mask; \
          --shadow-res too; model `box.width`"
     );
+}
+
+#[test]
+fn shadow_overrides_are_typed_and_lay_only_what_they_name() {
+    let written = "partition = \"cascades\"\n[filter]\ntechnique = \"pcss\"\n[map]\nresolution = 512\n";
+    let parsed: ShadowOverrides = toml::from_str(written).unwrap();
+    assert_eq!((parsed.filter.technique.clone(), parsed.map.resolution), (Some(Technique::PCSS), Some(512)));
+    assert_eq!(parsed.bias.slope_bias, None, "what it does not name is left alone");
+    let again: ShadowOverrides = toml::from_str(&toml::to_string(&parsed).unwrap()).unwrap();
+    assert_eq!(again, parsed, "written and read back");
+    assert!(toml::from_str::<ShadowOverrides>("[map]\nresolutoin = 512").is_err(), "a misspelt key");
+
+    let base = ShadowSettings {
+        bias: BiasSettings { slope_bias: 2.5, ..BiasSettings::default() },
+        ..Default::default()
+    };
+    let laid = base.with_overrides(&parsed).unwrap();
+    assert_eq!((laid.partition, laid.map.resolution), (Partition::Cascades, 512));
+    assert_eq!((laid.filter.technique, laid.bias.slope_bias), (Technique::PCSS, 2.5));
+    let bad = ShadowOverrides {
+        map: MapSettingsPatch { resolution: Some(3), ..Default::default() },
+        ..Default::default()
+    };
+    assert_eq!(base.with_overrides(&bad).unwrap_err().setting, "shadow.map.resolution");
 }
