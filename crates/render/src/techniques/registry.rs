@@ -141,7 +141,7 @@ impl TechniqueRegistry {
 
     /// [`TechniqueRegistry::check`], and that the technique can shadow `light`
     /// (called `name` in messages): a point light's cube map takes the techniques
-    /// with a cube lookup, its paraboloids those that read [`MapSupport::paraboloid`].
+    /// with a cube lookup, its paraboloids those that read [`MapSupport::paraboloid`](super::MapSupport::paraboloid).
     pub fn check_light(
         &self,
         shadow: &ShadowSettings,
