@@ -12,8 +12,9 @@ use gnomon_scene::{Camera, Light, Scene};
 const MAGIC: &[u8; 8] = b"GNOMREF1";
 /// Part of every key: bump it whenever the tracer's results change, so that caches
 /// written by an older tracer are not served. 2: hit points from the barycentrics and
-/// the t error bound (false self-shadowing on large, distant triangles).
-const TRACER_REVISION: u32 = 2;
+/// the t error bound (false self-shadowing on large, distant triangles). 3: each
+/// pixel says whether its surface faces the light.
+const TRACER_REVISION: u32 = 3;
 
 pub fn cache_dir() -> Option<PathBuf> {
     if let Some(d) = std::env::var_os("GNOMON_CACHE_DIR") {
@@ -65,6 +66,7 @@ pub fn load(path: &Path, options: &ReferenceOptions) -> Option<ReferenceImage> {
         height,
         samples,
         visibility: r.f32s(n)?,
+        faces_light: r.take(n)?.iter().map(|&b| b != 0).collect(),
         std_error: r.f32s(n)?,
         object_id: r.u32s(n)?,
         triangle: r.u32s(n)?,
@@ -86,6 +88,7 @@ pub fn store(path: &Path, image: &ReferenceImage) -> std::io::Result<()> {
     let floats = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
     let ints = |b: &mut Vec<u8>, v: &[u32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
     floats(&mut bytes, &image.visibility);
+    bytes.extend(image.faces_light.iter().map(|&b| u8::from(b)));
     floats(&mut bytes, &image.std_error);
     ints(&mut bytes, &image.object_id);
     ints(&mut bytes, &image.triangle);
@@ -145,6 +148,7 @@ mod tests {
             height: 1,
             samples: 64,
             visibility: vec![0.25, f32::NAN],
+            faces_light: vec![true, false],
             std_error: vec![0.01, 0.0],
             object_id: vec![3, 0],
             triangle: vec![17, 0],
@@ -164,6 +168,7 @@ mod tests {
             (vec![3, 0], vec![17, 0], 130)
         );
         assert_eq!(back.position[0], Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(back.faces_light, [true, false]);
         assert!(load(&path, &ReferenceOptions { width: 1, height: 2, samples: 64 }).is_none());
         std::fs::write(&path, b"GNOMREF1junk").unwrap();
         assert!(load(&path, &options).is_none(), "a truncated file is ignored");

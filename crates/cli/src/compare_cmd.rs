@@ -121,6 +121,8 @@ struct Report<'a> {
     backend: String,
     aliasing: AliasingSummary,
     camera_path: Option<PathReport>,
+    /// What each metric divides by (`metrics::DENOMINATORS`).
+    denominators: std::collections::BTreeMap<&'static str, &'static str>,
     rows: Vec<Row>,
 }
 
@@ -155,6 +157,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let gpu = Gpu::new_headless()?;
     if args.verbose {
         eprintln!("gnomon: {}", gpu.info);
+        eprintln!("gnomon: {}", crate::render_cmd::open_casters_line(&scene, settings.shadow.bias.cull));
     }
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(settings)?;
@@ -222,7 +225,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let summary = if soft {
             format!("MAE {:.4}  p99 {:.3}", m.mae, m.p99)
         } else {
-            format!("mismatch {:.3}%", 100.0 * m.mismatch_rate)
+            format!("mismatch {:.3}% of light-facing", 100.0 * m.mismatch_rate)
         };
         let mut caption = vec![name.to_string()];
         if let Some((s, f, l)) = timing {
@@ -240,6 +243,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                     summary,
                     format!("false shadow {:.3}%", 100.0 * m.false_shadow_rate),
                     format!("false lit {:.3}%", 100.0 * m.false_lit_rate),
+                    format!("all surfaces: mismatch {:.3}%", 100.0 * m.surface_mismatch_rate),
                 ],
                 downscale: Downscale::Salient(if soft { soft_priority } else { hard_priority }),
             },
@@ -286,6 +290,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             travel: args.path_travel,
             frozen_cascades: settings.shadow.cascades.freeze,
         }),
+        denominators: metrics::DENOMINATORS.iter().copied().collect(),
         rows,
     };
     let table = markdown_table(&report, soft);
@@ -420,16 +425,19 @@ fn markdown_table(report: &Report, soft: bool) -> String {
             if p.frozen_cascades { ", cascades frozen at the first frame" } else { "" }
         ));
     }
+    s.push_str(
+        "Mismatch, false shadow, false lit, MAE, RMSE and p99 are over the compared pixels: those where both images see the same surface and it faces the light (geometric N·L > 0) inside its cone and range. All-surface mismatch divides by every surface pixel both see, light-facing or not (compared + unlit)\n\n",
+    );
     let path = report.camera_path.is_some();
-    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | silhouette | shadow ms | filter ms | lighting ms |");
+    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | all-surface mismatch | unlit | silhouette | shadow ms | filter ms | lighting ms |");
     s.push_str(if path { " flips − reference | shimmer |\n" } else { "\n" });
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     s.push_str(if path { "---|---|\n" } else { "\n" });
     let ms = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into());
     for r in &report.rows {
         let m = &r.metrics;
         s.push_str(&format!(
-            "| {} | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.3} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.3} | {} | {:.3}% | {} | {} | {} | {} | {} |\n",
             technique_label(r),
             100.0 * m.mismatch_rate,
             100.0 * m.false_shadow_rate,
@@ -438,6 +446,8 @@ fn markdown_table(report: &Report, soft: bool) -> String {
             m.rmse,
             m.p99,
             m.compared,
+            100.0 * m.surface_mismatch_rate,
+            m.unlit,
             m.silhouette,
             ms(r.shadow_ms),
             if r.filter_ms.is_some() { ms(r.filter_ms) } else { "–".into() },

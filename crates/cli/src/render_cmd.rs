@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use gnomon_render::{Gpu, OutputRequest, Renderer};
-use gnomon_scene::Settings;
+use gnomon_scene::{
+    Scene, Settings,
+    settings::{CullMode, value_name},
+};
 
 use crate::output::{self, Staged};
 
@@ -78,6 +81,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             "gnomon: scene bounds {:.3} to {:.3}; camera at {:.3} looking at {:.3}",
             b.min, b.max, camera.eye, camera.target
         );
+        eprintln!("gnomon: {}", open_casters_line(&scene, settings.shadow.bias.cull));
     }
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(settings)?;
@@ -166,6 +170,26 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         eprintln!("gnomon: done in {:.1} ms", started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(())
+}
+
+/// `--verbose`'s line on open meshes: how many single-sided casters `cull auto` found
+/// open (drawn with both faces), whatever the cull mode in use.
+pub(crate) fn open_casters_line(scene: &Scene, cull: CullMode) -> String {
+    let open = scene.open_casters(&scene.closed_meshes());
+    format!(
+        "{} of {} single-sided caster meshes are open ({} of {} triangles); cull {}: {}",
+        open.open_meshes,
+        open.meshes,
+        open.open_triangles,
+        open.triangles,
+        value_name(&cull),
+        match cull {
+            CullMode::Auto => "open meshes draw both faces, closed ones cull back faces",
+            CullMode::Back => "every single-sided mesh culls back faces; open ones may leak",
+            CullMode::Front => "every single-sided mesh culls front faces; open ones may leak",
+            CullMode::None => "every mesh draws both faces",
+        }
+    )
 }
 
 /// One light's line of `--verbose`: what it is, what its map holds, the draws into

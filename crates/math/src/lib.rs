@@ -2,7 +2,8 @@
 //! projections, and the mapping from normalized device coordinates to shadow-map
 //! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
 //! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
-//! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]).
+//! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]);
+//! whether a mesh is closed, for face culling in the shadow pass ([`topology`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -25,6 +26,7 @@ mod projection;
 pub mod solar;
 #[cfg(test)]
 mod test_rng;
+pub mod topology;
 pub mod warping;
 
 pub use aabb::Aabb;

@@ -11,6 +11,9 @@ pub const FALSE_SHADOW: [u8; 3] = [235, 60, 50];
 pub const FALSE_LIT: [u8; 3] = [40, 140, 255];
 /// Pixel where the two images see different surfaces, never compared (yellow).
 pub const SILHOUETTE: [u8; 3] = [230, 190, 30];
+/// Pixel of a surface that faces away from the light or lies outside its cone or
+/// range: no shadow decides it, never compared (dark blue-grey).
+pub const UNLIT: [u8; 3] = [52, 56, 72];
 /// Pixel where neither image sees a surface (near-black).
 pub const BACKGROUND: [u8; 3] = [28, 28, 34];
 /// Compared pixel lit in both images (light grey).
@@ -23,11 +26,12 @@ pub const HARD_LEGEND: &[(&str, [u8; 3])] = &[
     ("false shadow", FALSE_SHADOW),
     ("false lit", FALSE_LIT),
     ("silhouette", SILHOUETTE),
+    ("faces away", UNLIT),
     ("correct lit", CORRECT_LIT),
     ("correct shadow", CORRECT_SHADOW),
 ];
 
-/// RGBA8 pixels: background and silhouette colours, and `compared(i)` elsewhere.
+/// RGBA8 pixels: background, silhouette and unlit colours, and `compared(i)` elsewhere.
 fn paint(classes: &[PixelClass], compared: impl Fn(usize) -> [u8; 3]) -> Vec<u8> {
     classes
         .iter()
@@ -36,6 +40,7 @@ fn paint(classes: &[PixelClass], compared: impl Fn(usize) -> [u8; 3]) -> Vec<u8>
             let [r, g, b] = match class {
                 PixelClass::Background => BACKGROUND,
                 PixelClass::Silhouette => SILHOUETTE,
+                PixelClass::Unlit => UNLIT,
                 PixelClass::Compared => compared(i),
             };
             [r, g, b, 255]

@@ -36,6 +36,10 @@ pub struct ReferenceImage {
     /// 0 outside a spot light's cone or range, and where the surface faces away
     /// from the light, as in the rasterizer.
     pub visibility: Vec<f32>,
+    /// Whether the surface faces the light (geometric N·L > 0 toward the light's
+    /// centre) and lies inside its cone and range: the pixels whose visibility a
+    /// shadow decides. False on a miss.
+    pub faces_light: Vec<bool>,
     /// Standard error of each pixel's estimate (0 for exact visibility).
     pub std_error: Vec<f32>,
     /// Instance index + 1 of the primary hit; 0 on a miss.
@@ -117,6 +121,14 @@ impl Emitter {
         }
     }
 
+    /// Whether light can reach `hit` at all: inside the light's cone and range, on the
+    /// side of the surface (the camera-facing geometric normal) that faces the
+    /// light's centre, as the rasterizer tests it.
+    fn faces(&self, hit: &Hit) -> bool {
+        let (centre, receives) = self.centre(hit.position);
+        receives && hit.normal.dot(centre) > 0.0
+    }
+
     /// A shadow ray toward the light sample `u` from `p`: (direction, length).
     fn sample(&self, p: Vec3, u: Vec2) -> (Vec3, f32) {
         match *self {
@@ -192,11 +204,18 @@ pub fn reference_visibility(
                         return PixelResult::MISS;
                     };
                     let pixel_seed = hash(y * w + x);
-                    let (visibility, std_error, shadow_rays) =
-                        shade(traced, &emitter, &hit, samples, pixel_seed);
+                    let faces_light = emitter.faces(&hit);
+                    let (visibility, std_error, shadow_rays) = if faces_light {
+                        shade(traced, &emitter, &hit, samples, pixel_seed)
+                    } else {
+                        // Outside a spot's cone, or on a surface turned away from the
+                        // light, nothing arrives.
+                        (0.0, 0.0, 0)
+                    };
                     PixelResult {
                         rays: 1 + shadow_rays,
                         visibility,
+                        faces_light,
                         std_error,
                         object_id: hit.object_id,
                         triangle: hit.triangle,
@@ -217,6 +236,7 @@ pub fn reference_visibility(
         height: h,
         samples,
         visibility: Vec::with_capacity(n),
+        faces_light: Vec::with_capacity(n),
         std_error: Vec::with_capacity(n),
         object_id: Vec::with_capacity(n),
         triangle: Vec::with_capacity(n),
@@ -227,6 +247,7 @@ pub fn reference_visibility(
     for p in rows.into_iter().flatten() {
         image.rays += p.rays;
         image.visibility.push(p.visibility);
+        image.faces_light.push(p.faces_light);
         image.std_error.push(p.std_error);
         image.object_id.push(p.object_id);
         image.triangle.push(p.triangle);
@@ -239,6 +260,7 @@ pub fn reference_visibility(
 struct PixelResult {
     rays: u64,
     visibility: f32,
+    faces_light: bool,
     std_error: f32,
     object_id: u32,
     triangle: u32,
@@ -250,6 +272,7 @@ impl PixelResult {
     const MISS: PixelResult = PixelResult {
         rays: 1,
         visibility: f32::NAN,
+        faces_light: false,
         std_error: 0.0,
         object_id: 0,
         triangle: 0,
@@ -258,14 +281,9 @@ impl PixelResult {
     };
 }
 
-/// Visibility of the light at `hit`, the standard error of the estimate, and the
-/// number of shadow rays traced.
+/// Visibility of the light at `hit` (which [faces](Emitter::faces) it), the standard
+/// error of the estimate, and the number of shadow rays traced.
 fn shade(traced: &TracedScene, emitter: &Emitter, hit: &Hit, samples: u32, seed: u32) -> (f32, f32, u64) {
-    let (centre, receives) = emitter.centre(hit.position);
-    // Outside a spot's cone, or on a surface turned away from the light, nothing arrives.
-    if !receives || hit.normal.dot(centre) <= 0.0 {
-        return (0.0, 0.0, 0);
-    }
     let origin = offset_ray_origin(hit.position, hit.normal);
     let rays = std::cell::Cell::new(0u64);
     let visible = |u: Vec2| {

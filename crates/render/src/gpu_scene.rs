@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt;
 use crate::{
     Gpu, RenderError,
     gpu_types::{INSTANCE_SLOT, InstanceGpu, VertexGpu, VertexStream},
-    passes::Layouts,
+    passes::{Layouts, shadow::Sides},
 };
 
 /// Instances that share a mesh, a material texture and the state their draws need:
@@ -32,8 +32,9 @@ pub(crate) struct Batch {
     pub casts_shadow: bool,
     /// Alpha-tested (glTF MASK): the shadow pass must sample the texture.
     pub masked: bool,
-    /// Both faces cast shadows (glTF `doubleSided`), whatever the cull setting.
-    pub double_sided: bool,
+    /// Which faces can block light: a double-sided material, or a closed or an
+    /// open mesh (what `cull auto` culls by).
+    pub sides: Sides,
     /// Index into [`GpuScene::material_groups`]: the texture this batch samples.
     pub material_group: usize,
     /// The batch's instances, in the order the instance buffer holds them.
@@ -106,11 +107,12 @@ impl GpuScene {
         let positions: Vec<[f32; 3]> = vertices.iter().map(|v| v.position).collect();
         let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
 
-        let (batches, order) = batch_instances(scene, &ranges, &mesh_bounds);
+        let closed = scene.closed_meshes();
+        let (batches, order) = batch_instances(scene, &ranges, &mesh_bounds, &closed);
         let mut shadow_order: Vec<u32> = (0..batches.len() as u32).collect();
         shadow_order.sort_by_key(|&b| {
             let b = &batches[b as usize];
-            (b.masked, b.double_sided, b.material_group)
+            (b.masked, b.sides, b.material_group)
         });
         let bounds = batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
 
@@ -313,21 +315,27 @@ struct BatchKey {
     /// The base-colour texture's bind group (0 for none).
     material_group: usize,
     masked: bool,
-    double_sided: bool,
+    sides: Sides,
     casts_shadow: bool,
     mesh: usize,
 }
 
 /// Groups the instances into batches by everything a draw of them shares, each with
 /// its culling tree; returns the batches and the instances in buffer order.
-fn batch_instances(scene: &Scene, ranges: &[MeshRange], mesh_bounds: &[Aabb]) -> (Vec<Batch>, Vec<usize>) {
+/// `closed` says, per mesh, whether it is closed ([`Scene::closed_meshes`]).
+fn batch_instances(
+    scene: &Scene,
+    ranges: &[MeshRange],
+    mesh_bounds: &[Aabb],
+    closed: &[bool],
+) -> (Vec<Batch>, Vec<usize>) {
     let key_of = |i: usize| {
         let inst = &scene.instances[i];
         let material = &scene.materials[inst.material];
         BatchKey {
             material_group: material.base_color_texture.map_or(0, |t| t + 1),
             masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
-            double_sided: material.double_sided,
+            sides: Sides::of(scene, inst, closed),
             casts_shadow: inst.casts_shadow,
             mesh: inst.mesh,
         }
@@ -339,7 +347,7 @@ fn batch_instances(scene: &Scene, ranges: &[MeshRange], mesh_bounds: &[Aabb]) ->
     let mut order: Vec<usize> = Vec::with_capacity(members.len());
     let mut batches = Vec::new();
     for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
-        let BatchKey { material_group, masked, double_sided, casts_shadow, mesh } = key_of(group[0]);
+        let BatchKey { material_group, masked, sides, casts_shadow, mesh } = key_of(group[0]);
         let bounds: Vec<Aabb> = group
             .iter()
             .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
@@ -353,7 +361,7 @@ fn batch_instances(scene: &Scene, ranges: &[MeshRange], mesh_bounds: &[Aabb]) ->
             first_instance: order.len() as u32,
             casts_shadow,
             masked,
-            double_sided,
+            sides,
             material_group,
             tree,
         });

@@ -139,6 +139,18 @@ mod tests {
         }
     }
 
+    /// `cull auto` culls only closed meshes: the solids must weld into closed
+    /// surfaces (a sphere's poles and seam, a box's split corners), the plane not.
+    #[test]
+    fn solids_are_closed_and_the_plane_is_open() {
+        for m in [cuboid(Vec3::new(1.0, 2.0, 0.5)), uv_sphere(1.0, 16, 8), cylinder(0.5, 2.0, 12)] {
+            let c = m.closedness();
+            assert!(c.is_closed(), "{}: {c:?}", m.name);
+        }
+        let plane = plane(2.0, 3.0).closedness();
+        assert_eq!((plane.is_closed(), plane.open_edges), (false, 4));
+    }
+
     #[test]
     fn builders_have_the_requested_size() {
         let b = cuboid(Vec3::new(1.0, 2.0, 0.5)).bounds();

@@ -446,7 +446,7 @@ fn build(
     extras.has_sun = sun.is_some();
     extras.has_spot = spot.is_some();
     extras.has_point = point.is_some();
-    scene.camera = camera.unwrap_or_else(|| fitted_camera(center, radius));
+    scene.camera = camera.unwrap_or_else(|| crate::framing::default_camera(&scene));
     if let Some(s) = sun {
         scene.sun = s;
     }
@@ -481,21 +481,6 @@ fn build(
     }
     scene.lights = lights;
     Ok((scene, extras))
-}
-
-/// A camera looking at the bounding sphere from 30° azimuth and 25° elevation, far
-/// enough to see all of it with a 45° field of view.
-pub fn fitted_camera(center: Vec3, radius: f32) -> Camera {
-    let fov: f32 = 45.0;
-    let distance = radius / (0.5 * fov.to_radians()).sin() * 1.05;
-    Camera {
-        eye: center + sun_direction(25.0, 30.0) * distance,
-        target: center,
-        up: Vec3::Y,
-        fov_y_degrees: fov,
-        near: (distance - radius).max(distance * 1e-3) * 0.5,
-        far: distance + 2.0 * radius,
-    }
 }
 
 /// Area-weighted vertex normals, for meshes that come without them.

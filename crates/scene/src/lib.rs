@@ -5,12 +5,15 @@
 
 pub mod builtin;
 pub mod camera_path;
+mod casters;
+pub mod framing;
 pub mod geometry;
 pub mod gltf_loader;
 mod model;
 pub mod scene_file;
 pub mod settings;
 
+pub use casters::OpenCasters;
 pub use model::{
     AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneError,
     SceneLight, SpotLight, Texture, Wrap, sun_direction,

@@ -303,8 +303,8 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
     scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let bounds = scene.bounds();
     if file.builtin.is_none() {
-        // glTF models bring no camera: frame them all.
-        scene.camera = gltf_loader::fitted_camera(bounds.center(), bounds.bounding_radius().max(1e-3));
+        // glTF models placed by a scene file bring no camera: frame them all.
+        scene.camera = crate::framing::default_camera(&scene);
     }
     if file.ground {
         scene.add_ground_plane();

@@ -24,7 +24,7 @@ use crate::{
         lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
         moments::MomentInput,
         screen_space,
-        shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape, Sides},
+        shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
     },
     pool::{Binding, ViewKey},
     readback,
@@ -512,7 +512,7 @@ impl Renderer {
             let batch = &uploaded.batches[*batch as usize];
             let key = ShadowPipelineKey::new(
                 bias,
-                if batch.double_sided { Sides::Double } else { Sides::Single },
+                batch.sides,
                 if batch.masked { Coverage::Masked } else { Coverage::Opaque },
                 DepthRange::clamped_if(depth.unclipped),
                 depth.target,

@@ -5,7 +5,7 @@
 //! (cull mode, winding, depth clamp and bias). No instance data, no culling work, no
 //! state changes: what any shadow pass must at least cost.
 
-use std::ops::Range;
+use std::{collections::BTreeMap, ops::Range};
 
 use glam::{Mat4, Vec3};
 use gnomon_scene::{Scene, settings::BiasSettings};
@@ -24,33 +24,38 @@ use crate::{
 pub struct DepthBaselineScene {
     positions: wgpu::Buffer,
     indices: wgpu::Buffer,
-    /// Index ranges of the single-sided and the double-sided casters.
-    single_sided: Range<u32>,
-    double_sided: Range<u32>,
+    /// Index ranges of the casters of each kind of [`Sides`], drawn with its own cull.
+    ranges: Vec<(Sides, Range<u32>)>,
     /// Triangles it draws per layer.
     pub triangles: usize,
 }
 
 impl DepthBaselineScene {
-    /// Flattens every shadow-casting instance of `scene` into world space. Alpha-masked
+    /// Flattens every shadow-casting instance of `scene` into world space, grouped by
+    /// the faces that can block light (as the shadow pass's batches are). Alpha-masked
     /// casters are drawn solid: the baseline has no texture to test.
     pub fn upload(gpu: &Gpu, scene: &Scene) -> Result<Self, RenderError> {
+        let closed = scene.closed_meshes();
         let mut positions: Vec<Vec3> = Vec::new();
-        let (mut single, mut double) = (Vec::new(), Vec::new());
+        let mut by_sides: BTreeMap<Sides, Vec<u32>> = BTreeMap::new();
         for instance in scene.instances.iter().filter(|i| i.casts_shadow) {
             let mesh = &scene.meshes[instance.mesh];
             let base = positions.len() as u32;
             positions.extend(mesh.positions.iter().map(|&p| instance.world_from_object.transform_point3(p)));
-            let indices =
-                if scene.materials[instance.material].double_sided { &mut double } else { &mut single };
-            indices.extend(mesh.indices.iter().map(|&i| base + i));
+            let sides = by_sides.entry(Sides::of(scene, instance, &closed)).or_default();
+            sides.extend(mesh.indices.iter().map(|&i| base + i));
         }
-        if single.is_empty() && double.is_empty() {
+        let mut indices = Vec::new();
+        let mut ranges = Vec::new();
+        for (sides, list) in by_sides {
+            let start = indices.len() as u32;
+            indices.extend(list);
+            ranges.push((sides, start..indices.len() as u32));
+        }
+        if indices.is_empty() {
             return Err(RenderError::EmptyScene(scene.name.clone()));
         }
-        let triangles = (single.len() + double.len()) / 3;
-        let (single_len, double_len) = (single.len() as u32, double.len() as u32);
-        single.extend(double);
+        let triangles = indices.len() / 3;
         let device = &gpu.device;
         gpu.checked("uploading the depth-only baseline", || Self {
             positions: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -60,11 +65,10 @@ impl DepthBaselineScene {
             }),
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("baseline indices"),
-                contents: bytemuck::cast_slice(&single),
+                contents: bytemuck::cast_slice(&indices),
                 usage: wgpu::BufferUsages::INDEX,
             }),
-            single_sided: 0..single_len,
-            double_sided: single_len..single_len + double_len,
+            ranges,
             triangles,
         })
     }
@@ -184,18 +188,18 @@ impl DepthBaselinePass {
         let device = &gpu.device;
         let matrix = pool.uniform(&gpu.queue, "baseline clip_from_world", &clip_from_world);
         let group = pool.bind_group("depth-only baseline", &self.group_layout, &[Binding::Buffer(matrix)]);
-        let (single, double) = (raster.key(Sides::Single), raster.key(Sides::Double));
-        // Both pipelines exist before the pass borrows them.
-        self.pipeline(device, single);
-        self.pipeline(device, double);
+        // Every pipeline exists before the pass borrows them.
+        for (sides, _) in &scene.ranges {
+            self.pipeline(device, raster.key(*sides));
+        }
         // The same pass set-up (attachment, load and store) as the shadow pass's.
         let mut pass = super::begin_depth_pass(encoder, "depth-only baseline", target, timestamp_writes);
         pass.set_bind_group(0, &group, &[]);
         pass.set_vertex_buffer(0, scene.positions.slice(..));
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (range, key) in [(&scene.single_sided, single), (&scene.double_sided, double)] {
+        for (sides, range) in &scene.ranges {
             if !range.is_empty() {
-                pass.set_pipeline(&self.pipelines[&key]);
+                pass.set_pipeline(&self.pipelines[&raster.key(*sides)]);
                 pass.draw_indexed(range.clone(), 0, 0..1);
             }
         }

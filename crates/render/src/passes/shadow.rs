@@ -12,7 +12,10 @@
 
 use std::collections::HashMap;
 
-use gnomon_scene::settings::{BiasSettings, CullMode};
+use gnomon_scene::{
+    Instance, Scene,
+    settings::{BiasSettings, CullMode},
+};
 
 use super::{LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADOW_FORMAT, compose_wgsl};
 use crate::gpu_types::VertexStream;
@@ -53,7 +56,8 @@ impl DepthRange {
 /// Everything that makes two shadow pipelines differ.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct ShadowPipelineKey {
-    pub cull: CullMode,
+    /// The faces the rasterizer culls, once `cull auto` is resolved for the casters.
+    pub cull: Option<wgpu::Face>,
     pub depth_bias: i32,
     slope_bias_bits: u32,
     pub coverage: Coverage,
@@ -62,7 +66,8 @@ pub(crate) struct ShadowPipelineKey {
 }
 
 impl ShadowPipelineKey {
-    /// The key for casters drawn with `bias`; double-sided casters are never culled.
+    /// The key for casters of `sides` drawn with `bias`: double-sided casters are never
+    /// culled, and `cull auto` culls back faces of closed meshes only.
     pub fn new(
         bias: &BiasSettings,
         sides: Sides,
@@ -71,9 +76,14 @@ impl ShadowPipelineKey {
         target: DepthTarget,
     ) -> Self {
         Self {
-            cull: match sides {
-                Sides::Double => CullMode::None,
-                Sides::Single => bias.cull,
+            cull: match (sides, bias.cull) {
+                (Sides::Double, _)
+                | (Sides::Open | Sides::Closed, CullMode::None)
+                | (Sides::Open, CullMode::Auto) => None,
+                (Sides::Closed, CullMode::Auto) | (Sides::Open | Sides::Closed, CullMode::Back) => {
+                    Some(wgpu::Face::Back)
+                }
+                (Sides::Open | Sides::Closed, CullMode::Front) => Some(wgpu::Face::Front),
             },
             depth_bias: bias.depth_bias,
             slope_bias_bits: bias.slope_bias.to_bits(),
@@ -88,11 +98,29 @@ impl ShadowPipelineKey {
     }
 }
 
-/// Whether a caster's material is drawn from both sides.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// Which faces of a batch of casters can block light, from its material and mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub(crate) enum Sides {
-    Single,
+    /// A glTF double-sided material: both faces cast, whatever the cull setting.
     Double,
+    /// A single-sided material on a closed mesh: every ray into it crosses a front
+    /// face and a back face, so culling either loses no blocker.
+    Closed,
+    /// A single-sided material on an open mesh (a wall, a roof, a drape): `cull auto`
+    /// draws both faces.
+    Open,
+}
+
+impl Sides {
+    /// The faces of `instance` that can block light; `closed` says per mesh whether
+    /// it is closed ([`Scene::closed_meshes`]).
+    pub fn of(scene: &Scene, instance: &Instance, closed: &[bool]) -> Sides {
+        match (scene.materials[instance.material].double_sided, closed[instance.mesh]) {
+            (true, _) => Sides::Double,
+            (false, true) => Sides::Closed,
+            (false, false) => Sides::Open,
+        }
+    }
 }
 
 /// A shadow pipeline's shape: its entry points, what it reads and how it rasterizes.
@@ -145,11 +173,7 @@ impl ShadowPipelineShape {
             },
             // A cube face's and a paraboloid's views are mirrored (`gnomon_math::omni`).
             front_face: if writes_distance { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
-            cull_mode: match key.cull {
-                CullMode::Back => Some(wgpu::Face::Back),
-                CullMode::Front => Some(wgpu::Face::Front),
-                CullMode::None => None,
-            },
+            cull_mode: key.cull,
             unclipped_depth: key.depth_range == DepthRange::Clamped,
             // The clamp stays 0: wgpu 30 does not enable the Vulkan feature
             // (depthBiasClamp) that a non-zero clamp needs. A distance pass biases the

@@ -27,11 +27,11 @@ const COVERAGES: [Coverage; 2] = [Coverage::Opaque, Coverage::Masked];
 /// Every shadow pipeline key over targets, coverage, culls, sides and depth ranges.
 fn all_keys() -> Vec<ShadowPipelineKey> {
     let mut keys = Vec::new();
-    for cull in [CullMode::Back, CullMode::Front, CullMode::None] {
+    for cull in [CullMode::Auto, CullMode::Back, CullMode::Front, CullMode::None] {
         let bias = BiasSettings { cull, ..BiasSettings::default() };
         for target in TARGETS {
             for coverage in COVERAGES {
-                for sides in [Sides::Single, Sides::Double] {
+                for sides in [Sides::Double, Sides::Closed, Sides::Open] {
                     for range in [DepthRange::Clipped, DepthRange::Clamped] {
                         keys.push(ShadowPipelineKey::new(&bias, sides, coverage, range, target));
                     }

@@ -9,8 +9,15 @@ use super::*;
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum CullMode {
-    /// Cull faces turned away from the light: the usual choice.
+    /// Cull the back faces of closed meshes, and draw both faces of open ones (and of
+    /// glTF double-sided materials). Culling is safe only on a closed mesh: through a
+    /// single-sided wall or roof whose back faces the light, a culled pass lets the
+    /// light in. Closedness is found when the scene is uploaded
+    /// (`gnomon_math::topology`).
     #[default]
+    Auto,
+    /// Cull faces turned away from the light on every single-sided mesh, closed or
+    /// not: leaks through open meshes whose back faces the light.
     Back,
     /// Cull faces turned toward the light, so closed meshes store their back faces:
     /// the classic anti-acne trick, which can leak where meshes are open or thin.
@@ -62,7 +69,7 @@ impl BiasSettings {
 
 impl Default for BiasSettings {
     fn default() -> Self {
-        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.6, cull: CullMode::Back }
+        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.6, cull: CullMode::Auto }
     }
 }
 
