@@ -172,15 +172,20 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 /// The tree's leaves are MASK (cutoff 0.5) and double-sided. Needs `../shared`.
 ///
 /// Issue 4 asks for a mismatch under 2 % for `pcf2x2` at 2048² under a directional
-/// light. Asserted on the view `gnomon compare tree.glb --sun-elevation 55
-/// --sun-azimuth 200` uses (the camera fitted to the bounds, no ground; every compared
-/// pixel is foliage or trunk, so this is leaves shadowing leaves): 1.67 % measured on
-/// lavapipe. The errors are one-texel fringes around each leaf's shadow, so the figure
+/// light, over every surface pixel (the measure of its time, kept as
+/// `surface_mismatch_rate`). Asserted on the view `gnomon compare tree.glb
+/// --sun-elevation 55 --sun-azimuth 200` uses (the default framing of the bounds, no
+/// ground; every compared pixel is foliage or trunk, so this is leaves shadowing
+/// leaves): 1.67 % measured on lavapipe with the framing of the time, 1.64 % with
+/// today's closer one. Over the light-facing pixels alone the same view is 2.67 %
+/// (reported, not bound: a third of this view's pixels are leaves seen from their
+/// unlit side). The errors are one-texel fringes around each leaf's shadow, so the figure
 /// depends on the sun and the framing; the README lists the other views measured,
 /// including those above 2 %. A close view with a ground, where 2 % is not met, is
 /// held to a regression bound.
-/// Issue 4's 2 % on the fitted view (1.674 % measured), and a regression bound on the
-/// close view with a ground (2.092 % measured), where 2 % is not met.
+/// Issue 4's 2 % on the fitted view (all surfaces: 1.642 % measured), and a regression
+/// bound on the close view with a ground (all surfaces: 2.092 % measured), where 2 % is
+/// not met.
 const TREE_FITTED_MISMATCH: f64 = 0.02;
 const TREE_CLOSE_MISMATCH: f64 = 0.025;
 
@@ -196,22 +201,29 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let measure = |scene: &Scene, s: &Settings, what: &str| {
         let m = compare(&render(scene, s), &reference(scene, s));
         eprintln!(
-            "tree, {what}, pcf2x2, 2048²: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} compared",
+            "tree, {what}, pcf2x2, 2048²: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} light-facing pixels; {:.3}% of all {} surface pixels",
             100.0 * m.mismatch_rate,
             100.0 * m.false_shadow_rate,
             100.0 * m.false_lit_rate,
             m.compared,
+            100.0 * m.surface_mismatch_rate,
+            m.surface(),
+        );
+        figure(
+            &format!("tree, {what}, pcf2x2: mismatch over light-facing pixels"),
+            percent(m.mismatch_rate),
+            "none: reported",
         );
         m
     };
     let fitted = measure(&scene, &s, "fitted view");
     figure(
-        "tree, fitted view, pcf2x2: mismatch",
-        percent(fitted.mismatch_rate),
+        "tree, fitted view, pcf2x2: mismatch over all surfaces",
+        percent(fitted.surface_mismatch_rate),
         percent(TREE_FITTED_MISMATCH),
     );
-    assert!(fitted.compared > 40_000, "{fitted:?}");
-    assert!(fitted.mismatch_rate < TREE_FITTED_MISMATCH, "{fitted:?}");
+    assert!(fitted.surface() > 40_000, "{fitted:?}");
+    assert!(fitted.surface_mismatch_rate < TREE_FITTED_MISMATCH, "{fitted:?}");
 
     // Close to the tree, with a ground three times its width.
     let b = scene.bounds();
@@ -223,14 +235,14 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     scene.camera.far = 10.0 * r;
     let close = measure(&scene, &s, "close view with ground");
     figure(
-        "tree, close view with ground, pcf2x2: mismatch",
-        percent(close.mismatch_rate),
+        "tree, close view with ground, pcf2x2: mismatch over all surfaces",
+        percent(close.surface_mismatch_rate),
         percent(TREE_CLOSE_MISMATCH),
     );
-    assert!(close.compared > 300_000, "{close:?}");
+    assert!(close.surface() > 300_000, "{close:?}");
     // Issue 4's 2 % is not met on this view (README); this bound only guards it
     // against getting worse.
-    assert!(close.mismatch_rate < TREE_CLOSE_MISMATCH, "{close:?}");
+    assert!(close.surface_mismatch_rate < TREE_CLOSE_MISMATCH, "{close:?}");
 }
 
 #[test]

@@ -131,7 +131,8 @@ fn opaque_casters_into_a_projected_map_take_the_depth_only_path() {
         .into_iter()
         .filter(|k| k.target == DepthTarget::Projected && k.coverage == Coverage::Opaque)
         .collect();
-    assert_eq!(opaque.len(), 12);
+    // 4 cull modes × 3 kinds of sides × 2 depth ranges.
+    assert_eq!(opaque.len(), 24);
     for key in opaque {
         let shape = ShadowPipelineShape::of(&key);
         assert_eq!(shape.fragment_entry, None, "{key:?}: no fragment stage");
