@@ -124,7 +124,7 @@ fn is_interior(scene: &Scene, triangles: &[[Vec3A; 3]]) -> bool {
 
 /// Looking at the bounds' centre from 25° up and 30° round, just far enough for
 /// every corner of the bounds to lie in a frame of [`FRAME_ASPECT`].
-pub fn exterior_camera(scene: &Scene) -> Camera {
+fn exterior_camera(scene: &Scene) -> Camera {
     let bounds = scene.bounds();
     let centre = bounds.center();
     let radius = bounds.bounding_radius().max(1e-3);
