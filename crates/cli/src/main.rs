@@ -3,6 +3,7 @@
 
 mod bench_cmd;
 mod cache;
+mod calibrate;
 mod compare_cmd;
 mod grid;
 mod lab;
@@ -34,6 +35,10 @@ enum Command {
     /// Time every pass (median and p95) per technique, with optional setting sweeps
     /// and the depth-only baseline; write bench.json and bench.md.
     Bench(Box<bench_cmd::BenchArgs>),
+    /// Sweep a technique's bias settings against the reference over several views;
+    /// plot the Pareto front of false shadow against false lit and pick the setting
+    /// with the least mismatch, checked on held-out views.
+    Calibrate(Box<calibrate::CalibrateArgs>),
     /// Open the interactive viewer: every technique and setting live, with debug views.
     View(Box<view_cmd::ViewArgs>),
     /// List the built-in scenes.
@@ -61,6 +66,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(args)) => compare_cmd::run(&args),
         Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Bench(args)) => bench_cmd::run(&args),
+        Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Scenes) => {
             for b in gnomon_scene::builtin::BUILTINS {
                 println!("{:<10} {}", b.name, b.description);
