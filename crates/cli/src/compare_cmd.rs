@@ -225,7 +225,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let summary = if soft {
             format!("MAE {:.4}  p99 {:.3}", m.mae, m.p99)
         } else {
-            format!("mismatch {:.3}% of light-facing", 100.0 * m.mismatch_rate)
+            format!("mismatch {:.3}% light-facing", 100.0 * m.mismatch_rate)
         };
         let mut caption = vec![name.to_string()];
         if let Some((s, f, l)) = timing {
