@@ -39,7 +39,8 @@ const HOST_AMBIENT: f32 = 0.12;
 
 @fragment
 fn host_fs(in: HostVertex, @builtin(front_facing) front: bool) -> HostTargets {
-    // The shading normal on the side the camera sees, as the receiver asks.
+    // The shading normal on the side the camera sees, for the host's own lighting
+    // (the receiver turns the normal it is given to that side itself).
     let n = select(-1.0, 1.0, front) * normalize(in.normal);
     // Gnomon's shadows, called in uniform control flow.
     let visibility = shadow_visibility(in.world, n, in.clip);

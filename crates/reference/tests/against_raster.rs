@@ -119,6 +119,12 @@ fn foundation_techniques_mismatch_under_a_twentieth_of_a_percent_on_spheres() {
 /// A single-sided wall (an open mesh) standing on a ground, its front facing +z and
 /// the sun behind it, 40° up: the sun sees only the wall's back faces.
 fn open_wall() -> Scene {
+    wall_under(sun_direction(40.0, 180.0))
+}
+
+/// A wall 8 wide and 4 tall standing on a ground, its front facing +z, under a sun
+/// from `toward_sun`; the camera looks at the wall's front.
+fn wall_under(toward_sun: Vec3) -> Scene {
     let camera = Camera {
         eye: Vec3::new(0.0, 6.0, 14.0),
         target: Vec3::new(0.0, 0.0, 3.0),
@@ -128,7 +134,7 @@ fn open_wall() -> Scene {
         far: 100.0,
     };
     let sun = DirectionalLight {
-        direction: -sun_direction(40.0, 180.0),
+        direction: -toward_sun,
         color: Vec3::ONE,
         intensity: 1.0,
         angular_diameter_degrees: 0.0,
@@ -180,4 +186,49 @@ fn the_reference_and_the_rasterizer_agree_on_an_open_wall_lit_from_behind() {
     assert_eq!(measure(&scene, &none, &truth), auto);
     // The wall's front, facing away from the sun, is seen but never compared.
     assert!(auto.unlit > 10_000, "{auto:?}");
+}
+
+/// The wall as a double-sided card facing a low sun (20° up, in front of it), as
+/// exported cards come: `reversed normals` points its authored normals against its
+/// winding (the `environment` scene's mountain cards and bamboo leaves do), and
+/// `mirrored` places it with a mirroring transform, which reverses its winding on
+/// screen. Two-sided shading must take the side the camera sees from the triangle's
+/// plane, not from the winding: turned by the winding, the normal points away from the
+/// sun, the normal offset looks the shadow up behind the card, and the card falls in
+/// its own shadow (measured before the fix: every pixel of the card falsely shadowed).
+#[test]
+fn a_card_facing_the_sun_is_lit_whichever_way_its_normals_and_winding_point() {
+    let s = settings(640, 360, Technique::PCF2X2);
+    let card = |reversed_normals: bool, mirrored: bool| {
+        let mut scene = wall_under(sun_direction(20.0, 0.0));
+        let wall = scene.instances[1].clone();
+        scene.materials[wall.material].double_sided = true;
+        if reversed_normals {
+            scene.meshes[wall.mesh].normals.iter_mut().for_each(|n| *n = -*n);
+        }
+        if mirrored {
+            // Mirrored across its own vertical axis: the same plane, its winding reversed.
+            scene.instances[1].world_from_object =
+                wall.world_from_object * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        }
+        scene
+    };
+    let truth = reference(&card(false, false), &s);
+    let wall_pixels = truth.object_id.iter().filter(|&&id| id == 2).count();
+    assert!(wall_pixels > 20_000, "the card fills part of the view: {wall_pixels} pixels");
+    for (reversed_normals, mirrored) in [(false, false), (true, false), (false, true)] {
+        let scene = card(reversed_normals, mirrored);
+        let m = measure(&scene, &s, &truth);
+        eprintln!(
+            "card facing the sun (normals reversed: {reversed_normals}, mirrored: {mirrored}): mismatch {:.3}% (false shadow {:.3}%) of {} light-facing pixels",
+            100.0 * m.mismatch_rate,
+            100.0 * m.false_shadow_rate,
+            m.compared
+        );
+        assert!(m.compared > wall_pixels, "the card is compared: {m:?}");
+        assert!(
+            m.mismatch_rate < OPEN_WALL_MISMATCH,
+            "normals reversed: {reversed_normals}, mirrored: {mirrored}: {m:?}"
+        );
+    }
 }

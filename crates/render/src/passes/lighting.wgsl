@@ -23,9 +23,9 @@ struct FragmentOut {
 };
 
 @fragment
-fn fs_main(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut {
+fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let inst = instances[in.instance];
-    let normals = surface_normals(in, front);
+    let normals = surface_normals(in);
     let n = normals.shading;
     let geometric_n = normals.geometric;
     let geometry = light_geometry(in.world);

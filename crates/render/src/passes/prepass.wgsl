@@ -11,8 +11,8 @@ struct PrepassTargets {
 
 // The vertex stage is surface.wgsl's vs_surface, the lighting pass's own.
 @fragment
-fn fs_prepass(in: SurfaceVertex, @builtin(front_facing) front: bool) -> PrepassTargets {
-    let normals = surface_normals(in, front);
+fn fs_prepass(in: SurfaceVertex) -> PrepassTargets {
+    let normals = surface_normals(in);
     if alpha_cut(instances[in.instance], in.uv) {
         discard;
     }

@@ -20,8 +20,8 @@
 // cone or a light's range; 1 fully lit. Exactly what Gnomon's own lighting pass
 // computes for the same point.
 //
-// `normal`: the unit shading normal on the side the camera sees (flip it on back
-// faces, as `@builtin(front_facing)` tells). `frag_coord`: the fragment's
+// `normal`: the unit shading normal, on either side: it is turned to the side the
+// camera sees, by the triangle's plane. `frag_coord`: the fragment's
 // `@builtin(position)`, for the per-pixel rotation of the filter taps.
 //
 // Call it from a fragment shader in uniform control flow, before any `discard`: it

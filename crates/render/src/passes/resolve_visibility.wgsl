@@ -17,7 +17,11 @@ fn pixel_visibility(
     pixel: vec2<f32>,
     view_depth: f32,
 ) -> vec2<f32> {
-    var shadow = lookup_visibility(world, n, l, world_dx, world_dy, pixel, view_depth);
+    // The normal offset moves the lookup along `n`: it must point to the side the
+    // camera sees, or the offset looks up behind the surface. A host's shader may pass
+    // a normal turned by the winding, which authored normals can contradict.
+    let seen_n = facing_side(n, geometric_n);
+    var shadow = lookup_visibility(world, seen_n, l, world_dx, world_dy, pixel, view_depth);
     if light.kind != LIGHT_SUN && cone <= 0.0 {
         // Outside a spot's cone or a light's range no light arrives: visibility 0 by
         // definition.

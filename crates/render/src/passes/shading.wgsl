@@ -24,3 +24,10 @@ fn light_geometry(world: vec3<f32>) -> vec4<f32> {
     let falloff = smoothstep(light.cos_outer, light.cos_inner, cos_angle);
     return vec4<f32>(l, select(0.0, falloff, inside));
 }
+
+// `n` turned into the hemisphere of `toward`: the side of a surface a given
+// direction sees. Two-sided surfaces take their shading normal from the side the
+// camera sees this way, not from the winding (see surface.wgsl).
+fn facing_side(n: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
+    return select(n, -n, dot(n, toward) < 0.0);
+}

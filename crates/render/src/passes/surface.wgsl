@@ -33,8 +33,9 @@ fn vs_surface(
 }
 
 struct SurfaceNormals {
-    // The interpolated normal, flipped on back faces: two-sided shading, so that a
-    // back face seen by the camera is lit as its flipped side, as a ray tracer sees it.
+    // The interpolated normal, turned to the side the camera sees: two-sided shading,
+    // so that a back face seen by the camera is lit as its flipped side, as a ray
+    // tracer sees it.
     shading: vec3<f32>,
     // The triangle's plane normal, facing the camera: the world position's
     // derivatives are constant across a triangle.
@@ -42,15 +43,21 @@ struct SurfaceNormals {
 };
 
 // Must be called in uniform control flow (it takes derivatives).
-fn surface_normals(in: SurfaceVertex, front: bool) -> SurfaceNormals {
+//
+// The shading normal is turned into the geometric normal's hemisphere rather than
+// flipped by `@builtin(front_facing)`: the winding says which side the camera sees
+// only when the authored normals agree with it, and exported cards often disagree
+// (the `environment` scene's double-sided mountain cards and bamboo leaves point
+// their normals against their winding). Turned by the winding, such a card's normal
+// points away from the camera and the sun it faces, and the normal offset then looks
+// the shadow up behind the card itself: the whole card fell in its own shadow. The
+// same rule serves mirrored instances, whose transform reverses the winding.
+fn surface_normals(in: SurfaceVertex) -> SurfaceNormals {
     var out: SurfaceNormals;
     out.geometric = normalize(cross(dpdx(in.world), dpdy(in.world)));
     if dot(out.geometric, camera.eye - in.world) < 0.0 {
         out.geometric = -out.geometric;
     }
-    out.shading = normalize(in.normal);
-    if !front {
-        out.shading = -out.shading;
-    }
+    out.shading = facing_side(normalize(in.normal), out.geometric);
     return out;
 }
