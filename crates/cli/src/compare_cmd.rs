@@ -324,14 +324,7 @@ fn measure_flicker(
         let fraction = k as f32 / (args.path_frames - 1) as f32;
         let camera = camera_on_path(&start, kind, args.path_travel, fraction);
         let mut s = settings.clone();
-        // Every camera field explicit, so that no plane is refitted along the path.
-        s.camera = CameraSettings {
-            eye: Some(camera.eye),
-            target: Some(camera.target),
-            fov_y_degrees: Some(camera.fov_y_degrees),
-            near: Some(camera.near),
-            far: Some(camera.far),
-        };
+        s.camera = CameraSettings::pinned(&camera);
         let reference = bar.suspend(|| lab::reference(scene, &s, !args.no_cache))?.image;
         for (t, technique) in args.techniques.iter().enumerate() {
             s.shadow.filter.technique = technique.clone();

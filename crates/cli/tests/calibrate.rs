@@ -17,10 +17,11 @@ fn calibrate(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
 
 #[test]
 fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
-    let dir = temp_dir("calibrate");
+    let temp = temp_dir("calibrate");
+    let dir = temp.path();
     std::fs::write(dir.join("scene.toml"), "builtin = \"contact\"\n").unwrap();
     let out = calibrate(
-        &dir,
+        dir,
         &[
             "--technique",
             "hard",
@@ -54,7 +55,7 @@ fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
     let slope = bias["slope_bias"].as_float().unwrap();
     assert!([0.0, 1.5, 3.0].contains(&slope), "{written}");
     let render = std::process::Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&*dir)
+        .current_dir(dir)
         .args(["render", "scene.toml", "--width", "64", "--height", "36", "--out", "check.png"])
         .output()
         .unwrap();
@@ -63,7 +64,8 @@ fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
 
 #[test]
 fn calibrate_refuses_empty_inverted_and_pointless_sweeps_before_any_work() {
-    let dir = temp_dir("calibrate-bad");
+    let temp = temp_dir("calibrate-bad");
+    let dir = temp.path();
     for (args, says) in [
         (&["--sweep-slope-bias", "3..1:4"][..], "inverted"),
         (&["--sweep-slope-bias", "0..1:0"][..], "1 to 64 values"),
@@ -71,8 +73,12 @@ fn calibrate_refuses_empty_inverted_and_pointless_sweeps_before_any_work() {
         (&["--sweep-slope-bias", "1..1:1", "--sweep-normal-offset", "0..0:1"][..], "nothing to sweep"),
         (&["--views", "1"][..], "--views = 1"),
         (&["--light", "all", "--light-index", "3"][..], "light"),
+        // `contact` has no light list: a scene without lights to calibrate for.
+        (&["--light", "all"][..], "calibration needs a light"),
+        (&["--technique", "pcf2x2", "--sweep-kernel", "3..7:3"][..], "has no PCF kernel to sweep"),
+        (&["--technique", "pcf", "--sweep-kernel", "0..7:3"][..], "--sweep-kernel = 0 is invalid"),
     ] {
-        let out = calibrate(&dir, &[args, &["--out", "cal"]].concat());
+        let out = calibrate(dir, &[args, &["--out", "cal"]].concat());
         assert!(!out.status.success(), "{args:?} was accepted");
         assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
         assert!(!dir.join("cal").exists(), "{args:?} wrote output");

@@ -9,8 +9,9 @@ use support::{files_in, gnomon, stderr, temp_dir};
 
 #[test]
 fn no_arguments_renders_spheres_to_gnomon_png() {
-    let dir = temp_dir("default");
-    let out = gnomon(&dir, &[]);
+    let temp = temp_dir("default");
+    let dir = temp.path();
+    let out = gnomon(dir, &[]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "gnomon.png");
     let image = image::open(dir.join("gnomon.png")).unwrap().to_rgba8();
@@ -18,14 +19,15 @@ fn no_arguments_renders_spheres_to_gnomon_png() {
     // Not blank: the image has sky, lit ground and shadow, so many distinct colours.
     let distinct: std::collections::HashSet<_> = image.pixels().map(|p| p.0).collect();
     assert!(distinct.len() > 1000, "only {} distinct colours", distinct.len());
-    assert_eq!(files_in(&dir), ["gnomon.png"]);
+    assert_eq!(files_in(dir), ["gnomon.png"]);
 }
 
 #[test]
 fn float_outputs_are_written_with_their_documented_layout() {
-    let dir = temp_dir("floats");
+    let temp = temp_dir("floats");
+    let dir = temp.path();
     let out = gnomon(
-        &dir,
+        dir,
         &[
             "render",
             "contact",
@@ -74,8 +76,9 @@ fn float_outputs_are_written_with_their_documented_layout() {
 
 #[test]
 fn an_unknown_scene_names_the_valid_ones() {
-    let dir = temp_dir("unknown");
-    let out = gnomon(&dir, &["render", "nope"]);
+    let temp = temp_dir("unknown");
+    let dir = temp.path();
+    let out = gnomon(dir, &["render", "nope"]);
     assert!(!out.status.success());
     let e = stderr(&out);
     assert!(
@@ -84,14 +87,15 @@ fn an_unknown_scene_names_the_valid_ones() {
             && e.contains(".glb"),
         "{e}"
     );
-    assert!(files_in(&dir).is_empty());
+    assert!(files_in(dir).is_empty());
 }
 
 #[test]
 fn a_shadow_map_beyond_the_device_limit_is_refused() {
-    let dir = temp_dir("limit");
+    let temp = temp_dir("limit");
+    let dir = temp.path();
     let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .env("GNOMON_MAX_TEXTURE_SIZE", "2048")
         .args(["render", "--shadow-res", "4096"])
         .output()
@@ -99,40 +103,42 @@ fn a_shadow_map_beyond_the_device_limit_is_refused() {
     assert!(!out.status.success());
     let e = stderr(&out);
     assert!(e.contains("--shadow-res = 4096") && e.contains("up to 2048"), "{e}");
-    assert!(files_in(&dir).is_empty());
-    let out = gnomon(&dir, &["render", "--shadow-res", "100000"]);
+    assert!(files_in(dir).is_empty());
+    let out = gnomon(dir, &["render", "--shadow-res", "100000"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("256 to 8192"), "{}", stderr(&out));
-    assert!(files_in(&dir).is_empty());
+    assert!(files_in(dir).is_empty());
 }
 
 #[test]
 fn an_unwritable_output_fails_cleanly_and_writes_nothing() {
-    let dir = temp_dir("unwritable");
+    let temp = temp_dir("unwritable");
+    let dir = temp.path();
     std::fs::write(dir.join("a-file"), b"x").unwrap();
     // The directory of --out does not exist.
-    let out = gnomon(&dir, &["render", "--out", "missing/x.png"]);
+    let out = gnomon(dir, &["render", "--out", "missing/x.png"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("missing") && stderr(&out).contains("does not exist"), "{}", stderr(&out));
     // One good output and one bad: neither is written.
     let out = gnomon(
-        &dir,
+        dir,
         &["render", "--width", "64", "--height", "64", "--out", "ok.png", "--visibility-out", "a-file/v.npy"],
     );
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--visibility-out"), "{}", stderr(&out));
     // A wrong extension names the valid ones.
-    let out = gnomon(&dir, &["render", "--visibility-out", "v.txt"]);
+    let out = gnomon(dir, &["render", "--visibility-out", "v.txt"]);
     assert!(stderr(&out).contains(".exr or .npy"), "{}", stderr(&out));
-    assert_eq!(files_in(&dir), ["a-file"]);
+    assert_eq!(files_in(dir), ["a-file"]);
 }
 
 #[test]
 fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
-    let dir = temp_dir("compare");
+    let temp = temp_dir("compare");
+    let dir = temp.path();
     let run = || {
         Command::new(env!("CARGO_BIN_EXE_gnomon"))
-            .current_dir(&dir)
+            .current_dir(dir)
             .env("GNOMON_CACHE_DIR", dir.join("cache"))
             .args(["compare", "contact", "--width", "160", "--height", "90", "--shadow-res", "512"])
             .args(["--techniques", "hard,pcf2x2", "--out", "cmp", "--timing-frames", "2"])
@@ -185,9 +191,10 @@ fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
 
 #[test]
 fn compare_along_a_camera_path_reports_m_flips_and_shimmer() {
-    let dir = temp_dir("camera-path");
+    let temp = temp_dir("camera-path");
+    let dir = temp.path();
     let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .env("GNOMON_CACHE_DIR", dir.join("cache"))
         .args(["compare", "columns", "--width", "160", "--height", "90", "--shadow-res", "512"])
         .args(["--techniques", "hard", "--out", "cmp", "--timing-frames", "1"])
@@ -207,7 +214,7 @@ fn compare_along_a_camera_path_reports_m_flips_and_shimmer() {
     assert!((0.0..0.05).contains(&shimmer), "{flicker}");
     // Bad path parameters name the flag and the valid range, and write nothing.
     let bad = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["compare", "columns", "--camera-path", "dolly", "--path-frames", "1", "--out", "bad"])
         .output()
         .unwrap();
@@ -218,9 +225,10 @@ fn compare_along_a_camera_path_reports_m_flips_and_shimmer() {
 
 #[test]
 fn reference_writes_visibility_and_standard_error() {
-    let dir = temp_dir("reference");
+    let temp = temp_dir("reference");
+    let dir = temp.path();
     let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .env("GNOMON_CACHE_DIR", dir.join("cache"))
         .args(["reference", "spheres", "--light", "spot", "--spot-radius", "0.4", "--samples", "16"])
         .args(["--width", "96", "--height", "54", "--out", "r.exr", "--std-error-out", "se.npy"])
@@ -228,9 +236,9 @@ fn reference_writes_visibility_and_standard_error() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("Mrays/s") && stderr(&out).contains("standard error"), "{}", stderr(&out));
-    let names = files_in(&dir);
+    let names = files_in(dir);
     assert!(names.contains(&"r.exr".to_string()) && names.contains(&"se.npy".to_string()), "{names:?}");
-    let bad = gnomon(&dir, &["reference", "--samples", "4"]);
+    let bad = gnomon(dir, &["reference", "--samples", "4"]);
     assert!(!bad.status.success() && stderr(&bad).contains("--samples"), "{}", stderr(&bad));
 }
 
@@ -246,7 +254,8 @@ const TRIANGLE_GLTF: &str = r#"{
 
 #[test]
 fn a_scene_file_renders_with_its_views_and_settings() {
-    let dir = temp_dir("scene-file");
+    let temp = temp_dir("scene-file");
+    let dir = temp.path();
     std::fs::write(dir.join("tri.gltf"), TRIANGLE_GLTF).unwrap();
     // The flat triangle is stood upright (90° about x), so that the ground, placed at
     // the scene's lowest point, meets its bottom edge and catches its shadow.
@@ -258,14 +267,14 @@ fn a_scene_file_renders_with_its_views_and_settings() {
     )
     .unwrap();
     let out = gnomon(
-        &dir,
+        dir,
         &["render", "scene.toml", "--view", "above", "--out", "s.png", "--visibility-out", "v.npy"],
     );
     assert!(out.status.success(), "{}", stderr(&out));
     let image = image::open(dir.join("s.png")).unwrap();
     assert_eq!((image.width(), image.height()), (96, 54), "the file's [settings.image] applies");
     // The command line overrides the file.
-    let out = gnomon(&dir, &["render", "scene.toml", "--width", "64", "--out", "s.png"]);
+    let out = gnomon(dir, &["render", "scene.toml", "--width", "64", "--out", "s.png"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(image::open(dir.join("s.png")).unwrap().width(), 64);
     // The triangle's shadow falls on the ground: some ground pixels are shadowed.
@@ -276,9 +285,9 @@ fn a_scene_file_renders_with_its_views_and_settings() {
         .filter(|c| f32::from_le_bytes((*c).try_into().unwrap()) < 0.5)
         .count();
     assert!(shadowed > 20, "{shadowed}");
-    let bad = gnomon(&dir, &["render", "scene.toml", "--view", "below"]);
+    let bad = gnomon(dir, &["render", "scene.toml", "--view", "below"]);
     assert!(!bad.status.success() && stderr(&bad).contains("no view `below`"), "{}", stderr(&bad));
-    let bad = gnomon(&dir, &["render", "spheres", "--view", "above"]);
+    let bad = gnomon(dir, &["render", "spheres", "--view", "above"]);
     assert!(
         !bad.status.success() && stderr(&bad).contains("views come from scene files"),
         "{}",
@@ -289,9 +298,10 @@ fn a_scene_file_renders_with_its_views_and_settings() {
 #[test]
 fn no_adapter_says_how_to_get_one() {
     // An empty WGPU_BACKEND enables no backend: the same as a machine with no driver.
-    let dir = temp_dir("no-adapter");
+    let temp = temp_dir("no-adapter");
+    let dir = temp.path();
     let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .env("WGPU_BACKEND", "")
         .arg("render")
         .output()
@@ -299,14 +309,15 @@ fn no_adapter_says_how_to_get_one() {
     assert!(!out.status.success());
     let e = stderr(&out);
     assert!(e.contains("no GPU adapter found") && e.contains("apt-get install mesa-vulkan-drivers"), "{e}");
-    assert!(files_in(&dir).is_empty());
+    assert!(files_in(dir).is_empty());
 }
 
 #[test]
 fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
-    let dir = temp_dir("many-lights");
+    let temp = temp_dir("many-lights");
+    let dir = temp.path();
     let out = gnomon(
-        &dir,
+        dir,
         &[
             "render",
             "lamps",
@@ -339,32 +350,33 @@ fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
     }
 
     // A technique a cube map cannot take is refused, naming the light.
-    let out = gnomon(&dir, &["render", "--light", "point", "--technique", "vsm", "-o", "vsm.png"]);
+    let out = gnomon(dir, &["render", "--light", "point", "--technique", "vsm", "-o", "vsm.png"]);
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("--technique") && err.contains("point light"), "{err}");
     assert!(!dir.join("vsm.png").exists());
     // --light all needs a light list.
-    let out = gnomon(&dir, &["render", "columns", "--light", "all", "-o", "none.png"]);
+    let out = gnomon(dir, &["render", "columns", "--light", "all", "-o", "none.png"]);
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("light list") && err.contains("lamps"), "{err}");
 }
 
 #[test]
 fn contact_shadows_render_through_the_mask_and_forward_refuses_them() {
-    let dir = temp_dir("contact-shadows");
+    let temp = temp_dir("contact-shadows");
+    let dir = temp.path();
     let args = ["render", "contact", "--width", "320", "--height", "180", "--contact-shadows", "--verbose"];
-    let out = gnomon(&dir, &[&args[..], &["-o", "contact.png"]].concat());
+    let out = gnomon(dir, &[&args[..], &["-o", "contact.png"]].concat());
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(dir.join("contact.png").is_file());
     assert!(err.contains("in the prepass (shadows resolved in a screen-space mask)"), "{err}");
     // Contact shadows march through the prepass's depth: the forward path has none.
-    let out = gnomon(&dir, &[&args[..], &["--shadow-path", "forward", "-o", "forward.png"]].concat());
+    let out = gnomon(dir, &[&args[..], &["--shadow-path", "forward", "-o", "forward.png"]].concat());
     let err = stderr(&out);
     assert!(!out.status.success() && !dir.join("forward.png").exists());
     assert!(err.contains("--contact-shadows") && err.contains("--shadow-path auto or mask"), "{err}");
     // An impossible parameter names its flag and range.
-    let out = gnomon(&dir, &[&args[..], &["--contact-steps", "0", "-o", "zero.png"]].concat());
+    let out = gnomon(dir, &[&args[..], &["--contact-steps", "0", "-o", "zero.png"]].concat());
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("--contact-steps") && err.contains("1 to 64"), "{err}");
 }
@@ -374,10 +386,11 @@ fn contact_shadows_render_through_the_mask_and_forward_refuses_them() {
 /// input named, before any window opens and with nothing written.
 #[test]
 fn the_viewer_saves_a_screenshot_and_refuses_bad_input() {
-    let dir = temp_dir("view");
+    let temp = temp_dir("view");
+    let dir = temp.path();
     let refused = |args: &[&str], needle: &str| {
         let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
-            .current_dir(&dir)
+            .current_dir(dir)
             .args(args)
             .env_remove("DISPLAY")
             .env_remove("WAYLAND_DISPLAY")
@@ -392,10 +405,10 @@ fn the_viewer_saves_a_screenshot_and_refuses_bad_input() {
     refused(&["view", "--frames", "0"], "--frames");
     refused(&["view", "nope"], "unknown scene `nope`");
     refused(&["view", "--frames", "2"], "xvfb-run");
-    assert!(files_in(&dir).is_empty());
+    assert!(files_in(dir).is_empty());
 
     let out = Command::new("xvfb-run")
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_gnomon")])
         .args(["view", "contact", "--frames", "3", "--screenshot", "shot.png", "--window", "900x600"])
         .output()
@@ -406,14 +419,15 @@ fn the_viewer_saves_a_screenshot_and_refuses_bad_input() {
     assert_eq!(shot.dimensions(), (900, 600));
     let distinct: std::collections::HashSet<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
     assert!(distinct.len() > 500, "a near-blank screenshot: {} colours", distinct.len());
-    assert_eq!(files_in(&dir), ["shot.png"]);
+    assert_eq!(files_in(dir), ["shot.png"]);
 }
 
 #[test]
 fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
-    let dir = temp_dir("bench");
+    let temp = temp_dir("bench");
+    let dir = temp.path();
     let out = gnomon(
-        &dir,
+        dir,
         &[
             "bench",
             "spheres",
@@ -492,8 +506,8 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
         (&["bench", "--frames", "0"][..], "--frames 0"),
         (&["bench", "instances:5"][..], "unknown scene"),
     ] {
-        let out = gnomon(&dir, args);
+        let out = gnomon(dir, args);
         assert!(!out.status.success() && stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
     }
-    assert_eq!(files_in(&dir), ["b"]);
+    assert_eq!(files_in(dir), ["b"]);
 }

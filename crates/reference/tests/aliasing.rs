@@ -90,13 +90,7 @@ fn flicker_along_truck(scene: &Scene, traced: &TracedScene, s: &Settings, frames
     for k in 0..frames {
         let camera = camera_on_path(&start, CameraPathKind::Truck, 0.05, k as f32 / (frames - 1) as f32);
         let mut sk = s.clone();
-        sk.camera = CameraSettings {
-            eye: Some(camera.eye),
-            target: Some(camera.target),
-            fov_y_degrees: Some(camera.fov_y_degrees),
-            near: Some(camera.near),
-            far: Some(camera.far),
-        };
+        sk.camera = CameraSettings::pinned(&camera);
         let frame = renderer.render_uploaded(&uploaded, scene, &sk, &OutputRequest::default()).unwrap();
         let options =
             gnomon_reference::ReferenceOptions { width: frame.width, height: frame.height, samples: 1 };

@@ -7,7 +7,7 @@ mod support;
 use glam::Vec2;
 use gnomon_render::{
     OutputRequest, RenderError, Renderer,
-    techniques::{MapSupport, ShadowTechnique, TechniqueRegistry},
+    techniques::{MapSupport, ShadowTechnique, TechniqueRegistry, Tunables},
 };
 use gnomon_scene::settings::{FilterSettings, LightKind, Settings, Technique, WarpKind};
 use support::*;
@@ -41,6 +41,11 @@ impl ShadowTechnique for PcfCross {
     fn maps(&self) -> MapSupport {
         MapSupport::ANY
     }
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
+    }
+
     /// One texel each way.
     fn filter_reach_texels(&self, _: &FilterSettings, _: f32) -> f32 {
         1.0

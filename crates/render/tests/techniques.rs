@@ -310,3 +310,54 @@ fn cascades_put_finer_texels_near_the_camera() {
         texels[0]
     );
 }
+
+/// Whether changing `change` in `s` changes any pixel's visibility by more than 1e-3.
+fn image_moves(scene: &Scene, s: &Settings, change: impl Fn(&mut Settings)) -> usize {
+    let before = render(scene, s);
+    let mut changed = s.clone();
+    change(&mut changed);
+    let after = render(scene, &changed);
+    before.visibility.iter().zip(&after.visibility).filter(|(a, b)| (*a - *b).abs() > 1e-3).count()
+}
+
+/// The contract's `tunables`: a technique states exactly the settings that move its
+/// shadow, which is what `gnomon calibrate` sweeps. A stated setting changes the
+/// image under the square occluder; an unstated one leaves every pixel as it was.
+#[test]
+fn every_technique_states_exactly_the_settings_that_move_its_shadow() {
+    let SquareOccluder { scene, .. } = square_under_sun();
+    for technique in TechniqueRegistry::builtin().iter() {
+        let mut s = settings(320, 240, 512);
+        s.shadow.filter.technique = technique.technique();
+        s.shadow.bias.normal_offset = 0.0;
+        let stated = technique.tunables();
+        let name = technique.technique().name().to_owned();
+        // A constant bias of half the light's depth range pushes every caster behind
+        // its receivers; an offset of 10 texels (scaled down to a fifth or so on ground facing the sun) moves
+        // the lookup across the edge; a
+        // kernel of 9 texels instead of 3 widens the filtered edge.
+        let moved = [
+            (
+                "raster bias",
+                stated.raster_bias,
+                image_moves(&scene, &s, |s| s.shadow.bias.depth_bias = 1 << 23),
+            ),
+            (
+                "normal offset",
+                stated.normal_offset,
+                image_moves(&scene, &s, |s| s.shadow.bias.normal_offset = 10.0),
+            ),
+            ("kernel", stated.kernel, image_moves(&scene, &s, |s| s.shadow.filter.pcf_kernel = 9.0)),
+        ];
+        for (setting, stated, pixels) in moved {
+            if stated {
+                assert!(
+                    pixels > 50,
+                    "{name} states that the {setting} moves its shadow, but {pixels} pixels moved"
+                );
+            } else {
+                assert_eq!(pixels, 0, "{name} states that the {setting} leaves its shadow alone");
+            }
+        }
+    }
+}

@@ -2,9 +2,10 @@
 //! its bounds, or, for an interior (a courtyard, a room), inside it.
 //!
 //! Outside, the camera looks at the bounds' centre from 25° above the horizon and 30°
-//! round from +z, as close as lets every corner of the bounding box into the frame:
-//! the bounding sphere then fills most of the frame height, where fitting the sphere
-//! itself in the frame leaves an elongated model a third of it.
+//! round from +z, as close as lets every vertex into the frame: the model itself then
+//! reaches the frame's edge, where fitting its bounding sphere leaves an elongated
+//! model a third of the frame, and fitting its bounding box leaves a round one (a
+//! tree's crown, a sphere) well inside it.
 //!
 //! A scene is an interior when it is walled in: from points at a third of its height
 //! around its centre, most horizontal rays meet, well away, a surface whose front
@@ -40,7 +41,11 @@ const FRAME_ASPECT: f32 = 16.0 / 9.0;
 /// once the scene's instances are placed.
 pub fn default_camera(scene: &Scene) -> Camera {
     let triangles = world_triangles(scene);
-    if is_interior(scene, &triangles) { interior_camera(scene, &triangles) } else { exterior_camera(scene) }
+    if is_interior(scene, &triangles) {
+        interior_camera(scene, &triangles)
+    } else {
+        exterior_camera(scene, &triangles)
+    }
 }
 
 /// Every instance's triangles in world space (a flat list: the probe casts a few
@@ -123,8 +128,9 @@ fn is_interior(scene: &Scene, triangles: &[[Vec3A; 3]]) -> bool {
 }
 
 /// Looking at the bounds' centre from 25° up and 30° round, just far enough for
-/// every corner of the bounds to lie in a frame of [`FRAME_ASPECT`].
-fn exterior_camera(scene: &Scene) -> Camera {
+/// every vertex of `triangles` (the scene's, in world space) to lie in a frame of
+/// [`FRAME_ASPECT`].
+fn exterior_camera(scene: &Scene, triangles: &[[Vec3A; 3]]) -> Camera {
     let bounds = scene.bounds();
     let centre = bounds.center();
     let radius = bounds.bounding_radius().max(1e-3);
@@ -133,13 +139,13 @@ fn exterior_camera(scene: &Scene) -> Camera {
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
     let tan_half = (0.5 * EXTERIOR_FOV_DEGREES.to_radians()).tan() * FILL;
-    // A corner q (from the centre) at eye distance d has view depth d + q·forward; it
+    // A vertex q (from the centre) at eye distance d has view depth d + q·forward; it
     // is in the frame when |q·up| ≤ tan_half · depth and |q·right| ≤ aspect · tan_half · depth.
-    let distance = bounds
-        .corners()
+    let distance = triangles
         .iter()
+        .flatten()
         .map(|&p| {
-            let q = p - centre;
+            let q = Vec3::from(p) - centre;
             q.dot(up).abs().max(q.dot(right).abs() / FRAME_ASPECT) / tan_half - q.dot(forward)
         })
         .fold(radius * 1e-3, f32::max);
@@ -215,7 +221,7 @@ fn interior_camera(scene: &Scene, triangles: &[[Vec3A; 3]]) -> Camera {
     let radius = bounds.bounding_radius().max(1e-3);
     // No spot sees only front faces: the probe was wrong, so frame the outside.
     let Some((_, eye, target)) = best else {
-        return exterior_camera(scene);
+        return exterior_camera(scene, triangles);
     };
     Camera {
         eye,
@@ -256,20 +262,19 @@ mod tests {
         scene
     }
 
-    /// Every corner lies inside the frame, and the widest reaches near its edge.
+    /// Every vertex lies inside the frame, and the widest reaches near its edge.
     fn assert_frames_tightly(scene: &Scene, camera: &Camera) {
         let clip_from_world = camera.clip_from_world(FRAME_ASPECT);
-        let reach = scene
-            .bounds()
-            .corners()
+        let reach = world_triangles(scene)
             .iter()
+            .flatten()
             .map(|&p| {
-                let clip = clip_from_world * p.extend(1.0);
-                assert!(clip.w > 0.0, "a corner behind the camera");
+                let clip = clip_from_world * Vec3::from(p).extend(1.0);
+                assert!(clip.w > 0.0, "a vertex behind the camera");
                 (clip.x / clip.w).abs().max((clip.y / clip.w).abs())
             })
             .fold(0.0f32, f32::max);
-        assert!((0.9..=1.0).contains(&reach), "the bounds reach {reach} of the half-frame");
+        assert!((0.9..=1.0).contains(&reach), "the model reaches {reach} of the half-frame");
     }
 
     #[test]
@@ -288,6 +293,12 @@ mod tests {
             Mat4::from_translation(Vec3::new(100.0, -4.0, 7.0)),
         )]);
         assert_frames_tightly(&slab, &default_camera(&slab));
+
+        // A round model fills the frame too: fitting its bounding box's corners left a
+        // sphere at about 0.6 of the half-frame.
+        let ball =
+            scene_of(vec![(geometry::uv_sphere(2.0, 48, 24), Mat4::from_translation(Vec3::splat(5.0)))]);
+        assert_frames_tightly(&ball, &default_camera(&ball));
     }
 
     /// Four inward-facing walls and a floor: a courtyard, seen from inside; the same

@@ -44,7 +44,8 @@ fn check_hierarchy(path: &Path) {
 
 #[test]
 fn hierarchy_transforms_and_materials_from_gltf_with_an_external_buffer() {
-    let dir = temp_dir("external");
+    let temp = temp_dir("external");
+    let dir = temp.path();
     std::fs::write(dir.join("tri.bin"), triangle_bytes()).unwrap();
     std::fs::write(dir.join("tri.gltf"), hierarchy_json(Some("tri.bin"))).unwrap();
     check_hierarchy(&dir.join("tri.gltf"));
@@ -52,7 +53,8 @@ fn hierarchy_transforms_and_materials_from_gltf_with_an_external_buffer() {
 
 #[test]
 fn hierarchy_transforms_and_materials_from_glb() {
-    let dir = temp_dir("glb");
+    let temp = temp_dir("glb");
+    let dir = temp.path();
     std::fs::write(dir.join("tri.glb"), glb(&hierarchy_json(None), &triangle_bytes())).unwrap();
     check_hierarchy(&dir.join("tri.glb"));
 }
@@ -88,7 +90,8 @@ fn every_broken_file_gives_a_clear_error() {
 
 #[test]
 fn truncated_and_garbage_files_do_not_panic() {
-    let dir = temp_dir("garbage");
+    let temp = temp_dir("garbage");
+    let dir = temp.path();
     let good = glb(&hierarchy_json(None), &triangle_bytes());
     for cut in [0, 4, 12, 20, 40, good.len() / 2, good.len() - 3] {
         let path = dir.join(format!("cut{cut}.glb"));
@@ -105,7 +108,8 @@ fn truncated_and_garbage_files_do_not_panic() {
 #[test]
 fn every_punctual_light_joins_the_light_list() {
     use gnomon_scene::Light;
-    let dir = temp_dir("lights");
+    let temp = temp_dir("lights");
+    let dir = temp.path();
     let json = hierarchy_json(None).replacen(
         r#""asset": {"version": "2.0"},"#,
         r#""asset": {"version": "2.0"},

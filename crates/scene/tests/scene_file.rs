@@ -49,8 +49,9 @@ pcf_kernel = 5
 
 #[test]
 fn models_lights_views_and_settings_come_from_the_file() {
-    let dir = temp_dir("scene-file");
-    let path = write_scene(&dir, SCENE);
+    let temp = temp_dir("scene-file");
+    let dir = temp.path();
+    let path = write_scene(dir, SCENE);
     let loaded = scene_file::load(&path, None).unwrap();
     let scene = &loaded.scene;
     // Two models of one instance each, and the ground.
@@ -82,9 +83,10 @@ fn models_lights_views_and_settings_come_from_the_file() {
 
 #[test]
 fn bad_scene_files_name_the_file_and_the_problem() {
-    let dir = temp_dir("scene-file-bad");
+    let temp = temp_dir("scene-file-bad");
+    let dir = temp.path();
     let check = |text: &str, expected: &str| {
-        let path = write_scene(&dir, text);
+        let path = write_scene(dir, text);
         let e = scene_file::load(&path, None).err().expect(expected).to_string();
         assert!(e.contains("scene.toml") && e.contains(expected), "{e}");
     };
@@ -98,7 +100,7 @@ fn bad_scene_files_name_the_file_and_the_problem() {
         "[[model]]\nfile = \"tri.glb\"\n[[light]]\ntype = \"sun\"\nelevation = 40.0\nazimuth = 0.0\n[light.shadow]\nmap.resolutoin = 512\n",
         "unknown field `resolutoin`",
     );
-    let path = write_scene(&dir, SCENE);
+    let path = write_scene(dir, SCENE);
     let e = scene_file::load(&path, Some("side")).err().unwrap().to_string();
     assert!(e.contains("no view `side`") && e.contains("front, top"), "{e}");
 }
@@ -139,8 +141,9 @@ range = 20.0
 #[test]
 fn point_lights_and_the_light_list_come_from_the_file() {
     use gnomon_scene::{Light, settings::LightKind};
-    let dir = temp_dir("scene-file-lights");
-    let scene = scene_file::load(&write_scene(&dir, LIGHTS), None).unwrap().scene;
+    let temp = temp_dir("scene-file-lights");
+    let dir = temp.path();
+    let scene = scene_file::load(&write_scene(dir, LIGHTS), None).unwrap().scene;
     assert_eq!(
         (scene.point.position, scene.point.range, scene.point.radius),
         (Vec3::new(0.0, 3.0, 0.0), 12.0, 0.1)
@@ -171,10 +174,11 @@ fn point_lights_and_the_light_list_come_from_the_file() {
 
 #[test]
 fn bad_light_entries_name_the_light_and_the_field() {
-    let dir = temp_dir("scene-file-bad-lights");
+    let temp = temp_dir("scene-file-bad-lights");
+    let dir = temp.path();
     let check = |light: &str, expected: &str| {
         let text = format!("[[model]]\nfile = \"tri.glb\"\n[[light]]\nname = \"lamp\"\n{light}");
-        let path = write_scene(&dir, &text);
+        let path = write_scene(dir, &text);
         let e = scene_file::load(&path, None).err().expect(expected).to_string();
         assert!(e.contains("scene.toml") && e.contains("`lamp`") && e.contains(expected), "{e}");
     };
@@ -182,10 +186,8 @@ fn bad_light_entries_name_the_light_and_the_field() {
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance > 0");
     check("type = \"area\"\n", "sun, spot or point");
     // The [point] table is checked the same way.
-    let path = write_scene(
-        &dir,
-        "[[model]]\nfile = \"tri.glb\"\n[point]\nposition = [0.0, 1.0, 0.0]\nrange = 0.0\n",
-    );
+    let path =
+        write_scene(dir, "[[model]]\nfile = \"tri.glb\"\n[point]\nposition = [0.0, 1.0, 0.0]\nrange = 0.0\n");
     let e = scene_file::load(&path, None).err().unwrap().to_string();
     assert!(e.contains("[point]") && e.contains("a distance > 0"), "{e}");
     check(
@@ -200,7 +202,8 @@ fn bad_light_entries_name_the_light_and_the_field() {
 
 #[test]
 fn a_light_may_have_contact_shadows_and_the_file_a_shadow_path() {
-    let dir = temp_dir("contact-shadows");
+    let temp = temp_dir("contact-shadows");
+    let dir = temp.path();
     let text = r#"
 ground = true
 [[model]]
@@ -219,7 +222,7 @@ range = 10.0
 [settings.screen]
 shadow_path = "mask"
 "#;
-    let loaded = scene_file::load(&write_scene(&dir, text), None).unwrap();
+    let loaded = scene_file::load(&write_scene(dir, text), None).unwrap();
     let mut s: Settings = loaded.settings.clone().unwrap().try_into().unwrap();
     assert_eq!(s.screen.shadow_path, gnomon_scene::settings::ShadowPath::Mask);
     s.light.kind = gnomon_scene::settings::LightKind::All;
@@ -228,7 +231,7 @@ shadow_path = "mask"
     assert!(!lights[1].shadow.contact.contact_shadows);
     // A contact parameter out of range is named with its light.
     let bad = text.replace("contact_length = 0.5", "contact_length = -1.0");
-    let mut scene = scene_file::load(&write_scene(&dir, &bad), None).map(|l| l.scene);
+    let mut scene = scene_file::load(&write_scene(dir, &bad), None).map(|l| l.scene);
     let e = match scene.as_mut() {
         Ok(scene) => s.resolve_lights(scene).unwrap_err().to_string(),
         Err(e) => e.to_string(),

@@ -1,5 +1,6 @@
-//! `gnomon calibrate`: sweep one technique's bias settings (depth bias, slope bias,
-//! normal offset) over a scene's views, measure each setting against the ray-traced
+//! `gnomon calibrate`: sweep the settings that move one technique's shadow (depth
+//! bias, slope bias, normal offset, and the PCF kernel where it has one; see
+//! [`plan`]) over a scene's views, measure each setting against the ray-traced
 //! reference on the light-facing pixels, and report the Pareto front of false shadow
 //! against false lit, the setting with the least total mismatch, and that setting's
 //! error on held-out views it was not chosen on, next to the defaults'.
@@ -7,6 +8,7 @@
 //! The views are a scene file's `[[view]]`s when it has two or more, else views
 //! generated along an orbit of the scene's camera; every other view is held out.
 
+mod plan;
 mod plot;
 mod sweep;
 
@@ -15,7 +17,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use gnomon_reference::metrics::{self, RasterView};
-use gnomon_render::{Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_render::{Gpu, GpuScene, OutputRequest, Renderer, techniques::TechniqueRegistry};
 use gnomon_scene::{
     Camera, Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
@@ -23,6 +25,7 @@ use gnomon_scene::{
     settings::{BiasSettings, CameraSettings},
 };
 use indicatif::{ProgressBar, ProgressStyle};
+use plan::Tuned;
 use sweep::{Measured, SweepRange};
 
 use crate::{lab, output};
@@ -31,15 +34,21 @@ use crate::{lab, output};
 pub struct CalibrateArgs {
     #[command(flatten)]
     pub scene: lab::SceneArgs,
-    /// Depth-bias values to sweep, LOW..HIGH:STEPS (rasterizer units).
-    #[arg(long, value_name = "RANGE", default_value = "0..0:1")]
-    pub sweep_depth_bias: SweepRange,
-    /// Slope-bias values to sweep, LOW..HIGH:STEPS.
-    #[arg(long, value_name = "RANGE", default_value = "0..4:9")]
-    pub sweep_slope_bias: SweepRange,
-    /// Normal-offset values to sweep, LOW..HIGH:STEPS (shadow texels).
-    #[arg(long, value_name = "RANGE", default_value = "0..2:9")]
-    pub sweep_normal_offset: SweepRange,
+    /// Depth-bias values to sweep, LOW..HIGH:STEPS (rasterizer units) [default: the
+    /// settings' depth bias, not swept].
+    #[arg(long, value_name = "RANGE")]
+    pub sweep_depth_bias: Option<SweepRange>,
+    /// Slope-bias values to sweep, LOW..HIGH:STEPS [default: 0..4:9].
+    #[arg(long, value_name = "RANGE")]
+    pub sweep_slope_bias: Option<SweepRange>,
+    /// Normal-offset values to sweep, LOW..HIGH:STEPS (shadow texels) [default: 0..2:9].
+    #[arg(long, value_name = "RANGE")]
+    pub sweep_normal_offset: Option<SweepRange>,
+    /// PCF kernel widths to sweep, LOW..HIGH:STEPS, in the kernel's unit, for the
+    /// techniques with a kernel [default: 1..9:5 for a kernel in texels; else the
+    /// settings' kernel, not swept].
+    #[arg(long, value_name = "RANGE")]
+    pub sweep_kernel: Option<SweepRange>,
     /// Views generated along an orbit of the scene's camera when the scene is not a
     /// scene file with two or more `[[view]]`s; every other view is held out
     /// (calibration never sees it). 2 to 64.
@@ -95,28 +104,26 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         args.orbit
     );
     settings.resolve_light(&scene).with_context(|| format!("{}: calibration needs a light", scene.name))?;
-    let ranges = [&args.sweep_depth_bias, &args.sweep_slope_bias, &args.sweep_normal_offset];
-    anyhow::ensure!(
-        ranges.iter().any(|r| r.steps > 1),
-        "nothing to sweep: --sweep-depth-bias, --sweep-slope-bias and --sweep-normal-offset each hold one value; give at least one LOW..HIGH:STEPS with STEPS ≥ 2"
-    );
     output::check_dir(&args.out, "--out")?;
     if let Some(path) = &args.write {
         output::check_file(path, &["toml"], "--write")?;
     }
-    let grid = bias_grid(args, &settings.shadow.bias);
+    let requested = plan::Requested {
+        depth_bias: args.sweep_depth_bias,
+        slope_bias: args.sweep_slope_bias,
+        normal_offset: args.sweep_normal_offset,
+        kernel: args.sweep_kernel,
+    };
+    let filter = &settings.shadow.filter;
+    let base = Tuned { bias: settings.shadow.bias.clone(), pcf_kernel: filter.pcf_kernel };
+    let grid =
+        plan::grid(&requested, &TechniqueRegistry::builtin(), &filter.technique, &base, filter.kernel_unit)?;
 
     let views: Vec<Settings> = view_cameras(args, &scene, &settings)?
         .into_iter()
         .map(|camera| {
             let mut s = settings.clone();
-            s.camera = CameraSettings {
-                eye: Some(camera.eye),
-                target: Some(camera.target),
-                fov_y_degrees: Some(camera.fov_y_degrees),
-                near: Some(camera.near),
-                far: Some(camera.far),
-            };
+            s.camera = CameraSettings::pinned(&camera);
             s
         })
         .collect();
@@ -137,21 +144,25 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut points = Vec::with_capacity(grid.len());
-    for bias in &grid {
-        let pooled = measure(&mut renderer, &uploaded, &scene, &calibration, bias, &bar)?;
-        points.push(pooled.rates(bias.clone()));
+    for tuned in &grid {
+        let pooled = measure(&mut renderer, &uploaded, &scene, &calibration, tuned, &bar)?;
+        points.push(pooled.rates(tuned.clone()));
     }
     bar.finish_and_clear();
     let front = sweep::pareto_front(&points);
     let chosen = sweep::least_mismatch(&points).context("an empty sweep")?;
-    let defaults = measure(&mut renderer, &uploaded, &scene, &calibration, &settings.shadow.bias, &bar)?
-        .rates(settings.shadow.bias.clone());
+    let defaults = measure(&mut renderer, &uploaded, &scene, &calibration, &base, &bar)?.rates(base.clone());
     let held_chosen = measure(&mut renderer, &uploaded, &scene, &held_out, &points[chosen].setting, &bar)?
         .rates(points[chosen].setting.clone());
-    let held_default = measure(&mut renderer, &uploaded, &scene, &held_out, &settings.shadow.bias, &bar)?
-        .rates(settings.shadow.bias.clone());
+    let held_default = measure(&mut renderer, &uploaded, &scene, &held_out, &base, &bar)?.rates(base.clone());
 
-    let title = format!("{}: {} bias sweep", scene.name, settings.shadow.filter.technique.name());
+    let technique = settings.shadow.filter.technique.name();
+    let swept_kernel = grid.iter().any(|t| t.pcf_kernel != base.pcf_kernel);
+    let title = format!(
+        "{}: {technique} {} sweep",
+        scene.name,
+        if swept_kernel { "bias and kernel" } else { "bias" }
+    );
     let rgb = plot::draw(&plot::PlotInput {
         title: &title,
         points: &points,
@@ -170,7 +181,8 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     staged.commit()?;
     print!("{report}");
     if let Some(path) = &args.write {
-        write_settings(path, &points[chosen].setting)?;
+        let tuned = &points[chosen].setting;
+        write_settings(path, &tuned.bias, swept_kernel.then_some(tuned.pcf_kernel))?;
     }
     Ok(())
 }
@@ -193,37 +205,20 @@ fn view_cameras(args: &CalibrateArgs, scene: &Scene, settings: &Settings) -> any
         .collect())
 }
 
-/// Every combination of the swept values, the other bias fields as given.
-fn bias_grid(args: &CalibrateArgs, base: &BiasSettings) -> Vec<BiasSettings> {
-    let mut grid = Vec::new();
-    for depth_bias in args.sweep_depth_bias.values() {
-        for slope_bias in args.sweep_slope_bias.values() {
-            for normal_offset in args.sweep_normal_offset.values() {
-                grid.push(BiasSettings {
-                    depth_bias: depth_bias.round() as i32,
-                    slope_bias,
-                    normal_offset,
-                    ..base.clone()
-                });
-            }
-        }
-    }
-    grid
-}
-
-/// Renders `views` with `bias` and pools their light-facing mismatches.
+/// Renders `views` with the `tuned` settings and pools their light-facing mismatches.
 fn measure(
     renderer: &mut Renderer,
     uploaded: &GpuScene,
     scene: &Scene,
     views: &[&View],
-    bias: &BiasSettings,
+    tuned: &Tuned,
     bar: &ProgressBar,
 ) -> anyhow::Result<Pooled> {
     let mut pooled = Pooled::default();
     for view in views {
         let mut s = view.settings.clone();
-        s.shadow.bias = bias.clone();
+        s.shadow.bias = tuned.bias.clone();
+        s.shadow.filter.pcf_kernel = tuned.pcf_kernel;
         let frame = renderer.render_uploaded(uploaded, scene, &s, &OutputRequest::default())?;
         let raster =
             RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
@@ -237,48 +232,43 @@ fn measure(
 }
 
 fn report_markdown(
-    points: &[Measured<BiasSettings>],
+    points: &[Measured<Tuned>],
     front: &[usize],
     chosen: usize,
-    (defaults, held_chosen, held_default): (
-        &Measured<BiasSettings>,
-        &Measured<BiasSettings>,
-        &Measured<BiasSettings>,
-    ),
+    (defaults, held_chosen, held_default): (&Measured<Tuned>, &Measured<Tuned>, &Measured<Tuned>),
 ) -> String {
     let pct = |v: f64| format!("{:.3}%", 100.0 * v);
-    let mut s = String::from(
-        "Rates over light-facing pixels, pooled over the views.\n\n| setting | depth bias | slope bias | normal offset | false shadow | false lit | mismatch |\n|---|---|---|---|---|---|---|\n",
-    );
-    for &i in front {
-        let p = &points[i];
-        let label = if i == chosen { "**chosen**" } else { "front" };
-        s += &format!(
-            "| {label} | {} | {} | {} | {} | {} | {} |\n",
-            p.setting.depth_bias,
-            p.setting.slope_bias,
-            p.setting.normal_offset,
+    let row = |label: &str, p: &Measured<Tuned>| {
+        let b = &p.setting.bias;
+        format!(
+            "| {label} | {} | {} | {} | {} | {} | {} | {} |\n",
+            b.depth_bias,
+            b.slope_bias,
+            b.normal_offset,
+            p.setting.pcf_kernel,
             pct(p.false_shadow),
             pct(p.false_lit),
             pct(p.mismatch())
-        );
+        )
+    };
+    let mut s = String::from(
+        "Rates over light-facing pixels, pooled over the views.\n\n| setting | depth bias | slope bias | normal offset | PCF kernel | false shadow | false lit | mismatch |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for &i in front {
+        s += &row(if i == chosen { "**chosen**" } else { "front" }, &points[i]);
     }
+    s += &row("defaults", defaults);
     s += &format!(
-        "| defaults | {} | {} | {} | {} | {} | {} |\n\nHeld-out views: chosen {} mismatch, defaults {}.\n",
-        defaults.setting.depth_bias,
-        defaults.setting.slope_bias,
-        defaults.setting.normal_offset,
-        pct(defaults.false_shadow),
-        pct(defaults.false_lit),
-        pct(defaults.mismatch()),
+        "\nHeld-out views: chosen {} mismatch, defaults {}.\n",
         pct(held_chosen.mismatch()),
         pct(held_default.mismatch())
     );
     s
 }
 
-/// Stores `bias` in `path`'s `[settings.shadow.bias]`, keeping the rest of the file.
-fn write_settings(path: &std::path::Path, bias: &BiasSettings) -> anyhow::Result<()> {
+/// Stores `bias` in `path`'s `[settings.shadow.bias]`, and `kernel` (when it was
+/// swept) as its `settings.shadow.filter.pcf_kernel`, keeping the rest of the file.
+fn write_settings(path: &std::path::Path, bias: &BiasSettings, kernel: Option<f32>) -> anyhow::Result<()> {
     let text = if path.is_file() { std::fs::read_to_string(path)? } else { String::new() };
     let mut doc: toml::Table =
         toml::from_str(&text).with_context(|| format!("--write {}: not TOML", path.display()))?;
@@ -287,6 +277,11 @@ fn write_settings(path: &std::path::Path, bias: &BiasSettings) -> anyhow::Result
     let shadow = table.entry("shadow").or_insert_with(|| toml::Table::new().into());
     let shadow = shadow.as_table_mut().context("--write: `settings.shadow` is not a table")?;
     shadow.insert("bias".into(), toml::Value::try_from(bias)?);
+    if let Some(kernel) = kernel {
+        let filter = shadow.entry("filter").or_insert_with(|| toml::Table::new().into());
+        let filter = filter.as_table_mut().context("--write: `settings.shadow.filter` is not a table")?;
+        filter.insert("pcf_kernel".into(), toml::Value::Float(kernel.into()));
+    }
     let temp = path.with_extension("toml.tmp");
     std::fs::write(&temp, toml::to_string_pretty(&doc)?)?;
     std::fs::rename(&temp, path)?;

@@ -3,7 +3,7 @@
 use glam::Vec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
 use crate::uniforms::TechniqueParams;
 
 pub struct Esm;
@@ -19,6 +19,11 @@ impl ShadowTechnique for Esm {
 
     fn maps(&self) -> MapSupport {
         MapSupport::LINEAR_DEPTH
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// The moment map's blur radius.

@@ -3,7 +3,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique};
+use super::{MapSupport, ShadowTechnique, Tunables};
 
 pub struct Hard;
 
@@ -18,6 +18,11 @@ impl ShadowTechnique for Hard {
 
     fn maps(&self) -> MapSupport {
         MapSupport::ANY
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// One point sample: no reach.

@@ -90,6 +90,30 @@ impl MapSupport {
     pub const LINEAR_DEPTH: MapSupport = MapSupport { paraboloid: false, warped: false, clamped_depth: true };
 }
 
+/// The settings that move where a technique puts its shadow edges: what
+/// `gnomon calibrate` may sweep for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tunables {
+    /// The shadow pass's rasterizer bias (`shadow.bias.depth_bias` and `slope_bias`):
+    /// every technique that reads the depths the shadow pass stored, directly or
+    /// through moments made from them.
+    pub raster_bias: bool,
+    /// The receiver's normal offset (`shadow.bias.normal_offset`): every technique
+    /// whose lookup position the offset moves.
+    pub normal_offset: bool,
+    /// The PCF kernel's width (`shadow.filter.pcf_kernel`).
+    pub kernel: bool,
+}
+
+impl Tunables {
+    /// Depths from the shadow pass, looked up at the offset position.
+    pub const BIAS: Tunables = Tunables { raster_bias: true, normal_offset: true, kernel: false };
+    /// The bias, and a kernel of `shadow.filter.pcf_kernel`.
+    pub const BIAS_AND_KERNEL: Tunables = Tunables { raster_bias: true, normal_offset: true, kernel: true };
+    /// Nothing: the technique's answer depends on none of these settings.
+    pub const NONE: Tunables = Tunables { raster_bias: false, normal_offset: false, kernel: false };
+}
+
 /// A shadow technique as the renderer sees it: every fact about it, in one place.
 pub trait ShadowTechnique: Sync {
     /// The name that selects this technique (`shadow.filter.technique`).
@@ -117,6 +141,8 @@ pub trait ShadowTechnique: Sync {
     /// (beyond the bilinear footprint): a sample-fitted cascade keeps this margin
     /// around its samples. `kernel_texels` is the PCF kernel's width in texels.
     fn filter_reach_texels(&self, settings: &FilterSettings, kernel_texels: f32) -> f32;
+    /// The settings that move its shadow edges.
+    fn tunables(&self) -> Tunables;
     /// The filterable map the technique samples, if any.
     fn filterable_map(&self, _settings: &FilterSettings) -> Option<FilterableMap> {
         None

@@ -4,7 +4,7 @@
 use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
 use crate::uniforms::TechniqueParams;
 
 /// One moment-map technique: the two differ only in the bound they reconstruct.
@@ -36,6 +36,11 @@ impl ShadowTechnique for Msm {
 
     fn maps(&self) -> MapSupport {
         MapSupport::LINEAR_DEPTH
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// The moment map's blur radius.

@@ -6,7 +6,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique};
+use super::{MapSupport, ShadowTechnique, Tunables};
 
 /// `pcf2x2`: one hardware bilinear comparison tap.
 pub struct Pcf2x2;
@@ -30,6 +30,11 @@ impl ShadowTechnique for Pcf2x2 {
 
     fn maps(&self) -> MapSupport {
         MapSupport::ANY
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// One bilinear tap: no reach beyond its footprint.
@@ -60,6 +65,11 @@ impl ShadowTechnique for PcfBox {
 
     fn maps(&self) -> MapSupport {
         MapSupport::ANY
+    }
+
+    /// The bias moves its edges, and its kernel is `pcf_kernel` wide.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS_AND_KERNEL
     }
 
     /// Half the kernel's width each side.
@@ -94,6 +104,11 @@ impl ShadowTechnique for PcfTent {
         MapSupport::ANY
     }
 
+    /// The bias moves its edges, and its kernel is `pcf_kernel` wide.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS_AND_KERNEL
+    }
+
     /// Half the kernel's width each side.
     fn filter_reach_texels(&self, _: &FilterSettings, kernel_texels: f32) -> f32 {
         0.5 * kernel_texels
@@ -124,6 +139,11 @@ impl ShadowTechnique for PcfPoisson {
 
     fn maps(&self) -> MapSupport {
         MapSupport::ANY
+    }
+
+    /// The bias moves its edges, and its kernel is `pcf_kernel` wide.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS_AND_KERNEL
     }
 
     /// The disk's radius, half the kernel's width.

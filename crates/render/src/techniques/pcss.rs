@@ -4,7 +4,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique};
+use super::{MapSupport, ShadowTechnique, Tunables};
 
 pub struct Pcss;
 
@@ -21,6 +21,11 @@ impl ShadowTechnique for Pcss {
     /// the true, unwarped and unclamped depth of a planar projection.
     fn maps(&self) -> MapSupport {
         MapSupport { paraboloid: false, warped: false, clamped_depth: false }
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// The largest penumbra radius it may filter with.

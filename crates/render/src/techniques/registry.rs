@@ -168,8 +168,9 @@ impl TechniqueRegistry {
         }
     }
 
-    /// The names of the techniques that `fits`, as a list for a message.
-    fn names(&self, fits: impl Fn(&TechniqueRef) -> bool) -> String {
+    /// The names of the techniques that `fits`, as a list for a message ("pcf,
+    /// pcf-tent or pcf-poisson"; "none" when none fits).
+    pub fn names(&self, fits: impl Fn(&TechniqueRef) -> bool) -> String {
         let names: Vec<String> = self.iter().filter(|t| fits(t)).map(|t| t.technique().to_string()).collect();
         match names.as_slice() {
             [] => "none".to_owned(),

@@ -5,7 +5,7 @@
 use glam::{UVec4, Vec4};
 use gnomon_scene::settings::{FilterSettings, MomentFormat, SettingsError, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique};
+use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
 use crate::uniforms::TechniqueParams;
 
 /// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
@@ -72,6 +72,11 @@ impl ShadowTechnique for Chebyshev {
         };
         bounded("shadow.filter.moments.evsm_positive", s.moments.evsm_positive)?;
         bounded("shadow.filter.moments.evsm_negative", s.moments.evsm_negative)
+    }
+
+    /// The bias moves its edges; it has no kernel of `pcf_kernel`.
+    fn tunables(&self) -> Tunables {
+        Tunables::BIAS
     }
 
     /// The moment map's blur radius.

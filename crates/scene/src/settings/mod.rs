@@ -144,6 +144,20 @@ pub struct CameraSettings {
     pub far: Option<f32>,
 }
 
+impl CameraSettings {
+    /// Every field set from `camera`: the view stays exactly there, with no plane
+    /// refitted to the scene (a camera path's frames, a calibration's views).
+    pub fn pinned(camera: &Camera) -> Self {
+        Self {
+            eye: Some(camera.eye),
+            target: Some(camera.target),
+            fov_y_degrees: Some(camera.fov_y_degrees),
+            near: Some(camera.near),
+            far: Some(camera.far),
+        }
+    }
+}
+
 /// The largest shadow map Gnomon allows, whatever the device.
 pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
 

@@ -1,36 +1,13 @@
 //! Writers for small glTF files built in the tests.
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
-
-/// A directory under the system's temporary folder, removed with everything in it
-/// when dropped, so test runs leave nothing behind.
-pub struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TempDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-pub fn temp_dir(name: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("gnomon-gltf-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+/// A fresh directory under the system's temporary folder, removed with everything
+/// in it when the guard is dropped, so test runs leave nothing behind.
+pub fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gnomon-gltf-{name}-"))
+        .tempdir()
+        .expect("create a temporary directory")
 }
 
 /// One triangle (positions only), 36 bytes.
