@@ -69,7 +69,7 @@ impl BiasSettings {
 
 impl Default for BiasSettings {
     fn default() -> Self {
-        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.6, cull: CullMode::Auto }
+        Self { depth_bias: 0, slope_bias: 1.5, normal_offset: 0.3, cull: CullMode::Auto }
     }
 }
 
