@@ -174,20 +174,21 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 /// Issue 4 asks for a mismatch under 2 % for `pcf2x2` at 2048² under a directional
 /// light, over every surface pixel (the measure of its time, kept as
 /// `surface_mismatch_rate`). Asserted on the view `gnomon compare tree.glb
-/// --sun-elevation 55 --sun-azimuth 200` uses (the default framing of the bounds, no
-/// ground; every compared pixel is foliage or trunk, so this is leaves shadowing
-/// leaves): 1.67 % measured on lavapipe with the framing of the time, 1.64 % with
-/// today's closer one. Over the light-facing pixels alone the same view is 2.67 %
-/// (reported, not bound: a third of this view's pixels are leaves seen from their
-/// unlit side). The errors are one-texel fringes around each leaf's shadow, so the figure
-/// depends on the sun and the framing; the README lists the other views measured,
-/// including those above 2 %. A close view with a ground, where 2 % is not met, is
-/// held to a regression bound.
-/// Issue 4's 2 % on the fitted view (all surfaces: 1.642 % measured), and a regression
-/// bound on the close view with a ground (all surfaces: 2.092 % measured), where 2 % is
-/// not met.
+/// --sun-elevation 55 --sun-azimuth 200` uses (the default framing, which fits every
+/// vertex in the frame, no ground; every compared pixel is foliage or trunk, so this
+/// is leaves shadowing leaves): 1.469 % measured on lavapipe with today's defaults
+/// (normal offset 0.3; 1.64 % with 0.6 and the framing of the bounding box). A close
+/// view with a ground, where 2 % is not met (2.017 %), is held to a regression bound.
+/// The errors are one-texel fringes around each leaf's shadow, so the figure depends
+/// on the sun and the framing.
 const TREE_FITTED_MISMATCH: f64 = 0.02;
 const TREE_CLOSE_MISMATCH: f64 = 0.025;
+/// The same two views over the light-facing pixels alone, the measure `compare`
+/// reports since issue 22: 2.408 % and 2.141 % measured on lavapipe (a third of the
+/// fitted view's pixels are leaves seen from their unlit side, which the all-surface
+/// rate counts as trivially right). Regression bounds about 1.25× those.
+const TREE_FITTED_LIGHT_FACING: f64 = 0.03;
+const TREE_CLOSE_LIGHT_FACING: f64 = 0.027;
 
 #[test]
 fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
@@ -209,14 +210,14 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
             100.0 * m.surface_mismatch_rate,
             m.surface(),
         );
-        figure(
-            &format!("tree, {what}, pcf2x2: mismatch over light-facing pixels"),
-            percent(m.mismatch_rate),
-            "none: reported",
-        );
         m
     };
     let fitted = measure(&scene, &s, "fitted view");
+    figure(
+        "tree, fitted view, pcf2x2: mismatch over light-facing pixels",
+        percent(fitted.mismatch_rate),
+        percent(TREE_FITTED_LIGHT_FACING),
+    );
     figure(
         "tree, fitted view, pcf2x2: mismatch over all surfaces",
         percent(fitted.surface_mismatch_rate),
@@ -224,6 +225,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     );
     assert!(fitted.surface() > 40_000, "{fitted:?}");
     assert!(fitted.surface_mismatch_rate < TREE_FITTED_MISMATCH, "{fitted:?}");
+    assert!(fitted.mismatch_rate < TREE_FITTED_LIGHT_FACING, "{fitted:?}");
 
     // Close to the tree, with a ground three times its width.
     let b = scene.bounds();
@@ -235,6 +237,11 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     scene.camera.far = 10.0 * r;
     let close = measure(&scene, &s, "close view with ground");
     figure(
+        "tree, close view with ground, pcf2x2: mismatch over light-facing pixels",
+        percent(close.mismatch_rate),
+        percent(TREE_CLOSE_LIGHT_FACING),
+    );
+    figure(
         "tree, close view with ground, pcf2x2: mismatch over all surfaces",
         percent(close.surface_mismatch_rate),
         percent(TREE_CLOSE_MISMATCH),
@@ -243,6 +250,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     // Issue 4's 2 % is not met on this view (README); this bound only guards it
     // against getting worse.
     assert!(close.surface_mismatch_rate < TREE_CLOSE_MISMATCH, "{close:?}");
+    assert!(close.mismatch_rate < TREE_CLOSE_LIGHT_FACING, "{close:?}");
 }
 
 #[test]

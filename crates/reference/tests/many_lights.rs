@@ -11,12 +11,12 @@ use gnomon_scene::{
     settings::{LightKind, Technique},
 };
 
-/// Each light's mismatch bound over all surfaces (`surface_mismatch_rate`, the measure
-/// they were set on), about 1.7× what was measured on lavapipe (in %): sun 0.151,
-/// spots 0.055, 0.047, 0.143, point lights 0.327, 0.511, 0.394, 0.454 (was 1 % for
-/// all). The light-facing rate, over the pixels inside each light's cone and range
-/// only, is reported beside it.
-const MISMATCH_BOUNDS: [f64; 8] = [0.0025, 0.001, 0.001, 0.0025, 0.0055, 0.0085, 0.0065, 0.0075];
+/// Each light's mismatch bound over its light-facing pixels (those inside its cone and
+/// range that face it), about 1.7× what was measured on lavapipe with the default
+/// normal offset of 0.3 texels (in %): sun 0.150, spots 0.086, 0.114, 0.224, point
+/// lights 0.281, 0.346, 0.381, 0.476. The all-surface rate, on which the earlier
+/// bounds were set, is reported beside it.
+const MISMATCH_BOUNDS: [f64; 8] = [0.0025, 0.0015, 0.002, 0.004, 0.005, 0.006, 0.0065, 0.008];
 
 fn all_lights(index: usize) -> Settings {
     let mut s = Settings::default();
@@ -64,13 +64,13 @@ fn eight_mixed_lights_each_match_the_reference() {
         assert!(m.compared > 0, "light {index} lights nothing in view");
         figure(
             &format!(
-                "lamps, light {index} ({}): mismatch over all surfaces (light-facing)",
+                "lamps, light {index} ({}): mismatch over light-facing pixels (all surfaces)",
                 light.light.type_name()
             ),
-            format!("{:.3}% ({:.3}%)", 100.0 * m.surface_mismatch_rate, 100.0 * m.mismatch_rate),
+            format!("{:.3}% ({:.3}%)", 100.0 * m.mismatch_rate, 100.0 * m.surface_mismatch_rate),
             format!("{:.2}%", 100.0 * bound),
         );
-        assert!(m.surface_mismatch_rate < bound, "light {index}: {m:?}");
+        assert!(m.mismatch_rate < bound, "light {index}: {m:?}");
 
         // The light's shadows do not depend on the other seven: alone in the
         // scene, with the same settings, it shades the same.
