@@ -1,0 +1,198 @@
+//! The inspection panel: the light's sliders, the debug views, the GPU timings table
+//! and the buttons that reproduce a view.
+
+use super::*;
+
+impl Model {
+    /// The light, the debug views, the GPU timings and the reproduction buttons.
+    pub(super) fn inspect_panel(&mut self, ui: &mut egui::Ui, images: &Images) {
+        ui.heading("Light");
+        let light = self.settings.resolve_light(&self.scene).ok();
+        self.light_sliders(ui, light);
+        if matches!(light, Some(Light::Directional(_))) {
+            let mut t = self.time_of_day;
+            let mut changed = false;
+            changed |= ui
+                .add(egui::Slider::new(&mut t.hour, 4.0..=20.0).text("time of day (h)"))
+                .on_hover_text("Local solar time; the sun follows its path across the sky.")
+                .changed();
+            changed |= ui
+                .add(egui::Slider::new(&mut t.latitude, -66.0..=66.0).text("latitude (°)"))
+                .on_hover_text("North positive. Scenes put north at +z and east at +x.")
+                .changed();
+            changed |= ui
+                .add(egui::Slider::new(&mut t.day, 1.0..=365.0).text("day of year"))
+                .on_hover_text("Sets the sun's declination: 172 is midsummer in the north.")
+                .changed();
+            self.time_of_day = t;
+            if changed {
+                self.place_sun();
+            }
+        }
+        ui.label(
+            "Right-drag in the view to move the light; the Light section of the settings sets it exactly.",
+        );
+
+        ui.separator();
+        ui.heading("Debug views");
+        let mut view = self.view;
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut view, View::Lit, "lit")
+                .on_hover_text("The lit image. Settings › Image › debug-view cascades tints it by cascade.");
+            ui.selectable_value(&mut view, View::TexelDensity, "texel density").on_hover_text(
+                "Lloyd's m: how many screen pixels one shadow texel spans, blue (1/16) to green (1) to red (16).",
+            );
+            ui.selectable_value(&mut view, View::Error, "error").on_hover_text(
+                "The shadow factor against the ray-traced reference for this view (Compare to compute it).",
+            );
+        });
+        if view != self.view {
+            self.pending.push(Action::Show(view));
+        }
+        let cascades = self.settings.image.debug_view == gnomon_scene::settings::DebugView::Cascades;
+        let mut tint = cascades;
+        if ui.checkbox(&mut tint, "cascade colours").on_hover_text("--debug-view cascades").changed() {
+            self.pending.push(Action::Set {
+                id: "debug_view".into(),
+                value: Some(if tint { "cascades" } else { "none" }.into()),
+            });
+        }
+        ui.checkbox(&mut self.show_maps, "shadow maps").on_hover_text(
+            "The reported light's depth map, every cascade (or cube face) side by side; near is black.",
+        );
+        if self.show_maps
+            && let Some((id, [w, h])) = images.maps
+        {
+            let width = ui.available_width();
+            ui.image((id, egui::vec2(width, width * h as f32 / w as f32)));
+        }
+        match &self.error_job {
+            Some(job) => {
+                ui.add(
+                    egui::ProgressBar::new(job.progress()).show_percentage().text("tracing the reference"),
+                );
+            }
+            None => {
+                if ui
+                    .button("Compare with the reference")
+                    .on_hover_text(
+                        "Ray-trace the ground truth for this view and show where the shadows are wrong.",
+                    )
+                    .clicked()
+                {
+                    self.pending.push(Action::CompareWithReference);
+                }
+            }
+        }
+        if let Some(error) = &self.error {
+            let stale = error.settings != self.frame_settings();
+            ui.label(&error.summary);
+            if stale {
+                ui.label(RichText::new("(for an earlier view)").weak());
+            }
+        }
+
+        ui.separator();
+        ui.heading("GPU time");
+        self.timings_table(ui);
+
+        ui.separator();
+        ui.heading("Reproduce");
+        if ui
+            .button("Copy as CLI command")
+            .on_hover_text("A `gnomon render` command for this view.")
+            .clicked()
+        {
+            self.pending.push(Action::CopyCommand);
+        }
+        ui.horizontal(|ui| {
+            ui.text_edit_singleline(&mut self.save_path);
+            if ui
+                .button("Save as scene file")
+                .on_hover_text("The scene, the camera and every setting.")
+                .clicked()
+            {
+                self.pending.push(Action::SaveSceneFile(self.save_path.clone().into()));
+            }
+        });
+    }
+
+    /// Sliders for the light: a sun's elevation and azimuth, or a spot or point
+    /// light's position; each sends its setting's flag.
+    fn light_sliders(&mut self, ui: &mut egui::Ui, light: Option<Light>) {
+        let xyz = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
+        match light {
+            Some(Light::Directional(sun)) => {
+                let to_sun = -sun.direction;
+                let mut elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
+                let mut azimuth = to_sun.x.atan2(to_sun.z).to_degrees().rem_euclid(360.0);
+                if ui.add(egui::Slider::new(&mut elevation, 1.0..=90.0).text("sun elevation (°)")).changed()
+                {
+                    self.pending
+                        .push(Action::Set { id: "sun_elevation".into(), value: Some(elevation.to_string()) });
+                }
+                if ui.add(egui::Slider::new(&mut azimuth, 0.0..=360.0).text("sun azimuth (°)")).changed() {
+                    self.pending
+                        .push(Action::Set { id: "sun_azimuth".into(), value: Some(azimuth.to_string()) });
+                }
+            }
+            Some(Light::Spot(spot)) => {
+                let mut p = spot.position;
+                if vec3_drag(ui, "spot position", &mut p, self.rig.distance()) {
+                    self.pending.push(Action::Set { id: "spot_position".into(), value: Some(xyz(p)) });
+                }
+            }
+            Some(Light::Point(point)) => {
+                let mut p = point.position;
+                if vec3_drag(ui, "point position", &mut p, self.rig.distance()) {
+                    self.pending.push(Action::Set { id: "point_position".into(), value: Some(xyz(p)) });
+                }
+            }
+            None => {}
+        }
+    }
+
+    fn timings_table(&self, ui: &mut egui::Ui) {
+        let Some(last) = self.timings.back() else {
+            ui.label("This device has no timestamp queries.");
+            return;
+        };
+        let n = self.timings.len() as f64;
+        let mean = |f: fn(&PassTimings) -> Option<f64>| -> Option<f64> {
+            let values: Vec<f64> = self.timings.iter().filter_map(f).collect();
+            (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+        };
+        egui::Grid::new("timings").num_columns(2).striped(true).show(ui, |ui| {
+            let rows: [(&str, Option<f64>); 6] = [
+                ("shadow maps", mean(|t| Some(t.shadow_ms))),
+                ("moment filtering", mean(|t| t.filter_ms)),
+                ("depth prepass", mean(|t| t.prepass_ms)),
+                ("shadow mask", mean(|t| t.mask_ms)),
+                ("lighting", mean(|t| Some(t.lighting_ms))),
+                ("frame", mean(|t| Some(t.frame_ms))),
+            ];
+            for (name, ms) in rows {
+                if let Some(ms) = ms {
+                    ui.label(name);
+                    ui.label(format!("{ms:.2} ms"));
+                    ui.end_row();
+                }
+            }
+        });
+        ui.label(
+            RichText::new(format!("mean of the last {n} frames; last frame {:.2} ms", last.frame_ms)).weak(),
+        );
+        if self.lights.len() > 1 {
+            for light in &self.lights {
+                ui.label(format!(
+                    "{} ({}, {}): shadow {:.2} ms, lighting {:.2} ms",
+                    light.name,
+                    light.kind,
+                    light.technique.name(),
+                    light.shadow_ms.unwrap_or(f64::NAN),
+                    light.lighting_ms.unwrap_or(f64::NAN)
+                ));
+            }
+        }
+    }
+}
