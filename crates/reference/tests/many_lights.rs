@@ -17,6 +17,10 @@ use gnomon_scene::{
 /// lights 0.281, 0.346, 0.381, 0.476. The all-surface rate, on which the earlier
 /// bounds were set, is reported beside it.
 const MISMATCH_BOUNDS: [f64; 8] = [0.0025, 0.0015, 0.002, 0.004, 0.005, 0.006, 0.0065, 0.008];
+/// The earlier bounds over all surfaces (`surface_mismatch_rate`), still held: about
+/// 1.7× what was measured when they were set (sun 0.151 %, spots 0.055, 0.047,
+/// 0.143 %, point lights 0.327, 0.511, 0.394, 0.454 %).
+const SURFACE_MISMATCH_BOUNDS: [f64; 8] = [0.0025, 0.001, 0.001, 0.0025, 0.0055, 0.0085, 0.0065, 0.0075];
 
 fn all_lights(index: usize) -> Settings {
     let mut s = Settings::default();
@@ -71,6 +75,7 @@ fn eight_mixed_lights_each_match_the_reference() {
             format!("{:.2}%", 100.0 * bound),
         );
         assert!(m.mismatch_rate < bound, "light {index}: {m:?}");
+        assert!(m.surface_mismatch_rate < SURFACE_MISMATCH_BOUNDS[index], "light {index}: {m:?}");
 
         // The light's shadows do not depend on the other seven: alone in the
         // scene, with the same settings, it shades the same.

@@ -1,7 +1,13 @@
 //! The inspection panel: the light's sliders, the debug views, the GPU timings table
 //! and the buttons that reproduce a view.
 
-use super::*;
+use egui::RichText;
+use glam::Vec3;
+use gnomon_render::PassTimings;
+use gnomon_scene::Light;
+
+use super::{Images, Model, vec3_drag};
+use crate::{Action, View};
 
 impl Model {
     /// The light, the debug views, the GPU timings and the reproduction buttons.
