@@ -10,7 +10,8 @@
 #   sh scripts/defaults-table.sh [GNOMON] [SHARED_SCENES] [OUT]
 #
 # SCENES (paths under SHARED_SCENES, space-separated) and CANDIDATES (a file of
-# `name|flags` lines) override the lists below.
+# `name|flags` lines) override the lists below; TIMING_FRAMES (default 3) sets the
+# frames each case is timed over.
 set -eu
 gnomon=${1:-target/release/gnomon}
 shared=${2:-../shared/scenes}
@@ -45,7 +46,7 @@ echo "$candidates" | while IFS='|' read -r name flags; do
       case "$flags" in *--techniques*) technique= ;; *) technique="--techniques pcf2x2" ;; esac
       # shellcheck disable=SC2086
       if "$gnomon" compare "$shared/$scene" --sun-elevation "$elevation" $technique \
-          --timing-frames 3 --out "$dir" $flags > /dev/null 2> "$out/last.log"; then
+          --timing-frames "${TIMING_FRAMES:-3}" --out "$dir" $flags > /dev/null 2> "$out/last.log"; then
         python3 - "$dir/metrics.json" "$name" "$scene" "$elevation" >> "$tsv" <<'PY'
 import json, sys
 path, name, scene, elevation = sys.argv[1:]

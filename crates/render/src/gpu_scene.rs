@@ -75,6 +75,9 @@ pub struct GpuScene {
     pub(crate) instances: wgpu::Buffer,
     /// Batches sorted by material group, so a bind group changes only between groups.
     pub(crate) batches: Vec<Batch>,
+    /// The shadow casters' BVH for ray-traced refinement, built on first use
+    /// ([`GpuScene::build_rays`]).
+    rays: std::sync::OnceLock<crate::rays::GpuBvh>,
     /// The batches in shadow-pass order: opaque before alpha-masked, then by cull
     /// state and texture, so that pipelines and bind groups change least.
     shadow_order: Vec<u32>,
@@ -151,10 +154,31 @@ impl GpuScene {
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
             ),
             batches,
+            rays: std::sync::OnceLock::new(),
             shadow_order,
             material_groups: material_groups(gpu, scene, layouts),
             bounds,
         })
+    }
+
+    /// Builds and uploads the shadow casters' BVH for ray-traced refinement, once:
+    /// `scene` must be the one this was uploaded from.
+    pub(crate) fn build_rays(
+        &self,
+        gpu: &Gpu,
+        scene: &Scene,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Result<&crate::rays::GpuBvh, RenderError> {
+        if let Some(built) = self.rays.get() {
+            return Ok(built);
+        }
+        let built = crate::rays::GpuBvh::upload(gpu, scene, layout)?;
+        Ok(self.rays.get_or_init(|| built))
+    }
+
+    /// The casters' BVH, if [`GpuScene::build_rays`] has built it.
+    pub(crate) fn rays(&self) -> Option<&crate::rays::GpuBvh> {
+        self.rays.get()
     }
 
     /// How many instances were uploaded (those with geometry).

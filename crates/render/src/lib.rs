@@ -21,6 +21,7 @@ mod gpu_types;
 mod layout;
 mod passes;
 mod pool;
+pub mod rays;
 mod readback;
 pub mod techniques;
 pub mod timing;
@@ -143,6 +144,34 @@ pub enum RenderError {
         /// Number of instances uploaded.
         instances: usize,
         /// Size of their per-instance data, in bytes.
+        bytes: u64,
+        /// The most bytes the device binds in one storage buffer.
+        limit: u64,
+    },
+    /// The BVH of the scene's shadow casters is deeper than the GPU tracer's stack.
+    #[error(
+        "scene `{scene}`: the BVH of its shadow casters is {depth} levels deep, but the GPU \
+         ray tracer walks at most {max}"
+    )]
+    RayTreeTooDeep {
+        /// Name of the scene.
+        scene: String,
+        /// Depth of the built tree, the root counting 1.
+        depth: u32,
+        /// The deepest tree the tracer walks.
+        max: u32,
+    },
+    /// One of the ray tracer's buffers is larger than the device binds.
+    #[error(
+        "scene `{scene}`: the GPU ray tracer's {buffer} take {bytes} bytes, but this device binds \
+         at most {limit} bytes in one storage buffer"
+    )]
+    RayBufferTooLarge {
+        /// Name of the scene.
+        scene: String,
+        /// Which buffer: nodes, triangles, alpha tests, alpha textures or alpha texels.
+        buffer: &'static str,
+        /// Its size.
         bytes: u64,
         /// The most bytes the device binds in one storage buffer.
         limit: u64,

@@ -6,7 +6,7 @@ use glam::Vec3;
 use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition},
+    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition, Refine},
 };
 
 use super::Renderer;
@@ -21,6 +21,7 @@ use crate::{
         shadow::DepthTarget,
     },
     pool::ViewKey,
+    rays,
     techniques::{self, TechniqueRef},
     uniforms::{LightGpu, LightInputs},
 };
@@ -48,6 +49,9 @@ pub(super) struct LightPlan {
     pub filterable_map: Option<techniques::FilterableMap>,
     pub moment_format: wgpu::TextureFormat,
     pub light_gpu: LightGpu,
+    /// Which of its pixels trace a shadow ray (on the mask path; off for a light with
+    /// an area).
+    pub refine: Refine,
 }
 
 impl LightPlan {
@@ -125,7 +129,10 @@ impl Renderer {
                 // Ambient light is added once, by the first light's pass.
                 light_gpu.ambient = Vec3::ZERO;
             }
+            let refine =
+                if mask_path { rays::light_refine(settings.screen.refine, &r.light) } else { Refine::Off };
             lights.push(LightPlan {
+                refine,
                 name: r.name,
                 light: r.light,
                 settings: light_settings,

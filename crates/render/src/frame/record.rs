@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use gnomon_math::culling::Frustum;
-use gnomon_scene::{Scene, Settings};
+use gnomon_scene::{Scene, Settings, settings::Refine};
 
 use super::{
     Renderer,
@@ -156,6 +156,9 @@ impl Renderer {
         settings.validate()?;
         self.check_limits(settings)?;
         let plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
+        if plan.lights.iter().any(|l| l.refine != Refine::Off) {
+            uploaded.build_rays(&self.gpu, scene, &self.layouts.rays)?;
+        }
         let planned = Instant::now();
         let culled = cull(uploaded, &plan);
         let cull_done = Instant::now();

@@ -12,8 +12,10 @@ use crate::{
     gpu_scene::Visible,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
+    rays,
     timing::PassKind,
 };
+use gnomon_scene::settings::Refine;
 
 /// What the screen-space passes draw into and read.
 pub(super) struct ScreenInputs<'a> {
@@ -79,13 +81,18 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            let key = MaskKey { technique: light.technique, lookup: bindings.lookup };
+            let key = MaskKey { technique: light.technique, lookup: bindings.lookup, refine: light.refine };
             pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
             pass.set_bind_group(0, &bindings.scene, &[]);
             pass.set_bind_group(1, &screen_group, &[]);
             pass.set_bind_group(2, mask_group, &[]);
             rec.stats.pipeline_changes += 1;
             rec.stats.bind_group_changes += 3;
+            if light.refine != Refine::Off {
+                let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
+                pass.set_bind_group(rays::GROUP, &bvh.group, &[]);
+                rec.stats.bind_group_changes += 1;
+            }
             pass.draw(0..3, 0..1);
             drop(pass);
             rec.clock.end(gpu, rec.encoder, slot);

@@ -6,6 +6,7 @@
 
 use std::collections::BTreeMap;
 
+use gnomon_scene::settings::Refine;
 use wgpu::naga;
 
 use super::{
@@ -56,8 +57,10 @@ fn every_variant() -> Vec<(String, String)> {
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
             }
             if let Lookup::Own(map) = lookup {
-                let key = screen_space::MaskKey { technique, lookup: map };
-                out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+                for refine in [Refine::Off, Refine::Rays, Refine::EveryPixel] {
+                    let key = screen_space::MaskKey { technique, lookup: map, refine };
+                    out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+                }
                 // The receiver with a host's fragment shader calling it, in the group
                 // a host might pick.
                 let source = receiver::receiver_wgsl(technique, map, 3) + HOST_SHADER;

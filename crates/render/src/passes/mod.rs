@@ -118,6 +118,9 @@ pub(crate) struct Layouts {
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
     pub material: wgpu::BindGroupLayout,
+    /// The casters' BVH ([`crate::rays`]): group 3 of a shadow-mask pass that
+    /// refines with rays.
+    pub rays: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -154,6 +157,7 @@ impl Layouts {
                 &[uniform_entry(0, fragment), unfilterable_texture_entry(1), unfilterable_texture_entry(2)],
             ),
             material: layout("material", &[fragment_entry(0, filterable), fragment_entry(1, filtering)]),
+            rays: crate::rays::layout(device),
         }
     }
 }

@@ -10,6 +10,7 @@ use super::{
     lighting::{self, Lookup, MapLookup},
 };
 use crate::{gpu_types::VertexStream, techniques::TechniqueRef};
+use gnomon_scene::settings::Refine;
 
 /// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
 pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -26,6 +27,8 @@ pub(crate) struct MaskKey {
     pub technique: TechniqueRef,
     /// How the light's map is looked up.
     pub lookup: MapLookup,
+    /// Which of its pixels trace a shadow ray.
+    pub refine: Refine,
 }
 
 /// The prepass's WGSL, composed: the lighting pass's vertex stage (`vs_surface`) and
@@ -45,6 +48,7 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
     parts.push(include_str!("octahedron.wgsl").to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
+    parts.extend(crate::rays::refine_wgsl(key.refine, key.lookup));
     parts.push(include_str!("shadow_mask.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -53,6 +57,8 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
 pub(crate) struct ScreenSpacePass {
     prepass: wgpu::RenderPipeline,
     mask_layout: wgpu::PipelineLayout,
+    /// The mask pipelines that trace rays also bind the casters' BVH (group 3).
+    refine_layout: wgpu::PipelineLayout,
     masks: HashMap<MaskKey, wgpu::RenderPipeline>,
 }
 
@@ -100,7 +106,17 @@ impl ScreenSpacePass {
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.screen), Some(&layouts.shadow)],
             immediate_size: 0,
         });
-        Self { prepass, mask_layout, masks: HashMap::new() }
+        let refine_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow mask, refined by rays"),
+            bind_group_layouts: &[
+                Some(&layouts.scene),
+                Some(&layouts.screen),
+                Some(&layouts.shadow),
+                Some(&layouts.rays),
+            ],
+            immediate_size: 0,
+        });
+        Self { prepass, mask_layout, refine_layout, masks: HashMap::new() }
     }
 
     /// The prepass pipeline: groups 0 (scene), 1 (camera) and 3 (material).
@@ -108,11 +124,14 @@ impl ScreenSpacePass {
         &self.prepass
     }
 
-    /// The mask pipeline of a technique and lookup: groups 0 (scene and light), 1
-    /// (camera and prepass) and 2 (the light's shadow resources), drawn as one
-    /// full-screen triangle.
+    /// The mask pipeline of a technique, lookup and refinement: groups 0 (scene and
+    /// light), 1 (camera and prepass), 2 (the light's shadow resources) and, when it
+    /// refines, 3 (the casters' BVH), drawn as one full-screen triangle.
     pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
-        let layout = &self.mask_layout;
+        let layout = match key.refine {
+            Refine::Off => &self.mask_layout,
+            Refine::Rays | Refine::EveryPixel => &self.refine_layout,
+        };
         self.masks.entry(key).or_insert_with(|| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("shadow mask"),

@@ -1,7 +1,8 @@
 // Screen-space shadow mask (as in Unity URP's screen-space shadows): one full-screen
 // pass per light over the prepass. It rebuilds each pixel's world position from its
 // linear view depth, resolves the light's shadow lookup there once, with the light's
-// own technique (`pixel_visibility`, resolve_visibility.wgsl), marches contact shadows
+// own technique (`pixel_visibility`, resolve_visibility.wgsl), traces a ray where the
+// map is unsure when refinement is on (`refined_visibility`, rays/), marches contact shadows
 // when the light has them (contact.wgsl), and stores the visibility in the light's
 // layer of the mask, for its lighting pass to read: one 32-bit float, visibility +
 // 2 × the shadow-map layer that shaded it (for the cascade debug view), so that the
@@ -64,6 +65,7 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     let geometry = light_geometry(world);
     let l = geometry.xyz;
     var shadow = pixel_visibility(world, n, geometric_n, l, geometry.w, world_dx, world_dy, frag.xy, view_depth);
+    shadow.x = refined_visibility(shadow.x, world, n, geometric_n, l, geometry.w, view_depth);
     if light.contact_steps > 0u && shadow.x > 0.0 {
         shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
     }

@@ -222,9 +222,22 @@ impl Settings {
     }
 
     /// Whether a frame with these lights resolves its shadows in a screen-space mask:
-    /// as --shadow-path says, and with `auto` when any light marches contact shadows.
-    /// Contact shadows with --shadow-path forward are refused: they need the prepass.
+    /// as --shadow-path says, and with `auto` when any light marches contact shadows
+    /// or shadows are refined by rays. Contact shadows or rays with --shadow-path
+    /// forward are refused: they need the prepass.
     pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
+        let refine = self.screen.refine;
+        if refine != Refine::Off {
+            return match self.screen.shadow_path {
+                ShadowPath::Forward => Err(SettingsError {
+                    setting: "screen.refine",
+                    value: value_name(&refine),
+                    valid: "off with --shadow-path forward: rays start from the mask path's depth prepass"
+                        .into(),
+                }),
+                ShadowPath::Mask | ShadowPath::Auto => Ok(true),
+            };
+        }
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {
             (ShadowPath::Forward, Some(light)) => Err(SettingsError {

@@ -20,6 +20,26 @@ pub enum ShadowPath {
     Mask,
 }
 
+/// Which pixels trace a shadow ray on the GPU, over the casters' BVH, in place of
+/// their shadow-map answer (hybrid ray-traced shadows, after Story's HFTS and
+/// Unreal's shadow-map ray tracing). Needs the mask path. Hard lights only: a light
+/// with an area (a sun's angular diameter, a spot's or point's radius) keeps its
+/// filtered shadow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Refine {
+    /// Every pixel keeps its shadow map's answer.
+    #[default]
+    Off,
+    /// Pixels the map is unsure of (taps that disagree, a receiver within a few
+    /// texels' depth of the stored depth) trace one ray; the rest keep the map's answer.
+    Rays,
+    /// Every pixel that faces the light traces a ray: exact, and the upper baseline of
+    /// cost.
+    EveryPixel,
+}
+
 /// How shadows are resolved on screen: the frame-wide choice of path (contact
 /// shadows, per light, are in the shadow settings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
@@ -33,6 +53,13 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub shadow_path: ShadowPath,
+    /// Which pixels trace a shadow ray instead of trusting the map: off, rays (where
+    /// the map is unsure) or every-pixel (needs --shadow-path auto or mask).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
+    )]
+    pub refine: Refine,
 }
 
 /// Contact shadows: a short ray marched in screen space from each pixel toward the

@@ -1,0 +1,155 @@
+//! Batches of shadow rays answered on the GPU: one compute invocation per ray over
+//! the casters' BVH. For a host that wants exact visibility at points of its own,
+//! and for the tests that hold the GPU tracer to the CPU reference.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::{GROUP, GpuBvh};
+use crate::{Gpu, RenderError, readback};
+
+/// A segment to test: from `origin` along the unit `direction`, up to `length`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRay {
+    /// Where the ray starts, already moved off its surface if it leaves one.
+    pub origin: Vec3,
+    /// Unit direction toward the light.
+    pub direction: Vec3,
+    /// How far to look: the light's distance, or the scene's size for a sun.
+    pub length: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct RayGpu {
+    origin: [f32; 3],
+    length: f32,
+    direction: [f32; 3],
+    _pad: f32,
+}
+
+/// Threads per workgroup of the query shader (`QUERY_WORKGROUP` there).
+const WORKGROUP: u32 = 64;
+
+/// A scene's casters on the GPU, ready to answer shadow rays.
+pub struct ShadowRays {
+    gpu: Gpu,
+    bvh: GpuBvh,
+    pipeline: wgpu::ComputePipeline,
+    io_layout: wgpu::BindGroupLayout,
+}
+
+impl ShadowRays {
+    /// Builds and uploads the BVH of `scene`'s shadow casters.
+    pub fn new(gpu: &Gpu, scene: &gnomon_scene::Scene) -> Result<Self, RenderError> {
+        scene.validate()?;
+        let device = &gpu.device;
+        let rays_layout = super::layout(device);
+        let bvh = GpuBvh::upload(gpu, scene, &rays_layout)?;
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow ray query"),
+            entries: &[storage(0, true), storage(1, false)],
+        });
+        let pipeline = gpu.checked("building the shadow ray query", || {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("shadow ray query"),
+                bind_group_layouts: &[Some(&io_layout), None, None, Some(&rays_layout)],
+                immediate_size: 0,
+            });
+            let source = format!(
+                "const QUERY_WORKGROUP: u32 = {WORKGROUP}u;\n{}\n{}",
+                super::trace_wgsl(),
+                include_str!("query.wgsl")
+            );
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("shadow ray query"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("shadow ray query"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("cs_query"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        Ok(Self { gpu: Gpu::clone(gpu), bvh, pipeline, io_layout })
+    }
+
+    /// Triangles in the tree: every shadow-casting instance's.
+    pub fn triangle_count(&self) -> usize {
+        self.bvh.triangles
+    }
+
+    /// For each ray, whether a caster blocks it.
+    pub fn occluded(&self, rays: &[ShadowRay]) -> Result<Vec<bool>, RenderError> {
+        if rays.is_empty() {
+            return Ok(Vec::new());
+        }
+        let device = &self.gpu.device;
+        let data: Vec<RayGpu> = rays
+            .iter()
+            .map(|r| RayGpu {
+                origin: r.origin.to_array(),
+                length: r.length,
+                direction: r.direction.to_array(),
+                _pad: 0.0,
+            })
+            .collect();
+        let answers = self.gpu.checked("tracing shadow rays", || {
+            let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow rays"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let output = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow ray answers"),
+                size: 4 * rays.len() as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow ray query"),
+                layout: &self.io_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+                ],
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &io, &[]);
+                pass.set_bind_group(GROUP, &self.bvh.group, &[]);
+                let groups = (rays.len() as u32).div_ceil(WORKGROUP);
+                // Workgroups in two dimensions: one dimension alone stops at 65,535.
+                let per_row = groups.min(device.limits().max_compute_workgroups_per_dimension);
+                pass.dispatch_workgroups(per_row, groups.div_ceil(per_row), 1);
+            }
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow ray answers, read back"),
+                size: output.size(),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, output.size());
+            self.gpu.queue.submit([encoder.finish()]);
+            staging
+        })?;
+        let words: Vec<u32> = readback::read_buffer(&self.gpu, &answers)?;
+        Ok(words.into_iter().take(rays.len()).map(|w| w != 0).collect())
+    }
+}

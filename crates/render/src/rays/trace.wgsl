@@ -1,0 +1,262 @@
+// Shadow rays against the casters' BVH (bvh.rs): is the segment from a surface point
+// toward the light blocked? The same answers as the CPU reference (reference/tracer.rs):
+// the watertight ray/triangle test of Woop, Benthin & Wald (JCGT 2(1), 2013) with
+// PBRT's bound on the error of t, cut-out casters tested against their texture's
+// alpha at mip 0, and the ray's origin moved off its surface by Wächter & Binder's
+// offset (Ray Tracing Gems, ch. 6).
+//
+// Group 3, bindings 2–6 (0 and 1 are the material texture, which passes sharing
+// scene_common.wgsl declare).
+
+struct BvhNode {
+    min: vec3<f32>,
+    // Triangles in the leaf; 0 for an inner node.
+    count: u32,
+    max: vec3<f32>,
+    // The first child (the second follows it), or the leaf's first triangle.
+    first: u32,
+};
+
+struct BvhTriangle {
+    v0: vec3<f32>,
+    // Index into bvh_alpha, or NO_ALPHA.
+    alpha: u32,
+    v1: vec3<f32>,
+    _pad1: u32,
+    v2: vec3<f32>,
+    _pad2: u32,
+};
+
+struct AlphaTest {
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
+    // Index into bvh_alpha_textures, or NO_TEXTURE.
+    texture: u32,
+    base_alpha: f32,
+    cutoff: f32,
+    _pad: u32,
+};
+
+struct AlphaTexture {
+    first_word: u32,
+    width: u32,
+    height: u32,
+    // 0 repeat, 1 mirrored repeat, 2 clamp to edge.
+    wrap_u: u32,
+    wrap_v: u32,
+    nearest: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(3) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(3) @binding(3) var<storage, read> bvh_triangles: array<BvhTriangle>;
+@group(3) @binding(4) var<storage, read> bvh_alpha: array<AlphaTest>;
+@group(3) @binding(5) var<storage, read> bvh_alpha_textures: array<AlphaTexture>;
+@group(3) @binding(6) var<storage, read> bvh_alpha_texels: array<u32>;
+
+// A texel index along an axis of `n` texels, wrapped as `mode` says.
+fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
+    if mode == 2u {
+        return clamp(i, 0, n - 1);
+    }
+    if mode == 1u {
+        let m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return select(m, 2 * n - 1 - m, m >= n);
+    }
+    return ((i % n) + n) % n;
+}
+
+fn alpha_texel(t: AlphaTexture, x: i32, y: i32) -> f32 {
+    let w = i32(t.width);
+    let h = i32(t.height);
+    let index = u32(wrap_texel(y, h, t.wrap_v) * w + wrap_texel(x, w, t.wrap_u));
+    let word = bvh_alpha_texels[t.first_word + index / 4u];
+    return f32((word >> (8u * (index % 4u))) & 0xffu) / 255.0;
+}
+
+// The texture's alpha at `uv`, nearest or bilinear as its sampler asks, at mip 0
+// (texel centres at half-integers), as reference/texture.rs samples it.
+fn sample_alpha(t: AlphaTexture, uv: vec2<f32>) -> f32 {
+    let size = vec2<f32>(f32(t.width), f32(t.height));
+    if t.nearest == 1u {
+        let p = floor(uv * size);
+        return alpha_texel(t, i32(p.x), i32(p.y));
+    }
+    let p = uv * size - vec2<f32>(0.5);
+    let base = floor(p);
+    let f = p - base;
+    let x = i32(base.x);
+    let y = i32(base.y);
+    let top = mix(alpha_texel(t, x, y), alpha_texel(t, x + 1, y), f.x);
+    let bottom = mix(alpha_texel(t, x, y + 1), alpha_texel(t, x + 1, y + 1), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// A ray made the +z axis by a permutation and a shear (Woop et al. §2).
+struct ShearedRay {
+    origin: vec3<f32>,
+    kx: u32,
+    ky: u32,
+    kz: u32,
+    shear: vec3<f32>,
+};
+
+fn shear_ray(origin: vec3<f32>, direction: vec3<f32>) -> ShearedRay {
+    let a = abs(direction);
+    var kz = 2u;
+    if a.x >= a.y && a.x >= a.z {
+        kz = 0u;
+    } else if a.y >= a.z {
+        kz = 1u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kz + 2u) % 3u;
+    // Keep the winding: swap when the dominant axis points backward.
+    if direction[kz] < 0.0 {
+        let swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    let dz = direction[kz];
+    return ShearedRay(origin, kx, ky, kz, vec3<f32>(direction[kx] / dz, direction[ky] / dz, 1.0 / dz));
+}
+
+// PBRT's γ(n) = nε / (1 − nε), ε half an ulp of 1.
+fn gamma(n: f32) -> f32 {
+    let e = n * 0.5 * 1.1920929e-7;
+    return e / (1.0 - e);
+}
+
+// Whether triangle `index` blocks the ray in (0, t_max]; its alpha test included.
+fn triangle_blocks(ray: ShearedRay, index: u32, t_max: f32) -> bool {
+    let tri = bvh_triangles[index];
+    let a = tri.v0 - ray.origin;
+    let b = tri.v1 - ray.origin;
+    let c = tri.v2 - ray.origin;
+    let s = ray.shear;
+    let ax = a[ray.kx] - s.x * a[ray.kz];
+    let ay = a[ray.ky] - s.y * a[ray.kz];
+    let bx = b[ray.kx] - s.x * b[ray.kz];
+    let by = b[ray.ky] - s.y * b[ray.kz];
+    let cx = c[ray.kx] - s.x * c[ray.kz];
+    let cy = c[ray.ky] - s.y * c[ray.kz];
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return false;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return false;
+    }
+    let az = s.z * a[ray.kz];
+    let bz = s.z * b[ray.kz];
+    let cz = s.z * c[ray.kz];
+    let t = (u * az + v * bz + w * cz) / det;
+    // A hit closer than the rounding error of t may be the surface the ray leaves
+    // (Pharr, Jakob & Humphreys, PBRT 3rd ed., §3.9.6).
+    let max_z = max(abs(az), max(abs(bz), abs(cz)));
+    let max_x = max(abs(ax), max(abs(bx), abs(cx)));
+    let max_y = max(abs(ay), max(abs(by), abs(cy)));
+    let delta_x = gamma(5.0) * (max_x + max_z);
+    let delta_y = gamma(5.0) * (max_y + max_z);
+    let delta_z = gamma(3.0) * max_z;
+    let delta_e = 2.0 * (gamma(2.0) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let max_e = max(abs(u), max(abs(v), abs(w)));
+    let delta_t = 3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) / abs(det);
+    if !(t > delta_t && t <= t_max) {
+        return false;
+    }
+    if tri.alpha == NO_ALPHA {
+        return true;
+    }
+    let test = bvh_alpha[tri.alpha];
+    // U weighs the vertex opposite edge BC (A), V the one opposite CA (B), W C.
+    let uv = (test.uv0 * u + test.uv1 * v + test.uv2 * w) / det;
+    var alpha = test.base_alpha;
+    if test.texture != NO_TEXTURE {
+        alpha *= sample_alpha(bvh_alpha_textures[test.texture], uv);
+    }
+    return alpha >= test.cutoff;
+}
+
+// Entry distance of the ray into a node's box, or a negative value on a miss. The far
+// distance is widened by 2γ(3) so that a ray grazing a face is not lost to rounding
+// (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
+fn enter_box(node: BvhNode, origin: vec3<f32>, inv_direction: vec3<f32>, t_max: f32) -> f32 {
+    let t0 = (node.min - origin) * inv_direction;
+    let t1 = (node.max - origin) * inv_direction;
+    let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_max)) * (1.0 + 2.0 * gamma(3.0));
+    return select(-1.0, near, near <= far);
+}
+
+// Whether a shadow caster blocks the segment from `origin` along the unit
+// `direction` before `t_max`. Any hit ends the walk: a shadow ray needs no closest one.
+fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
+    let ray = shear_ray(origin, direction);
+    // A zero component would give an infinite reciprocal, and 0 · ∞ a NaN slab
+    // distance that loses the box; a tiny component of the same sign gives a huge,
+    // finite one, so the slabs of that axis span everything or nothing, as they should.
+    let tiny = select(vec3<f32>(1e-30), vec3<f32>(-1e-30), direction < vec3<f32>(0.0));
+    let inv_direction = 1.0 / select(direction, tiny, abs(direction) < vec3<f32>(1e-30));
+    var stack: array<u32, TRACE_STACK_SIZE>;
+    var top = 0u;
+    var node_index = 0u;
+    if enter_box(bvh_nodes[0], origin, inv_direction, t_max) < 0.0 {
+        return false;
+    }
+    // A walk visits each node at most once; more steps than nodes means a broken tree,
+    // and a shader that never ends would hang the device.
+    let max_steps = arrayLength(&bvh_nodes);
+    for (var step = 0u; step <= max_steps; step++) {
+        let node = bvh_nodes[node_index];
+        if node.count > 0u {
+            for (var i = node.first; i < node.first + node.count; i++) {
+                if triangle_blocks(ray, i, t_max) {
+                    return true;
+                }
+            }
+        } else {
+            let left = node.first;
+            let right = node.first + 1u;
+            let t_left = enter_box(bvh_nodes[left], origin, inv_direction, t_max);
+            let t_right = enter_box(bvh_nodes[right], origin, inv_direction, t_max);
+            if t_left >= 0.0 && t_right >= 0.0 {
+                // Nearer first; the farther waits on the stack.
+                let near_first = t_left <= t_right;
+                node_index = select(right, left, near_first);
+                stack[top] = select(left, right, near_first);
+                top++;
+                continue;
+            }
+            if t_left >= 0.0 {
+                node_index = left;
+                continue;
+            }
+            if t_right >= 0.0 {
+                node_index = right;
+                continue;
+            }
+        }
+        if top == 0u {
+            return false;
+        }
+        top--;
+        node_index = stack[top];
+    }
+    return false;
+}
+
+// Moves a surface point off its surface along the geometric normal `n` (facing the
+// side the ray leaves from) by a few units in the last place of its coordinates
+// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray
+// Tracing Gems, ch. 6, 2019), as reference/tracer.rs does.
+fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let of_i = vec3<i32>(n * 256.0);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    return select(p_i, p + n / 65536.0, abs(p) < vec3<f32>(1.0 / 32.0));
+}
