@@ -83,6 +83,24 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
+/// Refuses a tree deeper than the shader's stack, or a buffer larger than `limit`
+/// bytes (what the device binds in one storage buffer).
+fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RenderError> {
+    if bvh.depth > bvh::MAX_DEPTH {
+        return Err(RenderError::RayTreeTooDeep {
+            scene: scene.to_owned(),
+            depth: bvh.depth,
+            max: bvh::MAX_DEPTH,
+        });
+    }
+    for (buffer, bytes) in bvh.buffer_sizes() {
+        if bytes > limit {
+            return Err(RenderError::RayBufferTooLarge { scene: scene.to_owned(), buffer, bytes, limit });
+        }
+    }
+    Ok(())
+}
+
 /// A scene's casters on the GPU, bound for tracing.
 pub(crate) struct GpuBvh {
     pub group: wgpu::BindGroup,
@@ -101,24 +119,8 @@ impl GpuBvh {
         layout: &wgpu::BindGroupLayout,
     ) -> Result<Self, RenderError> {
         let bvh = CasterBvh::build(scene);
-        if bvh.depth > bvh::MAX_DEPTH {
-            return Err(RenderError::RayTreeTooDeep {
-                scene: scene.name.clone(),
-                depth: bvh.depth,
-                max: bvh::MAX_DEPTH,
-            });
-        }
         let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
-        for (buffer, bytes) in bvh.buffer_sizes() {
-            if bytes > limit {
-                return Err(RenderError::RayBufferTooLarge {
-                    scene: scene.name.clone(),
-                    buffer,
-                    bytes,
-                    limit,
-                });
-            }
-        }
+        check_limits(&bvh, &scene.name, limit)?;
         // wgpu refuses a binding smaller than one element: an unused buffer holds one
         // zeroed element of the largest kind.
         let contents = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 64] } else { bytes.to_vec() };
@@ -156,5 +158,31 @@ impl GpuBvh {
             });
             Self { group, triangles: bvh.casters, _buffers: buffers }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tree_too_deep_or_a_buffer_too_large_is_refused_naming_the_limit() {
+        let mut bvh = CasterBvh::build(&gnomon_scene::builtin::spheres());
+        assert!(check_limits(&bvh, "spheres", u64::MAX).is_ok());
+        let triangles = bvh.buffer_sizes()[1].1;
+        let e = check_limits(&bvh, "spheres", triangles - 1).unwrap_err().to_string();
+        assert!(
+            e.contains("spheres")
+                && e.contains("triangles")
+                && e.contains(&format!("at most {}", triangles - 1)),
+            "{e}"
+        );
+        bvh.depth = bvh::MAX_DEPTH + 1;
+        let e = check_limits(&bvh, "spheres", u64::MAX).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("{} levels deep", bvh::MAX_DEPTH + 1))
+                && e.contains(&format!("at most {}", bvh::MAX_DEPTH)),
+            "{e}"
+        );
     }
 }
