@@ -266,6 +266,22 @@ fn light_all_takes_each_lights_own_shadow_settings() {
 }
 
 #[test]
+fn refining_by_rays_chooses_the_mask_path_and_forward_refuses_it() {
+    let scene = crate::builtin::spheres();
+    let mut s = Settings::default();
+    let lights = s.resolve_lights(&scene).unwrap();
+    for refine in [Refine::Rays, Refine::EveryPixel] {
+        s.screen.refine = refine;
+        s.screen.shadow_path = ShadowPath::Auto;
+        assert!(s.uses_shadow_mask(&lights).unwrap(), "{refine:?}: auto takes the mask");
+        s.screen.shadow_path = ShadowPath::Forward;
+        let e = s.uses_shadow_mask(&lights).unwrap_err();
+        assert_eq!(e.setting, "screen.refine");
+        assert!(e.to_string().contains(&value_name(&refine)) && e.valid.contains("forward"), "{e}");
+    }
+}
+
+#[test]
 fn contact_shadows_choose_the_mask_path_and_are_checked() {
     let scene = crate::builtin::lamps();
     let mut s = Settings::default();
