@@ -112,6 +112,10 @@ struct ConfigReport {
     /// shadow pass's time over the baseline's (lights the baseline can draw).
     depth_only: Option<Summary>,
     shadow_over_depth_only: Option<f64>,
+    /// With refinement by rays, in the last frame: the pixels traced as a share of
+    /// the screen (every refining light together, in %), and the rays cast.
+    traced_percent: Option<f64>,
+    rays: Option<u64>,
 }
 
 #[derive(Serialize, Debug)]
@@ -207,6 +211,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             if let Some(ms) = timings.mask_ms {
                 push("mask".into(), ms);
             }
+            if let Some(ms) = timings.trace_ms {
+                push("trace".into(), ms);
+            }
             push("lighting".into(), timings.lighting_ms);
             push("GPU frame".into(), timings.frame_ms);
             push("CPU submit".into(), cost.cpu.submit_ms);
@@ -238,9 +245,13 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         }
         let summary = |name: &str| series.get(name).map(|values| summarize(name, values));
         let last = last.expect("at least one frame");
+        crate::render_cmd::warn_unrefined(&last.lights);
         let is_layer = |name: &String| name.starts_with("shadow L");
         let depth_only = summary("depth-only");
         let ratio = summary("shadow ÷ depth-only").map(|r| r.median_ms);
+        let traced: Vec<u64> = last.lights.iter().filter_map(|l| l.traced_pixels).map(u64::from).collect();
+        let rays = (!traced.is_empty()).then(|| traced.iter().sum::<u64>());
+        let pixels = f64::from(settings.image.width) * f64::from(settings.image.height);
         reports.push(ConfigReport {
             technique: config.technique.name().to_string(),
             sweep_value: config.sweep_value.clone(),
@@ -256,6 +267,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             lighting_instances: last.stats.lighting_instances,
             depth_only,
             shadow_over_depth_only: ratio,
+            traced_percent: rays.map(|r| 100.0 * r as f64 / pixels),
+            rays,
         });
     }
     progress.finish_and_clear();
@@ -410,11 +423,12 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
     }
     // In frame order, whichever configurations have them.
-    const ORDER: [&str; 12] = [
+    const ORDER: [&str; 13] = [
         "shadow",
         "filter",
         "prepass",
         "mask",
+        "trace",
         "lighting",
         "GPU frame",
         "CPU submit",
@@ -427,6 +441,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
     columns.sort_by_key(|c| ORDER.iter().position(|o| o == c).unwrap_or(ORDER.len()));
     let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));
     let has_baseline = report.configs.iter().any(|c| c.depth_only.is_some());
+    let has_rays = report.configs.iter().any(|c| c.rays.is_some());
     let _ = write!(md, "| technique |");
     if let Some(flag) = sweep {
         let _ = write!(md, " {flag} |");
@@ -437,8 +452,15 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
     if has_baseline {
         let _ = write!(md, " depth-only | shadow ÷ depth-only |");
     }
+    if has_rays {
+        let _ = write!(md, " traced, % of screen (rays) |");
+    }
     let _ = writeln!(md, " shadow draws (instances) | lighting draws (instances) |");
-    let cells = columns.len() + 3 + usize::from(sweep.is_some()) + 2 * usize::from(has_baseline);
+    let cells = columns.len()
+        + 3
+        + usize::from(sweep.is_some())
+        + 2 * usize::from(has_baseline)
+        + usize::from(has_rays);
     let _ = writeln!(md, "|{}", "---|".repeat(cells));
     let cell = |s: Option<&Summary>| {
         s.map_or("–".to_string(), |s| format!("{:.3} ({:.3})", s.median_ms, s.p95_ms))
@@ -454,6 +476,13 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         if has_baseline {
             let ratio = config.shadow_over_depth_only.map_or("–".into(), |r| format!("{r:.3}"));
             let _ = write!(md, " {} | {ratio} |", cell(config.depth_only.as_ref()));
+        }
+        if has_rays {
+            let traced = match (config.traced_percent, config.rays) {
+                (Some(percent), Some(rays)) => format!("{percent:.2} ({rays})"),
+                _ => "–".into(),
+            };
+            let _ = write!(md, " {traced} |");
         }
         let _ = writeln!(
             md,

@@ -98,9 +98,7 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
     match render {
         RenderError::ShadowMapTooLarge { requested, .. } => Some(format!("--shadow-res = {requested}: ")),
         RenderError::MomentFormatUnsupported { .. } => Some("--moment-format rgba32float: ".into()),
-        RenderError::RayTreeTooDeep { .. } | RenderError::RayBufferTooLarge { .. } => {
-            Some("--refine: ".into())
-        }
+        RenderError::RaysUnavailable(_) => Some("--refine: ".into()),
         RenderError::NoAdapter { .. }
         | RenderError::DeviceRequest { .. }
         | RenderError::ImageTooLarge { .. }

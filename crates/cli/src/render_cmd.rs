@@ -88,6 +88,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let request = OutputRequest { shadow_map: args.shadow_map_out.is_some(), ..Default::default() };
     let render_started = std::time::Instant::now();
     let frame = renderer.render(&scene, settings, &request)?;
+    warn_unrefined(&frame.lights);
     if args.verbose {
         let shadows = match frame.lights.as_slice() {
             [one] => format!("technique {}, shadow map {}²", one.technique.name(), one.resolution),
@@ -127,13 +128,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
             let prepass = t.prepass_ms.map(|p| format!(", prepass {p:.2} ms")).unwrap_or_default();
             let mask = t.mask_ms.map(|m| format!(", shadow mask {m:.2} ms")).unwrap_or_default();
+            let trace = t.trace_ms.map(|m| format!(", ray trace {m:.2} ms")).unwrap_or_default();
             eprintln!(
-                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}{prepass}{mask}, lighting pass {:.2} ms",
+                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}{prepass}{mask}{trace}, lighting pass {:.2} ms",
                 t.frame_ms, t.shadow_ms, t.lighting_ms
             );
         }
         for (i, light) in frame.lights.iter().enumerate() {
             eprintln!("gnomon: {}", light_line(i, light));
+            if let Some(traced) = light.traced_pixels {
+                eprintln!("gnomon: {}", traced_line(i, traced, frame.pixel_count()));
+            }
         }
     }
 
@@ -192,6 +197,27 @@ pub(crate) fn open_casters_line(scene: &Scene, cull: CullMode) -> String {
     )
 }
 
+/// Warns, once per reason, of lights drawn unrefined though `--refine` asked for rays:
+/// the device cannot trace the scene or an image this large.
+pub(crate) fn warn_unrefined(lights: &[gnomon_render::LightStats]) {
+    let mut said: Vec<&gnomon_render::rays::RaysUnavailable> = Vec::new();
+    for why in lights.iter().filter_map(|l| l.refine_fallback.as_ref()) {
+        if !said.contains(&why) {
+            eprintln!("gnomon: warning: --refine: {why}; shadows drawn unrefined");
+            said.push(why);
+        }
+    }
+}
+
+/// `--verbose`'s line on a light refined by rays: the pixels that traced a ray, as a
+/// share of the screen.
+pub(crate) fn traced_line(index: usize, traced: u32, pixels: usize) -> String {
+    format!(
+        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({traced} rays)",
+        100.0 * f64::from(traced) / pixels.max(1) as f64
+    )
+}
+
 /// One light's line of `--verbose`: what it is, what its map holds, the draws into
 /// each layer and its GPU time.
 fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
@@ -204,7 +230,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
     let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
     let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
     format!(
-        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}{}",
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}{}{}",
         light.name,
         light.kind,
         light.technique.name(),
@@ -213,6 +239,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         ms("shadow", light.shadow_ms),
         ms("moments", light.filter_ms),
         ms("mask", light.mask_ms),
+        ms("trace", light.trace_ms),
         ms("lighting", light.lighting_ms),
     )
 }

@@ -77,7 +77,8 @@ pub struct GpuScene {
     pub(crate) batches: Vec<Batch>,
     /// The shadow casters' BVH for ray-traced refinement, built on first use
     /// ([`GpuScene::build_rays`]).
-    rays: std::sync::OnceLock<crate::rays::GpuBvh>,
+    /// Or why the device cannot take it, kept so that it is not built again.
+    rays: std::sync::OnceLock<Result<crate::rays::GpuBvh, crate::rays::RaysUnavailable>>,
     /// The batches in shadow-pass order: opaque before alpha-masked, then by cull
     /// state and texture, so that pipelines and bind groups change least.
     shadow_order: Vec<u32>,
@@ -162,23 +163,30 @@ impl GpuScene {
     }
 
     /// Builds and uploads the shadow casters' BVH for ray-traced refinement, once:
-    /// `scene` must be the one this was uploaded from.
+    /// `scene` must be the one this was uploaded from. Ok(Err) says why this device
+    /// cannot trace it (the same answer every time); Err is a failure of the device.
     pub(crate) fn build_rays(
         &self,
         gpu: &Gpu,
         scene: &Scene,
         layout: &wgpu::BindGroupLayout,
-    ) -> Result<&crate::rays::GpuBvh, RenderError> {
-        if let Some(built) = self.rays.get() {
-            return Ok(built);
+    ) -> Result<Result<&crate::rays::GpuBvh, crate::rays::RaysUnavailable>, RenderError> {
+        if self.rays.get().is_none() {
+            let built = match crate::rays::GpuBvh::upload(gpu, scene, layout) {
+                Ok(bvh) => Ok(bvh),
+                Err(RenderError::RaysUnavailable(why)) => Err(why),
+                Err(failure) => return Err(failure),
+            };
+            // Another thread may have built it meanwhile: either answer is the same.
+            let _ = self.rays.set(built);
         }
-        let built = crate::rays::GpuBvh::upload(gpu, scene, layout)?;
-        Ok(self.rays.get_or_init(|| built))
+        let built = self.rays.get().expect("set above");
+        Ok(built.as_ref().map_err(Clone::clone))
     }
 
     /// The casters' BVH, if [`GpuScene::build_rays`] has built it.
     pub(crate) fn rays(&self) -> Option<&crate::rays::GpuBvh> {
-        self.rays.get()
+        self.rays.get().and_then(|built| built.as_ref().ok())
     }
 
     /// How many instances were uploaded (those with geometry).

@@ -148,34 +148,12 @@ pub enum RenderError {
         /// The most bytes the device binds in one storage buffer.
         limit: u64,
     },
-    /// The BVH of the scene's shadow casters is deeper than the GPU tracer's stack.
-    #[error(
-        "scene `{scene}`: the BVH of its shadow casters is {depth} levels deep, but the GPU \
-         ray tracer walks at most {max}"
-    )]
-    RayTreeTooDeep {
-        /// Name of the scene.
-        scene: String,
-        /// Depth of the built tree, the root counting 1.
-        depth: u32,
-        /// The deepest tree the tracer walks.
-        max: u32,
-    },
-    /// One of the ray tracer's buffers is larger than the device binds.
-    #[error(
-        "scene `{scene}`: the GPU ray tracer's {buffer} take {bytes} bytes, but this device binds \
-         at most {limit} bytes in one storage buffer"
-    )]
-    RayBufferTooLarge {
-        /// Name of the scene.
-        scene: String,
-        /// Which buffer: nodes, triangles, alpha tests, alpha textures or alpha texels.
-        buffer: &'static str,
-        /// Its size.
-        bytes: u64,
-        /// The most bytes the device binds in one storage buffer.
-        limit: u64,
-    },
+    /// The GPU ray tracer cannot take the scene or the frame on this device
+    /// ([`crate::rays::RaysUnavailable`]). A frame that asked for refinement by rays
+    /// does not fail for it: it is drawn unrefined and reports why
+    /// ([`LightStats::refine_fallback`]); [`crate::rays::ShadowRays`] does.
+    #[error(transparent)]
+    RaysUnavailable(#[from] rays::RaysUnavailable),
     /// wgpu reported a validation, out-of-memory or internal error, or a wait or readback failed.
     #[error("the GPU reported an error while {during}: {message}")]
     Gpu {

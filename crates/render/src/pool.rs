@@ -84,6 +84,12 @@ impl ViewKey {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum Binding {
     Buffer(wgpu::Buffer),
+    /// The first `size` bytes of a buffer, for a binding with a dynamic offset that
+    /// moves this window along it.
+    BufferWindow {
+        buffer: wgpu::Buffer,
+        size: u64,
+    },
     View(wgpu::TextureView),
     Sampler(wgpu::Sampler),
 }
@@ -337,6 +343,13 @@ impl Pool {
                 binding: *binding,
                 resource: match b {
                     Binding::Buffer(buffer) => buffer.as_entire_binding(),
+                    Binding::BufferWindow { buffer, size } => {
+                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(*size),
+                        })
+                    }
                     Binding::View(view) => wgpu::BindingResource::TextureView(view),
                     Binding::Sampler(sampler) => wgpu::BindingResource::Sampler(sampler),
                 },

@@ -16,8 +16,11 @@ pub enum PassKind {
     Shadow,
     /// A filterable technique's moment pass: encoding, blur and mipmaps.
     Filter,
-    /// A light's screen-space shadow-mask pass.
+    /// A light's screen-space shadow-mask pass (with refinement by rays, the
+    /// classification of its pixels).
     Mask,
+    /// A light's trace pass: the rays of the pixels its mask pass was unsure of.
+    Trace,
     /// A light's lighting pass.
     Lighting,
 }
@@ -30,6 +33,7 @@ impl PassKind {
             PassKind::Shadow => "shadow",
             PassKind::Filter => "filter",
             PassKind::Mask => "mask",
+            PassKind::Trace => "trace",
             PassKind::Lighting => "lighting",
         }
     }

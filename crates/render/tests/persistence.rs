@@ -15,7 +15,7 @@ use gnomon_render::{
 };
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{LightKind, OmniMap, Partition, ShadowPath, Technique},
+    settings::{LightKind, OmniMap, Partition, Refine, ShadowPath, Technique},
 };
 
 /// Frames checked after the warm-up.
@@ -179,6 +179,23 @@ fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
         let mut renderer = Renderer::new(&gpu).unwrap();
         let created = created_in_steady_state(&mut renderer, &scene, &settings);
         assert_eq!(created.total(), 0, "{path:?}: {created:?}");
+    }
+}
+
+/// Refinement by rays lists its pixels and traces them in pooled buffers and groups:
+/// steady frames create none of them either, for a sun and for every lamp at once.
+#[test]
+fn refined_frames_create_nothing_in_steady_state() {
+    let gpu = Gpu::new_headless().unwrap();
+    for (scene, light) in [(builtin::spheres(), LightKind::Sun), (builtin::lamps(), LightKind::All)] {
+        for refine in [Refine::Rays, Refine::EveryPixel] {
+            let mut settings = small(Technique::PCF, light);
+            settings.screen.refine = refine;
+            settings.screen.shadow_path = ShadowPath::Mask;
+            let mut renderer = Renderer::new(&gpu).unwrap();
+            let created = created_in_steady_state(&mut renderer, &scene, &settings);
+            assert_eq!(created.total(), 0, "{} {refine:?}: {created:?}", scene.name);
+        }
     }
 }
 

@@ -63,6 +63,7 @@ impl LateTimes {
                 light.filter_ms = arrived.filter_ms;
                 light.lighting_ms = arrived.lighting_ms;
                 light.mask_ms = arrived.mask_ms;
+                light.trace_ms = arrived.trace_ms;
             }
             reported.passes = timed.passes.clone();
             reported.timings = timed.timings;

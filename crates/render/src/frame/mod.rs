@@ -12,6 +12,7 @@ mod outputs;
 mod plan;
 mod receiver;
 mod record;
+mod refine;
 mod screen;
 
 use gnomon_scene::{Scene, Settings, settings::MomentFormat};
@@ -31,6 +32,7 @@ use crate::{
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
+    rays::TracePass,
     techniques::TechniqueRegistry,
     timing::ClockChoice,
 };
@@ -43,6 +45,7 @@ struct Passes {
     shadow: ShadowPass,
     lighting: LightingPass,
     screen_space: ScreenSpacePass,
+    trace: TracePass,
     moments: MomentPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
@@ -82,6 +85,7 @@ impl Renderer {
                 shadow: ShadowPass::new(device, &layouts),
                 lighting: LightingPass::new(device, &layouts),
                 screen_space: ScreenSpacePass::new(device, &layouts),
+                trace: TracePass::new(device, &layouts),
                 moments: MomentPass::new(device, &gpu.queue),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),

@@ -154,6 +154,14 @@ pub struct LightStats {
     pub lighting_ms: Option<f64>,
     /// GPU time of its shadow-mask pass, on the mask path.
     pub mask_ms: Option<f64>,
+    /// GPU time of its trace pass, where it refines its shadow by rays.
+    pub trace_ms: Option<f64>,
+    /// Pixels its shadow was refined at, one ray each, where it refines by rays and
+    /// the frame was waited for (not a live frame's).
+    pub traced_pixels: Option<u32>,
+    /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
+    /// device cannot trace this scene or an image this large.
+    pub refine_fallback: Option<crate::rays::RaysUnavailable>,
 }
 
 impl LightStats {
@@ -240,6 +248,8 @@ pub struct PassTimings {
     pub prepass_ms: Option<f64>,
     /// On the mask path: the shadow-mask passes, every light's.
     pub mask_ms: Option<f64>,
+    /// With refinement by rays: the trace passes, every refining light's.
+    pub trace_ms: Option<f64>,
     /// The whole frame on the GPU, from the first shadow pass's start to the last
     /// lighting pass's end (SDSM's prepass not included).
     pub frame_ms: f64,
@@ -286,6 +296,8 @@ pub(super) struct FrameReadbacks {
     pub targets: Vec<PendingReadback>,
     /// The reported light's map, every layer.
     pub shadow_map: Option<PendingReadback>,
+    /// With refinement by rays, a copy of the lights' counters (`rays::RefineLists`).
+    pub refine_counters: Option<wgpu::Buffer>,
 }
 
 /// A frame submitted to the GPU, its pass times read, its images waiting.
@@ -461,6 +473,9 @@ impl TimedLights {
                 filter_ms: None,
                 lighting_ms: None,
                 mask_ms: None,
+                trace_ms: None,
+                traced_pixels: None,
+                refine_fallback: None,
             })
             .collect();
         TimedLights { lights, passes: Vec::new(), timings: None }
@@ -482,6 +497,7 @@ impl TimedLights {
             light.filter_ms = time_of(PassKind::Filter);
             light.lighting_ms = time_of(PassKind::Lighting);
             light.mask_ms = time_of(PassKind::Mask);
+            light.trace_ms = time_of(PassKind::Trace);
         }
         let lights = &self.lights;
         self.timings = Some(PassTimings {
@@ -490,6 +506,7 @@ impl TimedLights {
             lighting_ms: sum_of(lights, |l| l.lighting_ms).unwrap_or(0.0),
             prepass_ms: times.passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
             mask_ms: sum_of(lights, |l| l.mask_ms),
+            trace_ms: sum_of(lights, |l| l.trace_ms),
             frame_ms: times.frame_ms,
             source: times.source,
         });

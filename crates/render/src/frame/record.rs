@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use gnomon_math::culling::Frustum;
-use gnomon_scene::{Scene, Settings, settings::Refine};
+use gnomon_scene::{Scene, Settings};
 
 use super::{
     Renderer,
@@ -23,7 +23,6 @@ use crate::{
         SHADOW_FORMAT, begin_depth_pass,
         lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
         moments::MomentInput,
-        screen_space,
         shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
     },
     pool::{Binding, ViewKey},
@@ -155,10 +154,8 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_limits(settings)?;
-        let plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
-        if plan.lights.iter().any(|l| l.refine != Refine::Off) {
-            uploaded.build_rays(&self.gpu, scene, &self.layouts.rays)?;
-        }
+        let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
+        let fallback = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();
         let culled = cull(uploaded, &plan);
         let cull_done = Instant::now();
@@ -174,11 +171,18 @@ impl Renderer {
         };
         let untimed = TimedLights::untimed(&plan, &culled);
         let times = recorded.times.take().map(PendingTimes::submitted);
-        let timed = match (request.times, times) {
+        let mut timed = match (request.times, times) {
             (_, None) => untimed,
             (TimesWanted::Now, Some(times)) => untimed.timed(times.read(&gpu)?),
             (TimesWanted::Late, Some(times)) => self.late_times.push(&gpu, &mut self.pool, times, untimed)?,
         };
+        let counters = recorded.readbacks.refine_counters.take();
+        let traced = match request.times {
+            // A frame waited for reports the pixels each light traced.
+            TimesWanted::Now => counters,
+            TimesWanted::Late => None,
+        };
+        super::refine::report(&gpu, &plan, &mut timed, fallback, traced)?;
         Ok(Submitted::new(plan, recorded, timed, cpu))
     }
 
@@ -192,8 +196,9 @@ impl Renderer {
         request: &SubmitRequest,
     ) -> Recorded {
         let gpu = self.gpu.clone();
-        // Every layer of every light, each light's filter, mask and lighting, and the prepass.
-        let timed_passes = plan.lights.iter().map(|p| p.layers() + 3).sum::<u32>() + 1;
+        // Every layer of every light, each light's filter, mask, trace and lighting, and
+        // the prepass.
+        let timed_passes = plan.lights.iter().map(|p| p.layers() + 4).sum::<u32>() + 1;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut rec = Recording {
             encoder: &mut encoder,
@@ -233,8 +238,7 @@ impl Renderer {
         let camera_group =
             self.pool.bind_group("camera", &self.layouts.camera, &[Binding::Buffer(camera_buffer.clone())]);
         // On the mask path, one layer of the mask per light.
-        let mask_layers =
-            if plan.mask_path { self.mask_layers(width, height, plan.lights.len()) } else { vec![] };
+        let mask_layers = if plan.mask_path { self.mask_layers(plan, width, height) } else { vec![] };
         let mut readbacks = FrameReadbacks::default();
         let mut lit = Vec::with_capacity(plan.lights.len());
         let mut shown_map = None;
@@ -258,7 +262,8 @@ impl Renderer {
                 depth: &targets.depth,
                 mask_layers: &mask_layers,
             };
-            self.record_screen_space(rec, uploaded, plan, &lit, &screen);
+            let lists = self.record_screen_space(rec, uploaded, plan, &lit, &screen);
+            readbacks.refine_counters = lists.map(|lists| lists.copy_counters(&mut self.pool, rec.encoder));
         }
         let shared =
             SharedLighting { plan, camera_group: &camera_group, targets: &targets, visible: &culled.camera };
@@ -277,17 +282,6 @@ impl Renderer {
             color: targets.textures[0].clone(),
             shadow_map: shown_map.expect("the reported light is one of the lights"),
         }
-    }
-
-    /// One layer of the shadow mask per light.
-    fn mask_layers(&mut self, width: u32, height: u32, lights: usize) -> Vec<wgpu::TextureView> {
-        let mask = self.pool.texture(
-            "shadow mask",
-            wgpu::Extent3d { width, height, depth_or_array_layers: lights as u32 },
-            screen_space::MASK_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        (0..lights as u32).map(|layer| self.pool.view(&mask, ViewKey::layer(layer))).collect()
     }
 
     /// The colour and data targets of the lighting passes, and their depth buffer.

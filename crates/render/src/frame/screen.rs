@@ -1,10 +1,11 @@
 //! The mask path's screen-space passes: a depth-and-normal prepass from the camera,
 //! then one shadow-mask pass per light (the technique's lookup and contact shadows,
-//! per pixel) into its layer of the mask, which the lighting passes then read.
+//! per pixel) into its layer of the mask, which the lighting passes then read; where
+//! a light refines its shadow by rays, its trace pass follows its mask pass.
 
 use super::{
     Renderer,
-    plan::FramePlan,
+    plan::{FramePlan, LightPlan},
     record::{LightBindings, Recording},
 };
 use crate::{
@@ -12,7 +13,7 @@ use crate::{
     gpu_scene::Visible,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
-    rays,
+    rays::{ListAccess, RefineLists, TraceGroups},
     timing::PassKind,
 };
 use gnomon_scene::settings::Refine;
@@ -40,7 +41,9 @@ fn cleared(view: &wgpu::TextureView, clear: wgpu::Color) -> Option<wgpu::RenderP
 
 impl Renderer {
     /// The depth-and-normal prepass into `inputs.depth`, then each light's mask pass
-    /// into its layer of the mask.
+    /// into its layer of the mask, followed, where the light refines its shadow by
+    /// rays, by its trace pass. Returns the refinement's lists, whose counters say
+    /// how many pixels each light traced.
     pub(super) fn record_screen_space(
         &mut self,
         rec: &mut Recording,
@@ -48,7 +51,7 @@ impl Renderer {
         plan: &FramePlan,
         lit: &[LightBindings],
         inputs: &ScreenInputs,
-    ) {
+    ) -> Option<RefineLists> {
         let (width, height) = (inputs.depth.texture().width(), inputs.depth.texture().height());
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
@@ -63,40 +66,98 @@ impl Renderer {
             &self.layouts.screen,
             &[
                 Binding::Buffer(inputs.camera_buffer.clone()),
-                Binding::View(view_depth),
-                Binding::View(normals),
+                Binding::View(view_depth.clone()),
+                Binding::View(normals.clone()),
             ],
         );
-        let gpu = &self.gpu;
+        // The list of unsure pixels and each light's counters, cleared: zero
+        // workgroups until a mask pass lists a pixel.
+        let refine = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
+            let lists = RefineLists::new(&mut self.pool, width, height, plan.lights.len());
+            rec.encoder.clear_buffer(&lists.counters, 0, None);
+            let prepass = [&view_depth, &normals];
+            let camera = inputs.camera_buffer;
+            let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
+            let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
+            (lists, [append, read])
+        });
         for (index, ((light, bindings), layer)) in
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
         {
-            let mask_group = bindings.mask.as_ref().expect("a mask pass group on the mask path");
-            let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Mask, Some(index as u32), None);
-            let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow mask"),
-                color_attachments: &[cleared(layer, wgpu::Color::WHITE)],
-                depth_stencil_attachment: None,
-                timestamp_writes: rec.clock.render_writes(slot),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            let key = MaskKey { technique: light.technique, lookup: bindings.lookup, refine: light.refine };
-            pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
-            pass.set_bind_group(0, &bindings.scene, &[]);
-            pass.set_bind_group(1, &screen_group, &[]);
-            pass.set_bind_group(2, mask_group, &[]);
-            rec.stats.pipeline_changes += 1;
-            rec.stats.bind_group_changes += 3;
-            if light.refine != Refine::Off {
+            let refined = match (&refine, light.refine) {
+                (_, Refine::Off) | (None, _) => None,
+                (Some(lists), Refine::Rays | Refine::EveryPixel) => Some(lists),
+            };
+            let screen = match refined {
+                Some((_, [append, _])) => (append, RefineLists::counter_offset(index as u32)),
+                None => (&screen_group, 0),
+            };
+            self.record_mask(rec, light, bindings, layer, screen, index as u32);
+            if let Some((lists, [_, read])) = refined {
+                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
-                pass.set_bind_group(rays::GROUP, &bvh.group, &[]);
-                rec.stats.bind_group_changes += 1;
+                let groups = TraceGroups {
+                    scene: &bindings.scene,
+                    screen: read,
+                    mask: &mask,
+                    bvh: &bvh.group,
+                    counters: &lists.counters,
+                };
+                self.record_trace(rec, &groups, index as u32);
             }
-            pass.draw(0..3, 0..1);
-            drop(pass);
-            rec.clock.end(gpu, rec.encoder, slot);
         }
+        refine.map(|(lists, _)| lists)
+    }
+
+    /// Light `index`'s mask pass into its `layer` of the mask, with group 1 `screen`
+    /// bound at its dynamic offset (the light's counters, when it refines).
+    fn record_mask(
+        &mut self,
+        rec: &mut Recording,
+        light: &LightPlan,
+        bindings: &LightBindings,
+        layer: &wgpu::TextureView,
+        (screen_group, offset): (&wgpu::BindGroup, u32),
+        index: u32,
+    ) {
+        let gpu = &self.gpu;
+        let mask_group = bindings.mask.as_ref().expect("a mask pass group on the mask path");
+        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Mask, Some(index), None);
+        let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow mask"),
+            color_attachments: &[cleared(layer, wgpu::Color::WHITE)],
+            depth_stencil_attachment: None,
+            timestamp_writes: rec.clock.render_writes(slot),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let key = MaskKey { technique: light.technique, lookup: bindings.lookup, refine: light.refine };
+        pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
+        pass.set_bind_group(0, &bindings.scene, &[]);
+        let offsets = [offset];
+        let offsets: &[u32] = if light.refine == Refine::Off { &[] } else { &offsets };
+        pass.set_bind_group(1, screen_group, offsets);
+        pass.set_bind_group(2, mask_group, &[]);
+        rec.stats.pipeline_changes += 1;
+        rec.stats.bind_group_changes += 3;
+        pass.draw(0..3, 0..1);
+        drop(pass);
+        rec.clock.end(gpu, rec.encoder, slot);
+    }
+
+    /// Light `index`'s trace pass: a ray for each pixel its mask pass listed.
+    fn record_trace(&mut self, rec: &mut Recording, groups: &TraceGroups, index: u32) {
+        let gpu = &self.gpu;
+        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Trace, Some(index), None);
+        let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shadow mask ray trace"),
+            timestamp_writes: rec.clock.compute_writes(slot),
+        });
+        self.passes.trace.record(&mut pass, groups, index);
+        rec.stats.pipeline_changes += 1;
+        rec.stats.bind_group_changes += 4;
+        drop(pass);
+        rec.clock.end(gpu, rec.encoder, slot);
     }
 
     /// The camera's depth, normals and view depth.
@@ -141,5 +202,26 @@ impl Renderer {
         rec.stats.bind_group_changes += binds;
         drop(pass);
         rec.clock.end(gpu, rec.encoder, slot);
+    }
+
+    /// One layer of the shadow mask per light of `plan`, writable by the trace passes
+    /// where a light refines by rays.
+    pub(super) fn mask_layers(
+        &mut self,
+        plan: &FramePlan,
+        width: u32,
+        height: u32,
+    ) -> Vec<wgpu::TextureView> {
+        let refining = plan.lights.iter().any(|l| l.refine != Refine::Off);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let usage = if refining { usage | wgpu::TextureUsages::STORAGE_BINDING } else { usage };
+        let lights = plan.lights.len() as u32;
+        let mask = self.pool.texture(
+            "shadow mask",
+            wgpu::Extent3d { width, height, depth_or_array_layers: lights },
+            screen_space::MASK_FORMAT,
+            usage,
+        );
+        (0..lights).map(|layer| self.pool.view(&mask, ViewKey::layer(layer))).collect()
     }
 }

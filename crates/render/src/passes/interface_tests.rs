@@ -85,6 +85,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("sample bounds".into(), depth_reduce::bounds_wgsl()));
     out.push(("map preview".into(), map_preview::preview_wgsl()));
     out.push(("blit".into(), blit::blit_wgsl()));
+    out.push(("ray trace".into(), crate::rays::trace_pass_wgsl()));
     out
 }
 

@@ -92,6 +92,9 @@ pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
 pub(crate) const CAMERA_WGSL: &str =
     concat!(include_str!("camera.wgsl"), "\n@group(1) @binding(0) var<uniform> camera: Camera;\n");
 
+/// The prepass's bindings and `world_at`, for the passes that read the prepass.
+pub(crate) const SCREEN_COMMON_WGSL: &str = include_str!("screen_common.wgsl");
+
 /// The shadow receiver: a host's shader reads a light's shadows through it.
 pub(crate) mod receiver;
 
@@ -100,7 +103,8 @@ pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 
 /// Bind group layouts shared by the passes.
 pub(crate) struct Layouts {
-    /// Group 0: instances (storage) and the light (uniform).
+    /// Group 0: instances (storage) and the light (uniform); the trace pass's
+    /// compute stage reads the light too.
     pub scene: wgpu::BindGroupLayout,
     /// Group 1 of the lighting pass and the prepass: the camera.
     pub camera: wgpu::BindGroupLayout,
@@ -118,14 +122,21 @@ pub(crate) struct Layouts {
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
     pub material: wgpu::BindGroupLayout,
-    /// The casters' BVH ([`crate::rays`]): group 3 of a shadow-mask pass that
-    /// refines with rays.
+    /// The casters' BVH ([`crate::rays`]): group 3 of the trace pass.
     pub rays: wgpu::BindGroupLayout,
+    /// Group 1 of a shadow-mask pass that refines with rays: `screen`'s bindings,
+    /// the list of unsure pixels and the light's counters, written.
+    pub refine_screen: wgpu::BindGroupLayout,
+    /// Group 1 of the trace pass: the same, read.
+    pub trace_screen: wgpu::BindGroupLayout,
+    /// Group 2 of the trace pass: the light's layer of the mask, written.
+    pub refined_mask: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
     pub fn new(device: &wgpu::Device) -> Self {
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let vfc = vf | wgpu::ShaderStages::COMPUTE;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
         };
@@ -142,8 +153,8 @@ impl Layouts {
             scene: layout(
                 "scene",
                 &[
-                    wgpu::BindGroupLayoutEntry { binding: 0, visibility: vf, ty: instances, count: None },
-                    uniform_entry(1, vf),
+                    wgpu::BindGroupLayoutEntry { binding: 0, visibility: vfc, ty: instances, count: None },
+                    uniform_entry(1, vfc),
                 ],
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
@@ -158,6 +169,9 @@ impl Layouts {
             ),
             material: layout("material", &[fragment_entry(0, filterable), fragment_entry(1, filtering)]),
             rays: crate::rays::layout(device),
+            refine_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Append),
+            trace_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Read),
+            refined_mask: crate::rays::refined_mask_layout(device),
         }
     }
 }

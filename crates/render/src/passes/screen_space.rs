@@ -48,7 +48,8 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
     parts.push(include_str!("octahedron.wgsl").to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
-    parts.extend(crate::rays::refine_wgsl(key.refine, key.lookup));
+    parts.push(super::SCREEN_COMMON_WGSL.to_owned());
+    parts.extend(crate::rays::classify_wgsl(key.refine, key.lookup));
     parts.push(include_str!("shadow_mask.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -57,7 +58,7 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
 pub(crate) struct ScreenSpacePass {
     prepass: wgpu::RenderPipeline,
     mask_layout: wgpu::PipelineLayout,
-    /// The mask pipelines that trace rays also bind the casters' BVH (group 3).
+    /// The mask pipelines that list pixels for rays bind the list in group 1.
     refine_layout: wgpu::PipelineLayout,
     masks: HashMap<MaskKey, wgpu::RenderPipeline>,
 }
@@ -108,12 +109,7 @@ impl ScreenSpacePass {
         });
         let refine_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow mask, refined by rays"),
-            bind_group_layouts: &[
-                Some(&layouts.scene),
-                Some(&layouts.screen),
-                Some(&layouts.shadow),
-                Some(&layouts.rays),
-            ],
+            bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.refine_screen), Some(&layouts.shadow)],
             immediate_size: 0,
         });
         Self { prepass, mask_layout, refine_layout, masks: HashMap::new() }
@@ -125,8 +121,9 @@ impl ScreenSpacePass {
     }
 
     /// The mask pipeline of a technique, lookup and refinement: groups 0 (scene and
-    /// light), 1 (camera and prepass), 2 (the light's shadow resources) and, when it
-    /// refines, 3 (the casters' BVH), drawn as one full-screen triangle.
+    /// light), 1 (camera and prepass, and when it refines the list of unsure pixels
+    /// and the light's counters) and 2 (the light's shadow resources), drawn as one
+    /// full-screen triangle.
     pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
         let layout = match key.refine {
             Refine::Off => &self.mask_layout,

@@ -1,16 +1,12 @@
 // Screen-space shadow mask (as in Unity URP's screen-space shadows): one full-screen
 // pass per light over the prepass. It rebuilds each pixel's world position from its
 // linear view depth, resolves the light's shadow lookup there once, with the light's
-// own technique (`pixel_visibility`, resolve_visibility.wgsl), traces a ray where the
-// map is unsure when refinement is on (`refined_visibility`, rays/), marches contact shadows
-// when the light has them (contact.wgsl), and stores the visibility in the light's
-// layer of the mask, for its lighting pass to read: one 32-bit float, visibility +
+// own technique (`pixel_visibility`, resolve_visibility.wgsl), lists the pixels whose
+// map answer is unsure for the trace pass when refinement is on (`ray_decides`,
+// rays/refine_classify.wgsl), marches contact shadows when the light has them
+// (contact.wgsl), and stores the visibility in the light's layer of the mask, for its lighting pass to read: one 32-bit float, visibility +
 // 2 × the shadow-map layer that shaded it (for the cascade debug view), so that the
 // mask path keeps the forward path's visibility exactly.
-
-// The prepass's outputs, with the camera (camera.wgsl) in group 1.
-@group(1) @binding(1) var prepass_view_depth: texture_2d<f32>;
-@group(1) @binding(2) var prepass_normals: texture_2d<f32>;
 
 // Declared for scene_common.wgsl's material helpers, which this pass never calls.
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
@@ -21,14 +17,6 @@
 fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
     return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
-// The world point that the ray through pixel position `pixel` (in pixels, centres at
-// .5) meets at view depth `view_depth`.
-fn world_at(pixel: vec2<f32>, view_depth: f32) -> vec3<f32> {
-    let ndc = vec2<f32>(pixel.x * camera.inv_width * 2.0 - 1.0, 1.0 - pixel.y * camera.inv_height * 2.0);
-    let view = vec3<f32>(ndc * view_depth / vec2<f32>(camera.scale_x, camera.scale_y), -view_depth);
-    return (camera.world_from_view * vec4<f32>(view, 1.0)).xyz;
 }
 
 // Where the ray through `pixel` meets the plane through `origin` with normal `n`.
@@ -65,9 +53,18 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     let geometry = light_geometry(world);
     let l = geometry.xyz;
     var shadow = pixel_visibility(world, n, geometric_n, l, geometry.w, world_dx, world_dy, frag.xy, view_depth);
-    shadow.x = refined_visibility(shadow.x, world, n, geometric_n, l, geometry.w, view_depth);
+    // Where the map is unsure and refinement is on, a ray decides: the pixel is
+    // stored lit (with its contact shadow) and the trace pass darkens it if the ray
+    // is blocked.
+    let traced = ray_decides(shadow, world, n, geometric_n, l, geometry.w);
+    if traced {
+        shadow.x = 1.0;
+    }
     if light.contact_steps > 0u && shadow.x > 0.0 {
         shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
+    }
+    if traced {
+        defer_to_ray(vec2<u32>(texel), u32(shadow.y));
     }
     return shadow.x + 2.0 * shadow.y;
 }

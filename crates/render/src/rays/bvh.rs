@@ -141,7 +141,15 @@ impl CasterBvh {
                 Aabb::new(min - pad, max + pad)
             })
             .collect();
-        let bvh = build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut Default::default());
+        let bvh = build_bvh2(
+            &boxes,
+            BvhBuildParams {
+                max_prims_per_leaf: 4,
+                collapse_traversal_cost: 1.0,
+                ..BvhBuildParams::medium_build()
+            },
+            &mut Default::default(),
+        );
         let mut alpha = Vec::new();
         let triangles = bvh
             .primitive_indices

@@ -2,17 +2,25 @@
 //! scene's casters in a BVH built on the CPU and flattened into storage buffers
 //! (`bvh.rs`), walked by a WGSL shader (`trace.wgsl`) that gives the CPU reference's
 //! answers. [`ShadowRays`] answers batches of rays, for a host or a test; the
-//! renderer binds the same buffers where it refines a shadow.
+//! renderer's trace pass (`refine.rs`) binds the same buffers where it refines a
+//! shadow.
 
 mod bvh;
 mod query;
+mod refine;
 
 pub use query::{ShadowRay, ShadowRays};
+#[cfg(test)]
+pub(crate) use refine::trace_pass_wgsl;
+pub(crate) use refine::{
+    ListAccess, RefineLists, TraceGroups, TracePass, classify_wgsl, refined_mask_layout,
+    screen_layout as refine_screen_layout,
+};
 
 use gnomon_scene::{Light, settings::Refine};
 use wgpu::util::DeviceExt;
 
-use crate::{Gpu, RenderError, passes::lighting::MapLookup};
+use crate::{Gpu, RenderError};
 use bvh::CasterBvh;
 
 /// The bind group slot the tracer's buffers take in every pipeline that traces.
@@ -27,28 +35,6 @@ pub(crate) fn trace_wgsl() -> String {
         bvh::NO_TEXTURE,
         include_str!("trace.wgsl")
     )
-}
-
-/// The WGSL of `refined_visibility`, which the shadow-mask pass calls with each
-/// pixel's map answer: the answer itself when `refine` is off, otherwise the
-/// classification and the ray (refine.wgsl), with the footprint test of the light's
-/// kind of map.
-pub(crate) fn refine_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
-    let every_pixel = match refine {
-        Refine::Off => return vec![include_str!("refine_off.wgsl").to_owned()],
-        Refine::Rays => false,
-        Refine::EveryPixel => true,
-    };
-    let footprint = match lookup {
-        MapLookup::Map => include_str!("refine_map.wgsl"),
-        MapLookup::Cube | MapLookup::Paraboloid => include_str!("refine_omni.wgsl"),
-    };
-    vec![
-        format!("const REFINE_EVERY_PIXEL: bool = {every_pixel};\n"),
-        trace_wgsl(),
-        include_str!("refine.wgsl").to_owned(),
-        footprint.to_owned(),
-    ]
 }
 
 /// The refinement a light gets: `refine` for a hard light, none for a light with an
@@ -83,11 +69,75 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
+/// Why the GPU ray tracer cannot take a scene or a frame on a device: each names the
+/// limit it meets. A frame asked to refine by rays is then drawn unrefined.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RaysUnavailable {
+    /// The BVH of the scene's shadow casters is deeper than the GPU tracer's stack.
+    #[error(
+        "scene `{scene}`: the BVH of its shadow casters is {depth} levels deep, but the GPU \
+         ray tracer walks at most {max}"
+    )]
+    TreeTooDeep {
+        /// Name of the scene.
+        scene: String,
+        /// Depth of the built tree, the root counting 1.
+        depth: u32,
+        /// The deepest tree the tracer walks.
+        max: u32,
+    },
+    /// One of the ray tracer's buffers is larger than the device binds.
+    #[error(
+        "scene `{scene}`: the GPU ray tracer's {buffer} take {bytes} bytes, but this device binds \
+         at most {limit} bytes in one storage buffer"
+    )]
+    BufferTooLarge {
+        /// Name of the scene.
+        scene: String,
+        /// Which buffer: nodes, triangles, alpha tests, alpha textures or alpha texels.
+        buffer: &'static str,
+        /// Its size.
+        bytes: u64,
+        /// The most bytes the device binds in one storage buffer.
+        limit: u64,
+    },
+    /// The list of pixels to trace, room for every pixel of the image, is larger than
+    /// the device binds.
+    #[error(
+        "an image of {width}×{height} pixels needs a list of {bytes} bytes for the pixels its \
+         rays refine, but this device binds at most {limit} bytes in one storage buffer"
+    )]
+    ImageTooLarge {
+        /// The image's width in pixels.
+        width: u32,
+        /// The image's height in pixels.
+        height: u32,
+        /// The list's size.
+        bytes: u64,
+        /// The most bytes the device binds in one storage buffer.
+        limit: u64,
+    },
+}
+
+/// The most bytes a device binds in one storage buffer.
+pub(crate) fn storage_limit(gpu: &Gpu) -> u64 {
+    gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size)
+}
+
+/// Refuses an image whose list of pixels to trace is larger than `limit` bytes.
+pub(crate) fn check_image(width: u32, height: u32, limit: u64) -> Result<(), RaysUnavailable> {
+    let bytes = RefineLists::list_bytes(width, height);
+    if bytes > limit {
+        return Err(RaysUnavailable::ImageTooLarge { width, height, bytes, limit });
+    }
+    Ok(())
+}
+
 /// Refuses a tree deeper than the shader's stack, or a buffer larger than `limit`
 /// bytes (what the device binds in one storage buffer).
-fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RenderError> {
+fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RaysUnavailable> {
     if bvh.depth > bvh::MAX_DEPTH {
-        return Err(RenderError::RayTreeTooDeep {
+        return Err(RaysUnavailable::TreeTooDeep {
             scene: scene.to_owned(),
             depth: bvh.depth,
             max: bvh::MAX_DEPTH,
@@ -95,7 +145,7 @@ fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RenderEr
     }
     for (buffer, bytes) in bvh.buffer_sizes() {
         if bytes > limit {
-            return Err(RenderError::RayBufferTooLarge { scene: scene.to_owned(), buffer, bytes, limit });
+            return Err(RaysUnavailable::BufferTooLarge { scene: scene.to_owned(), buffer, bytes, limit });
         }
     }
     Ok(())
@@ -119,8 +169,7 @@ impl GpuBvh {
         layout: &wgpu::BindGroupLayout,
     ) -> Result<Self, RenderError> {
         let bvh = CasterBvh::build(scene);
-        let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
-        check_limits(&bvh, &scene.name, limit)?;
+        check_limits(&bvh, &scene.name, storage_limit(gpu))?;
         // wgpu refuses a binding smaller than one element: an unused buffer holds one
         // zeroed element of the largest kind.
         let contents = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 64] } else { bytes.to_vec() };
@@ -184,5 +233,13 @@ mod tests {
                 && e.contains(&format!("at most {}", bvh::MAX_DEPTH)),
             "{e}"
         );
+    }
+
+    #[test]
+    fn an_image_too_large_for_the_list_of_pixels_is_refused_naming_the_limit() {
+        let bytes = RefineLists::list_bytes(1920, 1080);
+        assert!(check_image(1920, 1080, bytes).is_ok());
+        let e = check_image(1920, 1080, bytes - 1).unwrap_err().to_string();
+        assert!(e.contains("1920×1080") && e.contains(&format!("at most {}", bytes - 1)), "{e}");
     }
 }

@@ -22,9 +22,18 @@ const UNSURE_RING_TEXELS: i32 = 2;
 // depth is too close to the receiver's to trust.
 const UNSURE_DEPTH_TEXELS: f32 = 2.0;
 
-// `n` is the normal the lookup is offset along; `geometric_n` gives the receiver's plane.
-fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, view_depth: f32) -> bool {
-    let layer = select_cascade(view_depth, world, n, l);
+// The map's (u, v, depth) moved by a world-space step `t` from a point of clip-space
+// w `w` and normalized device coordinates `ndc` in a layer with `clip_from_world`,
+// to first order: clip moves by M·(t, 0), so NDC by the quotient rule's
+// (Δclip.xyz − ndc·Δclip.w) / w. Exact for orthographic maps, where w ≡ 1.
+fn map_step(clip_from_world: mat4x4<f32>, ndc: vec3<f32>, w: f32, t: vec3<f32>) -> vec3<f32> {
+    let d = clip_from_world * vec4<f32>(t, 0.0);
+    return (d.xyz - ndc * d.w) / w * vec3<f32>(0.5, -0.5, 1.0);
+}
+
+// `layer` is the one the lookup shaded with; `n` is the normal it was offset along;
+// `geometric_n` gives the receiver's plane.
+fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
     let c = shadow_coords(layer, world, n, l);
     if c.w < 0.5 {
         // Outside every layer: the map has nothing to say.
@@ -36,10 +45,11 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     // The receiver's plane, through two tangents a texel long, in map coordinates.
     let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(geometric_n.x) > 0.9);
     let tangent = normalize(cross(geometric_n, helper));
-    let t1 = tangent * texel_world;
-    let t2 = cross(geometric_n, tangent) * texel_world;
-    let a = shadow_coords(layer, world + t1, n, l).xyz - c.xyz;
-    let b = shadow_coords(layer, world + t2, n, l).xyz - c.xyz;
+    let clip_from_world = light.cascade_clip_from_world[layer];
+    let w = (clip_from_world * vec4<f32>(world, 1.0)).w;
+    let ndc = vec3<f32>((c.x - 0.5) * 2.0, (0.5 - c.y) * 2.0, c.z);
+    let a = map_step(clip_from_world, ndc, w, tangent * texel_world);
+    let b = map_step(clip_from_world, ndc, w, cross(geometric_n, tangent) * texel_world);
     let det = a.x * b.y - a.y * b.x;
     if abs(det) < 1e-12 / (size * size) {
         // The receiver is seen edge-on from the light.
@@ -47,31 +57,38 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     }
     // ∂depth/∂(u, v), by the 2×2 inverse, then per texel.
     let gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
-    let along_ray = abs(shadow_coords(layer, world - l * texel_world, n, l).z - c.z);
+    let along_ray = abs(map_step(clip_from_world, ndc, w, -l * texel_world).z);
     let slope = abs(gradient.x) + abs(gradient.y);
     let tolerance = 0.5 * slope;
     let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.slope_bias + 1.0) * slope;
 
+    // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels; the receiver's
+    // plane there is c.z + gradient · ((i, j) − p).
     let p = c.xy * size - vec2<f32>(0.5);
     let base = vec2<i32>(floor(p));
-    let last = i32(size) - 1;
+    let first = base - vec2<i32>(UNSURE_RING_TEXELS);
+    let end = base + vec2<i32>(2 + UNSURE_RING_TEXELS);
+    if any(first < vec2<i32>(0)) || any(end > vec2<i32>(i32(size))) {
+        return true;
+    }
     var lit = false;
     var shadowed = false;
-    for (var dy = -UNSURE_RING_TEXELS; dy <= 1 + UNSURE_RING_TEXELS; dy++) {
-        for (var dx = -UNSURE_RING_TEXELS; dx <= 1 + UNSURE_RING_TEXELS; dx++) {
-            let texel = base + vec2<i32>(dx, dy);
-            if any(texel < vec2<i32>(0)) || any(texel > vec2<i32>(last)) {
+    // The footprint, 2 + 2 × UNSURE_RING_TEXELS texels a side, in 2×2 blocks, each
+    // gathered at its texels' shared corner (gather's order: (x, y+1), (x+1, y+1),
+    // (x+1, y), (x, y)).
+    for (var y = first.y; y < end.y; y += 2) {
+        for (var x = first.x; x < end.x; x += 2) {
+            let corner = vec2<f32>(f32(x + 1), f32(y + 1)) / size;
+            let stored = textureGather(shadow_map, shadow_gather, corner, layer);
+            let r = c.z + dot(gradient, vec2<f32>(f32(x), f32(y)) - p);
+            let receiver = vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
+            let is_lit = stored >= receiver - vec4<f32>(tolerance);
+            let is_shadowed = stored <= receiver - vec4<f32>(margin);
+            if !all(is_lit | is_shadowed) {
                 return true;
             }
-            let stored = textureLoad(shadow_map, texel, i32(layer), 0);
-            let receiver = c.z + dot(gradient, vec2<f32>(texel) - p);
-            if stored >= receiver - tolerance {
-                lit = true;
-            } else if stored <= receiver - margin {
-                shadowed = true;
-            } else {
-                return true;
-            }
+            lit = lit || any(is_lit);
+            shadowed = shadowed || any(is_shadowed);
         }
     }
     return lit && shadowed;

@@ -1,12 +1,13 @@
-// No refinement: the map's answer stands.
-fn refined_visibility(
-    visibility: f32,
+// No refinement: the map's answer stands everywhere.
+fn ray_decides(
+    shadow: vec2<f32>,
     world: vec3<f32>,
     n: vec3<f32>,
     geometric_n: vec3<f32>,
     l: vec3<f32>,
     cone: f32,
-    view_depth: f32,
-) -> f32 {
-    return visibility;
+) -> bool {
+    return false;
 }
+
+fn defer_to_ray(pixel: vec2<u32>, layer: u32) {}

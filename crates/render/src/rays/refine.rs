@@ -1,0 +1,269 @@
+//! Ray-traced refinement of the shadow mask (hybrid ray-traced shadows, after Story's
+//! HFTS): each light's mask pass stores the map's answer and lists the pixels it is
+//! unsure of (`refine_classify.wgsl`); then a compute pass, dispatched indirectly
+//! over that list alone, casts their rays and darkens those a caster blocks
+//! (`refine_trace.wgsl`). Only listed pixels pay for a ray, and a group of the trace
+//! pass holds listed pixels only, so no lane waits on a neighbour's ray.
+
+use gnomon_scene::settings::Refine;
+
+use crate::{
+    passes::{self, Layouts, compose_wgsl, lighting::MapLookup},
+    pool::{Binding, Pool},
+};
+
+/// Pixels per workgroup of the trace pass, and per workgroup the mask pass counts.
+pub(crate) const GROUP_SIZE: u32 = 64;
+/// The most workgroups the trace pass dispatches: the least
+/// `max_compute_workgroups_per_dimension` WebGPU allows a device, so every device
+/// accepts the dispatch. Listed pixels past them are looped over.
+pub(crate) const MAX_GROUPS: u32 = 65_535;
+/// Bytes from one light's counters to the next: the largest
+/// `min_storage_buffer_offset_alignment` WebGPU allows, so every device accepts the
+/// dynamic offset.
+pub(crate) const COUNTER_STRIDE: u64 = 256;
+/// Bytes of one light's counters (`RefineCounters` in refine_list.wgsl): the three
+/// workgroup counts of the indirect dispatch, then the pixels listed.
+const COUNTER_BYTES: u64 = 16;
+/// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
+pub(crate) const PIXEL_BYTES: u64 = 8;
+
+/// The list's declarations, with the constants they share with Rust.
+fn list_wgsl() -> String {
+    format!(
+        "const REFINE_GROUP_SIZE: u32 = {GROUP_SIZE}u;\nconst REFINE_MAX_GROUPS: u32 = {MAX_GROUPS}u;\n{}",
+        include_str!("refine_list.wgsl")
+    )
+}
+
+/// The WGSL of `ray_decides` and `defer_to_ray`, which the shadow-mask pass calls
+/// with each pixel's map answer: never, when `refine` is off; otherwise the
+/// classification (refine_classify.wgsl) with the footprint test of the light's kind
+/// of map, and the list it appends to.
+pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
+    let every_pixel = match refine {
+        Refine::Off => return vec![include_str!("refine_off.wgsl").to_owned()],
+        Refine::Rays => false,
+        Refine::EveryPixel => true,
+    };
+    let footprint = match lookup {
+        MapLookup::Map => include_str!("refine_map.wgsl"),
+        MapLookup::Cube | MapLookup::Paraboloid => include_str!("refine_omni.wgsl"),
+    };
+    vec![
+        format!("const REFINE_EVERY_PIXEL: bool = {every_pixel};\n"),
+        list_wgsl(),
+        include_str!("refine_classify.wgsl").to_owned(),
+        footprint.to_owned(),
+    ]
+}
+
+/// The trace pass's WGSL, composed.
+pub(crate) fn trace_pass_wgsl() -> String {
+    let mut parts = passes::lighting::camera_shading_wgsl();
+    parts.push(include_str!("../passes/octahedron.wgsl").to_owned());
+    parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
+    parts.push(list_wgsl());
+    parts.push(super::trace_wgsl());
+    parts.push(include_str!("refine_trace.wgsl").to_owned());
+    let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
+    compose_wgsl(&refs)
+}
+
+/// Who uses a group 1 of [`screen_layout`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ListAccess {
+    /// The refining mask pass, which appends to the list and counts.
+    Append,
+    /// The trace pass, which reads them, and dispatches by the counters: they must be
+    /// read-only there.
+    Read,
+}
+
+/// Group 1 of a refining mask pass (`Append`) or of the trace pass (`Read`): the
+/// camera and the prepass (bindings 0–2, as `Layouts::screen`), the list (3) and the
+/// light's counters (4, at a dynamic offset of [`COUNTER_STRIDE`] per light).
+pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::BindGroupLayout {
+    let (stages, read_only, label) = match access {
+        ListAccess::Append => (wgpu::ShaderStages::FRAGMENT, false, "screen, listing unsure pixels"),
+        ListAccess::Read => (wgpu::ShaderStages::COMPUTE, true, "screen, tracing unsure pixels"),
+    };
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry { binding, visibility: stages, ty, count: None };
+    let texture = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    };
+    let buffer =
+        |ty, has_dynamic_offset| wgpu::BindingType::Buffer { ty, has_dynamic_offset, min_binding_size: None };
+    let storage = wgpu::BufferBindingType::Storage { read_only };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            entry(0, buffer(wgpu::BufferBindingType::Uniform, false)),
+            entry(1, texture),
+            entry(2, texture),
+            entry(3, buffer(storage, false)),
+            entry(4, buffer(storage, true)),
+        ],
+    })
+}
+
+/// Group 2 of the trace pass: the light's layer of the mask, written.
+pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("refined shadow mask"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: passes::screen_space::MASK_FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        }],
+    })
+}
+
+/// The trace pass's pipeline.
+pub(crate) struct TracePass {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl TracePass {
+    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow mask ray trace"),
+            bind_group_layouts: &[
+                Some(&layouts.scene),
+                Some(&layouts.trace_screen),
+                Some(&layouts.refined_mask),
+                Some(&layouts.rays),
+            ],
+            immediate_size: 0,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shadow mask ray trace"),
+            source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl().into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("shadow mask ray trace"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("cs_trace"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { pipeline }
+    }
+
+    /// Records the trace pass of light `light`: its listed pixels' rays, written
+    /// into `mask_layer`. `scene` is the light's group 0, `bvh` the casters'.
+    pub fn record(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, groups.scene, &[]);
+        pass.set_bind_group(1, groups.screen, &[RefineLists::counter_offset(light)]);
+        pass.set_bind_group(2, groups.mask, &[]);
+        pass.set_bind_group(super::GROUP, groups.bvh, &[]);
+        pass.dispatch_workgroups_indirect(groups.counters, u64::from(RefineLists::counter_offset(light)));
+    }
+}
+
+/// The groups one light's trace pass binds.
+pub(crate) struct TraceGroups<'a> {
+    /// The instances and the light's uniform.
+    pub scene: &'a wgpu::BindGroup,
+    /// The camera, the prepass, the list and the counters, read only
+    /// ([`RefineLists::group`] with [`ListAccess::Read`]).
+    pub screen: &'a wgpu::BindGroup,
+    /// The light's layer of the mask, written ([`RefineLists::mask_group`]).
+    pub mask: &'a wgpu::BindGroup,
+    /// The casters' BVH.
+    pub bvh: &'a wgpu::BindGroup,
+    /// The counters, whose first three words at the light's offset are the dispatch.
+    pub counters: &'a wgpu::Buffer,
+}
+
+/// A frame's list of unsure pixels (room for every pixel of the screen, reused by
+/// each light in turn) and each light's counters.
+pub(crate) struct RefineLists {
+    pub pixels: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
+}
+
+impl RefineLists {
+    /// Bytes of the list for a `width` × `height` screen: a pixel lists itself at most
+    /// once per light.
+    pub fn list_bytes(width: u32, height: u32) -> u64 {
+        u64::from(width) * u64::from(height) * PIXEL_BYTES
+    }
+
+    /// The lists of a frame of `lights` lights on a `width` × `height` screen, from
+    /// `pool`. The counters must be cleared before the first mask pass.
+    pub fn new(pool: &mut Pool, width: u32, height: u32, lights: usize) -> Self {
+        let pixels =
+            pool.buffer("unsure pixels", Self::list_bytes(width, height), wgpu::BufferUsages::STORAGE);
+        let counters = pool.buffer(
+            "refinement counters",
+            COUNTER_STRIDE * lights as u64,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        );
+        Self { pixels, counters }
+    }
+
+    /// The dynamic offset of light `light`'s counters.
+    pub fn counter_offset(light: u32) -> u32 {
+        light * COUNTER_STRIDE as u32
+    }
+
+    /// Group 1 of the refining mask pass (`Append`) or the trace pass (`Read`), with
+    /// the camera and the prepass's `view_depth` and `normals`.
+    pub fn group(
+        &self,
+        pool: &mut Pool,
+        layouts: &Layouts,
+        access: ListAccess,
+        camera: &wgpu::Buffer,
+        [view_depth, normals]: [&wgpu::TextureView; 2],
+    ) -> wgpu::BindGroup {
+        let layout = match access {
+            ListAccess::Append => &layouts.refine_screen,
+            ListAccess::Read => &layouts.trace_screen,
+        };
+        pool.bind_group(
+            "screen, refined by rays",
+            layout,
+            &[
+                Binding::Buffer(camera.clone()),
+                Binding::View(view_depth.clone()),
+                Binding::View(normals.clone()),
+                Binding::Buffer(self.pixels.clone()),
+                Binding::BufferWindow { buffer: self.counters.clone(), size: COUNTER_BYTES },
+            ],
+        )
+    }
+
+    /// The trace pass's group 2: `mask_layer`, written.
+    pub fn mask_group(pool: &mut Pool, layouts: &Layouts, mask_layer: &wgpu::TextureView) -> wgpu::BindGroup {
+        pool.bind_group("refined shadow mask", &layouts.refined_mask, &[Binding::View(mask_layer.clone())])
+    }
+
+    /// Records a copy of the counters into a mappable buffer, to read back.
+    pub fn copy_counters(&self, pool: &mut Pool, encoder: &mut wgpu::CommandEncoder) -> wgpu::Buffer {
+        let size = self.counters.size();
+        let usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
+        let copy = pool.buffer("refinement counters, read back", size, usage);
+        encoder.copy_buffer_to_buffer(&self.counters, 0, &copy, 0, size);
+        copy
+    }
+
+    /// Pixels each light listed, from a copy of the counters read back.
+    pub fn listed(counters: &[u32], lights: usize) -> Vec<u32> {
+        let stride = (COUNTER_STRIDE / 4) as usize;
+        (0..lights).map(|light| counters.get(light * stride + 3).copied().unwrap_or(0)).collect()
+    }
+}

@@ -1,0 +1,11 @@
+// The list of pixels that the mask pass leaves to a ray (refine_classify.wgsl, which
+// writes it) and the trace pass answers (refine_trace.wgsl, which reads it), at group 1
+// binding 3, beside the camera and the prepass; each light's counters at binding 4,
+// at the light's own offset.
+
+struct UnsurePixel {
+    // x | y << 16.
+    pixel: u32,
+    // The shadow-map layer that shaded it, kept in the mask for the cascade view.
+    layer: u32,
+};
