@@ -29,6 +29,21 @@ pub(super) struct ScreenInputs<'a> {
     pub mask_layers: &'a [wgpu::TextureView],
 }
 
+/// Group 1 of a light's mask pass.
+struct MaskScreen<'a> {
+    group: &'a wgpu::BindGroup,
+    /// The light's counters in the group of a refining pass; none in the plain one.
+    counter_offset: Option<u32>,
+}
+
+/// A frame's refinement by rays: the lists, and group 1 as the mask passes (which
+/// append) and the trace passes (which read) bind it.
+struct Refining {
+    lists: RefineLists,
+    append: wgpu::BindGroup,
+    read: wgpu::BindGroup,
+}
+
 /// A cleared colour attachment.
 fn cleared(view: &wgpu::TextureView, clear: wgpu::Color) -> Option<wgpu::RenderPassColorAttachment<'_>> {
     Some(wgpu::RenderPassColorAttachment {
@@ -72,28 +87,31 @@ impl Renderer {
         );
         // The list of unsure pixels and each light's counters, cleared: zero
         // workgroups until a mask pass lists a pixel.
-        let refine = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
+        let refining = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
             let lists = RefineLists::new(&mut self.pool, width, height, plan.lights.len());
             rec.encoder.clear_buffer(&lists.counters, 0, None);
             let prepass = [&view_depth, &normals];
             let camera = inputs.camera_buffer;
             let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
             let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
-            (lists, [append, read])
+            Refining { lists, append, read }
         });
         for (index, ((light, bindings), layer)) in
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
         {
-            let refined = match (&refine, light.refine) {
+            let refined = match (&refining, light.refine) {
                 (_, Refine::Off) | (None, _) => None,
-                (Some(lists), Refine::Rays | Refine::EveryPixel) => Some(lists),
+                (Some(refining), Refine::Rays | Refine::EveryPixel) => Some(refining),
             };
             let screen = match refined {
-                Some((_, [append, _])) => (append, RefineLists::counter_offset(index as u32)),
-                None => (&screen_group, 0),
+                Some(refining) => MaskScreen {
+                    group: &refining.append,
+                    counter_offset: Some(RefineLists::counter_offset(index as u32)),
+                },
+                None => MaskScreen { group: &screen_group, counter_offset: None },
             };
-            self.record_mask(rec, light, bindings, layer, screen, index as u32);
-            if let Some((lists, [_, read])) = refined {
+            self.record_mask(rec, light, bindings, layer, &screen, index as u32);
+            if let Some(Refining { lists, read, .. }) = refined {
                 let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
                 let groups = TraceGroups {
@@ -106,18 +124,17 @@ impl Renderer {
                 self.record_trace(rec, &groups, index as u32);
             }
         }
-        refine.map(|(lists, _)| lists)
+        refining.map(|refining| refining.lists)
     }
 
-    /// Light `index`'s mask pass into its `layer` of the mask, with group 1 `screen`
-    /// bound at its dynamic offset (the light's counters, when it refines).
+    /// Light `index`'s mask pass into its `layer` of the mask, with group 1 `screen`.
     fn record_mask(
         &mut self,
         rec: &mut Recording,
         light: &LightPlan,
         bindings: &LightBindings,
         layer: &wgpu::TextureView,
-        (screen_group, offset): (&wgpu::BindGroup, u32),
+        screen: &MaskScreen,
         index: u32,
     ) {
         let gpu = &self.gpu;
@@ -134,9 +151,7 @@ impl Renderer {
         let key = MaskKey { technique: light.technique, lookup: bindings.lookup, refine: light.refine };
         pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
         pass.set_bind_group(0, &bindings.scene, &[]);
-        let offsets = [offset];
-        let offsets: &[u32] = if light.refine == Refine::Off { &[] } else { &offsets };
-        pass.set_bind_group(1, screen_group, offsets);
+        pass.set_bind_group(1, screen.group, screen.counter_offset.as_slice());
         pass.set_bind_group(2, mask_group, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 3;

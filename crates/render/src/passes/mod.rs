@@ -92,6 +92,10 @@ pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
 pub(crate) const CAMERA_WGSL: &str =
     concat!(include_str!("camera.wgsl"), "\n@group(1) @binding(0) var<uniform> camera: Camera;\n");
 
+/// The octahedral encoding of the prepass's normals, for the passes that write or read
+/// them.
+pub(crate) const OCTAHEDRON_WGSL: &str = include_str!("octahedron.wgsl");
+
 /// The prepass's bindings and `world_at`, for the passes that read the prepass.
 pub(crate) const SCREEN_COMMON_WGSL: &str = include_str!("screen_common.wgsl");
 

@@ -36,7 +36,7 @@ pub(crate) struct MaskKey {
 pub(crate) fn prepass_wgsl() -> String {
     let mut parts = lighting::camera_shading_wgsl();
     parts.push(lighting::SURFACE_WGSL.to_owned());
-    parts.push(include_str!("octahedron.wgsl").to_owned());
+    parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("prepass.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -46,7 +46,7 @@ pub(crate) fn prepass_wgsl() -> String {
 pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     let mut parts = lighting::camera_shading_wgsl();
     parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
-    parts.push(include_str!("octahedron.wgsl").to_owned());
+    parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());
     parts.extend(crate::rays::classify_wgsl(key.refine, key.lookup));

@@ -61,7 +61,7 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
 /// The trace pass's WGSL, composed.
 pub(crate) fn trace_pass_wgsl() -> String {
     let mut parts = passes::lighting::camera_shading_wgsl();
-    parts.push(include_str!("../passes/octahedron.wgsl").to_owned());
+    parts.push(passes::OCTAHEDRON_WGSL.to_owned());
     parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
     parts.push(list_wgsl());
     parts.push(super::trace_wgsl());
@@ -158,8 +158,8 @@ impl TracePass {
         Self { pipeline }
     }
 
-    /// Records the trace pass of light `light`: its listed pixels' rays, written
-    /// into `mask_layer`. `scene` is the light's group 0, `bvh` the casters'.
+    /// Records the trace pass of light `light`: its listed pixels' rays, written into
+    /// its layer of the mask (`groups.mask`).
     pub fn record(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, groups.scene, &[]);
