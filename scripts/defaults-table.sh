@@ -5,7 +5,8 @@
 # pixels. Writes OUT/cases.tsv (one line per candidate, scene and elevation) and
 # prints a markdown summary per candidate: the median and worst share of light-facing
 # pixels wrong, the cases above issue 22's 0.3 %, and the median GPU time of the
-# shadow and lighting passes.
+# shadow and lighting passes. Candidates are measured with --refine off unless their
+# flags name --refine.
 #
 #   sh scripts/defaults-table.sh [GNOMON] [SHARED_SCENES] [OUT]
 #
@@ -23,16 +24,17 @@ monkeyhead/monkeyhead.glb pmndrs/bunny.glb pmndrs/suzi.glb"}
 if [ -n "${CANDIDATES:-}" ]; then
   candidates=$(cat "$CANDIDATES")
 else
-  candidates="defaults|
+  # Round one: one change at a time from the old defaults (normal offset 0.6).
+  candidates="old defaults (slope 1.5, normal offset 0.6)|--normal-offset 0.6
 normal offset 0.3|--normal-offset 0.3
 normal offset 0|--normal-offset 0
 slope 1, normal offset 0.3|--slope-bias 1 --normal-offset 0.3
 slope 2, normal offset 0|--slope-bias 2 --normal-offset 0
-hard|--techniques hard
-pcf 3×3|--techniques pcf --pcf-kernel 3
-map 4096²|--shadow-res 4096
-4 stable cascades|--partition cascades
-4 tight cascades, SDSM bounds|--partition cascades --cascade-fit tight --sdsm --sdsm-bounds"
+hard|--techniques hard --normal-offset 0.6
+pcf 3×3|--techniques pcf --pcf-kernel 3 --normal-offset 0.6
+map 4096²|--shadow-res 4096 --normal-offset 0.6
+4 stable cascades|--partition cascades --normal-offset 0.6
+4 tight cascades, SDSM bounds|--partition cascades --cascade-fit tight --sdsm --sdsm-bounds --normal-offset 0.6"
 fi
 tsv="$out/cases.tsv"
 printf 'candidate\tscene\televation\tmismatch\tfalse_shadow\tfalse_lit\tcompared\tshadow_ms\tlighting_ms\n' > "$tsv"
@@ -42,11 +44,14 @@ echo "$candidates" | while IFS='|' read -r name flags; do
     for elevation in 20 45 70; do
       dir="$out/run"
       rm -rf "$dir"
-      # The default technique, unless the candidate names its own.
+      # The default technique, unless the candidate names its own. The candidates
+      # choose the map's settings, so they are measured unrefined unless they name
+      # --refine (the default refines by rays, which hides most of what they change).
       case "$flags" in *--techniques*) technique= ;; *) technique="--techniques pcf2x2" ;; esac
+      case "$flags" in *--refine*) refine= ;; *) refine="--refine off" ;; esac
       # shellcheck disable=SC2086
       if "$gnomon" compare "$shared/$scene" --sun-elevation "$elevation" $technique \
-          --timing-frames "${TIMING_FRAMES:-3}" --out "$dir" $flags > /dev/null 2> "$out/last.log"; then
+          --timing-frames "${TIMING_FRAMES:-3}" --out "$dir" $refine $flags > /dev/null 2> "$out/last.log"; then
         python3 - "$dir/metrics.json" "$name" "$scene" "$elevation" >> "$tsv" <<'PY'
 import json, sys
 path, name, scene, elevation = sys.argv[1:]

@@ -11,7 +11,7 @@ use gnomon_examples::host::{self, HostMesh, HostRenderer, HostTargets};
 use gnomon_render::{Gpu, OutputRequest, RenderError, Renderer, read_texture, wgpu};
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{LightKind, OmniMap, ShadowPath, Technique},
+    settings::{LightKind, OmniMap, Refine, ShadowPath, Technique},
 };
 
 // Wide enough that the sky shows beside the ground: background pixels are compared too.
@@ -57,6 +57,9 @@ fn host_visibility(gpu: &Gpu, renderer: &mut Renderer, scene: &Scene, settings: 
 fn settings(technique: Technique, light: LightKind, omni: OmniMap) -> Settings {
     let mut s = Settings::default();
     (s.image.width, s.image.height) = (WIDTH, HEIGHT);
+    // The host's shader reads the maps alone: Gnomon's frame, compared with it, must
+    // not refine them by rays either.
+    s.screen.refine = Refine::Off;
     s.shadow.map.resolution = 512;
     s.shadow.filter.technique = technique;
     s.light.kind = light;
@@ -122,4 +125,13 @@ fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
     let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
     assert!(matches!(error, RenderError::ReceiverNeedsMapPath));
     assert!(error.to_string().contains("screen.shadow_path"), "{error}");
+    // Rays asked for by name need the prepass too; the default, auto, yields to the
+    // host's shader.
+    settings.screen.shadow_path = ShadowPath::Auto;
+    settings.screen.refine = Refine::Rays;
+    let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
+    assert!(matches!(error, RenderError::ReceiverNeedsMapPath));
+    assert!(error.to_string().contains("screen.refine"), "{error}");
+    settings.screen.refine = Refine::Auto;
+    assert!(renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).is_ok());
 }

@@ -335,8 +335,13 @@ fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(dir.join("lamps.png").is_file());
-    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("gnomon: light ")).collect();
+    let (refined, lines): (Vec<&str>, Vec<&str>) = err
+        .lines()
+        .filter(|l| l.starts_with("gnomon: light "))
+        .partition(|l| l.contains(": refined by rays at "));
     assert_eq!(lines.len(), 8, "{err}");
+    // The default refines every hard light by rays, and says where.
+    assert!(!refined.is_empty() && refined.len() <= 8, "{err}");
     assert!(lines[0].contains("`sun` (sun, pcf-poisson, map 4 × 2048²)"), "{}", lines[0]);
     assert!(
         lines[4].contains("(point, pcf2x2, map 6 × 512²)") && lines[4].contains("shadow draws ["),

@@ -259,6 +259,8 @@ fn the_mask_paths_prepass_cuts_the_same_holes() {
     // sees, and shades, the same ground as the forward path.
     let scene = checker_scene();
     let mut s = settings(Technique::PCF2X2);
+    // The two paths' map answers: the default's rays refine only the mask path.
+    s.screen.refine = gnomon_scene::settings::Refine::Off;
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Forward;
     let forward = render(&scene, &s);
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Mask;

@@ -14,11 +14,15 @@ use gnomon_reference::{
 use gnomon_render::Frame;
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{LightKind, OmniMap, Partition, ShadowPath, Technique},
+    settings::{LightKind, OmniMap, Partition, Refine, ShadowPath, Technique},
 };
 
+/// The default settings at a size, unrefined: these tests compare the two paths'
+/// map answers, and contact shadows with the map's, which the default's rays would
+/// correct on the mask path alone.
 fn settings(width: u32, height: u32) -> Settings {
     let mut s = Settings::default();
+    s.screen.refine = Refine::Off;
     s.image.width = width;
     s.image.height = height;
     s

@@ -258,6 +258,17 @@ impl Light {
             Light::Point(_) => "point",
         }
     }
+
+    /// Whether the light is a point source (a sun of no angular diameter, a spot or
+    /// point of no radius), whose hard shadow one ray per pixel decides; a light with
+    /// an area casts a penumbra that one ray to its centre would harden.
+    pub fn is_hard(&self) -> bool {
+        match self {
+            Light::Directional(sun) => sun.angular_diameter_degrees == 0.0,
+            Light::Spot(spot) => spot.radius == 0.0,
+            Light::Point(point) => point.radius == 0.0,
+        }
+    }
 }
 
 /// One light of a scene's light list (`--light all`): the light, and the shadow

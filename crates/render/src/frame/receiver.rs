@@ -3,7 +3,10 @@
 //! light with the WGSL that reads it (`shadow_visibility`, documented in
 //! `passes/receiver.wgsl`). The host shades with its own pipeline and shader.
 
-use gnomon_scene::{Light, Scene, Settings, settings::Technique};
+use gnomon_scene::{
+    Light, Scene, Settings,
+    settings::{Refine, ScreenSpaceSettings, Technique},
+};
 
 use super::{
     Renderer,
@@ -81,8 +84,10 @@ impl Renderer {
     /// Nothing is submitted here, except SDSM's depth prepass, which needs the camera's
     /// depths before the maps are fitted.
     ///
-    /// The mask path (`screen.shadow_path = "mask"`, contact shadows) needs Gnomon's
-    /// own depth prepass: on it, this returns [`RenderError::ReceiverNeedsMapPath`].
+    /// The mask path (`screen.shadow_path = "mask"`, contact shadows, refinement by
+    /// rays asked for by name) needs Gnomon's own depth prepass: on it, this returns
+    /// [`RenderError::ReceiverNeedsMapPath`]. The default refinement, `auto`, runs only
+    /// where Gnomon draws the image: here the maps' answer is the host's.
     pub fn record_shadows(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -93,6 +98,15 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_map_limits(settings)?;
+        let unrefined;
+        let settings = match settings.screen.refine {
+            Refine::Auto => {
+                let screen = ScreenSpaceSettings { refine: Refine::Off, ..settings.screen.clone() };
+                unrefined = Settings { screen, ..settings.clone() };
+                &unrefined
+            }
+            Refine::Off | Refine::Rays | Refine::EveryPixel => settings,
+        };
         let plan = self.plan_frame(uploaded, scene, settings, None)?;
         if plan.mask_path {
             return Err(RenderError::ReceiverNeedsMapPath);

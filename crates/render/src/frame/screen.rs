@@ -101,7 +101,7 @@ impl Renderer {
         {
             let refined = match (&refining, light.refine) {
                 (_, Refine::Off) | (None, _) => None,
-                (Some(refining), Refine::Rays | Refine::EveryPixel) => Some(refining),
+                (Some(refining), Refine::Auto | Refine::Rays | Refine::EveryPixel) => Some(refining),
             };
             let screen = match refined {
                 Some(refining) => MaskScreen {

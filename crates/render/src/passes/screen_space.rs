@@ -127,7 +127,7 @@ impl ScreenSpacePass {
     pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
         let layout = match key.refine {
             Refine::Off => &self.mask_layout,
-            Refine::Rays | Refine::EveryPixel => &self.refine_layout,
+            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.refine_layout,
         };
         self.masks.entry(key).or_insert_with(|| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

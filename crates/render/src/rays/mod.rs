@@ -37,15 +37,17 @@ pub(crate) fn trace_wgsl() -> String {
     )
 }
 
-/// The refinement a light gets: `refine` for a hard light, none for a light with an
-/// area, whose soft shadow one ray to its centre would harden.
+/// The refinement a light gets on the mask path: `refine` for a hard light (with
+/// `auto` resolved to `rays`), none for a light with an area, whose soft shadow one
+/// ray to its centre would harden.
 pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
-    let hard = match light {
-        Light::Directional(sun) => sun.angular_diameter_degrees == 0.0,
-        Light::Spot(spot) => spot.radius == 0.0,
-        Light::Point(point) => point.radius == 0.0,
-    };
-    if hard { refine } else { Refine::Off }
+    if !light.is_hard() {
+        return Refine::Off;
+    }
+    match refine {
+        Refine::Auto => Refine::Rays,
+        Refine::Off | Refine::Rays | Refine::EveryPixel => refine,
+    }
 }
 
 /// The layout of the tracer's group: bindings 2–6, read-only storage (0 and 1 stay

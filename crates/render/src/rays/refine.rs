@@ -43,7 +43,8 @@ fn list_wgsl() -> String {
 pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
     let every_pixel = match refine {
         Refine::Off => return vec![include_str!("refine_off.wgsl").to_owned()],
-        Refine::Rays => false,
+        // The frame's plan resolves `auto` to `rays` (`super::light_refine`).
+        Refine::Auto | Refine::Rays => false,
         Refine::EveryPixel => true,
     };
     let footprint = match lookup {

@@ -21,8 +21,13 @@ pub fn render(scene: &Scene, settings: &Settings) -> Frame {
     renderer.render(scene, settings, &OutputRequest::default()).expect("render")
 }
 
+/// The default settings at a size and map resolution, unrefined: these tests measure
+/// the shadow maps themselves, which the default's rays would correct where the map
+/// is unsure (refinement is tested against exact shadows in `analytic_shadows.rs` and
+/// against the reference in `gnomon-reference`'s `refine.rs`).
 pub fn settings(width: u32, height: u32, resolution: u32) -> Settings {
     let mut s = Settings::default();
+    s.screen.refine = gnomon_scene::settings::Refine::Off;
     s.image.width = width;
     s.image.height = height;
     s.shadow.map.resolution = resolution;

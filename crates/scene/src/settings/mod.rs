@@ -223,21 +223,26 @@ impl Settings {
 
     /// Whether a frame with these lights resolves its shadows in a screen-space mask:
     /// as --shadow-path says, and with `auto` when any light marches contact shadows
-    /// or shadows are refined by rays. Contact shadows or rays with --shadow-path
-    /// forward are refused: they need the prepass.
+    /// or any hard light's shadow is refined by rays (which `auto` refinement asks
+    /// for). Contact shadows, or rays asked for by name, with --shadow-path forward
+    /// are refused: they need the prepass.
     pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
         let refine = self.screen.refine;
-        if refine != Refine::Off {
-            return match self.screen.shadow_path {
-                ShadowPath::Forward => Err(SettingsError {
-                    setting: "screen.refine",
-                    value: value_name(&refine),
-                    valid: "off with --shadow-path forward: rays start from the mask path's depth prepass"
-                        .into(),
-                }),
-                ShadowPath::Mask | ShadowPath::Auto => Ok(true),
-            };
-        }
+        let rays = match refine {
+            Refine::Off => false,
+            Refine::Auto => lights.iter().any(|l| l.light.is_hard()),
+            Refine::Rays | Refine::EveryPixel => {
+                if self.screen.shadow_path == ShadowPath::Forward {
+                    return Err(SettingsError {
+                        setting: "screen.refine",
+                        value: value_name(&refine),
+                        valid: "off or auto with --shadow-path forward: rays start from the mask path's depth prepass"
+                            .into(),
+                    });
+                }
+                true
+            }
+        };
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {
             (ShadowPath::Forward, Some(light)) => Err(SettingsError {
@@ -248,7 +253,7 @@ impl Settings {
             }),
             (ShadowPath::Forward, None) => Ok(false),
             (ShadowPath::Mask, _) => Ok(true),
-            (ShadowPath::Auto, contact) => Ok(contact.is_some()),
+            (ShadowPath::Auto, contact) => Ok(contact.is_some() || rays),
         }
     }
 

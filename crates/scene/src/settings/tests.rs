@@ -282,11 +282,35 @@ fn refining_by_rays_chooses_the_mask_path_and_forward_refuses_it() {
 }
 
 #[test]
+fn refining_by_default_takes_the_mask_path_for_hard_lights_only() {
+    let scene = crate::builtin::spheres();
+    let mut s = Settings::default();
+    assert_eq!(s.screen.refine, Refine::Auto);
+    let lights = s.resolve_lights(&scene).unwrap();
+    assert!(lights.iter().all(|l| l.light.is_hard()), "the default sun is a point source");
+    assert!(s.uses_shadow_mask(&lights).unwrap(), "auto refinement takes the mask for a hard sun");
+    // Forward asked for by name: auto refinement yields, with no error.
+    s.screen.shadow_path = ShadowPath::Forward;
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto refinement gives way to --shadow-path forward");
+    // A sun with a disk: no light for one ray to decide, so auto stays forward.
+    s.screen.shadow_path = ShadowPath::Auto;
+    s.light.sun_angular_diameter = Some(1.0);
+    let soft = s.resolve_lights(&scene).unwrap();
+    assert!(!soft[0].light.is_hard());
+    assert!(!s.uses_shadow_mask(&soft).unwrap(), "auto refinement with only area lights is forward");
+    s.screen.refine = Refine::Rays;
+    assert!(s.uses_shadow_mask(&soft).unwrap(), "rays by name take the mask as before");
+}
+
+#[test]
 fn contact_shadows_choose_the_mask_path_and_are_checked() {
     let scene = crate::builtin::lamps();
-    let mut s = Settings::default();
+    let mut s = Settings {
+        screen: ScreenSpaceSettings { refine: Refine::Off, ..Default::default() },
+        ..Default::default()
+    };
     let lights = s.resolve_lights(&scene).unwrap();
-    assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto without contact shadows is forward");
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto without contact shadows or rays is forward");
     s.screen.shadow_path = ShadowPath::Mask;
     assert!(s.uses_shadow_mask(&lights).unwrap());
     // One light with contact shadows is enough for auto to take the mask...
