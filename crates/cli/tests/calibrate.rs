@@ -38,10 +38,24 @@ fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    assert_eq!(files_in(&dir.join("cal")), ["calibration.md", "front.png"]);
+    assert_eq!(files_in(&dir.join("cal")), ["calibration.json", "calibration.md", "front.png"]);
     let report = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(report.contains("**chosen**") && report.contains("| defaults |"), "{report}");
     assert!(report.contains("Held-out views: chosen"), "{report}");
+    // The sweep measures the map alone; the defaults as they render, with rays, are
+    // measured on the held-out views beside it.
+    assert!(report.contains("with --refine off") && report.contains("refined by rays"), "{report}");
+    // The JSON holds every setting of the 3 × 2 grid, and the choice is the least
+    // total mismatch among them.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("cal/calibration.json")).unwrap()).unwrap();
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 6, "{json}");
+    let least = points.iter().map(|p| p["mismatch"].as_f64().unwrap()).fold(f64::INFINITY, f64::min);
+    assert_eq!(json["chosen"]["mismatch"].as_f64(), Some(least), "{json}");
+    assert_eq!(json["refine"], "off");
+    let refined = json["held_out"]["defaults_refined_by_rays"]["mismatch"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&refined), "{json}");
     let plot = image::open(dir.join("cal/front.png")).unwrap();
     assert_eq!((plot.width(), plot.height()), (960, 720));
     // The plot is drawn, not blank: many distinct colours (text, axes, points).

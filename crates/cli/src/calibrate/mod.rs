@@ -3,7 +3,10 @@
 //! [`plan`]) over a scene's views, measure each setting against the ray-traced
 //! reference on the light-facing pixels, and report the Pareto front of false shadow
 //! against false lit, the setting with the least total mismatch, and that setting's
-//! error on held-out views it was not chosen on, next to the defaults'.
+//! error on held-out views it was not chosen on, next to the defaults'. It measures
+//! the map alone unless rays are asked for by name; under the default refinement,
+//! the defaults as they render, rays included, are measured on the held-out views
+//! too.
 //!
 //! The views are a scene file's `[[view]]`s when it has two or more, else views
 //! generated along an orbit of the scene's camera; every other view is held out.
@@ -95,8 +98,10 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let (scene, mut settings) = lab::load(&args.scene, &args.settings)?;
     // The bias is the map's: calibration measures the map's own answer, unless rays
     // were asked for by name. The default's rays would correct most of what the bias
-    // moves, leaving little to choose between settings.
-    if settings.screen.refine == Refine::Auto {
+    // moves, leaving little to choose between settings; the defaults as they render,
+    // rays included, are measured on the held-out views for comparison.
+    let renders_refined = settings.screen.refine == Refine::Auto;
+    if renders_refined {
         settings.screen.refine = Refine::Off;
     }
     anyhow::ensure!(
@@ -145,25 +150,72 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let mut renderer = Renderer::new(&gpu)?;
     renderer.check_limits(&settings)?;
     let uploaded = renderer.upload(&scene)?;
-    let bar = ProgressBar::new((grid.len() * calibration.len()) as u64).with_style(
+    let extra = 2 * held_out.len() + calibration.len() + if renders_refined { held_out.len() } else { 0 };
+    let bar = ProgressBar::new((grid.len() * calibration.len() + extra) as u64).with_style(
         ProgressStyle::with_template("calibrate {bar:40} {pos}/{len} renders, {eta} left")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    let mut measuring = Measuring { renderer: &mut renderer, uploaded: &uploaded, scene: &scene, bar: &bar };
+    // The map alone, or with the rays asked for by name.
+    let refine = settings.screen.refine;
     let mut points = Vec::with_capacity(grid.len());
     for tuned in &grid {
-        let pooled = measure(&mut renderer, &uploaded, &scene, &calibration, tuned, &bar)?;
-        points.push(pooled.rates(tuned.clone()));
+        points.push(measuring.measure(&calibration, tuned, refine)?.rates(tuned.clone()));
     }
-    bar.finish_and_clear();
     let front = sweep::pareto_front(&points);
     let chosen = sweep::least_mismatch(&points).context("an empty sweep")?;
-    let defaults = measure(&mut renderer, &uploaded, &scene, &calibration, &base, &bar)?.rates(base.clone());
-    let held_chosen = measure(&mut renderer, &uploaded, &scene, &held_out, &points[chosen].setting, &bar)?
-        .rates(points[chosen].setting.clone());
-    let held_default = measure(&mut renderer, &uploaded, &scene, &held_out, &base, &bar)?.rates(base.clone());
+    let results = Results {
+        defaults: measuring.measure(&calibration, &base, refine)?.rates(base.clone()),
+        held_chosen: measuring
+            .measure(&held_out, &points[chosen].setting, refine)?
+            .rates(points[chosen].setting.clone()),
+        held_default: measuring.measure(&held_out, &base, refine)?.rates(base.clone()),
+        held_default_refined: renders_refined
+            .then(|| {
+                Ok::<_, anyhow::Error>(measuring.measure(&held_out, &base, Refine::Auto)?.rates(base.clone()))
+            })
+            .transpose()?,
+        refine,
+        points,
+        front,
+        chosen,
+    };
+    bar.finish_and_clear();
+    write_outputs(args, &scene, &settings, &results)
+}
 
+/// Everything a calibration measured.
+struct Results {
+    /// The refinement every setting was measured with: off (the map alone), unless
+    /// rays were asked for by name.
+    refine: Refine,
+    /// Every setting of the sweep, on the calibration views.
+    points: Vec<Measured<Tuned>>,
+    /// Indices into `points` of the Pareto front.
+    front: Vec<usize>,
+    /// Index into `points` of the least total mismatch.
+    chosen: usize,
+    /// The settings' own bias and kernel, on the calibration views.
+    defaults: Measured<Tuned>,
+    /// The chosen setting on the held-out views.
+    held_chosen: Measured<Tuned>,
+    /// The settings' own bias and kernel on the held-out views.
+    held_default: Measured<Tuned>,
+    /// The same refined by rays where the map is unsure, as the defaults render
+    /// (`--refine auto`); `None` when rays were asked for, or refused, by name.
+    held_default_refined: Option<Measured<Tuned>>,
+}
+
+/// Draws the front, writes the report and the JSON beside it (all or nothing), and
+/// the chosen setting into `--write`'s scene file.
+fn write_outputs(
+    args: &CalibrateArgs,
+    scene: &Scene,
+    settings: &Settings,
+    r: &Results,
+) -> anyhow::Result<()> {
     let technique = settings.shadow.filter.technique.name();
-    let swept_kernel = grid.iter().any(|t| t.pcf_kernel != base.pcf_kernel);
+    let swept_kernel = r.points.iter().any(|t| t.setting.pcf_kernel != r.defaults.setting.pcf_kernel);
     let title = format!(
         "{}: {technique} {} sweep",
         scene.name,
@@ -171,10 +223,10 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     );
     let rgb = plot::draw(&plot::PlotInput {
         title: &title,
-        points: &points,
-        front: &front,
-        chosen,
-        defaults: (defaults.false_shadow, defaults.false_lit),
+        points: &r.points,
+        front: &r.front,
+        chosen: r.chosen,
+        defaults: (r.defaults.false_shadow, r.defaults.false_lit),
     })?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("--out: cannot create {}", args.out.display()))?;
@@ -182,12 +234,14 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let (w, h) = plot::PLOT_SIZE;
     let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
     staged.png_rgba(&args.out.join("front.png"), w, h, &rgba)?;
-    let report = report_markdown(&points, &front, chosen, (&defaults, &held_chosen, &held_default));
+    let report = report_markdown(r);
     staged.text(&args.out.join("calibration.md"), &report)?;
+    let json = serde_json::to_string_pretty(&report_json(scene, technique, r))?;
+    staged.text(&args.out.join("calibration.json"), &json)?;
     staged.commit()?;
     print!("{report}");
     if let Some(path) = &args.write {
-        let tuned = &points[chosen].setting;
+        let tuned = &r.points[r.chosen].setting;
         write_settings(path, &tuned.bias, swept_kernel.then_some(tuned.pcf_kernel))?;
     }
     Ok(())
@@ -211,38 +265,42 @@ fn view_cameras(args: &CalibrateArgs, scene: &Scene, settings: &Settings) -> any
         .collect())
 }
 
-/// Renders `views` with the `tuned` settings and pools their light-facing mismatches.
-fn measure(
-    renderer: &mut Renderer,
-    uploaded: &GpuScene,
-    scene: &Scene,
-    views: &[&View],
-    tuned: &Tuned,
-    bar: &ProgressBar,
-) -> anyhow::Result<Pooled> {
-    let mut pooled = Pooled::default();
-    for view in views {
-        let mut s = view.settings.clone();
-        s.shadow.bias = tuned.bias.clone();
-        s.shadow.filter.pcf_kernel = tuned.pcf_kernel;
-        let frame = renderer.render_uploaded(uploaded, scene, &s, &OutputRequest::default())?;
-        let raster =
-            RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-        let m = metrics::measure(raster, &view.reference, &metrics::classify(raster, &view.reference));
-        pooled.compared += m.compared;
-        pooled.false_shadow += m.false_shadow;
-        pooled.false_lit += m.false_lit;
-        bar.inc(1);
-    }
-    Ok(pooled)
+/// What every measurement of a calibration renders with.
+struct Measuring<'a> {
+    renderer: &'a mut Renderer,
+    uploaded: &'a GpuScene,
+    scene: &'a Scene,
+    bar: &'a ProgressBar,
 }
 
-fn report_markdown(
-    points: &[Measured<Tuned>],
-    front: &[usize],
-    chosen: usize,
-    (defaults, held_chosen, held_default): (&Measured<Tuned>, &Measured<Tuned>, &Measured<Tuned>),
-) -> String {
+impl Measuring<'_> {
+    /// Renders `views` with the `tuned` settings and `refine`, and pools their
+    /// light-facing mismatches.
+    fn measure(&mut self, views: &[&View], tuned: &Tuned, refine: Refine) -> anyhow::Result<Pooled> {
+        let mut pooled = Pooled::default();
+        for view in views {
+            let mut s = view.settings.clone();
+            s.shadow.bias = tuned.bias.clone();
+            s.shadow.filter.pcf_kernel = tuned.pcf_kernel;
+            s.screen.refine = refine;
+            let frame =
+                self.renderer.render_uploaded(self.uploaded, self.scene, &s, &OutputRequest::default())?;
+            let raster = RasterView {
+                visibility: &frame.visibility,
+                object_id: &frame.object_id,
+                depth: &frame.depth,
+            };
+            let m = metrics::measure(raster, &view.reference, &metrics::classify(raster, &view.reference));
+            pooled.compared += m.compared;
+            pooled.false_shadow += m.false_shadow;
+            pooled.false_lit += m.false_lit;
+            self.bar.inc(1);
+        }
+        Ok(pooled)
+    }
+}
+
+fn report_markdown(r: &Results) -> String {
     let pct = |v: f64| format!("{:.3}%", 100.0 * v);
     let row = |label: &str, p: &Measured<Tuned>| {
         let b = &p.setting.bias;
@@ -257,19 +315,57 @@ fn report_markdown(
             pct(p.mismatch())
         )
     };
-    let mut s = String::from(
-        "Rates over light-facing pixels, pooled over the views.\n\n| setting | depth bias | slope bias | normal offset | PCF kernel | false shadow | false lit | mismatch |\n|---|---|---|---|---|---|---|---|\n",
+    let mut s = format!(
+        "Rates over light-facing pixels, pooled over the views, with --refine {}.\n\n| setting | depth bias | slope bias | normal offset | PCF kernel | false shadow | false lit | mismatch |\n|---|---|---|---|---|---|---|---|\n",
+        gnomon_scene::settings::value_name(&r.refine)
     );
-    for &i in front {
-        s += &row(if i == chosen { "**chosen**" } else { "front" }, &points[i]);
+    for &i in &r.front {
+        s += &row(if i == r.chosen { "**chosen**" } else { "front" }, &r.points[i]);
     }
-    s += &row("defaults", defaults);
+    s += &row("defaults", &r.defaults);
     s += &format!(
         "\nHeld-out views: chosen {} mismatch, defaults {}.\n",
-        pct(held_chosen.mismatch()),
-        pct(held_default.mismatch())
+        pct(r.held_chosen.mismatch()),
+        pct(r.held_default.mismatch())
     );
+    if let Some(refined) = &r.held_default_refined {
+        s += &format!(
+            "The defaults as they render, refined by rays where the map is unsure (--refine auto): {} on the held-out views.\n",
+            pct(refined.mismatch())
+        );
+    }
     s
+}
+
+/// The report as JSON: every setting measured, the front, the choice and the
+/// held-out check.
+fn report_json(scene: &Scene, technique: &str, r: &Results) -> serde_json::Value {
+    let entry = |p: &Measured<Tuned>| {
+        serde_json::json!({
+            "depth_bias": p.setting.bias.depth_bias,
+            "slope_bias": p.setting.bias.slope_bias,
+            "normal_offset": p.setting.bias.normal_offset,
+            "pcf_kernel": p.setting.pcf_kernel,
+            "false_shadow": p.false_shadow,
+            "false_lit": p.false_lit,
+            "mismatch": p.mismatch(),
+        })
+    };
+    serde_json::json!({
+        "scene": scene.name,
+        "technique": technique,
+        "denominator": "light-facing pixels, pooled over the views",
+        "refine": gnomon_scene::settings::value_name(&r.refine),
+        "points": r.points.iter().map(entry).collect::<Vec<_>>(),
+        "front": r.front,
+        "chosen": entry(&r.points[r.chosen]),
+        "defaults": entry(&r.defaults),
+        "held_out": {
+            "chosen": entry(&r.held_chosen),
+            "defaults": entry(&r.held_default),
+            "defaults_refined_by_rays": r.held_default_refined.as_ref().map(entry),
+        },
+    })
 }
 
 /// Stores `bias` in `path`'s `[settings.shadow.bias]`, and `kernel` (when it was
