@@ -11,7 +11,8 @@ use common::{
 };
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_scene::{
-    AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry, settings::Technique,
+    AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry,
+    settings::{Refine, ScreenSpaceSettings, Technique, value_name},
 };
 
 const CELLS: u32 = 8;
@@ -173,14 +174,14 @@ fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
 ///
 /// Issue 4 asks for a mismatch under 2 % for `pcf2x2` at 2048² under a directional
 /// light, over every surface pixel (the measure of its time, kept as
-/// `surface_mismatch_rate`). Asserted on the view `gnomon compare tree.glb
-/// --sun-elevation 55 --sun-azimuth 200` uses (the default framing, which fits every
-/// vertex in the frame, no ground; every compared pixel is foliage or trunk, so this
-/// is leaves shadowing leaves): 1.469 % measured on lavapipe with today's defaults
-/// (normal offset 0.3; 1.64 % with 0.6 and the framing of the bounding box). A close
-/// view with a ground, where 2 % is not met (2.017 %), is held to a regression bound.
-/// The errors are one-texel fringes around each leaf's shadow, so the figure depends
-/// on the sun and the framing.
+/// `surface_mismatch_rate`), of the map alone (`--refine off`). Asserted on the view
+/// `gnomon compare tree.glb --sun-elevation 55 --sun-azimuth 200 --refine off` uses
+/// (the default framing, which fits every vertex in the frame, no ground; every
+/// compared pixel is foliage or trunk, so this is leaves shadowing leaves): 1.469 %
+/// measured on lavapipe (normal offset 0.3; 1.64 % with 0.6 and the framing of the
+/// bounding box). A close view with a ground, where 2 % is not met (2.017 %), is held
+/// to a regression bound. The errors are one-texel fringes around each leaf's shadow,
+/// so the figure depends on the sun and the framing.
 const TREE_FITTED_MISMATCH: f64 = 0.02;
 const TREE_CLOSE_MISMATCH: f64 = 0.025;
 /// The same two views over the light-facing pixels alone, the measure `compare`
@@ -189,9 +190,18 @@ const TREE_CLOSE_MISMATCH: f64 = 0.025;
 /// rate counts as trivially right). Regression bounds about 1.25× those.
 const TREE_FITTED_LIGHT_FACING: f64 = 0.03;
 const TREE_CLOSE_LIGHT_FACING: f64 = 0.027;
+/// The same two views with the default's rays where the map is unsure, over the
+/// light-facing pixels: 0.022 % and 0.155 % measured on lavapipe, a hundredth and a
+/// fourteenth of the map's alone. Issue 25's 0.02 % is not met on either. On the
+/// close view the rest is the two tracers' disagreement, not the classification: a
+/// ray at every pixel (`--refine every-pixel`) leaves 0.135 % (0.013 % on the fitted
+/// view); its cause is open (docs/rays.md). These are regression bounds about 1.5×
+/// the measurements.
+const TREE_FITTED_REFINED: f64 = 0.00035;
+const TREE_CLOSE_REFINED: f64 = 0.0025;
 
 #[test]
-fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
+fn tree_pcf2x2_agrees_with_the_alpha_aware_reference_with_and_without_rays() {
     let Some(path) = common::shared_scene("tree/tree.glb") else { return };
     let (mut scene, extras) = gnomon_scene::gltf_loader::load(&path).unwrap();
     assert!(!extras.has_camera, "the tree ships without a camera: the loader fits one");
@@ -199,33 +209,44 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     let mut s = settings(Technique::PCF2X2);
     s.image.width = 1280;
     s.image.height = 720;
-    let measure = |scene: &Scene, s: &Settings, what: &str| {
-        let m = compare(&render(scene, s), &reference(scene, s));
-        eprintln!(
-            "tree, {what}, pcf2x2, 2048²: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} light-facing pixels; {:.3}% of all {} surface pixels",
-            100.0 * m.mismatch_rate,
-            100.0 * m.false_shadow_rate,
-            100.0 * m.false_lit_rate,
-            m.compared,
-            100.0 * m.surface_mismatch_rate,
-            m.surface(),
-        );
-        m
+    // The map alone, then refined by rays as the default renders, against one reference.
+    let measure = |scene: &Scene, what: &str| {
+        let truth = reference(scene, &s);
+        [Refine::Off, Refine::Auto].map(|refine| {
+            let m = compare(&render(scene, &Settings { screen: ScreenSpaceSettings { refine, ..s.screen.clone() }, ..s.clone() }), &truth);
+            eprintln!(
+                "tree, {what}, pcf2x2, 2048², --refine {}: mismatch {:.3}% (false shadow {:.3}%, false lit {:.3}%) of {} light-facing pixels; {:.3}% of all {} surface pixels",
+                value_name(&refine),
+                100.0 * m.mismatch_rate,
+                100.0 * m.false_shadow_rate,
+                100.0 * m.false_lit_rate,
+                m.compared,
+                100.0 * m.surface_mismatch_rate,
+                m.surface(),
+            );
+            m
+        })
     };
-    let fitted = measure(&scene, &s, "fitted view");
+    let [fitted, fitted_refined] = measure(&scene, "fitted view");
     figure(
-        "tree, fitted view, pcf2x2: mismatch over light-facing pixels",
+        "tree, fitted view, pcf2x2, map alone: mismatch over light-facing pixels",
         percent(fitted.mismatch_rate),
         percent(TREE_FITTED_LIGHT_FACING),
     );
     figure(
-        "tree, fitted view, pcf2x2: mismatch over all surfaces",
+        "tree, fitted view, pcf2x2, map alone: mismatch over all surfaces",
         percent(fitted.surface_mismatch_rate),
         percent(TREE_FITTED_MISMATCH),
+    );
+    figure(
+        "tree, fitted view, pcf2x2, refined by rays: mismatch over light-facing pixels",
+        percent(fitted_refined.mismatch_rate),
+        percent(TREE_FITTED_REFINED),
     );
     assert!(fitted.surface() > 40_000, "{fitted:?}");
     assert!(fitted.surface_mismatch_rate < TREE_FITTED_MISMATCH, "{fitted:?}");
     assert!(fitted.mismatch_rate < TREE_FITTED_LIGHT_FACING, "{fitted:?}");
+    assert!(fitted_refined.mismatch_rate < TREE_FITTED_REFINED, "{fitted_refined:?}");
 
     // Close to the tree, with a ground three times its width.
     let b = scene.bounds();
@@ -235,22 +256,28 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference() {
     scene.camera.target = Vec3::new(c.x, b.min.y + 0.3 * b.extent().y, c.z);
     scene.camera.near = 0.01 * r;
     scene.camera.far = 10.0 * r;
-    let close = measure(&scene, &s, "close view with ground");
+    let [close, close_refined] = measure(&scene, "close view with ground");
     figure(
-        "tree, close view with ground, pcf2x2: mismatch over light-facing pixels",
+        "tree, close view with ground, pcf2x2, map alone: mismatch over light-facing pixels",
         percent(close.mismatch_rate),
         percent(TREE_CLOSE_LIGHT_FACING),
     );
     figure(
-        "tree, close view with ground, pcf2x2: mismatch over all surfaces",
+        "tree, close view with ground, pcf2x2, map alone: mismatch over all surfaces",
         percent(close.surface_mismatch_rate),
         percent(TREE_CLOSE_MISMATCH),
+    );
+    figure(
+        "tree, close view with ground, pcf2x2, refined by rays: mismatch over light-facing pixels",
+        percent(close_refined.mismatch_rate),
+        percent(TREE_CLOSE_REFINED),
     );
     assert!(close.surface() > 300_000, "{close:?}");
     // Issue 4's 2 % is not met on this view (README); this bound only guards it
     // against getting worse.
     assert!(close.surface_mismatch_rate < TREE_CLOSE_MISMATCH, "{close:?}");
     assert!(close.mismatch_rate < TREE_CLOSE_LIGHT_FACING, "{close:?}");
+    assert!(close_refined.mismatch_rate < TREE_CLOSE_REFINED, "{close_refined:?}");
 }
 
 #[test]
@@ -260,7 +287,7 @@ fn the_mask_paths_prepass_cuts_the_same_holes() {
     let scene = checker_scene();
     let mut s = settings(Technique::PCF2X2);
     // The two paths' map answers: the default's rays refine only the mask path.
-    s.screen.refine = gnomon_scene::settings::Refine::Off;
+    s.screen.refine = Refine::Off;
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Forward;
     let forward = render(&scene, &s);
     s.screen.shadow_path = gnomon_scene::settings::ShadowPath::Mask;
