@@ -32,8 +32,9 @@ pub struct BenchArgs {
     /// Untimed frames first, so that pipelines are built and caches warm; 0 to 10000.
     #[arg(long, value_name = "N", default_value_t = 10, help_heading = "Benchmark")]
     pub warmup: u32,
-    /// Image size, WIDTHxHEIGHT (instead of --width and --height).
-    #[arg(long, value_name = "WxH", value_parser = parse_size, help_heading = "Benchmark")]
+    /// The former spelling of --width and --height, as WIDTHxHEIGHT; every command
+    /// takes --width and --height.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, hide = true, conflicts_with_all = ["width", "height"])]
     pub size: Option<(u32, u32)>,
     /// Time every value of one setting: FLAG=V1,V2,… with FLAG a settings flag
     /// without its dashes, e.g. `shadow-res=512,1024,2048,4096`.

@@ -1,7 +1,9 @@
 //! The reference cache: a ray-traced reference is stored under a hash of everything it
 //! depends on (scene geometry, camera, light, image size, samples), so `compare` runs
 //! after the first reuse it. Location: `$GNOMON_CACHE_DIR`, else
-//! `$XDG_CACHE_HOME/gnomon`, else `~/.cache/gnomon`.
+//! `$XDG_CACHE_HOME/gnomon`, else `~/.cache/gnomon`. The cache holds at most
+//! `$GNOMON_CACHE_MAX_MIB` MiB (2048 by default): storing a reference removes the
+//! least recently used ones past that. `gnomon cache` lists and clears it.
 
 use std::path::{Path, PathBuf};
 
@@ -48,9 +50,70 @@ pub fn path_for(key: &str) -> Option<PathBuf> {
     cache_dir().map(|d| d.join(format!("reference-{key}.bin")))
 }
 
+/// The cache's size limit when `$GNOMON_CACHE_MAX_MIB` does not set one: a 4K
+/// reference takes 265 MB, so this keeps the last seven or so.
+const DEFAULT_MAX_MIB: u64 = 2048;
+
+/// The cache's size limit in bytes: `$GNOMON_CACHE_MAX_MIB`, else [`DEFAULT_MAX_MIB`].
+fn max_bytes() -> anyhow::Result<u64> {
+    let mib = match std::env::var("GNOMON_CACHE_MAX_MIB") {
+        Ok(text) => text.trim().parse::<u64>().ok().filter(|&m| m <= 1 << 30).ok_or_else(|| {
+            anyhow::anyhow!(
+                "GNOMON_CACHE_MAX_MIB = `{text}` is invalid: a whole number of MiB, 0 to {}",
+                1u64 << 30
+            )
+        })?,
+        Err(_) => DEFAULT_MAX_MIB,
+    };
+    Ok(mib << 20)
+}
+
+/// One cached reference: its file, size and when it was last used.
+pub struct Entry {
+    pub path: PathBuf,
+    pub bytes: u64,
+    pub last_used: std::time::SystemTime,
+}
+
+/// Every cached reference in `dir`, least recently used first.
+pub fn entries(dir: &Path) -> Vec<Entry> {
+    let Ok(read) = std::fs::read_dir(dir) else { return Vec::new() };
+    let mut found: Vec<Entry> = read
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            e.file_name().to_str().is_some_and(|n| n.starts_with("reference-") && n.ends_with(".bin"))
+        })
+        .filter_map(|e| {
+            let meta = e.metadata().ok()?;
+            Some(Entry { path: e.path(), bytes: meta.len(), last_used: meta.modified().ok()? })
+        })
+        .collect();
+    found.sort_by_key(|e| e.last_used);
+    found
+}
+
+/// Removes the least recently used references of `dir` until it holds at most
+/// `max_bytes`, keeping `keep` (the one just stored) whatever its size.
+fn trim(dir: &Path, max_bytes: u64, keep: &Path) {
+    let all = entries(dir);
+    let mut total: u64 = all.iter().map(|e| e.bytes).sum();
+    for e in all.iter().filter(|e| e.path != keep) {
+        if total <= max_bytes {
+            break;
+        }
+        if std::fs::remove_file(&e.path).is_ok() {
+            total -= e.bytes;
+        }
+    }
+}
+
 /// Loads a cached reference of the expected size, or `None` (missing, unreadable or stale).
+/// A hit marks the file as used, for the least-recently-used trim.
 pub fn load(path: &Path, options: &ReferenceOptions) -> Option<ReferenceImage> {
     let bytes = std::fs::read(path).ok()?;
+    if let Ok(file) = std::fs::File::options().append(true).open(path) {
+        let _ = file.set_modified(std::time::SystemTime::now());
+    }
     let mut r = Reader { bytes: &bytes, at: 0 };
     if r.take(8)? != MAGIC {
         return None;
@@ -98,8 +161,17 @@ pub fn store(path: &Path, image: &ReferenceImage) -> std::io::Result<()> {
         std::fs::create_dir_all(dir)?;
     }
     let temp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&temp, bytes)?;
-    std::fs::rename(&temp, path)
+    crate::output::track_temporary(&temp);
+    let written = std::fs::write(&temp, bytes).and_then(|()| std::fs::rename(&temp, path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    crate::output::forget_temporary(&temp);
+    written?;
+    if let Some(dir) = path.parent() {
+        trim(dir, max_bytes().map_err(std::io::Error::other)?, path);
+    }
+    Ok(())
 }
 
 struct Reader<'a> {
@@ -135,6 +207,54 @@ impl Reader<'_> {
                 .collect(),
         )
     }
+}
+
+/// `gnomon cache`: what the reference cache holds, or clear it.
+#[derive(clap::Args, Debug)]
+pub struct CacheArgs {
+    /// Remove every cached reference.
+    #[arg(long)]
+    pub clear: bool,
+}
+
+pub fn run(args: &CacheArgs) -> anyhow::Result<()> {
+    let dir = cache_dir()
+        .ok_or_else(|| anyhow::anyhow!("no cache directory: set GNOMON_CACHE_DIR, XDG_CACHE_HOME or HOME"))?;
+    let all = entries(&dir);
+    let total: u64 = all.iter().map(|e| e.bytes).sum();
+    if args.clear {
+        let mut freed = 0;
+        for e in &all {
+            std::fs::remove_file(&e.path)
+                .map_err(|err| anyhow::anyhow!("cannot remove {}: {err}", e.path.display()))?;
+            freed += e.bytes;
+        }
+        println!(
+            "removed {} references, {:.1} MiB, from {}",
+            all.len(),
+            freed as f64 / 1048576.0,
+            dir.display()
+        );
+        return Ok(());
+    }
+    let now = std::time::SystemTime::now();
+    for e in all.iter().rev() {
+        let age = now.duration_since(e.last_used).unwrap_or_default().as_secs();
+        println!(
+            "{:>10.1} MiB  used {:>6} min ago  {}",
+            e.bytes as f64 / 1048576.0,
+            age / 60,
+            e.path.display()
+        );
+    }
+    println!(
+        "{} references, {:.1} MiB of at most {} MiB (GNOMON_CACHE_MAX_MIB), in {}",
+        all.len(),
+        total as f64 / 1048576.0,
+        max_bytes()? >> 20,
+        dir.display()
+    );
+    Ok(())
 }
 
 #[cfg(test)]
@@ -173,5 +293,26 @@ mod tests {
         std::fs::write(&path, b"GNOMREF1junk").unwrap();
         assert!(load(&path, &options).is_none(), "a truncated file is ignored");
         std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn trimming_removes_the_least_recently_used_references_first_and_keeps_the_new_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let day = std::time::Duration::from_secs(86_400);
+        let now = std::time::SystemTime::now();
+        for (name, days_ago) in [("a", 3), ("b", 1), ("c", 2), ("new", 5)] {
+            let path = dir.path().join(format!("reference-{name}.bin"));
+            std::fs::write(&path, vec![0u8; 1000]).unwrap();
+            let file = std::fs::File::options().append(true).open(&path).unwrap();
+            file.set_modified(now - day * days_ago).unwrap();
+        }
+        std::fs::write(dir.path().join("unrelated.txt"), vec![0u8; 5000]).unwrap();
+        trim(dir.path(), 2500, &dir.path().join("reference-new.bin"));
+        let left: Vec<String> = entries(dir.path())
+            .iter()
+            .map(|e| e.path.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(left, ["reference-new.bin", "reference-b.bin"], "a (3 days) and c (2 days) went first");
+        assert!(dir.path().join("unrelated.txt").exists(), "only references are touched");
     }
 }

@@ -137,6 +137,17 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
     );
+    // Each technique's files are named after it: a repeated one would overwrite its own.
+    if let Some((i, repeated)) =
+        args.techniques.iter().enumerate().find(|(i, t)| args.techniques[..*i].contains(t))
+    {
+        anyhow::bail!(
+            "--techniques names `{}` twice (at {} and {}): name each once",
+            repeated.name(),
+            args.techniques.iter().position(|t| t == repeated).unwrap_or(0) + 1,
+            i + 1
+        );
+    }
     anyhow::ensure!(
         (2..=240).contains(&args.path_frames),
         "--path-frames = {} is invalid: 2 to 240",

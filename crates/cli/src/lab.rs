@@ -3,7 +3,6 @@
 
 use std::time::Instant;
 
-use anyhow::Context;
 use gnomon_reference::{ReferenceImage, ReferenceOptions, TracedScene, reference_visibility};
 use gnomon_scene::{Camera, Light, Scene, Settings, builtin};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -32,11 +31,21 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
     let (mut scene, settings) = if is_toml {
         anyhow::ensure!(path.is_file(), "{name}: no such file");
         let loaded = gnomon_scene::scene_file::load(path, view)?;
+        for warning in &loaded.warnings {
+            eprintln!("gnomon: warning: {name}: {warning}");
+        }
         let settings = match &loaded.settings {
             Some(table) => gnomon_scene::scene_file::merge_settings(table, command_line)
                 .map_err(|e| anyhow::anyhow!("{name}: [settings]: {e}"))?,
             None => command_line.clone(),
         };
+        // A value the file gave is the file's fault: name its line, not a flag.
+        if let Err(e) = settings.validate() {
+            return Err(match loaded.blame(&e, command_line) {
+                Some(located) => located.into(),
+                None => e.into(),
+            });
+        }
         (loaded.scene, settings)
     } else {
         if let Some(v) = view {
@@ -47,6 +56,13 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
     settings.validate()?;
     if settings.scene.ground {
         scene.add_ground_plane();
+    }
+    // A setting this render ignores is said, not silently dropped (an unresolvable
+    // light is reported by the command itself).
+    if let Ok(lights) = settings.resolve_lights(&scene) {
+        for unused in settings.unused(&lights) {
+            eprintln!("gnomon: warning: {}", gnomon_scene::settings::in_flags(&unused.to_string()));
+        }
     }
     Ok((scene, settings))
 }
@@ -62,6 +78,9 @@ pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
     if is_gltf {
         anyhow::ensure!(path.is_file(), "{name}: no such file");
         let (scene, extras) = gnomon_scene::gltf_loader::load(path)?;
+        for warning in &extras.warnings {
+            eprintln!("gnomon: warning: {name}: {warning}");
+        }
         if extras.ignored_lights > 0 {
             eprintln!(
                 "gnomon: {name}: {} light(s) ignored (a directional or spot light without a direction)",
@@ -70,11 +89,12 @@ pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
         }
         return Ok(scene);
     }
-    builtin::build(name).with_context(|| {
-        format!(
+    builtin::build(name).map_err(|e| match e {
+        builtin::BuiltinError::Unknown(_) => anyhow::anyhow!(
             "unknown scene `{name}`: give a scene file (.toml), a glTF file (.gltf or .glb) or one of the built-in scenes {}",
             builtin::names().join(", ")
-        )
+        ),
+        out_of_range @ builtin::BuiltinError::InstancesOutOfRange(_) => out_of_range.into(),
     })
 }
 

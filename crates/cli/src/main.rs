@@ -41,6 +41,8 @@ enum Command {
     Calibrate(Box<calibrate::CalibrateArgs>),
     /// Open the interactive viewer: every technique and setting live, with debug views.
     View(Box<view_cmd::ViewArgs>),
+    /// List the cached ray-traced references (size, last use), or clear them.
+    Cache(cache::CacheArgs),
     /// List the built-in scenes.
     Scenes,
     /// List the shadow techniques.
@@ -52,13 +54,38 @@ enum Command {
 fn parse_cli(techniques: &gnomon_render::techniques::TechniqueRegistry) -> Cli {
     use clap::{CommandFactory, FromArgMatches};
     let command = gnomon_scene::settings::offer_techniques(Cli::command(), &techniques.choices());
+    let command = gnomon_scene::settings::accept_negative_values(command);
     let matches = command.get_matches();
     Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
 }
 
+/// Points `XDG_RUNTIME_DIR` at a private directory when it is unset or not a
+/// directory: Mesa's Vulkan window-system code prints "XDG_RUNTIME_DIR is invalid or
+/// not set" on every run otherwise, though a headless run never needs it.
+fn quiet_runtime_dir() {
+    let valid = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if valid {
+        return;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        let user = std::fs::metadata("/proc/self").map(|m| m.uid()).unwrap_or(0);
+        let dir = std::env::temp_dir().join(format!("gnomon-runtime-{user}"));
+        let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        if made.is_ok() || dir.is_dir() {
+            // SAFETY: called first thing in `main`, before any thread exists that
+            // could read the environment concurrently.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_runtime_dir();
     let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
     let cli = parse_cli(&techniques);
+    output::remove_temporaries_on_interrupt();
     let result = match cli.command {
         None => render_cmd::run(&render_cmd::RenderArgs::default_from_cli()),
         Some(Command::Render(args)) => render_cmd::run(&args),
@@ -67,6 +94,7 @@ fn main() -> ExitCode {
         Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Bench(args)) => bench_cmd::run(&args),
         Some(Command::Calibrate(args)) => calibrate::run(&args),
+        Some(Command::Cache(args)) => cache::run(&args),
         Some(Command::Scenes) => {
             for b in gnomon_scene::builtin::BUILTINS {
                 println!("{:<10} {}", b.name, b.description);

@@ -51,7 +51,74 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// Encoded files waiting to be moved into place.
+/// Temporary files that exist right now (staged outputs, a cache file being
+/// written): what an interrupted run must remove.
+static LIVE_TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes every live temporary file and exits with 130 when the user presses Ctrl-C
+/// or the process is sent SIGTERM: an interrupted run leaves no hidden file behind.
+pub fn remove_temporaries_on_interrupt() {
+    let installed = ctrlc::set_handler(|| {
+        for temp in LIVE_TEMPS.lock().map(|t| t.clone()).unwrap_or_default() {
+            let _ = std::fs::remove_file(temp);
+        }
+        eprintln!("\ngnomon: interrupted; no output was written");
+        std::process::exit(130);
+    });
+    if let Err(e) = installed {
+        eprintln!("gnomon: warning: cannot catch Ctrl-C ({e}); an interrupted run may leave temporary files");
+    }
+}
+
+/// Marks `temp` as live (removed on an interrupt) until [`forget_temporary`].
+pub fn track_temporary(temp: &Path) {
+    if let Ok(mut live) = LIVE_TEMPS.lock() {
+        live.push(temp.to_path_buf());
+    }
+}
+
+/// `temp` was renamed into place or removed: an interrupt no longer touches it.
+pub fn forget_temporary(temp: &Path) {
+    if let Ok(mut live) = LIVE_TEMPS.lock() {
+        live.retain(|t| t != temp);
+    }
+}
+
+/// What a destination is called to compare it with others: its directory resolved
+/// (links and `..` included) and its file name, so that `a.png` and `./d/../a.png` are
+/// one file.
+fn identity(path: &Path) -> PathBuf {
+    let dir = parent_dir(path);
+    let dir = dir.canonicalize().unwrap_or_else(|_| std::path::absolute(dir).unwrap_or(dir.to_path_buf()));
+    dir.join(path.file_name().unwrap_or_default())
+}
+
+/// One output a command will write, named by the flag that asked for it.
+pub struct Planned<'a> {
+    /// The flag (or `--flag/name` for a file inside an output directory).
+    pub flag: String,
+    /// The file.
+    pub path: &'a Path,
+}
+
+/// Refuses, before any work, two outputs that would write the same file: the second
+/// would silently replace the first.
+pub fn refuse_shared_destinations(outputs: &[Planned]) -> anyhow::Result<()> {
+    for (i, a) in outputs.iter().enumerate() {
+        if let Some(b) = outputs[..i].iter().find(|b| identity(b.path) == identity(a.path)) {
+            bail!(
+                "{} {} and {} {} are the same file: give each output its own path",
+                b.flag,
+                b.path.display(),
+                a.flag,
+                a.path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Encoded files waiting to be moved into place: all of them, or none.
 #[derive(Default)]
 pub struct Staged {
     files: Vec<(PathBuf, PathBuf)>,
@@ -61,16 +128,25 @@ impl Drop for Staged {
     fn drop(&mut self) {
         for (temp, _) in &self.files {
             let _ = std::fs::remove_file(temp);
+            forget_temporary(temp);
         }
     }
 }
 
 impl Staged {
-    fn temp_for(&mut self, path: &Path) -> PathBuf {
+    fn temp_for(&mut self, path: &Path) -> anyhow::Result<PathBuf> {
+        if let Some((_, earlier)) = self.files.iter().find(|(_, dest)| identity(dest) == identity(path)) {
+            bail!(
+                "two outputs would write {} (and {}): give each its own path",
+                path.display(),
+                earlier.display()
+            );
+        }
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let temp = parent_dir(path).join(format!(".{name}.gnomon-{}.tmp", std::process::id()));
+        track_temporary(&temp);
         self.files.push((temp.clone(), path.to_path_buf()));
-        temp
+        Ok(temp)
     }
 
     fn write_with(
@@ -78,7 +154,7 @@ impl Staged {
         path: &Path,
         write: impl FnOnce(&Path) -> anyhow::Result<()>,
     ) -> anyhow::Result<()> {
-        let temp = self.temp_for(path);
+        let temp = self.temp_for(path)?;
         write(&temp).with_context(|| format!("cannot write {}", path.display()))
     }
 
@@ -138,20 +214,48 @@ impl Staged {
         self.write_with(path, |temp| Ok(std::fs::write(temp, text)?))
     }
 
-    /// Moves every staged file into place and returns the destinations.
+    /// Moves every staged file into place and returns the destinations. All or
+    /// nothing: a file already at a destination is set aside first and put back if
+    /// any later move fails, so a failed commit leaves every earlier file as it was.
     pub fn commit(mut self) -> anyhow::Result<Vec<PathBuf>> {
         let files = std::mem::take(&mut self.files);
-        let mut done = Vec::new();
-        for (i, (temp, dest)) in files.iter().enumerate() {
-            if let Err(e) = std::fs::rename(temp, dest) {
-                for (t, _) in &files[i..] {
-                    let _ = std::fs::remove_file(t);
-                }
-                return Err(e).with_context(|| format!("cannot write {}", dest.display()));
+        let mut moved: Vec<(&Path, Option<PathBuf>)> = Vec::new();
+        let mut failure = None;
+        for (temp, dest) in &files {
+            let backup = dest.exists().then(|| temp.with_extension("old"));
+            let result = match &backup {
+                Some(b) => std::fs::rename(dest, b).and_then(|()| {
+                    std::fs::rename(temp, dest).inspect_err(|_| {
+                        let _ = std::fs::rename(b, dest);
+                    })
+                }),
+                None => std::fs::rename(temp, dest),
+            };
+            if let Err(e) = result {
+                failure = Some(anyhow::Error::new(e).context(format!("cannot write {}", dest.display())));
+                break;
             }
-            done.push(dest.clone());
+            moved.push((dest, backup));
         }
-        Ok(done)
+        for (temp, _) in &files {
+            let _ = std::fs::remove_file(temp);
+            forget_temporary(temp);
+        }
+        if let Some(e) = failure {
+            for (dest, backup) in moved.into_iter().rev() {
+                let _ = match backup {
+                    Some(b) => std::fs::rename(b, dest),
+                    None => std::fs::remove_file(dest),
+                };
+            }
+            return Err(e);
+        }
+        for (_, backup) in &moved {
+            if let Some(b) = backup {
+                let _ = std::fs::remove_file(b);
+            }
+        }
+        Ok(files.into_iter().map(|(_, dest)| dest).collect())
     }
 }
 

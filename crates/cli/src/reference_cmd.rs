@@ -31,6 +31,10 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     output::check_file(&args.out, &["exr", "png"], "--out")?;
     if let Some(p) = &args.std_error_out {
         output::check_file(p, &["exr", "npy"], "--std-error-out")?;
+        output::refuse_shared_destinations(&[
+            output::Planned { flag: "--out".into(), path: &args.out },
+            output::Planned { flag: "--std-error-out".into(), path: p },
+        ])?;
     }
     let reference = lab::reference(&scene, &settings, !args.no_cache)?;
     let image = &reference.image;

@@ -54,6 +54,9 @@ impl RenderArgs {
     }
 }
 
+/// The files `--aov-out` writes into its directory.
+const AOV_FILES: [&str; 5] = ["position.exr", "normal.exr", "depth.exr", "object_id.exr", "visibility.exr"];
+
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     args.settings.validate()?;
@@ -71,6 +74,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.aov_out {
         output::check_dir(dir, "--aov-out")?;
     }
+    let aov_files: Vec<PathBuf> = args.aov_out.iter().flat_map(|d| AOV_FILES.map(|f| d.join(f))).collect();
+    let planned: Vec<output::Planned> =
+        [("--out", Some(&args.out)), ("--shadow-map-out", args.shadow_map_out.as_ref())]
+            .into_iter()
+            .chain([("--visibility-out", args.visibility_out.as_ref())])
+            .filter_map(|(flag, path)| path.map(|path| output::Planned { flag: flag.into(), path }))
+            .chain(aov_files.iter().map(|path| output::Planned { flag: "--aov-out".into(), path }))
+            .collect();
+    output::refuse_shared_destinations(&planned)?;
 
     let gpu = Gpu::new_headless()?;
     if args.verbose {
@@ -160,12 +172,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--aov-out: cannot create directory {}", dir.display()))?;
         let (w, h) = (frame.width, frame.height);
-        staged.exr_rgb(&dir.join("position.exr"), w, h, &frame.position)?;
-        staged.exr_rgb(&dir.join("normal.exr"), w, h, &frame.normal)?;
-        staged.float_image(&dir.join("depth.exr"), w, h, &frame.depth)?;
+        let [position, normal, depth, object_id, visibility] = AOV_FILES.map(|f| dir.join(f));
+        staged.exr_rgb(&position, w, h, &frame.position)?;
+        staged.exr_rgb(&normal, w, h, &frame.normal)?;
+        staged.float_image(&depth, w, h, &frame.depth)?;
         let ids: Vec<f32> = frame.object_id.iter().map(|&i| i as f32).collect();
-        staged.float_image(&dir.join("object_id.exr"), w, h, &ids)?;
-        staged.float_image(&dir.join("visibility.exr"), w, h, &frame.visibility)?;
+        staged.float_image(&object_id, w, h, &ids)?;
+        staged.float_image(&visibility, w, h, &frame.visibility)?;
     }
     let written = staged.commit()?;
     for path in &written {

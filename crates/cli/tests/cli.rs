@@ -509,7 +509,7 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
         (&["bench", "--sweep", "shadow-res=100"][..], "--sweep shadow-res=100"),
         (&["bench", "--size", "12"][..], "WIDTHxHEIGHT"),
         (&["bench", "--frames", "0"][..], "--frames 0"),
-        (&["bench", "instances:5"][..], "unknown scene"),
+        (&["bench", "instances:5"][..], "from 10 to 4000000"),
     ] {
         let out = gnomon(dir, args);
         assert!(!out.status.success() && stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));

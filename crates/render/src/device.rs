@@ -76,9 +76,7 @@ impl Gpu {
 
     /// Like [`Gpu::new_headless`], letting `adjust` lower the limits asked for.
     pub fn new_headless_with(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self, RenderError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
-            .map_err(|_| RenderError::no_adapter())?;
+        let adapter = headless_adapter()?;
         Self::with_adapter(&adapter, adjust)
     }
 
@@ -155,10 +153,54 @@ impl Gpu {
 impl RenderError {
     /// No adapter could be found, naming the `WGPU_BACKEND` choice that limited the search.
     pub fn no_adapter() -> Self {
+        Self::no_adapter_besides(None)
+    }
+
+    /// [`RenderError::no_adapter`], naming the OpenGL adapter that was found and
+    /// refused, if one was.
+    pub fn no_adapter_besides(gl: Option<&wgpu::AdapterInfo>) -> Self {
+        if let Some(info) = gl {
+            return RenderError::NoAdapter {
+                backends: format!(
+                    " but the OpenGL one `{}`, which cannot draw into the 32-bit float targets Gnomon renders to",
+                    info.name
+                ),
+            };
+        }
         let backends = match std::env::var("WGPU_BACKEND") {
             Ok(v) => format!(" for WGPU_BACKEND={v:?}"),
             Err(_) => String::new(),
         };
         RenderError::NoAdapter { backends }
+    }
+}
+
+/// The adapter a headless run uses. `WGPU_BACKEND` (with `WGPU_ADAPTER_NAME` and
+/// `WGPU_POWER_PREF`) chooses when set. Otherwise Vulkan, Metal or DX12 is preferred:
+/// wgpu would fall back to OpenGL, which cannot render the `Rgba32Float` targets the
+/// visibility and AOV outputs need, and a user would meet a validation error instead
+/// of the install hint. An OpenGL adapter, chosen or fallen back to, is refused with
+/// that hint.
+fn headless_adapter() -> Result<wgpu::Adapter, RenderError> {
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    let chosen_by_user = std::env::var_os("WGPU_BACKEND").is_some();
+    if !chosen_by_user {
+        descriptor.backends = wgpu::Backends::PRIMARY;
+    }
+    let instance = wgpu::Instance::new(descriptor);
+    let found = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None));
+    match found {
+        Ok(adapter) if adapter.get_info().backend != wgpu::Backend::Gl => Ok(adapter),
+        Ok(gl) => Err(RenderError::no_adapter_besides(Some(&gl.get_info()))),
+        Err(_) if chosen_by_user => Err(RenderError::no_adapter()),
+        Err(_) => {
+            // Say whether GL was there, so that the message explains why it was not used.
+            let mut gl_only = wgpu::InstanceDescriptor::new_without_display_handle();
+            gl_only.backends = wgpu::Backends::GL;
+            let gl = pollster::block_on(
+                wgpu::Instance::new(gl_only).request_adapter(&wgpu::RequestAdapterOptions::default()),
+            );
+            Err(RenderError::no_adapter_besides(gl.ok().map(|a| a.get_info()).as_ref()))
+        }
     }
 }

@@ -129,6 +129,7 @@ impl GpuScene {
                 instances: instance_data.len(),
                 bytes: instance_bytes,
                 limit,
+                max_instances: limit / std::mem::size_of_val(&instance_data[0]) as u64,
             });
         }
         let device = &gpu.device;

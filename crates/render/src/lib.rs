@@ -47,12 +47,13 @@ use gnomon_scene::{SceneError, settings::SettingsError};
 pub enum RenderError {
     /// No GPU adapter is available (for the backends `WGPU_BACKEND` allows, if set).
     #[error(
-        "no GPU adapter found{backends}. Gnomon needs a Vulkan, Metal, DX12 or GL driver. \
+        "no GPU adapter found{backends}. Gnomon needs a Vulkan, Metal or DX12 driver. \
          On Debian or Ubuntu without a GPU, install the CPU Vulkan driver lavapipe: \
          `sudo apt-get install mesa-vulkan-drivers`"
     )]
     NoAdapter {
-        /// The message's mention of `WGPU_BACKEND` when that variable narrowed the search; empty when unset.
+        /// The message's mention of `WGPU_BACKEND` when that variable narrowed the search, or of
+        /// the OpenGL adapter that was refused; empty otherwise.
         backends: String,
     },
     /// The adapter was found but refused to open a device with the limits and features asked for.
@@ -137,7 +138,7 @@ pub enum RenderError {
     /// The scene's instance data does not fit in one storage buffer binding on this device.
     #[error(
         "scene `{scene}`: its {instances} instances need {bytes} bytes of instance data, but this \
-         device binds at most {limit} bytes in one storage buffer; render fewer instances"
+         device binds at most {limit} bytes in one storage buffer: at most {max_instances} instances"
     )]
     SceneTooLarge {
         /// Name of the scene.
@@ -148,6 +149,8 @@ pub enum RenderError {
         bytes: u64,
         /// The most bytes the device binds in one storage buffer.
         limit: u64,
+        /// The most instances that fit in `limit`.
+        max_instances: u64,
     },
     /// The GPU ray tracer cannot take the scene or the frame on this device
     /// ([`crate::rays::RaysUnavailable`]). A frame that asked for refinement by rays

@@ -62,14 +62,31 @@ pub const DEFAULT_INSTANCES: usize = 10_000;
 /// uploading more than a device binds fails with an error that says so.
 pub const MAX_INSTANCES: usize = 4_000_000;
 
-/// Builds the built-in scene called `name` (`instances:N` for N objects), or `None`
-/// when there is none.
-pub fn build(name: &str) -> Option<Scene> {
-    if let Some(count) = name.strip_prefix("instances:") {
-        let count: usize = count.replace('_', "").parse().ok()?;
-        return (10..=MAX_INSTANCES).contains(&count).then(|| instances(count));
+/// A built-in scene that cannot be built.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BuiltinError {
+    /// No built-in scene has this name.
+    #[error("no built-in scene is called `{0}`")]
+    Unknown(String),
+    /// `instances:N` with N not a count in range.
+    #[error(
+        "`instances:{0}`: N must be a whole number from 10 to {MAX_INSTANCES} (a device binds fewer: \
+         the renderer says how many when it cannot take them)"
+    )]
+    InstancesOutOfRange(String),
+}
+
+/// Builds the built-in scene called `name` (`instances:N` for N objects).
+pub fn build(name: &str) -> Result<Scene, BuiltinError> {
+    if let Some(text) = name.strip_prefix("instances:") {
+        let count = text.replace('_', "").parse::<usize>().ok().filter(|n| (10..=MAX_INSTANCES).contains(n));
+        return count.map(instances).ok_or_else(|| BuiltinError::InstancesOutOfRange(text.into()));
     }
-    BUILTINS.iter().find(|b| b.name == name).map(|b| (b.build)())
+    BUILTINS
+        .iter()
+        .find(|b| b.name == name)
+        .map(|b| (b.build)())
+        .ok_or_else(|| BuiltinError::Unknown(name.into()))
 }
 
 /// The names of all built-in scenes, for error messages and help.
@@ -504,7 +521,7 @@ mod tests {
             assert!((scene.sun.direction.length() - 1.0).abs() < 1e-5);
             assert!(scene.sun.direction.y < 0.0, "{}: the sun shines downward", b.name);
         }
-        assert!(build("no-such-scene").is_none());
+        assert_eq!(build("no-such-scene").unwrap_err(), BuiltinError::Unknown("no-such-scene".into()));
     }
 
     #[test]
@@ -523,7 +540,9 @@ mod tests {
             assert!(lowest.abs() < 1e-4, "{} floats at {lowest}", i.name);
         }
         for bad in ["instances:", "instances:9", "instances:-5", "instances:many", "instances:4000001"] {
-            assert!(build(bad).is_none(), "{bad}");
+            let e = build(bad).unwrap_err();
+            assert!(matches!(e, BuiltinError::InstancesOutOfRange(_)), "{bad}: {e}");
+            assert!(e.to_string().contains("10 to 4000000"), "{e}");
         }
     }
 

@@ -9,13 +9,16 @@ mod casters;
 pub mod framing;
 pub mod geometry;
 pub mod gltf_loader;
+pub mod limits;
 mod model;
+mod scene_error;
 pub mod scene_file;
 pub mod settings;
 
 pub use casters::OpenCasters;
 pub use model::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneError,
-    SceneLight, SpotLight, Texture, Wrap, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight,
+    SpotLight, Texture, Wrap, sun_direction,
 };
+pub use scene_error::SceneError;
 pub use settings::Settings;

@@ -3,6 +3,8 @@
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_math::Aabb;
 
+use crate::SceneError;
+
 /// A triangle mesh in object space. Triangles are counter-clockwise when seen from
 /// the side their normals point to.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -323,105 +325,6 @@ pub struct Scene {
     pub has_ground: bool,
 }
 
-/// A scene that is not well formed.
-#[derive(Debug, thiserror::Error, PartialEq)]
-pub enum SceneError {
-    /// An instance's mesh index is not below the number of meshes.
-    #[error("scene `{scene}`: instance `{instance}` refers to mesh {mesh}, but there are {count} meshes")]
-    MeshOutOfRange {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the instance with the bad index.
-        instance: String,
-        /// The mesh index it gives.
-        mesh: usize,
-        /// The number of meshes in the scene.
-        count: usize,
-    },
-    /// An instance's material index is not below the number of materials.
-    #[error(
-        "scene `{scene}`: instance `{instance}` refers to material {material}, but there are {count} materials"
-    )]
-    MaterialOutOfRange {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the instance with the bad index.
-        instance: String,
-        /// The material index it gives.
-        material: usize,
-        /// The number of materials in the scene.
-        count: usize,
-    },
-    /// A mesh's positions, normals and texture coordinates differ in number.
-    #[error(
-        "scene `{scene}`: mesh `{mesh}` has {positions} positions, {normals} normals and {uvs} UVs; all three must match"
-    )]
-    AttributeCountMismatch {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the mesh at fault.
-        mesh: String,
-        /// Its number of positions.
-        positions: usize,
-        /// Its number of normals.
-        normals: usize,
-        /// Its number of texture coordinates.
-        uvs: usize,
-    },
-    /// A mesh's index reaches past its vertices, or its index count is not a multiple of 3.
-    #[error(
-        "scene `{scene}`: mesh `{mesh}` has an index {index} beyond its {vertices} vertices, or an index count not a multiple of 3"
-    )]
-    BadIndices {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the mesh at fault.
-        mesh: String,
-        /// The first index past the vertices (0 when only the index count is wrong).
-        index: u32,
-        /// The mesh's number of vertices.
-        vertices: usize,
-    },
-    /// A mesh has a position or normal with an infinite or NaN coordinate.
-    #[error("scene `{scene}`: mesh `{mesh}` has a non-finite position or normal")]
-    NonFinite {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the mesh at fault.
-        mesh: String,
-    },
-    /// A material's base-colour texture index is not below the number of textures.
-    #[error(
-        "scene `{scene}`: material `{material}` refers to texture {texture}, but there are {count} textures"
-    )]
-    TextureOutOfRange {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the material with the bad index.
-        material: String,
-        /// The texture index it gives.
-        texture: usize,
-        /// The number of textures in the scene.
-        count: usize,
-    },
-    /// A texture is empty (zero width or height) or its bytes are not 4 per texel.
-    #[error(
-        "scene `{scene}`: texture `{texture}` is {width}×{height} but holds {bytes} bytes, not 4 per texel"
-    )]
-    BadTexture {
-        /// Name of the scene at fault.
-        scene: String,
-        /// Name of the texture at fault.
-        texture: String,
-        /// Its width in texels.
-        width: u32,
-        /// Its height in texels.
-        height: u32,
-        /// The number of bytes it holds.
-        bytes: usize,
-    },
-}
-
 impl Scene {
     /// An empty scene seen by `camera` and lit by `sun`, for a program that keeps its
     /// own geometry to hand its shadow casters to Gnomon with [`Scene::place`]. Its
@@ -589,6 +492,27 @@ impl Scene {
                     count: self.materials.len(),
                 });
             }
+        }
+        self.validate_lights_and_camera()
+    }
+
+    /// Checks the camera and every light, the default sun, spot and point and the
+    /// light list, against [`crate::limits`].
+    pub(crate) fn validate_lights_and_camera(&self) -> Result<(), SceneError> {
+        let scene = &self.name;
+        self.camera.validate().map_err(|problem| SceneError::BadCamera { scene: scene.clone(), problem })?;
+        let defaults = [
+            ("sun", Light::Directional(self.sun)),
+            ("spot", Light::Spot(self.spot)),
+            ("point", Light::Point(self.point)),
+        ];
+        let listed = self.lights.iter().map(|l| (l.name.as_str(), l.light));
+        for (name, light) in defaults.into_iter().chain(listed) {
+            light.validate().map_err(|problem| SceneError::BadLight {
+                scene: scene.clone(),
+                light: name.into(),
+                problem,
+            })?;
         }
         Ok(())
     }

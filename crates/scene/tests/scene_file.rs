@@ -183,13 +183,13 @@ fn bad_light_entries_name_the_light_and_the_field() {
         assert!(e.contains("scene.toml") && e.contains("`lamp`") && e.contains(expected), "{e}");
     };
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\n", "needs `range`");
-    check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance > 0");
+    check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance in (0, 1e7]");
     check("type = \"area\"\n", "sun, spot or point");
     // The [point] table is checked the same way.
     let path =
         write_scene(dir, "[[model]]\nfile = \"tri.glb\"\n[point]\nposition = [0.0, 1.0, 0.0]\nrange = 0.0\n");
     let e = scene_file::load(&path, None).err().unwrap().to_string();
-    assert!(e.contains("[point]") && e.contains("a distance > 0"), "{e}");
+    assert!(e.contains("[point]") && e.contains("a distance in (0, 1e7]"), "{e}");
     check(
         "type = \"spot\"\nposition = [0.0, 1.0, 0.0]\ntarget = [0.0, 1.0, 0.0]\nouter_angle = 30.0\nrange = 5.0\n",
         "a spot must aim",
@@ -237,4 +237,57 @@ shadow_path = "mask"
         Err(e) => e.to_string(),
     };
     assert!(e.contains("`shadow.contact.contact_length`"), "{e}");
+}
+
+/// Every scene-file value the hardening audit found silently accepted is refused, and
+/// the error points at the line and column the user wrote.
+#[test]
+fn nonsense_light_and_view_values_are_refused_at_their_line_and_column() {
+    let temp = temp_dir("scene-file-audit");
+    let dir = temp.path();
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "[spot]\nposition = [2.0, 6.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nouter_angle = 40.0\ninner_angle = -50\nrange = 30.0\n",
+            ":7:15:",
+            "`inner_angle` = -50",
+        ),
+        ("[sun]\nelevation = 40\nazimuth = 10\ncolor = [nan, -1, 1e38]\n", ":6:9:", "`color`"),
+        ("[[view]]\nname = \"a\"\neye = [0, 3, 9]\ntarget = [0, 1, 0]\nfov = 0\n", ":7:7:", "`fov` = 0"),
+        ("[[view]]\nname = \"a\"\neye = [0, 3, 9]\ntarget = [0, 1, 0]\nnear = -1\n", ":7:8:", "`near` = -1"),
+        ("[sun]\nelevation = nan\nazimuth = 10\n", ":4:13:", "`elevation` = NaN"),
+        ("[sun]\nelevation = -30\nazimuth = 10\n", ":4:13:", "in (0, 90] degrees"),
+        ("[sun]\nelevation = 0\nazimuth = 10\n", ":4:13:", "in (0, 90] degrees"),
+        ("[sun]\nelevation = 30\nazimuth = inf\n", ":5:11:", "`azimuth` = inf"),
+        ("[sun]\nelevation = 30\nazimuth = 10\nangular_diameter = 1e30\n", ":6:20:", "`angular_diameter`"),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nrange = 5\nintensity = nan\n",
+            ":7:13:",
+            "`intensity` = NaN",
+        ),
+    ];
+    for (table, at, expected) in cases {
+        let text = format!("[[model]]\nfile = \"tri.glb\"\n{table}");
+        let e = scene_file::load(&write_scene(dir, &text), None).err().map(|e| e.to_string());
+        let e = e.unwrap_or_else(|| panic!("accepted:\n{text}"));
+        assert!(e.contains(at) && e.contains(expected), "expected {at} and {expected} in: {e}");
+    }
+}
+
+/// A setting out of range in a file's `[settings]` is blamed on the file, at its line,
+/// by its key, even when a flag would override it: the file must stand alone. A bad
+/// value after the merge that a flag gave is the flag's.
+#[test]
+fn a_bad_file_setting_is_blamed_on_the_file_not_on_a_flag() {
+    let temp = temp_dir("scene-file-blame");
+    let dir = temp.path();
+    let text = "[[model]]\nfile = \"tri.glb\"\n\n[settings.shadow.map]\nresolution = 3\n";
+    let e = scene_file::load(&write_scene(dir, text), None).err().expect("resolution 3").to_string();
+    assert!(e.contains("scene.toml:5:14:") && e.contains("`settings.shadow.map.resolution` = 3"), "{e}");
+    let good = text.replace("= 3", "= 512");
+    let loaded = scene_file::load(&write_scene(dir, &good), None).unwrap();
+    let mut flags = Settings::default();
+    flags.shadow.map.resolution = 100;
+    let merged = scene_file::merge_settings(loaded.settings.as_ref().unwrap(), &flags).unwrap();
+    let e = merged.validate().unwrap_err();
+    assert!(loaded.blame(&e, &flags).is_none(), "the flag set it: the flag is to blame");
 }

@@ -38,21 +38,28 @@ pub(super) fn check(
     if ok { Ok(()) } else { Err(SettingsError { setting, value: value.to_string(), valid: valid.into() }) }
 }
 
-pub(super) fn check_opt(
+/// An optional value against its [`crate::limits::Limit`].
+pub(super) fn check_limit(
     v: Option<f32>,
     setting: &'static str,
-    ok: impl Fn(f32) -> bool,
-    valid: &str,
+    limit: &crate::limits::Limit,
 ) -> Result<(), SettingsError> {
     match v {
-        Some(x) => check(x.is_finite() && ok(x), setting, x, valid),
+        Some(x) => check(limit.allows(x), setting, x, limit.valid),
         None => Ok(()),
     }
 }
 
+/// An optional position: every coordinate within [`crate::limits::COORDINATE`].
 pub(super) fn check_vec(v: Option<Vec3>, setting: &'static str) -> Result<(), SettingsError> {
+    let limit = &crate::limits::COORDINATE;
     match v {
-        Some(p) => check(p.is_finite(), setting, format!("{},{},{}", p.x, p.y, p.z), "three finite numbers"),
+        Some(p) => check(
+            p.to_array().iter().all(|&x| limit.allows(x)),
+            setting,
+            format!("{},{},{}", p.x, p.y, p.z),
+            limit.valid,
+        ),
         None => Ok(()),
     }
 }

@@ -9,13 +9,14 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::{Camera, Light, Scene, sun_direction};
+use crate::{Camera, Light, Scene, limits, sun_direction};
 
 mod error;
 mod filter;
 mod light;
 mod screen;
 mod shadow;
+mod unused;
 // The tests parse flags: they need the `cli` feature, which `cargo test --workspace`
 // turns on (the `gnomon` binary asks for it).
 #[cfg(all(test, feature = "cli"))]
@@ -24,11 +25,12 @@ mod tests;
 #[cfg(feature = "cli")]
 pub use error::in_flags;
 pub use error::{SettingsError, value_name};
-use error::{check, check_opt, check_vec};
+use error::{check, check_limit, check_vec};
 pub use filter::*;
 pub use light::*;
 pub use screen::*;
 pub use shadow::*;
+pub use unused::UnusedSetting;
 
 /// Everything that configures one render besides the scene itself.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
@@ -179,42 +181,22 @@ impl Settings {
         let c = &self.camera;
         check_vec(c.eye, "camera.eye")?;
         check_vec(c.target, "camera.target")?;
-        check_opt(
-            c.fov_y_degrees,
-            "camera.fov_y_degrees",
-            |x| x > 0.0 && x < 180.0,
-            "between 0 and 180 degrees, exclusive",
-        )?;
-        check_opt(c.near, "camera.near", |x| x > 0.0, "a distance > 0")?;
-        check_opt(c.far, "camera.far", |x| x > 0.0, "a distance > 0 and > the near distance")?;
+        check_limit(c.fov_y_degrees, "camera.fov_y_degrees", &limits::FIELD_OF_VIEW)?;
+        check_limit(c.near, "camera.near", &limits::CLIP_DISTANCE)?;
+        check_limit(c.far, "camera.far", &limits::CLIP_DISTANCE)?;
         let l = &self.light;
-        check_opt(l.sun_elevation, "light.sun_elevation", |x| x > 0.0 && x <= 90.0, "in (0, 90] degrees")?;
-        check_opt(l.sun_azimuth, "light.sun_azimuth", |_| true, "a finite angle in degrees")?;
+        check_limit(l.sun_elevation, "light.sun_elevation", &limits::SUN_ELEVATION)?;
+        check_limit(l.sun_azimuth, "light.sun_azimuth", &limits::SUN_AZIMUTH)?;
+        check_limit(l.sun_angular_diameter, "light.sun_angular_diameter", &limits::SUN_ANGULAR_DIAMETER)?;
         check_vec(l.spot_position, "light.spot_position")?;
         check_vec(l.spot_target, "light.spot_target")?;
-        check_opt(
-            l.spot_outer_angle,
-            "light.spot_outer_angle",
-            |x| x > 0.0 && x <= 89.0,
-            "in (0, 89] degrees",
-        )?;
-        check_opt(
-            l.spot_inner_angle,
-            "light.spot_inner_angle",
-            |x| (0.0..=89.0).contains(&x),
-            "in [0, outer angle] degrees",
-        )?;
-        check_opt(l.spot_range, "light.spot_range", |x| x > 0.0, "a distance > 0")?;
-        check_opt(l.spot_radius, "light.spot_radius", |x| x >= 0.0, "a distance ≥ 0")?;
+        check_limit(l.spot_outer_angle, "light.spot_outer_angle", &limits::SPOT_OUTER_ANGLE)?;
+        check_limit(l.spot_inner_angle, "light.spot_inner_angle", &limits::SPOT_INNER_ANGLE)?;
+        check_limit(l.spot_range, "light.spot_range", &limits::LIGHT_RANGE)?;
+        check_limit(l.spot_radius, "light.spot_radius", &limits::LIGHT_RADIUS)?;
         check_vec(l.point_position, "light.point_position")?;
-        check_opt(l.point_range, "light.point_range", |x| x > 0.0, "a distance > 0")?;
-        check_opt(l.point_radius, "light.point_radius", |x| x >= 0.0, "a distance ≥ 0")?;
-        check_opt(
-            l.sun_angular_diameter,
-            "light.sun_angular_diameter",
-            |x| (0.0..=30.0).contains(&x),
-            "in [0, 30] degrees",
-        )?;
+        check_limit(l.point_range, "light.point_range", &limits::LIGHT_RANGE)?;
+        check_limit(l.point_radius, "light.point_radius", &limits::LIGHT_RADIUS)?;
         self.shadow.validate()?;
         let n = self.reference.samples;
         check((8..=65536).contains(&n), "reference.samples", n, "8 to 65536 shadow rays per pixel")?;
@@ -289,6 +271,27 @@ impl Settings {
         )?;
         Ok(cam)
     }
+}
+
+/// `command` with every option that takes a value accepting one that starts with a
+/// minus: a negative number (`--sun-azimuth -56`) and a vector (`--camera-target
+/// -5,5,0`) need no `=`. Options whose values are names are left alone, so that a
+/// forgotten value before the next flag is still reported as one.
+#[cfg(feature = "cli")]
+pub fn accept_negative_values(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| {
+            let takes_a_value = arg.get_num_args().is_none_or(|n| n.takes_values()) && !arg.is_positional();
+            let is_vector =
+                arg.get_value_names().is_some_and(|names| names.iter().any(|n| n.as_str().contains(',')));
+            let is_number = arg.get_possible_values().is_empty();
+            match (takes_a_value, is_vector, is_number) {
+                (true, true, _) => arg.allow_hyphen_values(true),
+                (true, false, true) => arg.allow_negative_numbers(true),
+                _ => arg,
+            }
+        })
+        .mut_subcommands(accept_negative_values)
 }
 
 /// Parses `X,Y,Z` into a vector.

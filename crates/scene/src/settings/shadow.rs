@@ -41,24 +41,35 @@ pub enum CullMode {
 pub struct BiasSettings {
     /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
     /// For Depth32Float one unit is 2^(e−23) for a primitive whose largest depth has
-    /// exponent e: about 6e-8 at depth 0.5.
+    /// exponent e: about 6e-8 at depth 0.5. At most ±16777216 (2^24 units, the whole
+    /// [0, 1] depth range at depths in [0.5, 1)).
     #[cfg_attr(feature = "cli", arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias"))]
     pub depth_bias: i32,
     /// Rasterizer slope-scaled depth bias (D3D `SlopeScaledDepthBias`): multiplies the
     /// caster's depth slope per shadow texel, so 1 pushes a surface back by the depth
-    /// it spans across one texel. Must be finite and ≥ 0.
+    /// it spans across one texel. In [0, 100].
     #[cfg_attr(feature = "cli", arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias"))]
     pub slope_bias: f32,
     /// Normal-offset bias: the receiver is pushed along its surface normal by this many
     /// shadow texels (world size of a texel at the receiver) times 1 − N·L before the
     /// lookup, so surfaces facing the light are hardly moved and grazing ones fully
-    /// (Holbert, "Normal offset shadows", 2011). ≥ 0.
+    /// (Holbert, "Normal offset shadows", 2011). In [0, 64] texels.
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias"))]
     pub normal_offset: f32,
     /// Faces culled when drawing casters into the shadow map.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow bias"))]
     pub cull: CullMode,
 }
+
+/// The largest constant depth bias either way, in depth units: 2^24 units span the
+/// whole [0, 1] range of a Depth32Float map at depths in [0.5, 1), so any more pushes
+/// every caster past the far plane.
+pub const MAX_DEPTH_BIAS: i32 = 1 << 24;
+/// The largest slope-scaled bias: 100 texels' worth of a caster's depth slope, far
+/// past the few that any surface needs (a larger one only detaches every shadow).
+pub const MAX_SLOPE_BIAS: f32 = 100.0;
+/// The largest normal offset, in shadow texels: twice the widest PCF kernel.
+pub const MAX_NORMAL_OFFSET: f32 = 2.0 * MAX_KERNEL_TEXELS;
 
 impl BiasSettings {
     /// No bias at all, for demonstrating acne.
@@ -435,7 +446,7 @@ impl ShadowSettings {
             c.cascade_blend,
             "0 to 0.5",
         )?;
-        check_opt(c.shadow_distance, "shadow.cascades.shadow_distance", |x| x > 0.0, "a distance > 0")?;
+        check_limit(c.shadow_distance, "shadow.cascades.shadow_distance", &crate::limits::CLIP_DISTANCE)?;
         if c.sdsm_bounds {
             check(
                 c.sdsm,
@@ -452,16 +463,22 @@ impl ShadowSettings {
         }
         let b = &s.bias;
         check(
-            b.slope_bias.is_finite() && b.slope_bias >= 0.0,
-            "shadow.bias.slope_bias",
-            b.slope_bias,
-            "a finite factor ≥ 0",
+            (-MAX_DEPTH_BIAS..=MAX_DEPTH_BIAS).contains(&b.depth_bias),
+            "shadow.bias.depth_bias",
+            b.depth_bias,
+            format!("-{MAX_DEPTH_BIAS} to {MAX_DEPTH_BIAS} depth units"),
         )?;
         check(
-            b.normal_offset.is_finite() && b.normal_offset >= 0.0,
+            b.slope_bias.is_finite() && (0.0..=MAX_SLOPE_BIAS).contains(&b.slope_bias),
+            "shadow.bias.slope_bias",
+            b.slope_bias,
+            format!("a factor in [0, {MAX_SLOPE_BIAS}]"),
+        )?;
+        check(
+            b.normal_offset.is_finite() && (0.0..=MAX_NORMAL_OFFSET).contains(&b.normal_offset),
             "shadow.bias.normal_offset",
             b.normal_offset,
-            "a finite number of texels ≥ 0",
+            format!("in [0, {MAX_NORMAL_OFFSET}] texels"),
         )?;
         let r = s.map.resolution;
         check(

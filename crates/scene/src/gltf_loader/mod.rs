@@ -9,13 +9,16 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec3};
 use gltf::image::Format;
 
 use crate::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight,
-    SpotLight, Texture, Wrap, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, PointLight, Scene, SceneLight, SpotLight,
+    Texture, Wrap, sun_direction,
 };
+
+mod images;
+mod primitives;
 
 /// A glTF file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -41,6 +44,9 @@ pub struct FileExtras {
     /// Lights the file has that Gnomon cannot use (a directional or spot light with
     /// a degenerate transform).
     pub ignored_lights: usize,
+    /// What was loaded but not as the file says, in words, for the user to see:
+    /// skipped points and lines, singular node transforms, ignored extensions.
+    pub warnings: Vec<String>,
 }
 
 /// Loads `path` into a scene. The camera and the lights come from the file when it
@@ -80,9 +86,14 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
     }
     // The gltf crate validates the JSON and the buffer and accessor ranges; guard
     // against a panic on data it does not check all the same.
-    let imported = std::panic::catch_unwind(|| gltf::import(path))
-        .map_err(|_| fail("the glTF importer failed on malformed data".into()))?;
-    let (document, buffers, images) = match imported {
+    let base = path.parent().unwrap_or(Path::new("."));
+    let imported = std::panic::catch_unwind(|| {
+        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes)?;
+        let buffers = gltf::import_buffers(&document, Some(base), blob)?;
+        Ok::<_, gltf::Error>((document, buffers))
+    })
+    .map_err(|_| fail("the glTF importer failed on malformed data".into()))?;
+    let (document, buffers) = match imported {
         Ok(i) => i,
         Err(e) => {
             // Validation insists on min/max for positions, which files with NaN or
@@ -93,9 +104,43 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
             return Err(fail(describe(&e)));
         }
     };
+    let extension_warnings = extensions(&document).map_err(fail)?;
+    let images = std::panic::catch_unwind(|| images::import(&document, base, &buffers))
+        .map_err(|_| fail("the glTF image reader failed on malformed data".into()))?
+        .map_err(fail)?;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| build(path, &document, &buffers, &images)))
+        .map(|built| {
+            built.map(|(scene, mut extras)| {
+                extras.warnings.extend(extension_warnings);
+                (scene, extras)
+            })
+        })
         .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
         .map_err(fail)
+}
+
+/// The glTF extensions Gnomon reads; every other one is ignored (used) or refused
+/// (required).
+const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+
+/// Warnings for the extensions `document` uses that Gnomon ignores, or an error for
+/// one it requires that Gnomon cannot read (Draco is refused earlier, by name).
+fn extensions(document: &gltf::Document) -> Result<Vec<String>, String> {
+    let unsupported = |name: &&str| !SUPPORTED_EXTENSIONS.contains(name);
+    let required: Vec<&str> = document.extensions_required().filter(unsupported).collect();
+    if !required.is_empty() {
+        return Err(format!(
+            "requires the glTF extension(s) {}, which Gnomon cannot read (it reads {})",
+            required.join(", "),
+            SUPPORTED_EXTENSIONS.join(", ")
+        ));
+    }
+    let ignored: Vec<&str> = document.extensions_used().filter(unsupported).collect();
+    Ok(if ignored.is_empty() {
+        Vec::new()
+    } else {
+        vec![format!("ignores the glTF extension(s) {}: drawn as if they were absent", ignored.join(", "))]
+    })
 }
 
 /// Reads the positions of an unvalidated file and reports the first NaN or infinity.
@@ -211,58 +256,21 @@ fn build(
     let mut meshes = Vec::new();
     // For each glTF mesh: its primitives as (mesh index, material index, blend).
     let mut primitives_of = Vec::new();
+    let mut modes = primitives::ModeCounts::default();
     for mesh in document.meshes() {
         let mut list = Vec::new();
         for (k, prim) in mesh.primitives().enumerate() {
             let label = format!("mesh {} (`{}`) primitive {k}", mesh.index(), mesh.name().unwrap_or(""));
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                // Points and lines cast no shadow; skip them rather than fail.
-                continue;
-            }
             let material = prim.material().index().unwrap_or(default_material);
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| format!("{label} has no POSITION attribute"))?
-                .map(Vec3::from_array)
-                .collect();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            };
-            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(format!(
-                    "{label}: index {bad} is out of range for its {} vertices",
-                    positions.len()
-                ));
+            match primitives::read(&prim, buffers, texcoord_sets[material], label)? {
+                Some(m) => {
+                    modes.triangles += 1;
+                    meshes.push(m);
+                    list.push((meshes.len() - 1, material));
+                }
+                None if prim.mode() == gltf::mesh::Mode::Points => modes.points += 1,
+                None => modes.lines += 1,
             }
-            if !indices.len().is_multiple_of(3) {
-                return Err(format!("{label}: {} indices is not a whole number of triangles", indices.len()));
-            }
-            if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-                return Err(format!("{label}: a vertex position is not finite ({p})"));
-            }
-            let normals: Vec<Vec3> = match reader.read_normals() {
-                Some(n) => n.map(|n| Vec3::from_array(n).normalize_or_zero()).collect(),
-                None => smooth_normals(&positions, &indices),
-            };
-            if normals.len() != positions.len() {
-                return Err(format!("{label}: {} normals for {} positions", normals.len(), positions.len()));
-            }
-            let set = texcoord_sets[material];
-            let uvs: Vec<Vec2> = match reader.read_tex_coords(set) {
-                Some(t) => t.into_f32().map(Vec2::from_array).collect(),
-                None => vec![Vec2::ZERO; positions.len()],
-            };
-            if uvs.len() != positions.len() {
-                return Err(format!(
-                    "{label}: {} texture coordinates for {} positions",
-                    uvs.len(),
-                    positions.len()
-                ));
-            }
-            meshes.push(Mesh { name: label, positions, normals, uvs, indices });
-            list.push((meshes.len() - 1, material));
         }
         primitives_of.push(list);
     }
@@ -288,6 +296,7 @@ fn build(
     let mut stack: Vec<(gltf::Node, Mat4, usize)> =
         roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visits = 0usize;
+    let mut singular_nodes = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
         visits += 1;
         // A node graph with a cycle would expand forever; glTF requires a forest.
@@ -303,6 +312,9 @@ fn build(
         }
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
+            if world.determinant() == 0.0 {
+                singular_nodes += 1;
+            }
             for &(mesh_index, material) in &primitives_of[mesh.index()] {
                 instances.push(Instance {
                     name: format!("node {} `{}`", node.index(), node.name().unwrap_or("")),
@@ -350,11 +362,13 @@ fn build(
                 gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle }
                     if direction != Vec3::ZERO =>
                 {
+                    // glTF allows cones up to 90°; a spot's perspective map covers 89°.
+                    let outer = outer_cone_angle.to_degrees().clamp(1.0, 89.0);
                     Some(Light::Spot(SpotLight {
                         position,
                         direction,
-                        inner_angle_degrees: inner_cone_angle.to_degrees(),
-                        outer_angle_degrees: outer_cone_angle.to_degrees().clamp(1.0, 89.0),
+                        inner_angle_degrees: inner_cone_angle.to_degrees().clamp(0.0, outer),
+                        outer_angle_degrees: outer,
                         range: light.range().unwrap_or(f32::INFINITY),
                         color,
                         intensity: 1.0,
@@ -382,8 +396,19 @@ fn build(
             stack.push((child, world, depth + 1));
         }
     }
+    if let Some(skipped) = modes.skipped() {
+        extras.warnings.push(format!("{skipped} skipped: points and lines cast no shadow"));
+    }
+    if singular_nodes > 0 {
+        extras.warnings.push(format!(
+            "{singular_nodes} node(s) with meshes have a singular transform (determinant 0): they flatten to nothing"
+        ));
+    }
     if instances.is_empty() {
-        return Err("has no triangle meshes in its scene".into());
+        return Err(match modes.skipped() {
+            Some(skipped) => format!("has no triangles to draw in its scene, only {skipped}"),
+            None => "has no triangle meshes in its scene".into(),
+        });
     }
     // The light list in the file's order; the first of each type is the default.
     found.sort_by_key(|(index, _)| *index);
@@ -480,18 +505,6 @@ fn build(
         scene.point.range = 4.0 * radius + scene.point.position.distance(center);
     }
     scene.lights = lights;
+    scene.validate_lights_and_camera().map_err(|e| e.to_string())?;
     Ok((scene, extras))
-}
-
-/// Area-weighted vertex normals, for meshes that come without them.
-fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
-    let mut normals = vec![Vec3::ZERO; positions.len()];
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
-        for i in [a, b, c] {
-            normals[i] += n;
-        }
-    }
-    normals.iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect()
 }
