@@ -65,17 +65,13 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
             ));
         }
         let base = path.parent().unwrap_or(Path::new("."));
-        for (kind, uri) in raw
-            .buffers()
-            .filter_map(|b| match b.source() {
-                gltf::buffer::Source::Uri(u) => Some(("buffer", u)),
-                gltf::buffer::Source::Bin => None,
-            })
-            .chain(raw.images().filter_map(|i| match i.source() {
-                gltf::image::Source::Uri { uri, .. } => Some(("image", uri)),
-                gltf::image::Source::View { .. } => None,
-            }))
-        {
+        // The JSON itself, not the crate's wrappers: on an unvalidated file those
+        // unwrap indices that may be out of range (found by fuzzing).
+        let json = raw.document.as_json();
+        indices_the_crate_trusts(json).map_err(fail)?;
+        let buffers = json.buffers.iter().filter_map(|b| b.uri.as_deref().map(|u| ("buffer", u)));
+        let images = json.images.iter().filter_map(|i| i.uri.as_deref().map(|u| ("image", u)));
+        for (kind, uri) in buffers.chain(images) {
             if !uri.starts_with("data:") && !base.join(uri).is_file() {
                 return Err(fail(format!(
                     "its {kind} file `{uri}` is missing (looked in {})",
@@ -98,7 +94,10 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
         Err(e) => {
             // Validation insists on min/max for positions, which files with NaN or
             // infinite positions often lack; say what is really wrong when we can.
-            if let Some(problem) = non_finite_positions(path, &bytes) {
+            // Only then: any other fault may make the unvalidated read panic.
+            let only_bounds_missing = matches!(&e, gltf::Error::Validation(errors)
+                if errors.iter().all(|(path, _)| path.as_str().ends_with(".min") || path.as_str().ends_with(".max")));
+            if only_bounds_missing && let Some(problem) = non_finite_positions(path, &bytes) {
                 return Err(fail(problem));
             }
             return Err(fail(describe(&e)));
@@ -117,6 +116,42 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
         })
         .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
         .map_err(fail)
+}
+
+/// Checks the indices that the gltf crate uses unchecked: its validation looks up
+/// each POSITION accessor before checking that it exists, and an image in a buffer
+/// view is read with an unwrapped MIME type. Both panicked on fuzzed files.
+fn indices_the_crate_trusts(json: &gltf::json::Root) -> Result<(), String> {
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (k, primitive) in mesh.primitives.iter().enumerate() {
+            let accessors = primitive.attributes.values().chain(primitive.indices.as_ref());
+            if let Some(bad) = accessors.map(|a| a.value()).find(|&a| a >= json.accessors.len()) {
+                return Err(format!(
+                    "mesh {m} primitive {k} names accessor {bad}, but the file has {} accessors",
+                    json.accessors.len()
+                ));
+            }
+        }
+    }
+    for (i, image) in json.images.iter().enumerate() {
+        if let Some(view) = image.buffer_view {
+            if view.value() >= json.buffer_views.len() {
+                return Err(format!(
+                    "image {i} names buffer view {}, but the file has {} buffer views",
+                    view.value(),
+                    json.buffer_views.len()
+                ));
+            }
+            if image.mime_type.is_none() {
+                return Err(format!(
+                    "image {i} is in a buffer view but has no `mimeType` (glTF requires one)"
+                ));
+            }
+        } else if image.uri.is_none() {
+            return Err(format!("image {i} has neither a `uri` nor a `bufferView`"));
+        }
+    }
+    Ok(())
 }
 
 /// The glTF extensions Gnomon reads; every other one is ignored (used) or refused
@@ -147,6 +182,22 @@ fn extensions(document: &gltf::Document) -> Result<Vec<String>, String> {
 fn non_finite_positions(path: &Path, bytes: &[u8]) -> Option<String> {
     std::panic::catch_unwind(|| {
         let raw = gltf::Gltf::from_slice_without_validation(bytes).ok()?;
+        // The reader unwraps the accessors' and views' indices: read only a file whose
+        // indices are in range (the crate would panic, caught but printed).
+        let json = raw.document.as_json();
+        let views_in_range = json.buffer_views.iter().all(|v| v.buffer.value() < json.buffers.len());
+        let accessors_in_range = json
+            .accessors
+            .iter()
+            .all(|a| a.sparse.is_none() && a.buffer_view.is_none_or(|v| v.value() < json.buffer_views.len()));
+        let positions_in_range = json
+            .meshes
+            .iter()
+            .flat_map(|m| &m.primitives)
+            .all(|p| p.attributes.values().all(|a| a.value() < json.accessors.len()));
+        if !(views_in_range && accessors_in_range && positions_in_range) {
+            return None;
+        }
         let buffers = gltf::import_buffers(&raw.document, path.parent(), raw.blob.clone()).ok()?;
         for mesh in raw.document.meshes() {
             for (k, prim) in mesh.primitives().enumerate() {
