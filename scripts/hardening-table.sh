@@ -70,6 +70,60 @@ while IFS= read -r file; do
   run "glTF corpus" any render "$file" $small --out o.png
 done < <(find "$shared/assimp-gltf2" -name '*.gltf' -o -name '*.glb' | sort)
 
+# --- Hand-made glTF: each case the audit named, written here, plus the inputs
+# fuzzing found (crates/fuzz/regressions). Expected: a render, a warning or an error.
+hand="$work/hand"
+mkdir -p "$hand"
+python3 - "$hand" <<'EOF'
+import json, struct, sys, zlib
+out = sys.argv[1]
+quad = struct.pack('<12f', 0, 0, 0, 1, 0, 0, 0, 0, -1, 1, 0, -1) + struct.pack('<4H', 0, 1, 2, 3)
+def glb(doc, binary):
+    j = json.dumps(doc).encode()
+    j += b' ' * (-len(j) % 4)
+    binary += b'\0' * (-len(binary) % 4)
+    body = struct.pack('<I4s', len(j), b'JSON') + j + struct.pack('<I4s', len(binary), b'BIN\0') + binary
+    return b'glTF' + struct.pack('<II', 2, 12 + len(body)) + body
+def doc(modes=(5,), count=4, matrix=None, extra=None, image_bytes=0):
+    node = {"mesh": 0}
+    if matrix: node["matrix"] = matrix
+    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [node],
+         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": m} for m in modes]}],
+         "buffers": [{"byteLength": 56 + image_bytes}],
+         "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 8}],
+         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, -1], "max": [1, 0, 0]},
+                       {"bufferView": 1, "componentType": 5123, "count": count, "type": "SCALAR"}]}
+    if image_bytes:
+        d["bufferViews"].append({"buffer": 0, "byteOffset": 56, "byteLength": image_bytes})
+        d["images"] = [{"bufferView": 2, "mimeType": "image/png"}]
+    d.update(extra or {})
+    return d
+def chunk(kind, data):
+    return struct.pack('>I', len(data)) + kind + data + struct.pack('>I', zlib.crc32(kind + data))
+png = b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 20000, 20000, 8, 6, 0, 0, 0)) + chunk(b'IDAT', b'') + chunk(b'IEND', b'')
+cases = {
+    "valid-strip.glb": doc((5,)),
+    "valid-fan.glb": doc((6,)),
+    "warn-lines-and-points.glb": doc((5, 1, 0)),
+    "warn-zero-matrix.glb": doc(matrix=[0] * 16),
+    "warn-texture-transform.glb": doc(extra={"extensionsUsed": ["KHR_texture_transform"]}),
+    "error-points-only.glb": doc((0,)),
+    "error-index-overrun.glb": doc((4,), count=600),
+    "error-required-quantization.glb": doc(extra={"extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"]}),
+}
+for name, d in cases.items():
+    open(f"{out}/{name}", "wb").write(glb(d, quad))
+open(f"{out}/error-png-20000-squared.glb", "wb").write(glb(doc(image_bytes=len(png)), quad + png))
+EOF
+for file in "$hand"/*.glb "$(dirname "$0")"/../crates/fuzz/regressions/gltf/*; do
+  case $(basename "$file") in
+    valid-*) expect=any;;
+    warn-*) expect=warn;;
+    *) expect=error;;
+  esac
+  run "hand-made glTF" "$expect" render "$(realpath "$file")" $small --out o.png
+done
+
 # --- Scene files: every light, view and model value out of range, and typos. ---
 scene_file() {
   printf 'builtin = "columns"\n%b' "$1" > "$work/inputs/s.toml"
@@ -125,7 +179,8 @@ for f in "--depth-bias 2147483647" "--depth-bias -2147483647" "--slope-bias 1e30
   "--spot-inner-angle -50" "--spot-range 0" "--point-radius -1" "--shadow-res 3" "--shadow-res 99999" \
   "--pcf-kernel 0" "--cascades 0" "--cascades 99" "--samples 1" "--width 0" "--height 70000" \
   "--technique nope" "--light moon" "--refine rays --shadow-path forward" "--light all" "instances:5000000" \
-  "instances:many" "no-such-scene" "--out o.txt" "--out missing/o.png" "--visibility-out v.txt"; do
+  "instances:many" "no-such-scene" "--out o.txt" "--out missing/o.png" "--visibility-out v.txt" \
+  "--csm-scale 1e30" "--contact-distance 1e30" "--contact-bias inf" "--kernel-unit world --pcf-kernel 1e30"; do
   # shellcheck disable=SC2086
   run flags error render $small $f
 done
@@ -152,6 +207,6 @@ rm -rf "$work/inputs/D"
 
 echo "| inputs | tried | clean errors | warned | rendered (valid input) | panics | hangs | silently accepted | half-written |"
 echo "|---|---|---|---|---|---|---|---|---|"
-for c in "glTF corpus" "scene files" flags adapters outputs; do
+for c in "glTF corpus" "hand-made glTF" "scene files" flags adapters outputs; do
   echo "| $c | ${tried[$c]:-0} | ${clean[$c]:-0} | ${warned[$c]:-0} | ${rendered[$c]:-0} | ${panics[$c]:-0} | ${hangs[$c]:-0} | ${silent[$c]:-0} | ${partial[$c]:-0} |"
 done

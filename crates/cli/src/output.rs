@@ -59,10 +59,13 @@ static LIVE_TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::n
 /// or the process is sent SIGTERM: an interrupted run leaves no hidden file behind.
 pub fn remove_temporaries_on_interrupt() {
     let installed = ctrlc::set_handler(|| {
-        for temp in LIVE_TEMPS.lock().map(|t| t.clone()).unwrap_or_default() {
+        // Holding the lock until the exit keeps the main thread from staging another
+        // file in between (it registers each before creating it).
+        let live = LIVE_TEMPS.lock();
+        for temp in live.iter().flat_map(|t| t.iter()) {
             let _ = std::fs::remove_file(temp);
         }
-        eprintln!("\ngnomon: interrupted; no output was written");
+        eprintln!("\ngnomon: interrupted; its temporary files are removed");
         std::process::exit(130);
     });
     if let Err(e) = installed {

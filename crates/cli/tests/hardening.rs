@@ -32,12 +32,17 @@ fn flags_beyond_their_finite_range_are_refused_before_any_work() {
         ("--sun-angular-diameter", "1e30", "[0, 30]"),
         ("--fov", "0", "between 0 and 180"),
         ("--camera-near", "-1", "(0, 1e7]"),
+        ("--csm-scale", "1e30", "(0, 100]"),
+        ("--contact-distance", "1e30", "(0, 1e7]"),
+        ("--contact-bias", "inf", "[0, 1e7]"),
     ] {
         let out = render(dir, &[flag, value]);
         assert!(!out.status.success(), "{flag} {value} was accepted");
         let e = stderr(&out);
         assert!(e.contains(flag) && e.contains(range), "{flag} {value}: {e}");
     }
+    let out = render(dir, &["--kernel-unit", "world", "--pcf-kernel", "1e30"]);
+    assert!(stderr(&out).contains("--pcf-kernel") && stderr(&out).contains("(0, 1e7]"), "{}", stderr(&out));
     assert!(files_in(dir).is_empty());
 }
 
@@ -196,4 +201,43 @@ fn the_cache_command_lists_and_clears_references() {
         .output()
         .unwrap();
     assert!(!bad.status.success() && stderr(&bad).contains("GNOMON_CACHE_MAX_MIB"), "{}", stderr(&bad));
+}
+
+/// Ctrl-C while outputs are being staged removes every temporary file and writes no
+/// output: the run polls for the first staged file, then interrupts.
+#[test]
+fn an_interrupt_while_staging_leaves_no_file_behind() {
+    let temp = temp_dir("interrupt");
+    let dir = temp.path();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(dir)
+        .args(["render", "--width", "2048", "--height", "2048", "--aov-out", "aov", "--out", "a.png"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let staged = |d: &std::path::Path| files_in(d).iter().any(|f| f.contains(".gnomon-"));
+    let started = std::time::Instant::now();
+    let mut interrupted = false;
+    while started.elapsed() < std::time::Duration::from_secs(300) {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("finished ({status}) before a staged file was seen");
+        }
+        if staged(dir) || (dir.join("aov").is_dir() && staged(&dir.join("aov"))) {
+            let signal = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+            assert!(signal.success());
+            interrupted = true;
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    assert!(interrupted, "no staged file appeared");
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(stderr(&out).contains("interrupted"), "{}", stderr(&out));
+    let left: Vec<String> = files_in(dir).into_iter().filter(|f| f != "aov").collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+    if dir.join("aov").is_dir() {
+        assert!(files_in(&dir.join("aov")).is_empty(), "left behind: {:?}", files_in(&dir.join("aov")));
+    }
 }

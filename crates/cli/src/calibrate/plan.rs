@@ -96,7 +96,7 @@ const KERNEL: Knob = Knob {
     },
     range: |unit| match unit {
         KernelUnit::Texels => format!("1 to {MAX_KERNEL_TEXELS} texels"),
-        KernelUnit::World => "a world width > 0".into(),
+        KernelUnit::World => "a world width in (0, 1e7]".into(),
     },
 };
 

@@ -154,6 +154,22 @@ fn indices_the_crate_trusts(json: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
+/// Whether every POSITION accessor is what the reader reads: vec3 of f32, at least
+/// one. (On an unvalidated file the reader's debug assertions would fire.)
+fn positions_readable(json: &gltf::json::Root) -> bool {
+    use gltf::json::accessor::{ComponentType, GenericComponentType, Type};
+    use gltf::json::validation::Checked::Valid;
+    json.meshes.iter().flat_map(|m| &m.primitives).all(|p| {
+        p.attributes.iter().all(|(semantic, a)| {
+            let accessor = &json.accessors[a.value()];
+            *semantic != Valid(gltf::Semantic::Positions)
+                || (accessor.count.0 > 0
+                    && accessor.type_ == Valid(Type::Vec3)
+                    && matches!(accessor.component_type, Valid(GenericComponentType(ComponentType::F32))))
+        })
+    })
+}
+
 /// The glTF extensions Gnomon reads; every other one is ignored (used) or refused
 /// (required).
 const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
@@ -195,7 +211,7 @@ fn non_finite_positions(path: &Path, bytes: &[u8]) -> Option<String> {
             .iter()
             .flat_map(|m| &m.primitives)
             .all(|p| p.attributes.values().all(|a| a.value() < json.accessors.len()));
-        if !(views_in_range && accessors_in_range && positions_in_range) {
+        if !(views_in_range && accessors_in_range && positions_in_range && positions_readable(json)) {
             return None;
         }
         let buffers = gltf::import_buffers(&raw.document, path.parent(), raw.blob.clone()).ok()?;

@@ -52,6 +52,32 @@ pub fn triangle_list(mode: Mode, indices: &[u32]) -> Option<Vec<u32>> {
     Some(triangles.iter().filter(distinct).flatten().copied().collect())
 }
 
+/// Checks that `accessor` holds what the gltf crate's reader will read from it: at
+/// least one element, of `dimensions`, with one of `types`. The reader asserts the
+/// element size and computes `count − 1` unchecked, both only in debug builds
+/// (found by fuzzing); a release build would read garbage instead.
+fn check_accessor(
+    accessor: &gltf::Accessor,
+    what: &str,
+    dimensions: gltf::accessor::Dimensions,
+    types: &[gltf::accessor::DataType],
+    label: &str,
+) -> Result<(), String> {
+    let sparse_empty = accessor.sparse().is_some_and(|s| s.count() == 0);
+    if accessor.count() == 0 || sparse_empty {
+        return Err(format!("{label}: its {what} accessor {} has no elements", accessor.index()));
+    }
+    if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
+        return Err(format!(
+            "{label}: its {what} accessor {} holds {:?} of {:?}; glTF requires {dimensions:?} of {types:?}",
+            accessor.index(),
+            accessor.dimensions(),
+            accessor.data_type()
+        ));
+    }
+    Ok(())
+}
+
 /// Reads `prim` into a mesh with texture coordinates from set `texcoord_set`; `None`
 /// for a point or line primitive. `label` names it in errors.
 pub fn read(
@@ -61,8 +87,21 @@ pub fn read(
     label: String,
 ) -> Result<Option<Mesh>, String> {
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    use gltf::accessor::{DataType, Dimensions};
     let position_accessor =
         prim.get(&gltf::Semantic::Positions).ok_or_else(|| format!("{label} has no POSITION attribute"))?;
+    check_accessor(&position_accessor, "POSITION", Dimensions::Vec3, &[DataType::F32], &label)?;
+    if let Some(normals) = prim.get(&gltf::Semantic::Normals) {
+        check_accessor(&normals, "NORMAL", Dimensions::Vec3, &[DataType::F32], &label)?;
+    }
+    if let Some(uvs) = prim.get(&gltf::Semantic::TexCoords(texcoord_set)) {
+        let types = [DataType::F32, DataType::U8, DataType::U16];
+        check_accessor(&uvs, "TEXCOORD", Dimensions::Vec2, &types, &label)?;
+    }
+    if let Some(indices) = prim.indices() {
+        let types = [DataType::U8, DataType::U16, DataType::U32];
+        check_accessor(&indices, "index", Dimensions::Scalar, &types, &label)?;
+    }
     let positions: Vec<Vec3> = reader
         .read_positions()
         .ok_or_else(|| {

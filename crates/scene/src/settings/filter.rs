@@ -157,7 +157,7 @@ pub struct FilterSettings {
     )]
     pub technique: Technique,
     /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
-    /// 1 to 32 texels, or a world width > 0.
+    /// 1 to 32 texels, or a world width in (0, 1e7].
     #[cfg_attr(feature = "cli", arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter"))]
     pub pcf_kernel: f32,
     /// Unit of --pcf-kernel.
@@ -292,7 +292,7 @@ pub struct MomentSettings {
     /// exp(−α (k/M)²); 0 is the raw truncated series. ≥ 0.
     #[cfg_attr(feature = "cli", arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps"))]
     pub csm_attenuation: f32,
-    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. > 0.
+    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. In (0, 100].
     #[cfg_attr(feature = "cli", arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps"))]
     pub csm_scale: f32,
     /// Offset o of the convolution reconstruction (see --csm-scale): in [−0.5, 0.5].
@@ -381,10 +381,10 @@ impl MomentSettings {
             "0 to 1000",
         )?;
         check(
-            self.csm_scale.is_finite() && self.csm_scale > 0.0,
+            self.csm_scale.is_finite() && self.csm_scale > 0.0 && self.csm_scale <= 100.0,
             "shadow.filter.moments.csm_scale",
             self.csm_scale,
-            "> 0",
+            "in (0, 100]",
         )?;
         check(
             in_range(self.csm_offset, -0.5, 0.5),

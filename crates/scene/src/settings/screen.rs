@@ -104,11 +104,11 @@ pub struct ContactSettings {
     #[cfg_attr(feature = "cli", arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows"))]
     pub contact_thickness: f32,
     /// The ray starts this far along the surface's normal, in world units, so that its
-    /// first samples clear the receiver's own depth. ≥ 0.
+    /// first samples clear the receiver's own depth. In [0, 1e7].
     #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_bias, help_heading = "Contact shadows"))]
     pub contact_bias: f32,
     /// View depth beyond which contact shadows are off; they fade out over its last
-    /// quarter. > 0.
+    /// quarter. In (0, 1e7].
     #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_distance, help_heading = "Contact shadows"))]
     pub contact_distance: f32,
 }
@@ -148,16 +148,16 @@ impl ContactSettings {
             "a fraction of the view depth in (0, 1]",
         )?;
         check(
-            finite(self.contact_bias) && self.contact_bias >= 0.0,
+            crate::limits::LIGHT_RADIUS.allows(self.contact_bias),
             "shadow.contact.contact_bias",
             self.contact_bias,
-            "a distance ≥ 0",
+            crate::limits::LIGHT_RADIUS.valid,
         )?;
         check(
-            finite(self.contact_distance) && self.contact_distance > 0.0,
+            crate::limits::CLIP_DISTANCE.allows(self.contact_distance),
             "shadow.contact.contact_distance",
             self.contact_distance,
-            "a distance > 0",
+            crate::limits::CLIP_DISTANCE.valid,
         )?;
         Ok(())
     }

@@ -387,10 +387,10 @@ impl ShadowSettings {
                 ),
             )?,
             KernelUnit::World => check(
-                f.pcf_kernel.is_finite() && f.pcf_kernel > 0.0,
+                crate::limits::LIGHT_RANGE.allows(f.pcf_kernel),
                 "shadow.filter.pcf_kernel",
                 f.pcf_kernel,
-                "a world width > 0",
+                "a world width in (0, 1e7]",
             )?,
         }
         check(
