@@ -51,9 +51,9 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
         if let Some(v) = view {
             anyhow::bail!("--view {v}: views come from scene files (.toml), and `{name}` is not one");
         }
+        command_line.validate()?;
         (load_scene_file(name)?, command_line.clone())
     };
-    settings.validate()?;
     if settings.scene.ground {
         scene.add_ground_plane();
     }

@@ -283,27 +283,25 @@ fn apply_lights(file: &SceneFile, source: &Source, scene: &mut Scene) -> Result<
         source.fail_at(&path, format!("{table}: {}", e.problem))
     };
     let keep = |color: Vec3, intensity: f32| Fallback { color, intensity };
-    if let Some(sun) = &file.sun {
-        let fallback = keep(scene.sun.color, scene.sun.intensity);
-        let light =
-            LightEntry::from(sun).to_light(fallback).map_err(|e| failed("[sun]", &[Step::Key("sun")], e))?;
-        let Light::Directional(sun) = light else { unreachable!("a sun table builds a sun") };
+    // `[sun]`, `[spot]` and `[point]`: one light each, falling back on the scene's.
+    let single = |entry: LightEntry, key: &'static str, fallback: Fallback| {
+        entry.to_light(fallback).map_err(|e| failed(&format!("[{key}]"), &[Step::Key(key)], e))
+    };
+    if let Some(sun) = &file.sun
+        && let Light::Directional(sun) =
+            single(sun.into(), "sun", keep(scene.sun.color, scene.sun.intensity))?
+    {
         scene.sun = sun;
     }
-    if let Some(spot) = &file.spot {
-        let fallback = keep(scene.spot.color, scene.spot.intensity);
-        let light = LightEntry::from(spot)
-            .to_light(fallback)
-            .map_err(|e| failed("[spot]", &[Step::Key("spot")], e))?;
-        let Light::Spot(spot) = light else { unreachable!("a spot table builds a spot") };
+    if let Some(spot) = &file.spot
+        && let Light::Spot(spot) = single(spot.into(), "spot", keep(scene.spot.color, scene.spot.intensity))?
+    {
         scene.spot = spot;
     }
-    if let Some(point) = &file.point {
-        let fallback = keep(scene.point.color, scene.point.intensity);
-        let light = LightEntry::from(point)
-            .to_light(fallback)
-            .map_err(|e| failed("[point]", &[Step::Key("point")], e))?;
-        let Light::Point(point) = light else { unreachable!("a point table builds a point light") };
+    if let Some(point) = &file.point
+        && let Light::Point(point) =
+            single(point.into(), "point", keep(scene.point.color, scene.point.intensity))?
+    {
         scene.point = point;
     }
     if !file.light.is_empty() {

@@ -52,14 +52,12 @@ pub(super) fn check_limit(
 
 /// An optional position: every coordinate within [`crate::limits::COORDINATE`].
 pub(super) fn check_vec(v: Option<Vec3>, setting: &'static str) -> Result<(), SettingsError> {
-    let limit = &crate::limits::COORDINATE;
     match v {
-        Some(p) => check(
-            p.to_array().iter().all(|&x| limit.allows(x)),
-            setting,
-            format!("{},{},{}", p.x, p.y, p.z),
-            limit.valid,
-        ),
+        Some(p) => {
+            crate::limits::check_vec3(&crate::limits::COORDINATE, setting, p).map(|_| ()).map_err(|e| {
+                SettingsError { setting, value: format!("{},{},{}", p.x, p.y, p.z), valid: e.valid }
+            })
+        }
         None => Ok(()),
     }
 }
