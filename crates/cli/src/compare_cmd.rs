@@ -19,9 +19,9 @@ use gnomon_scene::{
     settings::{CameraSettings, Technique},
 };
 use image::RgbaImage;
-use serde::Serialize;
 
 use crate::{
+    compare_report::{AliasingSummary, PathReport, Report, Row, markdown_table},
     grid::{self, Downscale, Tile},
     lab, output,
 };
@@ -70,60 +70,6 @@ struct Rendered {
     technique: Technique,
     frame: Frame,
     timing: Option<(f64, Option<f64>, f64)>,
-}
-
-/// One technique's row of the report.
-#[derive(Serialize)]
-struct Row {
-    technique: String,
-    #[serde(flatten)]
-    metrics: Metrics,
-    /// Median GPU milliseconds of the shadow pass, where the adapter has timestamps.
-    shadow_ms: Option<f64>,
-    /// Median GPU milliseconds of the moment pass (encoding, blur, mipmaps) of the
-    /// filterable techniques.
-    filter_ms: Option<f64>,
-    /// The moment map's texel format, for the filterable techniques.
-    moment_format: Option<String>,
-    /// Median GPU milliseconds of the lighting pass.
-    lighting_ms: Option<f64>,
-    /// Flicker along `--camera-path`, when one was given.
-    flicker: Option<Flicker>,
-}
-
-/// Perspective aliasing of the shadow layout at the first frame (the same for every
-/// technique: the layout does not depend on the filter).
-#[derive(Serialize)]
-struct AliasingSummary {
-    /// Mean over the shaded pixels of m, the screen pixels one shadow texel covers.
-    mean: f32,
-    max: f32,
-}
-
-/// The camera path of a flicker measurement.
-#[derive(Serialize)]
-struct PathReport {
-    kind: CameraPathKind,
-    frames: u32,
-    travel: f32,
-    frozen_cascades: bool,
-}
-
-#[derive(Serialize)]
-struct Report<'a> {
-    scene: &'a str,
-    width: u32,
-    height: u32,
-    shadow_resolution: u32,
-    light: String,
-    reference_samples: u32,
-    adapter: String,
-    backend: String,
-    aliasing: AliasingSummary,
-    camera_path: Option<PathReport>,
-    /// What each metric divides by (`metrics::DENOMINATORS`).
-    denominators: std::collections::BTreeMap<&'static str, &'static str>,
-    rows: Vec<Row>,
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
@@ -234,11 +180,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let name = technique.name();
         staged.png_rgba(&args.out.join(format!("{name}.png")), w, h, &frame.color)?;
         staged.png_rgba(&args.out.join(format!("{name}-error.png")), w, h, &error)?;
-        let summary = if soft {
-            format!("MAE {:.4}  p99 {:.3}", m.mae, m.p99)
-        } else {
-            format!("mismatch {:.3}% light-facing", 100.0 * m.mismatch_rate)
-        };
+        let summary = edge_caption(&m, soft);
         let mut caption = vec![name.to_string()];
         if let Some((s, f, l)) = timing {
             caption.push(format!("shadow pass {s:.2} ms"));
@@ -251,12 +193,14 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             Tile { image: rgba(w, h, frame.color.clone()), caption, downscale: Downscale::Smooth },
             Tile {
                 image: rgba(w, h, error),
-                caption: vec![
-                    summary,
-                    format!("false shadow {:.3}%", 100.0 * m.false_shadow_rate),
-                    format!("false lit {:.3}%", 100.0 * m.false_lit_rate),
-                    format!("all surfaces: mismatch {:.3}%", 100.0 * m.surface_mismatch_rate),
-                ],
+                caption: summary
+                    .into_iter()
+                    .chain([
+                        format!("false shadow {:.3}%", 100.0 * m.false_shadow_rate),
+                        format!("false lit {:.3}%", 100.0 * m.false_lit_rate),
+                        format!("all surfaces: mismatch {:.3}%", 100.0 * m.surface_mismatch_rate),
+                    ])
+                    .collect(),
                 downscale: Downscale::Salient(if soft { soft_priority } else { hard_priority }),
             },
         ]);
@@ -370,6 +314,25 @@ fn measure_flicker(
     Ok(counters.iter().map(|c| Some(c.result())).collect())
 }
 
+/// The first lines of an error tile's caption (each under the tile's 30 characters),
+/// each figure named for its denominator: under an area light, the MAE over all
+/// compared pixels, over the penumbra, and the penumbra width error with its bias;
+/// under a point-like light, the mismatch rate and the MAE over the edge band.
+fn edge_caption(m: &Metrics, soft: bool) -> Vec<String> {
+    if soft {
+        let width = match (m.penumbra.width.error_px, m.penumbra.width.bias_px) {
+            (Some(e), Some(b)) => format!("width error {e:.1} px ({b:+.1})"),
+            _ => "width error: none resolved".to_string(),
+        };
+        vec![format!("MAE {:.4} all", m.mae), format!("MAE {:.4} penumbra", m.penumbra.error.mae), width]
+    } else {
+        vec![
+            format!("mismatch {:.3}% light-facing", 100.0 * m.mismatch_rate),
+            format!("edge MAE {:.3} within 2 px", m.edge.mae),
+        ]
+    }
+}
+
 /// Wrong pixels outrank silhouettes, which outrank correct ones.
 fn hard_priority(p: [u8; 4]) -> u32 {
     let c = [p[0], p[1], p[2]];
@@ -397,79 +360,6 @@ fn caption_reference(r: &gnomon_reference::ReferenceImage) -> Vec<String> {
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
-}
-
-/// The technique's name, with its moment map's format when that is not 32-bit float.
-fn technique_label(r: &Row) -> String {
-    match &r.moment_format {
-        Some(f) if f != "rgba32float" => format!("{} ({f})", r.technique),
-        _ => r.technique.to_string(),
-    }
-}
-
-fn markdown_table(report: &Report, soft: bool) -> String {
-    let mut s = format!(
-        "`{}` at {}×{}, shadow map {}², reference {} on {} ({})\n\n",
-        report.scene,
-        report.width,
-        report.height,
-        report.shadow_resolution,
-        if soft { format!("{} samples/pixel", report.reference_samples) } else { "exact".into() },
-        report.adapter,
-        report.backend
-    );
-    s.push_str(&format!(
-        "Perspective aliasing m (pixels one shadow texel spans; 1 is ideal): mean {:.3}, max {:.1}\n\n",
-        report.aliasing.mean, report.aliasing.max
-    ));
-    if let Some(p) = &report.camera_path {
-        s.push_str(&format!(
-            "Flicker along a {:?} path of {} frames, the eye travelling {} of its distance to the target{}. Flips: the pixels that change between shadow and light from frame to frame, the technique's rate minus the reference's. Shimmer: of the pixels that reproject onto the same surface point of the previous frame, those that flip while the reference does not\n\n",
-            p.kind,
-            p.frames,
-            p.travel,
-            if p.frozen_cascades { ", cascades frozen at the first frame" } else { "" }
-        ));
-    }
-    s.push_str(
-        "Mismatch, false shadow, false lit, MAE, RMSE and p99 are over the compared pixels: those where both images see the same surface and it faces the light (geometric N·L > 0) inside its cone and range. All-surface mismatch divides by every surface pixel both see, light-facing or not (compared + unlit)\n\n",
-    );
-    let path = report.camera_path.is_some();
-    s.push_str("| technique | mismatch | false shadow | false lit | MAE | RMSE | p99 | compared | all-surface mismatch | unlit | silhouette | shadow ms | filter ms | lighting ms |");
-    s.push_str(if path { " flips − reference | shimmer |\n" } else { "\n" });
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    s.push_str(if path { "---|---|\n" } else { "\n" });
-    let ms = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into());
-    for r in &report.rows {
-        let m = &r.metrics;
-        s.push_str(&format!(
-            "| {} | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.3} | {} | {:.3}% | {} | {} | {} | {} | {} |\n",
-            technique_label(r),
-            100.0 * m.mismatch_rate,
-            100.0 * m.false_shadow_rate,
-            100.0 * m.false_lit_rate,
-            m.mae,
-            m.rmse,
-            m.p99,
-            m.compared,
-            100.0 * m.surface_mismatch_rate,
-            m.unlit,
-            m.silhouette,
-            ms(r.shadow_ms),
-            if r.filter_ms.is_some() { ms(r.filter_ms) } else { "–".into() },
-            ms(r.lighting_ms)
-        ));
-        if let Some(f) = &r.flicker {
-            s.pop();
-            s.push_str(&format!(
-                " {:+.4}% of {:.4}% | {:.4}% |\n",
-                100.0 * f.excess_flip_rate,
-                100.0 * f.reference_flip_rate,
-                100.0 * f.shimmer_rate
-            ));
-        }
-    }
-    s
 }
 
 /// With `--light all`, a comparison measures one light, the one at `--light-index`,

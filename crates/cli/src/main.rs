@@ -5,6 +5,7 @@ mod bench_cmd;
 mod cache;
 mod calibrate;
 mod compare_cmd;
+mod compare_report;
 mod grid;
 mod lab;
 mod output;

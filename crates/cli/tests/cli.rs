@@ -172,7 +172,12 @@ fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
         assert!(compared > 5000, "{row}");
         let rate = row["mismatch_rate"].as_f64().unwrap();
         assert!((0.0..0.05).contains(&rate), "{row}");
+        // A sun without size: an exact reference, no penumbra, an edge band.
+        assert_eq!(row["penumbra"]["pixels"].as_u64(), Some(0), "{row}");
+        assert_eq!(row["penumbra"]["width"]["profiles"].as_u64(), Some(0), "{row}");
+        assert!(row["edge"]["pixels"].as_u64().unwrap() > 100, "{row}");
     }
+    assert!(table.contains("MAE, edge band"), "{table}");
     let grid = image::open(dir.join("cmp/grid.png")).unwrap();
     assert!(grid.width() > 960 && grid.height() > 3 * 270 / 2, "{}×{}", grid.width(), grid.height());
     // The second run reuses the reference.
@@ -186,6 +191,38 @@ fn compare_writes_grid_metrics_heatmaps_and_reuses_the_cached_reference() {
         for key in ["compared", "silhouette", "false_shadow", "false_lit", "mae", "p99"] {
             assert_eq!(a[key], b[key], "{key}");
         }
+    }
+}
+
+/// Under an area light, `compare` reports the error over the reference's penumbra
+/// beside the all-pixel one, with the penumbra width error, each named for its
+/// denominator in metrics.json, metrics.md and the captions.
+#[test]
+fn compare_reports_penumbra_metrics_under_an_area_light() {
+    let temp = temp_dir("compare-penumbra");
+    let dir = temp.path();
+    let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(dir)
+        .env("GNOMON_CACHE_DIR", dir.join("cache"))
+        .args(["compare", "contact", "--light", "spot", "--spot-radius", "0.25", "--samples", "32"])
+        .args(["--width", "240", "--height", "135", "--shadow-res", "1024"])
+        .args(["--techniques", "pcf,pcss", "--out", "cmp", "--timing-frames", "1"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(table.contains("MAE, penumbra") && table.contains("width error px"), "{table}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cmp/metrics.json")).unwrap()).unwrap();
+    assert!(json["denominators"]["penumbra.pixels, penumbra.mae, penumbra.rmse"].is_string(), "{json}");
+    for row in json["rows"].as_array().unwrap() {
+        let penumbra = &row["penumbra"];
+        assert!(penumbra["pixels"].as_u64().unwrap() > 100, "{row}");
+        // The penumbra is where the error is: its MAE exceeds the all-pixel one.
+        assert!(penumbra["mae"].as_f64().unwrap() > row["mae"].as_f64().unwrap(), "{row}");
+        let width = &penumbra["width"];
+        assert!(width["profiles"].as_u64().unwrap() > 10, "{row}");
+        assert!(width["error_px"].as_f64().unwrap() >= 0.0, "{row}");
     }
 }
 

@@ -9,6 +9,8 @@ pub mod aliasing;
 pub mod flicker;
 pub mod heatmap;
 pub mod metrics;
+pub mod penumbra;
+pub mod profile;
 pub mod sampling;
 pub mod texture;
 mod tracer;

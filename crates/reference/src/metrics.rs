@@ -7,7 +7,10 @@
 
 use serde::Serialize;
 
-use crate::ReferenceImage;
+use crate::{
+    ReferenceImage,
+    penumbra::{self, Penumbra, RegionError},
+};
 
 /// A technique's per-pixel output, as the metrics need it.
 #[derive(Clone, Copy)]
@@ -51,6 +54,18 @@ pub const DENOMINATORS: &[(&str, &str)] = &[
         "surface_mismatch_rate",
         "every pixel of a surface both images see, light-facing or not (compared + unlit)",
     ),
+    (
+        "penumbra.pixels, penumbra.mae, penumbra.rmse",
+        "the penumbra: compared pixels where the reference is strictly between 0 and 1 by more than its own standard error (R − SE > 0 and R + SE < 1); none under a point-like light",
+    ),
+    (
+        "penumbra.width.error_px, penumbra.width.bias_px, penumbra.width.reference_px",
+        "the resolved edge profiles: lines through penumbra pixels on the reference's 0.5 isoline, along its gradient, where both images' 10 %–90 % transitions were found on one surface (penumbra.width.profiles, less penumbra.width.unresolved)",
+    ),
+    (
+        "edge.pixels, edge.mae, edge.rmse",
+        "the edge band: compared pixels within 2 px of the reference's shadow boundary (where it crosses 0.5 between 4-neighbours on one surface)",
+    ),
 ];
 
 /// Relative depth difference under which two hits on the same object are one surface.
@@ -81,7 +96,8 @@ pub fn classify(raster: RasterView, reference: &ReferenceImage) -> Vec<PixelClas
 }
 
 /// Everything measured for one technique. Every count, rate and error is over the
-/// compared (light-facing) pixels, except [`Metrics::surface_mismatch_rate`].
+/// compared (light-facing) pixels, except [`Metrics::surface_mismatch_rate`], and
+/// [`Metrics::penumbra`] and [`Metrics::edge`], over subsets of them.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct Metrics {
     /// Light-facing pixels compared: the denominator of the rates.
@@ -112,6 +128,12 @@ pub struct Metrics {
     /// counted only light-facing pixels. Lower than [`Metrics::mismatch_rate`] by
     /// about the share of unlit pixels.
     pub surface_mismatch_rate: f64,
+    /// Over the reference's penumbra: its pixel count, MAE, RMSE and the width error
+    /// of its transitions. Empty under a point-like light.
+    pub penumbra: Penumbra,
+    /// Over the band of ±[`EDGE_BAND_PX`](crate::penumbra::EDGE_BAND_PX) pixels around
+    /// the reference's shadow boundary: where a hard shadow's filtering shows.
+    pub edge: RegionError,
 }
 
 impl Metrics {
@@ -136,6 +158,8 @@ pub fn measure(raster: RasterView, reference: &ReferenceImage, classes: &[PixelC
         rmse: 0.0,
         p99: 0.0,
         surface_mismatch_rate: 0.0,
+        penumbra: penumbra::measure_penumbra(raster, reference, classes),
+        edge: penumbra::measure_edge(raster, reference, classes),
     };
     // Mismatches on unlit pixels: both images should be dark there, but their tests
     // of which way a surface faces can differ at the terminator.

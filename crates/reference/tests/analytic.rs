@@ -6,7 +6,11 @@ mod common;
 
 use common::figures::{figure, percent};
 use glam::{Mat4, Vec2, Vec3};
-use gnomon_reference::{ReferenceImage, ReferenceOptions, TracedScene, reference_visibility};
+use gnomon_reference::{
+    ReferenceImage, ReferenceOptions, TracedScene,
+    metrics::{self, RasterView},
+    reference_visibility,
+};
 use gnomon_scene::{
     Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SpotLight, builtin, geometry,
 };
@@ -218,6 +222,51 @@ fn penumbra_width_matches_similar_triangles() {
     );
     // It is centred on the edge's projection, x = 0.
     assert!((0.5 * (hi + lo)).abs() < 0.05 * expected, "centre {}", 0.5 * (hi + lo));
+}
+
+/// The penumbra metrics on the traced penumbra of a straight edge: the analytic
+/// visibility (the uncovered share of the disk, a circular segment) measured against
+/// the 256-sample reference has a width error near 0, and the analytic visibility of a
+/// disk twice as large, a deliberately blurred penumbra, has the predicted one: the
+/// reference's own width, too wide.
+#[test]
+fn the_traced_penumbra_has_the_analytic_width() {
+    let (r, big_h, small_h) = (0.5, 6.0, 2.0);
+    let (scene, light, cam) = penumbra_scene(r);
+    let truth = trace(&scene, &cam, &light, 200, 150, 256);
+    // A ground point at x sees the disk cut by the edge's shadow line at
+    // u = x (H − h) / (h r) disk radii from its centre.
+    let analytic = |radius: f32| -> Vec<f32> {
+        (0..truth.pixel_count())
+            .map(|i| match truth.object_id[i] {
+                1 => common::disk_visible(truth.position[i].x * (big_h - small_h) / (small_h * radius)),
+                _ => truth.visibility[i],
+            })
+            .collect()
+    };
+    let measure = |v: &[f32]| {
+        let raster = RasterView { visibility: v, object_id: &truth.object_id, depth: &truth.depth };
+        metrics::measure(raster, &truth, &metrics::classify(raster, &truth)).penumbra
+    };
+    let own = measure(&analytic(r));
+    let blurred = measure(&analytic(2.0 * r)).width;
+    eprintln!("traced penumbra: analytic {own:?}\ntwice the disk {blurred:?}");
+    let w = own.width.reference_px.unwrap();
+    assert!(own.error.pixels > 1000 && own.width.profiles > 100, "{own:?}");
+    let error = own.width.error_px.unwrap();
+    figure(
+        "traced penumbra: width error of the analytic visibility (px)",
+        format!("{error:.3}"),
+        format!("< {:.3} (5 % of {w:.2})", 0.05 * w),
+    );
+    assert!(error < 0.05 * w, "{own:?}");
+    let (blurred_error, bias) = (blurred.error_px.unwrap(), blurred.bias_px.unwrap());
+    figure(
+        "traced penumbra: width error of twice the disk (px)",
+        format!("{blurred_error:.3}"),
+        format!("{w:.3} ± 5 %"),
+    );
+    assert!((blurred_error - w).abs() < 0.05 * w && (bias - w).abs() < 0.05 * w, "{blurred:?}");
 }
 
 #[test]

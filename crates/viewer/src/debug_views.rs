@@ -109,8 +109,12 @@ impl ErrorJob {
                 (
                     heatmap::soft(&frame.visibility, &reference, &classes),
                     format!(
-                        "error against a {}-sample reference: MAE {:.4}, p99 {:.3} (|V − R|, black 0 to red 1)",
-                        reference.samples, measured.mae, measured.p99
+                        "error against a {}-sample reference: MAE {:.4} over all compared pixels, {:.4} over the {} penumbra pixels, p99 {:.3} (|V − R|, black 0 to red 1)",
+                        reference.samples,
+                        measured.mae,
+                        measured.penumbra.error.mae,
+                        measured.penumbra.error.pixels,
+                        measured.p99
                     ),
                 )
             } else {

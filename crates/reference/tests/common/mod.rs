@@ -67,3 +67,11 @@ pub fn shared_scene(relative: &str) -> Option<std::path::PathBuf> {
         path.display()
     )
 }
+
+/// The share of a unit disk on the lit side of a straight edge at signed distance `u`
+/// (in disk radii) from the disk's centre: 1 − (acos u − u√(1 − u²))/π, the circular
+/// segment's area over π.
+pub fn disk_visible(u: f32) -> f32 {
+    let u = u.clamp(-1.0, 1.0);
+    1.0 - (u.acos() - u * (1.0 - u * u).sqrt()) / std::f32::consts::PI
+}
