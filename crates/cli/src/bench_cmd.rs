@@ -250,8 +250,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let is_layer = |name: &String| name.starts_with("shadow L");
         let depth_only = summary("depth-only");
         let ratio = summary("shadow ÷ depth-only").map(|r| r.median_ms);
-        let traced: Vec<u64> = last.lights.iter().filter_map(|l| l.traced_pixels).map(u64::from).collect();
-        let rays = (!traced.is_empty()).then(|| traced.iter().sum::<u64>());
+        let refined: Vec<&gnomon_render::LightStats> =
+            last.lights.iter().filter(|l| l.traced_pixels.is_some()).collect();
+        let traced = (!refined.is_empty())
+            .then(|| refined.iter().filter_map(|l| l.traced_pixels).map(u64::from).sum::<u64>());
+        let rays = (!refined.is_empty()).then(|| refined.iter().filter_map(|l| l.traced_rays()).sum::<u64>());
         let pixels = f64::from(settings.image.width) * f64::from(settings.image.height);
         reports.push(ConfigReport {
             technique: config.technique.name().to_string(),
@@ -268,7 +271,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             lighting_instances: last.stats.lighting_instances,
             depth_only,
             shadow_over_depth_only: ratio,
-            traced_percent: rays.map(|r| 100.0 * r as f64 / pixels),
+            traced_percent: traced.map(|t| 100.0 * t as f64 / pixels),
             rays,
         });
     }

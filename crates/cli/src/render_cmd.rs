@@ -148,8 +148,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         for (i, light) in frame.lights.iter().enumerate() {
             eprintln!("gnomon: {}", light_line(i, light));
-            if let Some(traced) = light.traced_pixels {
-                eprintln!("gnomon: {}", traced_line(i, traced, frame.pixel_count()));
+            if light.traced_pixels.is_some() {
+                eprintln!("gnomon: {}", traced_line(i, light, frame.pixel_count()));
             }
         }
     }
@@ -224,9 +224,15 @@ pub(crate) fn warn_unrefined(lights: &[gnomon_render::LightStats]) {
 
 /// `--verbose`'s line on a light refined by rays: the pixels that traced a ray, as a
 /// share of the screen.
-pub(crate) fn traced_line(index: usize, traced: u32, pixels: usize) -> String {
+pub(crate) fn traced_line(index: usize, light: &gnomon_render::LightStats, pixels: usize) -> String {
+    let traced = light.traced_pixels.unwrap_or(0);
+    let rays = light.traced_rays().unwrap_or(0);
+    let per_pixel = match light.rays_per_pixel {
+        1 => String::new(),
+        n => format!(", {n} per pixel over the light's area"),
+    };
     format!(
-        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({traced} rays)",
+        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({rays} rays{per_pixel})",
         100.0 * f64::from(traced) / pixels.max(1) as f64
     )
 }

@@ -403,6 +403,27 @@ fn verbose_reports_frame_time_and_draws_for_each_of_many_lights() {
 }
 
 #[test]
+fn penumbrae_refined_by_rays_report_their_rays_and_refuse_an_impossible_count() {
+    let temp = temp_dir("penumbra-rays");
+    let dir = temp.path();
+    let args = ["render", "contact", "--light", "spot", "--spot-radius", "0.5", "--technique", "pcss"];
+    let small = ["--width", "160", "--height", "90", "--refine", "rays", "--verbose"];
+    let out = gnomon(dir, &[&args[..], &small, &["--penumbra-rays", "8", "-o", "soft.png"]].concat());
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let line = err.lines().find(|l| l.contains(": refined by rays at ")).expect("a refined light's line");
+    let pixels: u64 = line.split(" at ").nth(1).and_then(|r| r.split(' ').next()?.parse().ok()).unwrap();
+    assert!(
+        pixels > 0 && line.contains(&format!("({} rays, 8 per pixel over the light's area)", 8 * pixels)),
+        "{line}"
+    );
+    let out = gnomon(dir, &[&args[..], &small, &["--penumbra-rays", "0", "-o", "none.png"]].concat());
+    let err = stderr(&out);
+    assert!(!out.status.success() && err.contains("--penumbra-rays") && err.contains("1 to 256"), "{err}");
+    assert!(!dir.join("none.png").exists());
+}
+
+#[test]
 fn contact_shadows_render_through_the_mask_and_forward_refuses_them() {
     let temp = temp_dir("contact-shadows");
     let dir = temp.path();

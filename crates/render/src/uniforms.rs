@@ -162,6 +162,16 @@ pub struct LightGpu {
     pub contact_bias: f32,
     /// Contact shadows: the view depth beyond which they are off (faded over its last quarter).
     pub contact_distance: f32,
+    /// Refinement by rays: the rays a refined pixel casts over the light's area
+    /// (`ScreenSpaceSettings::penumbra_rays`), 0 for a hard light, whose pixel casts
+    /// one ray to its centre.
+    pub penumbra_rays: u32,
+    /// Padding to the 16-byte alignment of `params`.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
     /// The technique's own parameters ([`TechniqueParams`]).
     pub params: TechniqueParams,
     /// Each layer's clip_from_world (a paraboloid's: its hemisphere's frame);
@@ -303,6 +313,7 @@ impl LightGpu {
             depth_bias: shadow.bias.depth_bias as f32,
             slope_bias: shadow.bias.slope_bias,
             contact_distance: contact.contact_distance,
+            penumbra_rays: if light.is_hard() { 0 } else { settings.screen.penumbra_rays },
             params,
             ..Default::default()
         };
@@ -422,7 +433,8 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             texel_per_distance, normal_offset, resolution, kernel_width, kernel_in_world, poisson_taps,
             receiver_plane_bias, light_size, blocker_taps, max_penumbra_texels, select_by_projection,
             cascade_blend, depth_bias, slope_bias, contact_steps, contact_length, contact_thickness,
-            contact_bias, contact_distance, params, cascade_clip_from_world, cascades,
+            contact_bias, contact_distance, penumbra_rays, _pad0, _pad1, _pad2, params, cascade_clip_from_world,
+            cascades,
         }),
         struct_layout!(TechniqueParams as "TechniqueParams" { reals, integers }),
         struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {

@@ -183,13 +183,20 @@ fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
 }
 
 /// Refinement by rays lists its pixels and traces them in pooled buffers and groups:
-/// steady frames create none of them either, for a sun and for every lamp at once.
+/// steady frames create none of them either, for a sun, for every lamp at once, and
+/// for a sun with a disk (whose penumbra filter copies the mask into a pooled texture).
 #[test]
 fn refined_frames_create_nothing_in_steady_state() {
     let gpu = Gpu::new_headless().unwrap();
-    for (scene, light) in [(builtin::spheres(), LightKind::Sun), (builtin::lamps(), LightKind::All)] {
+    let cases = [
+        (builtin::spheres(), LightKind::Sun, None),
+        (builtin::lamps(), LightKind::All, None),
+        (builtin::spheres(), LightKind::Sun, Some(2.0)),
+    ];
+    for (scene, light, sun_disk) in cases {
         for refine in [Refine::Rays, Refine::EveryPixel] {
             let mut settings = small(Technique::PCF, light);
+            settings.light.sun_angular_diameter = sun_disk;
             settings.screen.refine = refine;
             settings.screen.shadow_path = ShadowPath::Mask;
             let mut renderer = Renderer::new(&gpu).unwrap();

@@ -263,7 +263,8 @@ impl Light {
 
     /// Whether the light is a point source (a sun of no angular diameter, a spot or
     /// point of no radius), whose hard shadow one ray per pixel decides; a light with
-    /// an area casts a penumbra that one ray to its centre would harden.
+    /// an area casts a penumbra, which takes many rays over its area
+    /// (`ScreenSpaceSettings::penumbra_rays`).
     pub fn is_hard(&self) -> bool {
         match self {
             Light::Directional(sun) => sun.angular_diameter_degrees == 0.0,

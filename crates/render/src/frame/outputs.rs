@@ -156,9 +156,13 @@ pub struct LightStats {
     pub mask_ms: Option<f64>,
     /// GPU time of its trace pass, where it refines its shadow by rays.
     pub trace_ms: Option<f64>,
-    /// Pixels its shadow was refined at, one ray each, where it refines by rays and
-    /// the frame was waited for (not a live frame's).
+    /// Pixels its shadow was refined at, where it refines by rays and the frame was
+    /// waited for (not a live frame's).
     pub traced_pixels: Option<u32>,
+    /// Shadow rays each refined pixel asks for: 1 under a hard light, the settings'
+    /// `penumbra_rays` under a light with an area (a sample below the surface's
+    /// horizon is counted, though not traced).
+    pub rays_per_pixel: u32,
     /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
     /// device cannot trace this scene or an image this large.
     pub refine_fallback: Option<crate::rays::RaysUnavailable>,
@@ -168,6 +172,12 @@ impl LightStats {
     /// Draw calls into its map, every layer together.
     pub fn shadow_draws(&self) -> u32 {
         self.layer_draws.iter().sum()
+    }
+
+    /// Shadow rays its refinement asked for: the pixels traced times the rays of
+    /// each, where it refines by rays.
+    pub fn traced_rays(&self) -> Option<u64> {
+        self.traced_pixels.map(|pixels| u64::from(pixels) * u64::from(self.rays_per_pixel))
     }
 }
 
@@ -475,6 +485,7 @@ impl TimedLights {
                 mask_ms: None,
                 trace_ms: None,
                 traced_pixels: None,
+                rays_per_pixel: 1,
                 refine_fallback: None,
             })
             .collect();

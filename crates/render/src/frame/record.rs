@@ -196,9 +196,9 @@ impl Renderer {
         request: &SubmitRequest,
     ) -> Recorded {
         let gpu = self.gpu.clone();
-        // Every layer of every light, each light's filter, mask, trace and lighting, and
-        // the prepass.
-        let timed_passes = plan.lights.iter().map(|p| p.layers() + 4).sum::<u32>() + 1;
+        // Every layer of every light, each light's filter, mask, trace, penumbra filter
+        // and lighting, and the prepass.
+        let timed_passes = plan.lights.iter().map(|p| p.layers() + 5).sum::<u32>() + 1;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut rec = Recording {
             encoder: &mut encoder,

@@ -36,12 +36,21 @@ struct MaskScreen<'a> {
     counter_offset: Option<u32>,
 }
 
-/// A frame's refinement by rays: the lists, and group 1 as the mask passes (which
-/// append) and the trace passes (which read) bind it.
+/// A frame's refinement by rays: the lists, group 1 as the mask passes (which
+/// append) and the trace passes (which read) bind it, and the copy of a light's layer
+/// of the mask that its penumbra filter reads.
 struct Refining {
     lists: RefineLists,
     append: wgpu::BindGroup,
     read: wgpu::BindGroup,
+    traced: wgpu::TextureView,
+}
+
+/// What a penumbra filter copies: the light's layer of the mask (a view of one layer
+/// of the frame's mask texture) into the frame's `traced` texture.
+struct PenumbraCopy<'a> {
+    layer: &'a wgpu::TextureView,
+    traced: &'a wgpu::TextureView,
 }
 
 /// A cleared colour attachment.
@@ -94,7 +103,10 @@ impl Renderer {
             let camera = inputs.camera_buffer;
             let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
             let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
-            Refining { lists, append, read }
+            let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+            let traced = self.pool.texture("traced shadow mask", size, screen_space::MASK_FORMAT, usage);
+            let traced = self.pool.view(&traced, ViewKey::default());
+            Refining { lists, append, read, traced }
         });
         for (index, ((light, bindings), layer)) in
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
@@ -111,8 +123,8 @@ impl Renderer {
                 None => MaskScreen { group: &screen_group, counter_offset: None },
             };
             self.record_mask(rec, light, bindings, layer, &screen, index as u32);
-            if let Some(Refining { lists, read, .. }) = refined {
-                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer);
+            if let Some(Refining { lists, read, traced, .. }) = refined {
+                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer, traced);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
                 let groups = TraceGroups {
                     scene: &bindings.scene,
@@ -122,6 +134,9 @@ impl Renderer {
                     counters: &lists.counters,
                 };
                 self.record_trace(rec, &groups, index as u32);
+                if light.light_gpu.penumbra_rays > 0 {
+                    self.record_penumbra_filter(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
+                }
             }
         }
         refining.map(|refining| refining.lists)
@@ -175,6 +190,40 @@ impl Renderer {
         rec.clock.end(gpu, rec.encoder, slot);
     }
 
+    /// Light `index`'s penumbra filter, after its trace pass under a light with an
+    /// area: its layer of the mask is copied as traced, then each listed pixel is
+    /// averaged with its neighbours on the same surface from that copy.
+    fn record_penumbra_filter(
+        &mut self,
+        rec: &mut Recording,
+        groups: &TraceGroups,
+        copy: PenumbraCopy,
+        index: u32,
+    ) {
+        let gpu = &self.gpu;
+        let (mask, traced) = (copy.layer.texture(), copy.traced.texture());
+        rec.encoder.copy_texture_to_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: mask,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: index },
+                aspect: wgpu::TextureAspect::All,
+            },
+            traced.as_image_copy(),
+            wgpu::Extent3d { width: traced.width(), height: traced.height(), depth_or_array_layers: 1 },
+        );
+        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Trace, Some(index), None);
+        let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("penumbra filter"),
+            timestamp_writes: rec.clock.compute_writes(slot),
+        });
+        self.passes.trace.record_filter(&mut pass, groups, index);
+        rec.stats.pipeline_changes += 1;
+        rec.stats.bind_group_changes += 4;
+        drop(pass);
+        rec.clock.end(gpu, rec.encoder, slot);
+    }
+
     /// The camera's depth, normals and view depth.
     fn record_prepass(
         &mut self,
@@ -220,7 +269,7 @@ impl Renderer {
     }
 
     /// One layer of the shadow mask per light of `plan`, writable by the trace passes
-    /// where a light refines by rays.
+    /// (and copied by the penumbra filters) where a light refines by rays.
     pub(super) fn mask_layers(
         &mut self,
         plan: &FramePlan,
@@ -229,7 +278,9 @@ impl Renderer {
     ) -> Vec<wgpu::TextureView> {
         let refining = plan.lights.iter().any(|l| l.refine != Refine::Off);
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let usage = if refining { usage | wgpu::TextureUsages::STORAGE_BINDING } else { usage };
+        // The trace passes write it; a penumbra filter copies a layer of it first.
+        let writable = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let usage = if refining { usage | writable } else { usage };
         let lights = plan.lights.len() as u32;
         let mask = self.pool.texture(
             "shadow mask",

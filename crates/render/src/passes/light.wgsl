@@ -55,6 +55,10 @@ struct Light {
     contact_thickness: f32,       // thickness, fraction of view depth
     contact_bias: f32,            // start offset along the normal (world)
     contact_distance: f32,        // view depth where contact shadows end
+    penumbra_rays: u32,           // refinement: rays per pixel over the light's area (0: hard, one ray)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     params: TechniqueParams,
     // One layer of the shadow map per cascade (one in all for a single map).
     cascade_clip_from_world: array<mat4x4<f32>, MAX_CASCADES>,

@@ -37,15 +37,13 @@ pub(crate) fn trace_wgsl() -> String {
     )
 }
 
-/// The refinement a light gets on the mask path: `refine` for a hard light (with
-/// `auto` resolved to `rays`), none for a light with an area, whose soft shadow one
-/// ray to its centre would harden.
+/// The refinement a light gets on the mask path: `refine`, with `auto` resolved to
+/// `rays` for a hard light and to `off` for a light with an area, whose refined
+/// pixels cost `penumbra_rays` rays each: asked for by name only.
 pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
-    if !light.is_hard() {
-        return Refine::Off;
-    }
     match refine {
-        Refine::Auto => Refine::Rays,
+        Refine::Auto if light.is_hard() => Refine::Rays,
+        Refine::Auto => Refine::Off,
         Refine::Off | Refine::Rays | Refine::EveryPixel => refine,
     }
 }

@@ -66,6 +66,7 @@ pub(crate) fn trace_pass_wgsl() -> String {
     parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
     parts.push(list_wgsl());
     parts.push(super::trace_wgsl());
+    parts.push(include_str!("light_sample.wgsl").to_owned());
     parts.push(include_str!("refine_trace.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -110,26 +111,43 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
     })
 }
 
-/// Group 2 of the trace pass: the light's layer of the mask, written.
+/// Group 2 of the trace and filter passes: the light's layer of the mask, written
+/// (0), and a copy of it as the trace pass left it, read by the filter pass (1).
 pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("refined shadow mask"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: passes::screen_space::MASK_FORMAT,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        }],
+        entries: &[
+            entry(
+                0,
+                wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: passes::screen_space::MASK_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+            ),
+            entry(
+                1,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            ),
+        ],
     })
 }
 
-/// The trace pass's pipeline.
+/// The trace pass's pipeline, and the penumbra filter's that follows it under a
+/// light with an area (`cs_filter_penumbra` in refine_trace.wgsl).
 pub(crate) struct TracePass {
-    pipeline: wgpu::ComputePipeline,
+    trace: wgpu::ComputePipeline,
+    filter: wgpu::ComputePipeline,
 }
 
 impl TracePass {
@@ -148,21 +166,40 @@ impl TracePass {
             label: Some("shadow mask ray trace"),
             source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl().into()),
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("shadow mask ray trace"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("cs_trace"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        Self { pipeline }
+        let pipeline = |entry_point: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self { trace: pipeline("cs_trace"), filter: pipeline("cs_filter_penumbra") }
     }
 
     /// Records the trace pass of light `light`: its listed pixels' rays, written into
     /// its layer of the mask (`groups.mask`).
     pub fn record(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
-        pass.set_pipeline(&self.pipeline);
+        self.dispatch(&self.trace, pass, groups, light);
+    }
+
+    /// Records the penumbra filter of light `light`, after its trace pass and a copy
+    /// of its layer of the mask into the group's `traced_mask`: each listed pixel
+    /// becomes an edge-aware average of its neighbours.
+    pub fn record_filter(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
+        self.dispatch(&self.filter, pass, groups, light);
+    }
+
+    fn dispatch(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        pass: &mut wgpu::ComputePass,
+        groups: &TraceGroups,
+        light: u32,
+    ) {
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, groups.scene, &[]);
         pass.set_bind_group(1, groups.screen, &[RefineLists::counter_offset(light)]);
         pass.set_bind_group(2, groups.mask, &[]);
@@ -178,7 +215,8 @@ pub(crate) struct TraceGroups<'a> {
     /// The camera, the prepass, the list and the counters, read only
     /// ([`RefineLists::group`] with [`ListAccess::Read`]).
     pub screen: &'a wgpu::BindGroup,
-    /// The light's layer of the mask, written ([`RefineLists::mask_group`]).
+    /// The light's layer of the mask, written, and the copy the filter reads
+    /// ([`RefineLists::mask_group`]).
     pub mask: &'a wgpu::BindGroup,
     /// The casters' BVH.
     pub bvh: &'a wgpu::BindGroup,
@@ -248,9 +286,19 @@ impl RefineLists {
         )
     }
 
-    /// The trace pass's group 2: `mask_layer`, written.
-    pub fn mask_group(pool: &mut Pool, layouts: &Layouts, mask_layer: &wgpu::TextureView) -> wgpu::BindGroup {
-        pool.bind_group("refined shadow mask", &layouts.refined_mask, &[Binding::View(mask_layer.clone())])
+    /// The trace and filter passes' group 2: `mask_layer`, written, and `traced`, the
+    /// copy of it that the filter reads.
+    pub fn mask_group(
+        pool: &mut Pool,
+        layouts: &Layouts,
+        mask_layer: &wgpu::TextureView,
+        traced: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        pool.bind_group(
+            "refined shadow mask",
+            &layouts.refined_mask,
+            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone())],
+        )
     }
 
     /// Records a copy of the counters into a mappable buffer, to read back.

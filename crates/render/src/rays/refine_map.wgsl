@@ -13,6 +13,10 @@
 //   toward the light. This is where light leaks and acne live: unsure.
 // The pixel is unsure when any texel is, or when the footprint holds both kinds.
 //
+// Under a light with an area (light.penumbra_rays > 0), the pixel is also unsure
+// where the light's own footprint in the map (`area_unsure`) holds casters over part
+// of it: the penumbra as the geometry bounds it, not as the technique estimated it.
+//
 // What this cannot see: a caster thinner than a texel that the map's rasterization
 // missed altogether leaves no depth to disagree with.
 
@@ -91,5 +95,60 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
             shadowed = shadowed || any(is_shadowed);
         }
     }
-    return lit && shadowed;
+    if lit && shadowed {
+        return true;
+    }
+    return light.penumbra_rays > 0u && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
+}
+
+// Taps a side of `area_unsure`'s grid over the light's footprint.
+const AREA_SEARCH_TAPS: i32 = 6;
+
+// The radius, in world units, of the cone from a receiver at light distance
+// `receiver` to the light's area, at light distance `at`: light.light_size × (d − at)
+// for a sun (the tangent of its angular radius), light.light_size × (d − at) / d for
+// a spot's disk or a point's sphere (similar triangles from the light's centre).
+fn light_cone_radius(receiver: f32, at: f32) -> f32 {
+    let reach = light.light_size * max(receiver - at, 0.0);
+    return select(reach / receiver, reach, light.kind == LIGHT_SUN);
+}
+
+// Under a light with an area: whether the map shows, for the receiver at texel
+// position `p` (its plane: depth `receiver` + `gradient` per texel, at light
+// distance `distance`), both a caster inside the cone from the receiver to the light
+// (a depth in front of the receiver's plane by more than `margin`, no farther to
+// the side than the cone's radius at the caster's own distance, give or take the
+// grid's spacing) and a
+// texel with nothing in front of the receiver. The grid covers the cone's
+// cross-section at the map's near plane, PCSS's blocker-search region (Fernando
+// 2005), capped at light.max_penumbra_texels. A technique's own estimate of the
+// penumbra can be too narrow (PCSS's under a low sun is half the true width); this
+// bounds it by the geometry instead. Casters over the whole region leave the
+// technique's answer: most likely the umbra.
+fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, layer: u32, distance: f32) -> bool {
+    let near = light.map_near;
+    let radius = clamp(light_cone_radius(distance, near) / texel_world_size_at(layer, near), 1.0, light.max_penumbra_texels);
+    let last = vec2<i32>(i32(light.resolution) - 1);
+    let spacing = max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
+    var casters = false;
+    var light_seen = false;
+    for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
+        for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
+            let step = (vec2<f32>(f32(i), f32(j)) + vec2<f32>(0.5)) / f32(AREA_SEARCH_TAPS) * 2.0 - vec2<f32>(1.0);
+            let texel = clamp(vec2<i32>(floor(p + step * radius + vec2<f32>(0.5))), vec2<i32>(0), last);
+            let offset = vec2<f32>(texel) - p;
+            let stored = textureLoad(shadow_map, texel, layer, 0);
+            if stored > receiver + dot(gradient, offset) - margin {
+                light_seen = true;
+                continue;
+            }
+            // A caster seen at this tap may reach as far as the next tap toward the
+            // receiver: the tap grid's spacing is the slack of the test.
+            let at = light_distance_from_depth(stored);
+            if (length(offset) - spacing) * texel_world_size_at(layer, at) <= light_cone_radius(distance, at) {
+                casters = true;
+            }
+        }
+    }
+    return casters && light_seen;
 }

@@ -198,6 +198,13 @@ impl Settings {
         check_limit(l.point_range, "light.point_range", &limits::LIGHT_RANGE)?;
         check_limit(l.point_radius, "light.point_radius", &limits::LIGHT_RADIUS)?;
         self.shadow.validate()?;
+        let rays = self.screen.penumbra_rays;
+        check(
+            (1..=MAX_PENUMBRA_RAYS).contains(&rays),
+            "screen.penumbra_rays",
+            rays,
+            format!("1 to {MAX_PENUMBRA_RAYS} shadow rays per refined pixel"),
+        )?;
         let n = self.reference.samples;
         check((8..=65536).contains(&n), "reference.samples", n, "8 to 65536 shadow rays per pixel")?;
         Ok(())

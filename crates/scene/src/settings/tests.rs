@@ -48,6 +48,8 @@ fn flags_and_toml_agree() {
         "12",
         "--shadow-path",
         "mask",
+        "--penumbra-rays",
+        "32",
         "--contact-shadows",
         "--contact-length",
         "0.5",
@@ -82,6 +84,7 @@ fn flags_and_toml_agree() {
         contact_steps = 24
         [screen]
         shadow_path = "mask"
+        penumbra_rays = 32
     "#;
     let from_file: Settings = toml::from_str(text).unwrap();
     assert_eq!(parsed, from_file);
@@ -103,6 +106,13 @@ fn invalid_values_name_the_setting_and_the_range() {
     let mut s = Settings::default();
     s.camera.fov_y_degrees = Some(180.0);
     assert_eq!(s.validate().unwrap_err().setting, "camera.fov_y_degrees");
+    for rays in [0, MAX_PENUMBRA_RAYS + 1] {
+        let mut s = Settings::default();
+        s.screen.penumbra_rays = rays;
+        let e = s.validate().unwrap_err();
+        assert_eq!(e.setting, "screen.penumbra_rays");
+        assert!(e.to_string().contains(&format!("1 to {MAX_PENUMBRA_RAYS}")), "{e}");
+    }
     assert!(parse_vec3("1,2").is_err() && parse_vec3("1,x,3").is_err() && parse_vec3("1,inf,2").is_err());
     assert_eq!(parse_vec3(" 1, 2.5,-3").unwrap(), Vec3::new(1.0, 2.5, -3.0));
 }

@@ -52,6 +52,14 @@ const RULES: &[(&str, Uses, &str)] = &[
     ("shadow.cascades.cascade_selection", uses_cascades, CASCADES),
     ("shadow.cascades.cascade_blend", uses_cascades, CASCADES),
     ("shadow.cascades.sdsm", uses_cascades, CASCADES),
+    (
+        "screen.penumbra_rays",
+        |s, lights| {
+            matches!(s.screen.refine, Refine::Rays | Refine::EveryPixel)
+                && lights.iter().any(|l| !l.light.is_hard())
+        },
+        "`screen.refine` rays or every-pixel and a light with an area",
+    ),
 ];
 
 const CASCADES: &str = "`shadow.partition` cascades and a sun";
@@ -103,6 +111,21 @@ mod tests {
         let lights = s.resolve_lights(&scene).unwrap();
         let unused: Vec<&str> = s.unused(&lights).iter().map(|u| u.setting).collect();
         assert_eq!(unused, ["light.light_index", "light.spot_range"], "a point light uses the paraboloid");
+    }
+
+    #[test]
+    fn penumbra_rays_need_refinement_and_a_light_with_an_area() {
+        let scene = builtin::build("contact").unwrap();
+        let mut s = Settings::default();
+        s.screen.penumbra_rays = 32;
+        let unused = |s: &Settings| -> Vec<&str> {
+            s.unused(&s.resolve_lights(&scene).unwrap()).iter().map(|u| u.setting).collect()
+        };
+        assert_eq!(unused(&s), ["screen.penumbra_rays"], "a hard sun");
+        s.light.sun_angular_diameter = Some(1.0);
+        assert_eq!(unused(&s), ["screen.penumbra_rays"], "auto leaves an area light's penumbrae to the map");
+        s.screen.refine = Refine::Rays;
+        assert!(unused(&s).is_empty(), "refined penumbrae");
     }
 
     #[test]
