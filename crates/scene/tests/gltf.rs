@@ -99,6 +99,14 @@ fn truncated_and_garbage_files_do_not_panic() {
         let e = gltf_loader::load(&path).expect_err("truncated").to_string();
         assert!(e.contains(&format!("cut{cut}.glb")), "{e}");
     }
+    // A GLB header that declares fewer bytes than the header itself (found by
+    // fuzzing: the gltf crate's subtraction overflows on it).
+    let mut short = good.clone();
+    short[8..12].copy_from_slice(&0u32.to_le_bytes());
+    let path = dir.join("short.glb");
+    std::fs::write(&path, &short).unwrap();
+    let e = gltf_loader::load(&path).expect_err("a length below the header's").to_string();
+    assert!(e.contains("short.glb") && e.contains("declares a length of 0 bytes"), "{e}");
     let path = dir.join("noise.gltf");
     std::fs::write(&path, (0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 24) as u8).collect::<Vec<_>>())
         .unwrap();

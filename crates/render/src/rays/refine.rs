@@ -27,6 +27,8 @@ pub(crate) const COUNTER_STRIDE: u64 = 256;
 const COUNTER_BYTES: u64 = 16;
 /// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
 pub(crate) const PIXEL_BYTES: u64 = 8;
+/// Bytes of one listed pixel's penumbra filter radius.
+const RADIUS_BYTES: u64 = 4;
 
 /// The list's declarations, with the constants they share with Rust.
 fn list_wgsl() -> String {
@@ -112,7 +114,8 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
 }
 
 /// Group 2 of the trace and filter passes: the light's layer of the mask, written
-/// (0), and a copy of it as the trace pass left it, read by the filter pass (1).
+/// (0), a copy of it as the trace pass left it, read by the filter pass (1), and each
+/// listed pixel's filter radius, written by the trace pass and read by the filter (2).
 pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
@@ -137,6 +140,14 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
+                },
+            ),
+            entry(
+                2,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
                 },
             ),
         ],
@@ -225,10 +236,12 @@ pub(crate) struct TraceGroups<'a> {
 }
 
 /// A frame's list of unsure pixels (room for every pixel of the screen, reused by
-/// each light in turn) and each light's counters.
+/// each light in turn), each light's counters, and the listed pixels' penumbra
+/// filter radii (one word for each entry of the list).
 pub(crate) struct RefineLists {
     pub pixels: wgpu::Buffer,
     pub counters: wgpu::Buffer,
+    pub filter_radii: wgpu::Buffer,
 }
 
 impl RefineLists {
@@ -236,6 +249,11 @@ impl RefineLists {
     /// once per light.
     pub fn list_bytes(width: u32, height: u32) -> u64 {
         u64::from(width) * u64::from(height) * PIXEL_BYTES
+    }
+
+    /// Bytes of the filter radii for a `width` × `height` screen: less than the list's.
+    fn radii_bytes(width: u32, height: u32) -> u64 {
+        u64::from(width) * u64::from(height) * RADIUS_BYTES
     }
 
     /// The lists of a frame of `lights` lights on a `width` × `height` screen, from
@@ -251,7 +269,12 @@ impl RefineLists {
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         );
-        Self { pixels, counters }
+        let filter_radii = pool.buffer(
+            "penumbra filter radii",
+            Self::radii_bytes(width, height),
+            wgpu::BufferUsages::STORAGE,
+        );
+        Self { pixels, counters, filter_radii }
     }
 
     /// The dynamic offset of light `light`'s counters.
@@ -286,9 +309,10 @@ impl RefineLists {
         )
     }
 
-    /// The trace and filter passes' group 2: `mask_layer`, written, and `traced`, the
-    /// copy of it that the filter reads.
+    /// The trace and filter passes' group 2: `mask_layer`, written, `traced`, the
+    /// copy of it that the filter reads, and the filter radii.
     pub fn mask_group(
+        &self,
         pool: &mut Pool,
         layouts: &Layouts,
         mask_layer: &wgpu::TextureView,
@@ -297,7 +321,11 @@ impl RefineLists {
         pool.bind_group(
             "refined shadow mask",
             &layouts.refined_mask,
-            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone())],
+            &[
+                Binding::View(mask_layer.clone()),
+                Binding::View(traced.clone()),
+                Binding::Buffer(self.filter_radii.clone()),
+            ],
         )
     }
 

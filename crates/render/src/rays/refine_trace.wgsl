@@ -28,6 +28,9 @@ struct ListedPixels {
 @group(2) @binding(0) var refined_mask: texture_storage_2d<r32float, write>;
 // A copy of the mask as the trace pass left it, which the filter pass reads.
 @group(2) @binding(1) var traced_mask: texture_2d<f32>;
+// Each listed pixel's filter radius, by its index in the list: the trace pass
+// writes it from the penumbra's width, the filter pass reads it.
+@group(2) @binding(2) var<storage, read_write> filter_radii: array<u32>;
 
 // Declared for scene_common.wgsl's material helpers, which this pass never calls: the
 // two bindings of the tracer's group that trace.wgsl leaves free for them.
@@ -64,21 +67,58 @@ fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool
 }
 
 // The share of `light.penumbra_rays` rays from `origin` to points stratified over the
-// light's area that arrive. `pixel` seeds the pixel's own pattern, so neighbours'
-// errors are independent and the filter pass averages them down. A sample below the
-// surface's horizon is blocked by the surface itself, as in the reference.
-fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, pixel: u32) -> f32 {
+// light's area that arrive, and the mean distance to the caster that each blocked
+// ray met (-1 when none was blocked). `pixel` seeds the pixel's own pattern, so
+// neighbours' errors are independent and the filter pass averages them down. A
+// sample below the surface's horizon is blocked by the surface itself, as in the
+// reference, and has no caster's distance.
+fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, pixel: u32) -> vec2<f32> {
     let count = light.penumbra_rays;
     let grid = cmj_grid(count);
     let pattern = lowbias32(pixel ^ 0x9e3779b9u);
     var arrived = 0u;
+    var blocked = 0u;
+    var blocker_distance = 0.0;
     for (var s = 0u; s < count; s++) {
         let ray = light_sample(world, cmj(s, count, grid, pattern));
-        if dot(ray.xyz, geometric_n) > 0.0 && !ray_blocked(origin, ray.xyz, ray.w) {
+        if dot(ray.xyz, geometric_n) <= 0.0 {
+            continue;
+        }
+        let t = ray_first_hit(origin, ray.xyz, ray.w);
+        if t < 0.0 {
             arrived += 1u;
+        } else {
+            blocked += 1u;
+            blocker_distance += t;
         }
     }
-    return f32(arrived) / f32(count);
+    let mean_blocker = select(-1.0, blocker_distance / f32(max(blocked, 1u)), blocked > 0u);
+    return vec2<f32>(f32(arrived) / f32(count), mean_blocker);
+}
+
+// The penumbra filter's radius at a pixel whose blocked rays met casters `blocker`
+// away on average (-1: none), on a surface of normal `geometric_n` seen at
+// `view_depth`: a quarter of the penumbra's width in pixels, from similar triangles
+// (Fernando 2005: w = 2 r_light · d_blocker / (d_light − d_blocker) at the receiver,
+// 2 tan(θ_sun) · d_blocker under a sun), from 1 to MAX_FILTER_RADIUS. A binomial
+// kernel of radius r has a variance of r/2 px²; a penumbra w px wide from 10 % to
+// 90 % has one of about (w / 2.56)², so a radius of w / 4 widens it by
+// √(1 + 0.82 / w): 10 % at w = 4, 3 % at w = 12, while the noise of 16 rays falls
+// with every pixel the kernel takes in.
+fn penumbra_filter_radius(blocker: f32, world: vec3<f32>, geometric_n: vec3<f32>, view_depth: f32) -> u32 {
+    if blocker < 0.0 {
+        return 1u;
+    }
+    var width = 2.0 * light.light_size * blocker;
+    if light.kind != LIGHT_SUN {
+        width /= max(length(light.position - world) - blocker, 1e-6);
+    }
+    // On screen the receiver's plane is foreshortened by |n·v| across its steepest
+    // direction: the penumbra is at least that narrow there, and the kernel is round.
+    width *= abs(dot(geometric_n, normalize(camera.eye - world)));
+    let pixel_world = 2.0 * view_depth / (camera.scale_y * camera.height);
+    let radius = width / pixel_world / PIXELS_PER_FILTER_RADIUS;
+    return u32(clamp(radius, 1.0, f32(MAX_FILTER_RADIUS)));
 }
 
 @compute @workgroup_size(REFINE_GROUP_SIZE)
@@ -94,8 +134,9 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
         let origin = surface_ray_origin(world, geometric_n, view_depth);
         let layer = 2.0 * f32(entry.layer);
         if light.penumbra_rays > 0u {
-            let visibility = area_visibility(origin, world, geometric_n, entry.pixel);
-            textureStore(refined_mask, texel, vec4<f32>(layer + visibility, 0.0, 0.0, 0.0));
+            let traced = area_visibility(origin, world, geometric_n, entry.pixel);
+            textureStore(refined_mask, texel, vec4<f32>(layer + traced.x, 0.0, 0.0, 0.0));
+            filter_radii[index] = penumbra_filter_radius(traced.y, world, geometric_n, view_depth);
         } else if centre_ray_blocked(origin, world, light_geometry(world).xyz) {
             textureStore(refined_mask, texel, vec4<f32>(layer, 0.0, 0.0, 0.0));
         }
@@ -103,24 +144,26 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 }
 
 // The penumbra's filter, after the trace pass under a light with an area: each
-// listed pixel's visibility becomes a weighted average of its 3×3 neighbours',
+// listed pixel's visibility becomes a weighted average of its neighbours' within
+// the radius the trace pass chose from the penumbra's width (1 to
+// MAX_FILTER_RADIUS pixels),
 // traced or not, read from the copy `traced_mask` (a cross-bilateral filter, after
 // Tomasi & Manduchi 1998 and the joint bilateral upsampling of Kopf et al. 2007):
-// - spatial weights 1 2 1 / 2 4 2 / 1 2 1, a binomial kernel that leaves a
-//   visibility linear across three pixels unchanged;
+// - binomial spatial weights (1 2 1 at radius 1, 1 4 6 4 1 at 2, ...), which leave a
+//   visibility linear across the kernel unchanged;
 // - only neighbours on the same surface: within SURFACE_PIXELS pixel widths of the
 //   centre's tangent plane, with normals within SURFACE_COS, so that no caster's
 //   value is carried onto the floor behind it;
 // - only neighbours the light can reach (facing it, inside its cone);
 // - a range weight (`range_weight`) that keeps hard edges hard.
-// With each pixel's own pattern the estimates' noise is independent, and where all
-// nine count the weights' sum of squares is 36/256 of their squared sum: the noise's
-// standard deviation falls to 6/16 of one pixel's.
-// The kernel's reach in pixels, and its weights along each axis. A 5 × 5 binomial
-// did worse on `contact` (penumbra MAE 0.0192 against 0.0179): most penumbra pixels
-// lie within a few pixels of a contact, where a wider kernel blurs.
-const FILTER_RADIUS: i32 = 1;
-const BINOMIAL = array<f32, 3>(1.0, 2.0, 1.0);
+// With each pixel's own pattern the estimates' noise is independent: where all nine
+// of a radius-1 kernel count, its weights' sum of squares is 36/256 of their squared
+// sum, and the noise's standard deviation falls to 6/16 of one pixel's. A fixed
+// 5 × 5 kernel did worse than 3 × 3 on `contact` (penumbra MAE 0.0192 against
+// 0.0179): most penumbra pixels lie within a few pixels of a contact, where the
+// penumbra is narrow and a wide kernel blurs it. Hence the radius per pixel.
+const MAX_FILTER_RADIUS: u32 = 3u;
+const PIXELS_PER_FILTER_RADIUS: f32 = 4.0;
 // The range weight's width, in standard deviations of the estimates (1.5 and 2
 // measured 0.0191 and 0.0182 there, 3 measured 0.0179).
 const RANGE_SIGMAS: f32 = 3.0;
@@ -135,6 +178,17 @@ fn range_weight(p: f32, q: f32) -> f32 {
     let variance = max(p * (1.0 - p), q * (1.0 - q)) / f32(light.penumbra_rays);
     let d = p - q;
     return select(exp(-d * d / (2.0 * RANGE_SIGMAS * RANGE_SIGMAS * variance)), select(0.0, 1.0, d == 0.0), variance == 0.0);
+}
+
+// The binomial coefficient C(2r, r + d): the weight of offset d in a kernel of
+// radius r, 1 2 1 at r = 1.
+fn binomial(r: i32, d: i32) -> f32 {
+    let k = r + abs(d);
+    var c = 1.0;
+    for (var i = 1; i <= 2 * r - k; i++) {
+        c *= f32(k + i) / f32(i);
+    }
+    return c;
 }
 
 // The visibility of a mask texel, which stores it plus 2 × the map layer.
@@ -157,8 +211,9 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         let visibility = mask_visibility(textureLoad(traced_mask, texel, 0).x);
         var sum = 0.0;
         var weights = 0.0;
-        for (var dy = -FILTER_RADIUS; dy <= FILTER_RADIUS; dy++) {
-            for (var dx = -FILTER_RADIUS; dx <= FILTER_RADIUS; dx++) {
+        let radius = i32(min(filter_radii[index], MAX_FILTER_RADIUS));
+        for (var dy = -radius; dy <= radius; dy++) {
+            for (var dx = -radius; dx <= radius; dx++) {
                 let q = texel + vec2<i32>(dx, dy);
                 if any(q < vec2<i32>(0)) || any(q >= size) {
                     continue;
@@ -180,12 +235,12 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
                     continue;
                 }
                 let q_visibility = mask_visibility(textureLoad(traced_mask, q, 0).x);
-                let w = BINOMIAL[dx + FILTER_RADIUS] * BINOMIAL[dy + FILTER_RADIUS] * range_weight(visibility, q_visibility);
+                let w = binomial(radius, dx) * binomial(radius, dy) * range_weight(visibility, q_visibility);
                 sum += w * q_visibility;
                 weights += w;
             }
         }
-        // The centre always shares its own surface and weighs 4.
+        // The centre always shares its own surface, and weighs most.
         textureStore(refined_mask, texel, vec4<f32>(2.0 * f32(entry.layer) + sum / weights, 0.0, 0.0, 0.0));
     }
 }

@@ -129,8 +129,9 @@ fn gamma(n: f32) -> f32 {
     return e / (1.0 - e);
 }
 
-// Whether triangle `index` blocks the ray in (0, t_max]; its alpha test included.
-fn triangle_blocks(ray: ShearedRay, index: u32, t_max: f32) -> bool {
+// Where triangle `index` blocks the ray in (0, t_max], its alpha test included: the
+// distance along the ray, or -1 where it does not.
+fn triangle_hit(ray: ShearedRay, index: u32, t_max: f32) -> f32 {
     let tri = bvh_triangles[index];
     let a = tri.v0 - ray.origin;
     let b = tri.v1 - ray.origin;
@@ -146,11 +147,11 @@ fn triangle_blocks(ray: ShearedRay, index: u32, t_max: f32) -> bool {
     let v = ax * cy - ay * cx;
     let w = bx * ay - by * ax;
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return false;
+        return -1.0;
     }
     let det = u + v + w;
     if det == 0.0 {
-        return false;
+        return -1.0;
     }
     let az = s.z * a[ray.kz];
     let bz = s.z * b[ray.kz];
@@ -168,10 +169,10 @@ fn triangle_blocks(ray: ShearedRay, index: u32, t_max: f32) -> bool {
     let max_e = max(abs(u), max(abs(v), abs(w)));
     let delta_t = 3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) / abs(det);
     if !(t > delta_t && t <= t_max) {
-        return false;
+        return -1.0;
     }
     if tri.alpha == NO_ALPHA {
-        return true;
+        return t;
     }
     let test = bvh_alpha[tri.alpha];
     // U weighs the vertex opposite edge BC (A), V the one opposite CA (B), W C.
@@ -180,7 +181,7 @@ fn triangle_blocks(ray: ShearedRay, index: u32, t_max: f32) -> bool {
     if test.texture != NO_TEXTURE {
         alpha *= sample_alpha(bvh_alpha_textures[test.texture], uv);
     }
-    return alpha >= test.cutoff;
+    return select(-1.0, t, alpha >= test.cutoff);
 }
 
 // Entry distance of the ray into a node's box, or a negative value on a miss. The far
@@ -195,8 +196,16 @@ fn enter_box(node: BvhNode, origin: vec3<f32>, inv_direction: vec3<f32>, t_max: 
 }
 
 // Whether a shadow caster blocks the segment from `origin` along the unit
-// `direction` before `t_max`. Any hit ends the walk: a shadow ray needs no closest one.
+// `direction` before `t_max`.
 fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
+    return ray_first_hit(origin, direction, t_max) >= 0.0;
+}
+
+// The distance along the segment from `origin` along the unit `direction` to the
+// first caster the walk meets before `t_max`, or -1 where none blocks it. Any hit
+// ends the walk: a shadow ray needs no closest one, so this is some caster's
+// distance, not the nearest's.
+fn ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
     let ray = shear_ray(origin, direction);
     // A zero component would give an infinite reciprocal, and 0 · ∞ a NaN slab
     // distance that loses the box; a tiny component of the same sign gives a huge,
@@ -207,7 +216,7 @@ fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
     var top = 0u;
     var node_index = 0u;
     if enter_box(bvh_nodes[0], origin, inv_direction, t_max) < 0.0 {
-        return false;
+        return -1.0;
     }
     // A walk visits each node at most once; more steps than nodes means a broken tree,
     // and a shader that never ends would hang the device.
@@ -216,8 +225,9 @@ fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
         let node = bvh_nodes[node_index];
         if node.count > 0u {
             for (var i = node.first; i < node.first + node.count; i++) {
-                if triangle_blocks(ray, i, t_max) {
-                    return true;
+                let t = triangle_hit(ray, i, t_max);
+                if t >= 0.0 {
+                    return t;
                 }
             }
         } else {
@@ -243,12 +253,12 @@ fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
             }
         }
         if top == 0u {
-            return false;
+            return -1.0;
         }
         top--;
         node_index = stack[top];
     }
-    return false;
+    return -1.0;
 }
 
 // Moves a surface point off its surface along the geometric normal `n` (facing the

@@ -55,6 +55,7 @@ pub struct FileExtras {
 pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
     let fail = |problem: String| LoadError { path: path.to_path_buf(), problem };
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    glb_header_fits(&bytes).map_err(fail)?;
     // A first look without validation, for the problems validation would misname.
     if let Ok(raw) = gltf::Gltf::from_slice_without_validation(&bytes) {
         if raw.extensions_used().any(|e| e == "KHR_draco_mesh_compression") {
@@ -168,6 +169,28 @@ fn positions_readable(json: &gltf::json::Root) -> bool {
                     && matches!(accessor.component_type, Valid(GenericComponentType(ComponentType::F32))))
         })
     })
+}
+
+/// Refuses a binary glTF whose header declares a length shorter than the 12-byte
+/// header itself: the gltf crate (1.4.1, `Glb::from_slice`) subtracts the header's
+/// size from that length unchecked, which overflows (found by fuzzing).
+fn glb_header_fits(bytes: &[u8]) -> Result<(), String> {
+    const HEADER_BYTES: u32 = 12;
+    let Some(header) = bytes.strip_prefix(b"glTF") else { return Ok(()) };
+    let Some(length) = header.get(4..8) else {
+        return Err(format!(
+            "is a binary glTF (GLB) of {} bytes, shorter than the {HEADER_BYTES}-byte GLB header",
+            bytes.len()
+        ));
+    };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < HEADER_BYTES {
+        return Err(format!(
+            "is a binary glTF (GLB) whose header declares a length of {length} bytes, less than the \
+             {HEADER_BYTES}-byte header itself"
+        ));
+    }
+    Ok(())
 }
 
 /// The glTF extensions Gnomon reads; every other one is ignored (used) or refused
