@@ -2,7 +2,10 @@
 //! ranges give errors that name the setting and what is valid, never a panic.
 
 use gnomon_render::{Gpu, OutputRequest, RenderError, Renderer};
-use gnomon_scene::{Settings, builtin};
+use gnomon_scene::{
+    Settings, builtin,
+    settings::{Refine, Technique},
+};
 
 #[test]
 fn a_shadow_map_larger_than_the_device_allows_is_refused_by_name() {
@@ -46,4 +49,31 @@ fn an_empty_scene_is_refused() {
     scene.instances.clear();
     let err = renderer.render(&scene, &Settings::default(), &OutputRequest::default()).unwrap_err();
     assert!(matches!(err, RenderError::EmptyScene(_)), "{err:?}");
+}
+
+/// A host's device may have no more than WebGPU's default limits (the window example
+/// asks for just those): every pipeline, the ray tracer's included, must fit them.
+/// The trace pass once bound nine storage buffers, one more than the default allows.
+/// (Only the colour attachments' bytes per sample stay the adapter's: a frame read
+/// back whole, as `render` does, needs more than the default; a host drawing into its
+/// own target does not.)
+#[test]
+fn refined_frames_fit_webgpu_default_limits() {
+    let gpu = Gpu::new_headless_with(|l| {
+        *l = wgpu::Limits {
+            max_color_attachment_bytes_per_sample: l.max_color_attachment_bytes_per_sample,
+            ..wgpu::Limits::default()
+        }
+    })
+    .expect("adapter");
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (160, 90);
+    s.shadow.filter.technique = Technique::PCSS;
+    s.screen.refine = Refine::Rays;
+    for sun_disk in [None, Some(2.0)] {
+        s.light.sun_angular_diameter = sun_disk;
+        let frame = renderer.render(&builtin::contact(), &s, &OutputRequest::default()).unwrap();
+        assert!(frame.lights[0].traced_pixels.is_some_and(|p| p > 0), "{sun_disk:?}");
+    }
 }

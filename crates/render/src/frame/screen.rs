@@ -124,7 +124,7 @@ impl Renderer {
             };
             self.record_mask(rec, light, bindings, layer, &screen, index as u32);
             if let Some(Refining { lists, read, traced, .. }) = refined {
-                let mask = lists.mask_group(&mut self.pool, &self.layouts, layer, traced);
+                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer, traced);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
                 let groups = TraceGroups {
                     scene: &bindings.scene,

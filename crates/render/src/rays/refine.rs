@@ -27,8 +27,6 @@ pub(crate) const COUNTER_STRIDE: u64 = 256;
 const COUNTER_BYTES: u64 = 16;
 /// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
 pub(crate) const PIXEL_BYTES: u64 = 8;
-/// Bytes of one listed pixel's penumbra filter radius.
-const RADIUS_BYTES: u64 = 4;
 
 /// The list's declarations, with the constants they share with Rust.
 fn list_wgsl() -> String {
@@ -79,8 +77,8 @@ pub(crate) fn trace_pass_wgsl() -> String {
 pub(crate) enum ListAccess {
     /// The refining mask pass, which appends to the list and counts.
     Append,
-    /// The trace pass, which reads them, and dispatches by the counters: they must be
-    /// read-only there.
+    /// The trace pass, which reads them (writing only each entry's filter radius),
+    /// and dispatches by the counters: they must be read-only there.
     Read,
 }
 
@@ -100,22 +98,25 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
     };
     let buffer =
         |ty, has_dynamic_offset| wgpu::BindingType::Buffer { ty, has_dynamic_offset, min_binding_size: None };
-    let storage = wgpu::BufferBindingType::Storage { read_only };
+    // The trace pass writes each listed pixel's penumbra filter radius into its entry
+    // (refine_list.wgsl); the counters stay read-only there, as the dispatch's
+    // arguments.
+    let list = wgpu::BufferBindingType::Storage { read_only: false };
+    let counters = wgpu::BufferBindingType::Storage { read_only };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
         entries: &[
             entry(0, buffer(wgpu::BufferBindingType::Uniform, false)),
             entry(1, texture),
             entry(2, texture),
-            entry(3, buffer(storage, false)),
-            entry(4, buffer(storage, true)),
+            entry(3, buffer(list, false)),
+            entry(4, buffer(counters, true)),
         ],
     })
 }
 
 /// Group 2 of the trace and filter passes: the light's layer of the mask, written
-/// (0), a copy of it as the trace pass left it, read by the filter pass (1), and each
-/// listed pixel's filter radius, written by the trace pass and read by the filter (2).
+/// (0), and a copy of it as the trace pass left it, read by the filter pass (1).
 pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
@@ -140,14 +141,6 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
-                },
-            ),
-            entry(
-                2,
-                wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
                 },
             ),
         ],
@@ -236,12 +229,10 @@ pub(crate) struct TraceGroups<'a> {
 }
 
 /// A frame's list of unsure pixels (room for every pixel of the screen, reused by
-/// each light in turn), each light's counters, and the listed pixels' penumbra
-/// filter radii (one word for each entry of the list).
+/// each light in turn) and each light's counters.
 pub(crate) struct RefineLists {
     pub pixels: wgpu::Buffer,
     pub counters: wgpu::Buffer,
-    pub filter_radii: wgpu::Buffer,
 }
 
 impl RefineLists {
@@ -249,11 +240,6 @@ impl RefineLists {
     /// once per light.
     pub fn list_bytes(width: u32, height: u32) -> u64 {
         u64::from(width) * u64::from(height) * PIXEL_BYTES
-    }
-
-    /// Bytes of the filter radii for a `width` × `height` screen: less than the list's.
-    fn radii_bytes(width: u32, height: u32) -> u64 {
-        u64::from(width) * u64::from(height) * RADIUS_BYTES
     }
 
     /// The lists of a frame of `lights` lights on a `width` × `height` screen, from
@@ -269,12 +255,7 @@ impl RefineLists {
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         );
-        let filter_radii = pool.buffer(
-            "penumbra filter radii",
-            Self::radii_bytes(width, height),
-            wgpu::BufferUsages::STORAGE,
-        );
-        Self { pixels, counters, filter_radii }
+        Self { pixels, counters }
     }
 
     /// The dynamic offset of light `light`'s counters.
@@ -309,10 +290,9 @@ impl RefineLists {
         )
     }
 
-    /// The trace and filter passes' group 2: `mask_layer`, written, `traced`, the
-    /// copy of it that the filter reads, and the filter radii.
+    /// The trace and filter passes' group 2: `mask_layer`, written, and `traced`, the
+    /// copy of it that the filter reads.
     pub fn mask_group(
-        &self,
         pool: &mut Pool,
         layouts: &Layouts,
         mask_layer: &wgpu::TextureView,
@@ -321,11 +301,7 @@ impl RefineLists {
         pool.bind_group(
             "refined shadow mask",
             &layouts.refined_mask,
-            &[
-                Binding::View(mask_layer.clone()),
-                Binding::View(traced.clone()),
-                Binding::Buffer(self.filter_radii.clone()),
-            ],
+            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone())],
         )
     }
 

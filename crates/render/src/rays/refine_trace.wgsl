@@ -15,22 +15,20 @@
 // camera-facing geometric normal (the side the light is on, or the pixel would face
 // away from it and not be listed).
 
-// The list and the light's counters, read only: the counters are also the pass's
-// indirect dispatch, which no pass may write while it reads them so.
+// The light's counters, read only: they are also the pass's indirect dispatch, which
+// no pass may write while it reads them so.
 struct ListedPixels {
     groups: vec3<u32>,
     count: u32,
 };
 
-@group(1) @binding(3) var<storage, read> unsure_pixels: array<UnsurePixel>;
+// The list, whose entries the trace pass completes with their filter radius.
+@group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;
 @group(1) @binding(4) var<storage, read> listed: ListedPixels;
 
 @group(2) @binding(0) var refined_mask: texture_storage_2d<r32float, write>;
 // A copy of the mask as the trace pass left it, which the filter pass reads.
 @group(2) @binding(1) var traced_mask: texture_2d<f32>;
-// Each listed pixel's filter radius, by its index in the list: the trace pass
-// writes it from the penumbra's width, the filter pass reads it.
-@group(2) @binding(2) var<storage, read_write> filter_radii: array<u32>;
 
 // Declared for scene_common.wgsl's material helpers, which this pass never calls: the
 // two bindings of the tracer's group that trace.wgsl leaves free for them.
@@ -132,11 +130,13 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
         let geometric_n = octahedron_decode(textureLoad(prepass_normals, texel, 0).zw);
         let world = world_at(vec2<f32>(texel) + vec2<f32>(0.5), view_depth);
         let origin = surface_ray_origin(world, geometric_n, view_depth);
-        let layer = 2.0 * f32(entry.layer);
+        let map_layer = entry.layer & 0xffffu;
+        let layer = 2.0 * f32(map_layer);
         if light.penumbra_rays > 0u {
             let traced = area_visibility(origin, world, geometric_n, entry.pixel);
             textureStore(refined_mask, texel, vec4<f32>(layer + traced.x, 0.0, 0.0, 0.0));
-            filter_radii[index] = penumbra_filter_radius(traced.y, world, geometric_n, view_depth);
+            let radius = penumbra_filter_radius(traced.y, world, geometric_n, view_depth);
+            unsure_pixels[index].layer = map_layer | (radius << 16u);
         } else if centre_ray_blocked(origin, world, light_geometry(world).xyz) {
             textureStore(refined_mask, texel, vec4<f32>(layer, 0.0, 0.0, 0.0));
         }
@@ -145,8 +145,8 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 
 // The penumbra's filter, after the trace pass under a light with an area: each
 // listed pixel's visibility becomes a weighted average of its neighbours' within
-// the radius the trace pass chose from the penumbra's width (1 to
-// MAX_FILTER_RADIUS pixels),
+// the radius the trace pass chose from the penumbra's width and stored in the
+// pixel's entry (1 to MAX_FILTER_RADIUS pixels),
 // traced or not, read from the copy `traced_mask` (a cross-bilateral filter, after
 // Tomasi & Manduchi 1998 and the joint bilateral upsampling of Kopf et al. 2007):
 // - binomial spatial weights (1 2 1 at radius 1, 1 4 6 4 1 at 2, ...), which leave a
@@ -211,7 +211,7 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         let visibility = mask_visibility(textureLoad(traced_mask, texel, 0).x);
         var sum = 0.0;
         var weights = 0.0;
-        let radius = i32(min(filter_radii[index], MAX_FILTER_RADIUS));
+        let radius = i32(clamp(entry.layer >> 16u, 1u, MAX_FILTER_RADIUS));
         for (var dy = -radius; dy <= radius; dy++) {
             for (var dx = -radius; dx <= radius; dx++) {
                 let q = texel + vec2<i32>(dx, dy);
@@ -241,6 +241,6 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
             }
         }
         // The centre always shares its own surface, and weighs most.
-        textureStore(refined_mask, texel, vec4<f32>(2.0 * f32(entry.layer) + sum / weights, 0.0, 0.0, 0.0));
+        textureStore(refined_mask, texel, vec4<f32>(2.0 * f32(entry.layer & 0xffffu) + sum / weights, 0.0, 0.0, 0.0));
     }
 }
