@@ -216,8 +216,9 @@ impl TracePass {
 pub(crate) struct TraceGroups<'a> {
     /// The instances and the light's uniform.
     pub scene: &'a wgpu::BindGroup,
-    /// The camera, the prepass, the list and the counters, read only
-    /// ([`RefineLists::group`] with [`ListAccess::Read`]).
+    /// The camera, the prepass, the list (whose entries the trace pass completes
+    /// with their filter radius) and the counters, read only ([`RefineLists::group`]
+    /// with [`ListAccess::Read`]).
     pub screen: &'a wgpu::BindGroup,
     /// The light's layer of the mask, written, and the copy the filter reads
     /// ([`RefineLists::mask_group`]).
