@@ -45,6 +45,11 @@ pub struct BenchArgs {
     /// a ratio of it.
     #[arg(long, help_heading = "Benchmark")]
     pub depth_only: bool,
+    /// Sway N instances (spread over the scene's list) by a hundredth of the scene's
+    /// size every frame, and time how long the renderer takes to follow them (`CPU
+    /// move`: transforms, culling trees and, with rays, the BVH refitted).
+    #[arg(long, value_name = "N", help_heading = "Benchmark")]
+    pub moving: Option<usize>,
     /// How to time passes: GPU timestamps where the adapter has them (else the CPU
     /// wall clock), or the CPU wall clock always.
     #[arg(long, value_enum, default_value_t = ClockArg::Auto, help_heading = "Benchmark")]
@@ -135,6 +140,10 @@ struct Report {
     warmup: u32,
     frames: u32,
     sweep: Option<String>,
+    /// With --moving: how many instances moved every frame, and the time to build
+    /// the casters' BVH afresh, for scale against the refits in `CPU move`.
+    moving: Option<usize>,
+    rebuild_ms: Option<f64>,
     command: String,
     configs: Vec<ConfigReport>,
 }
@@ -144,7 +153,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.warmup <= 10_000, "--warmup {}: give 0 to 10000", args.warmup);
     args.settings.validate()?;
     output::check_dir(&args.out, "--out")?;
-    let (scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
+    let (mut scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
+    let mover = args.moving.map(|count| crate::bench_moving::Mover::new(&scene, count)).transpose()?;
     if let Some((width, height)) = args.size {
         base.image.width = width;
         base.image.height = height;
@@ -161,7 +171,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     for config in &configs {
         renderer.check_limits(&config.settings).with_context(|| config_name(args, config))?;
     }
-    let uploaded = renderer.upload(&scene)?;
+    let mut uploaded = renderer.upload(&scene)?;
     let baseline = if args.depth_only { Some(renderer.upload_depth_baseline(&scene)?) } else { None };
     let clock = match args.clock {
         ClockArg::Auto => ClockChoice::Auto,
@@ -180,7 +190,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     for config in &configs {
         progress.set_prefix(config_name(args, config));
         let settings = &config.settings;
+        let mut frame = 0;
         for _ in 0..args.warmup {
+            if let Some(mover) = &mover {
+                mover.step(&renderer, &mut uploaded, &mut scene, frame)?;
+                frame += 1;
+            }
             renderer.time_passes(&uploaded, &scene, settings, clock)?;
             if let Some(baseline) = &baseline {
                 renderer.time_depth_baseline(baseline, &uploaded, &scene, settings, clock)?;
@@ -197,6 +212,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         };
         let mut last: Option<FrameCost> = None;
         for _ in 0..args.frames {
+            if let Some(mover) = &mover {
+                push("CPU move".into(), mover.step(&renderer, &mut uploaded, &mut scene, frame)?);
+                frame += 1;
+            }
             let started = Instant::now();
             let cost = renderer.time_passes(&uploaded, &scene, settings, clock)?;
             let wall_ms = started.elapsed().as_secs_f64() * 1e3;
@@ -295,6 +314,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         warmup: args.warmup,
         frames: args.frames,
         sweep: args.sweep.clone(),
+        moving: mover.as_ref().map(|m| m.count()),
+        rebuild_ms: mover
+            .as_ref()
+            .map(|_| crate::bench_moving::Mover::rebuild_ms(&gpu, &scene))
+            .transpose()?,
         command: std::env::args().collect::<Vec<_>>().join(" "),
         configs: reports,
     };
@@ -402,7 +426,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
     let _ = writeln!(md, "# gnomon bench: {}\n", report.scene);
     let _ = writeln!(
         md,
-        "- adapter: {} ({}, {}), driver: {} {}\n- timing: {}\n- {} instances, {} triangles; image {}×{}; \
+        "- adapter: {} ({}, {}), driver: {} {}\n- timing: {}\n- {} instances{}, {} triangles; image {}×{}; \
          {} warm-up and {} timed frames per row; times in ms, median (p95)\n- command: `{}`\n",
         info.adapter,
         info.device_type,
@@ -411,6 +435,12 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         info.driver_info,
         report.timing,
         report.instances,
+        match (report.moving, report.rebuild_ms) {
+            (Some(n), Some(ms)) => format!(
+                " ({n} moving every frame: `CPU move`; building the casters' BVH afresh takes {ms:.1} ms)"
+            ),
+            _ => String::new(),
+        },
         report.triangles,
         report.width,
         report.height,
@@ -427,7 +457,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
     }
     // In frame order, whichever configurations have them.
-    const ORDER: [&str; 13] = [
+    const ORDER: [&str; 14] = [
         "shadow",
         "filter",
         "prepass",
@@ -435,6 +465,7 @@ fn markdown(report: &Report, info: &GpuInfo) -> String {
         "trace",
         "lighting",
         "GPU frame",
+        "CPU move",
         "CPU submit",
         "CPU fit",
         "CPU cull",

@@ -2,6 +2,7 @@
 //! settings in `gnomon-scene`), runs the renderer, and writes images and float outputs.
 
 mod bench_cmd;
+mod bench_moving;
 mod cache;
 mod calibrate;
 mod compare_cmd;
@@ -137,6 +138,7 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::Scene(_)
         | RenderError::EmptyScene(_)
         | RenderError::SceneTooLarge { .. }
+        | RenderError::UnknownInstance { .. }
         | RenderError::Gpu { .. } => None,
     }
 }

@@ -509,6 +509,8 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
             "--size",
             "96x64",
             "--depth-only",
+            "--moving",
+            "2",
             "--out",
             "b",
         ],
@@ -521,6 +523,7 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("b/bench.json")).unwrap()).unwrap();
     assert!(!report["adapter"].as_str().unwrap().is_empty() && report["driver"].is_string());
     assert_eq!((report["width"].as_u64(), report["height"].as_u64()), (Some(96), Some(64)));
+    assert!(report["moving"] == 2 && report["rebuild_ms"].as_f64().unwrap() > 0.0, "{report}");
     let configs = report["configs"].as_array().unwrap();
     let labels: Vec<(String, String)> = configs
         .iter()
@@ -531,7 +534,7 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
     for config in configs {
         let pass =
             |name: &str| config["passes"].as_array().unwrap().iter().find(|p| p["name"] == name).cloned();
-        for name in ["shadow", "lighting", "GPU frame", "CPU submit", "wall frame"] {
+        for name in ["shadow", "lighting", "GPU frame", "CPU submit", "wall frame", "CPU move"] {
             let p = pass(name).unwrap_or_else(|| panic!("no {name} in {config}"));
             let (median, p95) = (p["median_ms"].as_f64().unwrap(), p["p95_ms"].as_f64().unwrap());
             assert!(median > 0.0 && p95 >= median && p["samples"] == 3, "{name}: {p}");
@@ -567,6 +570,7 @@ fn bench_times_each_pass_and_layer_per_technique_and_sweep_value() {
         (&["bench", "--sweep", "shadow-res=100"][..], "--sweep shadow-res=100"),
         (&["bench", "--size", "12"][..], "WIDTHxHEIGHT"),
         (&["bench", "--frames", "0"][..], "--frames 0"),
+        (&["bench", "--moving", "0"][..], "--moving 0: give 1 to"),
         (&["bench", "instances:5"][..], "from 10 to 4000000"),
     ] {
         let out = gnomon(dir, args);

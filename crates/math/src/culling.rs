@@ -145,6 +145,30 @@ impl CullTree {
         Self::build_node(bounds, right, first + half, nodes);
     }
 
+    /// Gives the instance at `index` in the tree's order new bounds (it moved) and
+    /// refits every node's box to its children, bottom-up, keeping the tree's shape.
+    /// Culling stays exact, since every box still holds its subtree; only its speed
+    /// suffers when instances move far from where the tree grouped them, and then a
+    /// new [`CullTree::build`] pays off. Out-of-range indices are ignored.
+    pub fn refit(&mut self, moved: impl IntoIterator<Item = (u32, Aabb)>) {
+        for (index, bounds) in moved {
+            if let Some(slot) = self.bounds.get_mut(index as usize) {
+                *slot = bounds;
+            }
+        }
+        // Children follow their parent in the node array (the left one directly, the
+        // right one later), so a reverse sweep meets every child before its parent.
+        for index in (0..self.nodes.len()).rev() {
+            let node = self.nodes[index];
+            self.nodes[index].bounds = if node.right == 0 {
+                let range = node.first as usize..(node.first + node.count) as usize;
+                self.bounds[range].iter().copied().fold(Aabb::EMPTY, Aabb::union)
+            } else {
+                self.nodes[index + 1].bounds.union(self.nodes[node.right as usize].bounds)
+            };
+        }
+    }
+
     /// How many instances the tree holds.
     pub fn len(&self) -> usize {
         self.bounds.len()
@@ -274,6 +298,38 @@ mod tests {
                 assert!(runs.windows(2).all(|w| w[0].end < w[1].start), "adjacent runs are merged");
                 let expected: Vec<u32> = (0..count as u32)
                     .filter(|&i| frustum.intersects(&boxes[order[i as usize] as usize], near))
+                    .collect();
+                assert_eq!(culled, expected);
+            }
+        }
+    }
+
+    #[test]
+    fn a_refitted_tree_culls_exactly_what_the_box_test_culls() {
+        // Property: after random instances move anywhere (far from where the tree
+        // grouped them), culling still returns exactly the boxes the per-box test
+        // accepts.
+        let mut rng = Lcg(19);
+        for count in [1, 9, 100, 2000] {
+            let mut boxes = scattered_boxes(&mut rng, count);
+            let (mut tree, order) = CullTree::build(&boxes);
+            let moved: Vec<u32> = (0..count as u32).filter(|_| rng.next() < 0.3).collect();
+            for &i in &moved {
+                let replacement = scattered_boxes(&mut rng, 1)[0];
+                boxes[order[i as usize] as usize] = replacement;
+            }
+            tree.refit(moved.iter().map(|&i| (i, boxes[order[i as usize] as usize])));
+            assert_eq!(tree.bounds(), boxes.iter().copied().fold(Aabb::EMPTY, Aabb::union));
+            for _ in 0..20 {
+                let eye = rng.vec(-150.0, 150.0);
+                let view = crate::view_from_world_look_at(eye, eye + rng.vec(-1.0, 1.0), Vec3::Y);
+                let projection = crate::camera_clip_from_view(1.0, 1.5, 0.5, rng.range(20.0, 300.0));
+                let frustum = Frustum::from_clip_from_world(projection * view);
+                let mut runs = Vec::new();
+                tree.cull(&frustum, true, &mut runs);
+                let culled: Vec<u32> = runs.iter().flat_map(|r| r.clone()).collect();
+                let expected: Vec<u32> = (0..count as u32)
+                    .filter(|&i| frustum.intersects(&boxes[order[i as usize] as usize], true))
                     .collect();
                 assert_eq!(culled, expected);
             }

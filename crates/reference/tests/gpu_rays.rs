@@ -177,3 +177,37 @@ fn a_scene_without_casters_blocks_nothing() {
     assert!(tracer.occluded(&rays).unwrap().iter().all(|b| !b));
     assert!(tracer.occluded(&[]).unwrap().is_empty());
 }
+
+#[test]
+fn a_refitted_tree_answers_as_the_reference_of_the_moved_scene() {
+    // Every sphere of `spheres` moves (turned, lifted, one far past the old bounds):
+    // the refitted GPU tree must answer as the CPU reference built afresh on the moved
+    // scene, while the tree before the move disagrees with it on many rays.
+    let mut scene = builtin::spheres();
+    let mut tracer = ShadowRays::new(gpu(), &scene).unwrap();
+    let moved: Vec<usize> = (1..scene.instances.len()).collect();
+    for (k, &i) in moved.iter().enumerate() {
+        let lift = Mat4::from_translation(Vec3::new(0.4 * k as f32, 0.7, -0.3 * k as f32));
+        scene.instances[i].world_from_object =
+            lift * Mat4::from_rotation_y(0.5) * scene.instances[i].world_from_object;
+    }
+    scene.instances[moved[0]].world_from_object *= Mat4::from_translation(Vec3::new(12.0, 0.0, 0.0));
+    let rays = random_rays(&scene, 20_000, 0x2545_f491_4f6c_dd1d);
+    let cpu = TracedScene::build(&scene);
+    let truth: Vec<bool> = rays.iter().map(|r| cpu.occluded(r.origin, r.direction, r.length)).collect();
+    let differ = |answers: &[bool]| answers.iter().zip(&truth).filter(|(a, b)| a != b).count();
+    let stale = differ(&tracer.occluded(&rays).unwrap());
+    tracer.move_instances(&scene, &moved).unwrap();
+    let wrong = differ(&tracer.occluded(&rays).unwrap());
+    figure(
+        &format!(
+            "gpu rays after a refit vs cpu on the moved scene: disagreements of 20,000 (before the refit: {stale})"
+        ),
+        wrong,
+        2,
+    );
+    assert!(stale > 500, "the move should change many answers: {stale}");
+    assert!(wrong <= 2, "{wrong} of {} rays answered differently after the refit", rays.len());
+    let e = tracer.move_instances(&scene, &[99]).unwrap_err().to_string();
+    assert!(e.contains("no instance 99"), "{e}");
+}

@@ -1,5 +1,6 @@
 //! Shadows refined by GPU rays (`--refine`) against the reference: exact where the
-//! map alone is not, on the built-in scenes and on casters thinner than a texel.
+//! map alone is not, on the built-in scenes and on casters thinner than a texel, and
+//! after casters move.
 
 mod common;
 
@@ -9,6 +10,7 @@ use common::{
     reference, render,
 };
 use glam::{Mat4, Vec3};
+use gnomon_render::{OutputRequest, Renderer};
 use gnomon_scene::{
     Camera, DirectionalLight, Instance, Material, Scene, Settings, builtin, geometry,
     settings::{Refine, Technique},
@@ -146,4 +148,57 @@ fn casters_thinner_than_a_texel_are_shadowed_exactly_only_with_rays() {
     figure("thin bars, refined by rays: mismatch", percent(refined.mismatch_rate), percent(REFINED_MISMATCH));
     assert!(map.mismatch_rate > 0.005, "the map alone should miss sub-texel bars: {map:?}");
     assert!(refined.mismatch_rate <= REFINED_MISMATCH, "{refined:?}");
+}
+
+#[test]
+fn moved_casters_are_traced_where_they_now_stand() {
+    // Issue 25: "the BVH refit follows a moved instance". One column is laid across
+    // the aisle in view, another moved behind the camera, past the scene's old
+    // bounds; the uploaded scene follows them by a refit (`Renderer::move_instances`),
+    // and its refined and traced frames must match the reference of the moved scene
+    // as closely as a fresh upload's do.
+    let mut scene = builtin::columns();
+    let mut renderer = Renderer::new(common::gpu()).unwrap();
+    let mut uploaded = renderer.upload(&scene).unwrap();
+    let request = OutputRequest::default();
+    let before =
+        renderer.render_uploaded(&uploaded, &scene, &settings(Refine::EveryPixel), &request).unwrap();
+    let index = |name: &str| scene.instances.iter().position(|i| i.name == name).unwrap();
+    let (laid, behind) = (index("column L1"), index("column R0"));
+    scene.instances[laid].world_from_object = Mat4::from_translation(Vec3::new(3.0, 0.6, -11.0))
+        * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    scene.instances[behind].world_from_object = Mat4::from_translation(Vec3::new(2.0, 0.0, 30.0));
+    renderer.move_instances(&mut uploaded, &scene, &[laid, behind]).unwrap();
+    let truth = reference(&scene, &settings(Refine::Off));
+    let stale = compare(&before, &truth);
+    for (refine, bound) in [(Refine::EveryPixel, TRACED_MISMATCH), (Refine::Rays, REFINED_MISMATCH)] {
+        let frame = renderer.render_uploaded(&uploaded, &scene, &settings(refine), &request).unwrap();
+        let moved = compare(&frame, &truth);
+        figure(
+            &format!(
+                "columns, two columns moved, {refine:?} after a refit: mismatch (before the move: {})",
+                percent(stale.mismatch_rate)
+            ),
+            percent(moved.mismatch_rate),
+            percent(bound),
+        );
+        assert!(moved.mismatch_rate <= bound, "{refine:?}: {moved:?}");
+    }
+    assert!(stale.mismatch_rate > 0.005, "the move should change the shadows: {stale:?}");
+    // The map alone (moved transforms, refitted culling trees and bounds) draws what a
+    // fresh upload of the moved scene draws.
+    let unrefined = renderer.render_uploaded(&uploaded, &scene, &settings(Refine::Off), &request).unwrap();
+    let fresh = render(&scene, &settings(Refine::Off));
+    let differing =
+        unrefined.visibility.iter().zip(&fresh.visibility).filter(|(a, b)| (*a - *b).abs() > 0.01).count();
+    assert!(
+        differing as f64 <= 1e-4 * fresh.pixel_count() as f64,
+        "{differing} pixels differ from a fresh upload"
+    );
+    // A bad move is refused before anything changes.
+    let e = renderer.move_instances(&mut uploaded, &scene, &[scene.instances.len()]).unwrap_err().to_string();
+    assert!(e.contains(&format!("no instance {}", scene.instances.len())), "{e}");
+    scene.instances[laid].world_from_object.x_axis.y = f32::INFINITY;
+    let e = renderer.move_instances(&mut uploaded, &scene, &[laid]).unwrap_err().to_string();
+    assert!(e.contains("column L1") && e.contains("non-finite"), "{e}");
 }

@@ -86,6 +86,11 @@ pub struct GpuScene {
     pub(crate) material_groups: Vec<wgpu::BindGroup>,
     /// The world bounds of every instance: what a light's projection is fitted to.
     pub(crate) bounds: Aabb,
+    /// Each scene instance's slot in the instance buffer (None for one without
+    /// geometry, which is not uploaded).
+    slots: Vec<Option<u32>>,
+    /// Each mesh's bounds in its own space, for a moved instance's new box.
+    mesh_bounds: Vec<Aabb>,
 }
 
 impl GpuScene {
@@ -120,7 +125,11 @@ impl GpuScene {
         });
         let bounds = batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
 
-        let instance_data = instance_data(scene, &order);
+        let mut slots = vec![None; scene.instances.len()];
+        for (slot, &index) in order.iter().enumerate() {
+            slots[index] = Some(slot as u32);
+        }
+        let instance_data: Vec<InstanceGpu> = order.iter().map(|&i| instance_gpu(scene, i)).collect();
         let instance_bytes = std::mem::size_of_val(instance_data.as_slice()) as u64;
         let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         if instance_bytes > limit {
@@ -153,14 +162,59 @@ impl GpuScene {
             instances: buffer(
                 "scene instances",
                 bytemuck::cast_slice(&instance_data),
-                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+                // Moving an instance rewrites its record in place.
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
             ),
             batches,
             rays: std::sync::OnceLock::new(),
             shadow_order,
             material_groups: material_groups(gpu, scene, layouts),
             bounds,
+            slots,
+            mesh_bounds,
         })
+    }
+
+    /// Follows instances that moved: `scene` (the one this was uploaded from) holds
+    /// the new transforms of the instances numbered in `moved`. Rewrites their
+    /// transforms on the GPU, refits the culling trees and the scene's bounds, and
+    /// refits the casters' BVH if one was built for rays, all without a rebuild.
+    /// Refuses an index that is not the scene's, or a non-finite transform, before
+    /// changing anything.
+    pub(crate) fn move_instances(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+        moved: &[usize],
+    ) -> Result<(), RenderError> {
+        check_moved(scene, moved)?;
+        let size = std::mem::size_of::<InstanceGpu>() as u64;
+        let mut refits: Vec<Vec<(u32, Aabb)>> = vec![Vec::new(); self.batches.len()];
+        gpu.checked("moving instances", || {
+            for &index in moved {
+                let Some(slot) = self.slots[index] else { continue };
+                gpu.queue.write_buffer(
+                    &self.instances,
+                    slot as u64 * size,
+                    bytemuck::bytes_of(&instance_gpu(scene, index)),
+                );
+                // The batches hold consecutive slots, in order.
+                let batch = self.batches.partition_point(|b| b.first_instance <= slot) - 1;
+                let inst = &scene.instances[index];
+                let bounds = self.mesh_bounds[inst.mesh].transformed(inst.world_from_object);
+                refits[batch].push((slot - self.batches[batch].first_instance, bounds));
+            }
+        })?;
+        for (batch, moved) in self.batches.iter_mut().zip(refits) {
+            if !moved.is_empty() {
+                batch.tree.refit(moved);
+            }
+        }
+        self.bounds = self.batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
+        if let Some(Ok(bvh)) = self.rays.get_mut() {
+            bvh.refit(gpu, scene, moved)?;
+        }
+        Ok(())
     }
 
     /// Builds and uploads the shadow casters' BVH for ray-traced refinement, once:
@@ -403,31 +457,45 @@ fn batch_instances(
     (batches, order)
 }
 
-/// Each instance's GPU record, in buffer order.
-fn instance_data(scene: &Scene, order: &[usize]) -> Vec<InstanceGpu> {
-    order
-        .iter()
-        .map(|&i| {
-            let inst = &scene.instances[i];
-            let material = &scene.materials[inst.material];
-            let cutoff = match material.alpha_mode {
-                AlphaMode::Mask { cutoff } => cutoff,
-                AlphaMode::Opaque | AlphaMode::Blend => -1.0,
-            };
-            InstanceGpu {
-                world_from_object: inst.world_from_object,
-                base_color: material.base_color.extend(material.alpha),
-                // The object id is the scene's instance index + 1, whatever the
-                // buffer's order.
-                specular: material.specular,
-                shininess: material.shininess,
-                object_id: (i + 1) as u32,
-                alpha_cutoff: cutoff,
-                textured: material.base_color_texture.is_some().into(),
-                _pad0: 0,
-                _pad1: 0,
-                _pad2: 0,
+/// The GPU record of the scene's instance `i`.
+fn instance_gpu(scene: &Scene, i: usize) -> InstanceGpu {
+    let inst = &scene.instances[i];
+    let material = &scene.materials[inst.material];
+    let cutoff = match material.alpha_mode {
+        AlphaMode::Mask { cutoff } => cutoff,
+        AlphaMode::Opaque | AlphaMode::Blend => -1.0,
+    };
+    InstanceGpu {
+        world_from_object: inst.world_from_object,
+        base_color: material.base_color.extend(material.alpha),
+        // The object id is the scene's instance index + 1, whatever the buffer's order.
+        specular: material.specular,
+        shininess: material.shininess,
+        object_id: (i + 1) as u32,
+        alpha_cutoff: cutoff,
+        textured: material.base_color_texture.is_some().into(),
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
+    }
+}
+
+/// Refuses a moved instance that is not `scene`'s, or whose new transform is not
+/// finite: what [`GpuScene::move_instances`] and [`crate::rays::ShadowRays`] check
+/// before they change anything.
+pub(crate) fn check_moved(scene: &Scene, moved: &[usize]) -> Result<(), RenderError> {
+    let count = scene.instances.len();
+    for &index in moved {
+        let Some(inst) = scene.instances.get(index) else {
+            return Err(RenderError::UnknownInstance { scene: scene.name.clone(), index, count });
+        };
+        if !inst.world_from_object.is_finite() {
+            return Err(gnomon_scene::SceneError::NonFiniteTransform {
+                scene: scene.name.clone(),
+                instance: inst.name.clone(),
             }
-        })
-        .collect()
+            .into());
+        }
+    }
+    Ok(())
 }

@@ -152,6 +152,18 @@ pub enum RenderError {
         /// The most instances that fit in `limit`.
         max_instances: u64,
     },
+    /// An instance to move is not one of the uploaded scene's.
+    #[error(
+        "scene `{scene}` has {count} instances, numbered 0 to {count} − 1: there is no instance {index} to move"
+    )]
+    UnknownInstance {
+        /// Name of the scene.
+        scene: String,
+        /// The index asked for.
+        index: usize,
+        /// How many instances the scene has.
+        count: usize,
+    },
     /// The GPU ray tracer cannot take the scene or the frame on this device
     /// ([`crate::rays::RaysUnavailable`]). A frame that asked for refinement by rays
     /// does not fail for it: it is drawn unrefined and reports why

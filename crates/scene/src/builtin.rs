@@ -525,6 +525,15 @@ mod tests {
     }
 
     #[test]
+    fn a_non_finite_transform_is_refused_naming_the_instance() {
+        let mut scene = spheres();
+        scene.instances[1].world_from_object.w_axis.x = f32::NAN;
+        let name = scene.instances[1].name.clone();
+        let e = scene.validate().unwrap_err().to_string();
+        assert!(e.contains(&format!("instance `{name}`")) && e.contains("non-finite transform"), "{e}");
+    }
+
+    #[test]
     fn instances_takes_its_count_and_keeps_nine_tenths_far_away() {
         assert_eq!(build("instances").unwrap().instances.len(), 1 + DEFAULT_INSTANCES);
         let scene = build("instances:2_000").unwrap();

@@ -485,6 +485,9 @@ impl Scene {
                     count: self.meshes.len(),
                 });
             }
+            if !i.world_from_object.is_finite() {
+                return Err(SceneError::NonFiniteTransform { scene, instance: i.name.clone() });
+            }
             if i.material >= self.materials.len() {
                 return Err(SceneError::MaterialOutOfRange {
                     scene,

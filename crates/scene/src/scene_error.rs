@@ -67,6 +67,14 @@ pub enum SceneError {
         /// Name of the mesh at fault.
         mesh: String,
     },
+    /// An instance's transform has an infinite or NaN entry.
+    #[error("scene `{scene}`: instance `{instance}` has a non-finite transform (world_from_object)")]
+    NonFiniteTransform {
+        /// Name of the scene at fault.
+        scene: String,
+        /// Name of the instance at fault.
+        instance: String,
+    },
     /// A material's base-colour texture index is not below the number of textures.
     #[error(
         "scene `{scene}`: material `{material}` refers to texture {texture}, but there are {count} textures"

@@ -138,6 +138,24 @@ impl Renderer {
         GpuScene::upload(&self.gpu, scene, &self.layouts)
     }
 
+    /// Follows instances that moved since `uploaded` was made from `scene`: set their
+    /// new `world_from_object` in `scene`, then name them here (by their index in
+    /// `scene.instances`). Their transforms are rewritten on the GPU, and the culling
+    /// trees, the bounds the lights are fitted to and (once built for rays) the casters'
+    /// BVH are refitted, not rebuilt: the next frame draws and traces the scene as it
+    /// now stands, at a cost that follows what moved, not the scene's size. Anything
+    /// else changed in `scene` (meshes, materials, which instances cast) needs a new
+    /// [`Renderer::upload`]. An index out of range or a non-finite transform is
+    /// refused, naming it, before anything changes.
+    pub fn move_instances(
+        &self,
+        uploaded: &mut GpuScene,
+        scene: &Scene,
+        moved: &[usize],
+    ) -> Result<(), RenderError> {
+        uploaded.move_instances(&self.gpu, scene, moved)
+    }
+
     /// Checks `settings` against the device's limits and the registered techniques,
     /// for a frame Gnomon draws.
     pub fn check_limits(&self, settings: &Settings) -> Result<(), RenderError> {

@@ -4,11 +4,21 @@
 //! material needs (its UVs, cutoff and the alpha channel of its texture).
 //!
 //! Non-casters are left out: a shadow ray only asks whether something blocks it.
+//!
+//! When instances move, [`CasterBvh::refit`] moves their triangles and refits the
+//! boxes bottom-up over the same tree (Wald, Boulos & Shirley, "Ray tracing deformable
+//! scenes using dynamic bounding volume hierarchies", ACM TOG 26(1), 2007): linear in
+//! the tree's size, with no build, and every box still bounds its subtree, so rays
+//! get the same answers as from a fresh build; only traversal slows if instances move
+//! far from where the build grouped them.
+
+use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec3A};
 use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
+use rayon::prelude::*;
 
 /// The deepest BVH `trace.wgsl` walks: the size of its traversal stack
 /// (`TRACE_STACK_SIZE` there, which `rays::wgsl` writes from this constant). A deeper
@@ -85,6 +95,35 @@ pub(crate) fn wrap_code(wrap: Wrap) -> u32 {
     }
 }
 
+/// Where each caster's triangles lie in a built tree: what a refit needs.
+#[derive(Debug, Default)]
+pub(crate) struct TreeShape {
+    /// For each scene instance, its triangles' range in gathering order (empty for
+    /// one that casts no shadow).
+    instance_triangles: Vec<Range<u32>>,
+    /// For each gathered triangle, its position in the leaves (`triangles`).
+    leaf_of: Vec<u32>,
+    /// For each position in `triangles`, the leaf node holding it.
+    leaf_node: Vec<u32>,
+    /// Each node's parent ([`NO_PARENT`] for the root) and depth (the root's is 1).
+    parent: Vec<u32>,
+    depth: Vec<u32>,
+    /// The inner nodes, deepest first: the order a refit of the whole tree takes.
+    inner_deepest_first: Vec<u32>,
+    /// The absolute part of every box's padding (see [`triangle_box`]).
+    pad: f32,
+}
+
+/// The root's parent in [`TreeShape::parent`].
+const NO_PARENT: u32 = u32::MAX;
+
+/// What a refit changed, as runs of elements to upload.
+#[derive(Debug, Default, PartialEq)]
+pub(crate) struct Refitted {
+    pub nodes: Vec<Range<u32>>,
+    pub triangles: Vec<Range<u32>>,
+}
+
 /// The casters' BVH on the CPU, ready to upload.
 #[derive(Debug, Default)]
 pub(crate) struct CasterBvh {
@@ -97,12 +136,15 @@ pub(crate) struct CasterBvh {
     pub depth: u32,
     /// The casters' triangles (`triangles` holds one of zero area when there are none).
     pub casters: usize,
+    pub shape: TreeShape,
 }
 
-/// One caster triangle before the build, with its alpha test.
+/// The caster triangles before the build, with their alpha tests.
 struct Gathered {
     triangles: Vec<[Vec3A; 3]>,
     alpha: Vec<Option<AlphaGpu>>,
+    /// Per scene instance, its triangles' range (empty for a non-caster).
+    instance_triangles: Vec<Range<u32>>,
 }
 
 impl CasterBvh {
@@ -114,6 +156,8 @@ impl CasterBvh {
     pub fn build(scene: &Scene) -> Self {
         let (textures, texels, texture_slots) = alpha_textures(scene);
         let gathered = gather(scene, &texture_slots);
+        let scene_size = scene.bounds().extent().max_element().max(1e-3);
+        let pad = 1e-6 * scene_size;
         if gathered.triangles.is_empty() {
             let leaf = NodeGpu { min: [0.0; 3], count: 1, max: [0.0; 3], first: 0 };
             let point =
@@ -126,21 +170,14 @@ impl CasterBvh {
                 texels,
                 alpha: vec![],
                 casters: 0,
+                shape: TreeShape {
+                    instance_triangles: gathered.instance_triangles,
+                    pad,
+                    ..Default::default()
+                },
             };
         }
-        // Bounds inflated by a hair, as the CPU reference's are, so that the slab test
-        // stays conservative for rays grazing a box face (T. Ize, "Robust BVH Ray
-        // Traversal", JCGT 2(2), 2013, §3); the triangles themselves are exact.
-        let scene_size = scene.bounds().extent().max_element().max(1e-3);
-        let boxes: Vec<Aabb> = gathered
-            .triangles
-            .iter()
-            .map(|t| {
-                let (min, max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-                let pad = Vec3A::splat(1e-6 * scene_size) + min.abs().max(max.abs()) * 4.0 * f32::EPSILON;
-                Aabb::new(min - pad, max + pad)
-            })
-            .collect();
+        let boxes: Vec<Aabb> = gathered.triangles.iter().map(|t| triangle_box(t, pad)).collect();
         let bvh = build_bvh2(
             &boxes,
             BvhBuildParams {
@@ -173,9 +210,126 @@ impl CasterBvh {
                 first: n.first_index,
             })
             .collect();
-        let depth = tree_depth(&nodes);
         let casters = gathered.triangles.len();
-        Self { nodes, triangles, alpha, textures, texels, depth, casters }
+        let mut leaf_of = vec![0u32; casters];
+        for (leaf, &k) in bvh.primitive_indices.iter().enumerate() {
+            leaf_of[k as usize] = leaf as u32;
+        }
+        let (parent, node_depth, leaf_node) = tree_links(&nodes, casters);
+        let depth = node_depth.iter().copied().max().unwrap_or(1);
+        let mut inner_deepest_first: Vec<u32> =
+            (0..nodes.len() as u32).filter(|&n| nodes[n as usize].count == 0).collect();
+        inner_deepest_first.sort_unstable_by_key(|&n| std::cmp::Reverse(node_depth[n as usize]));
+        let shape = TreeShape {
+            instance_triangles: gathered.instance_triangles,
+            leaf_of,
+            leaf_node,
+            parent,
+            depth: node_depth,
+            inner_deepest_first,
+            pad,
+        };
+        Self { nodes, triangles, alpha, textures, texels, depth, casters, shape }
+    }
+
+    /// Moves the triangles of the `moved` instances to where `scene` now places them
+    /// and refits the boxes above them, keeping the tree's shape: the leaves that hold
+    /// a moved triangle and their ancestors, no other, so the cost follows what moved.
+    /// `scene` must be the one the tree was built from, with new transforms only.
+    /// Returns the runs of nodes and triangles that changed, for the upload.
+    pub fn refit(&mut self, scene: &Scene, moved: &[usize]) -> Refitted {
+        let mut changed = Vec::new();
+        for &index in moved {
+            let range = self.shape.instance_triangles.get(index).cloned().unwrap_or_default();
+            if range.is_empty() {
+                continue;
+            }
+            let inst = &scene.instances[index];
+            let mesh = &scene.meshes[inst.mesh];
+            let world =
+                |i: u32| inst.world_from_object.transform_point3(mesh.positions[i as usize]).to_array();
+            for (k, tri) in range.zip(mesh.indices.chunks_exact(3)) {
+                let leaf = self.shape.leaf_of[k as usize];
+                let t = &mut self.triangles[leaf as usize];
+                (t.v0, t.v1, t.v2) = (world(tri[0]), world(tri[1]), world(tri[2]));
+                changed.push(leaf);
+            }
+        }
+        if changed.is_empty() {
+            return Refitted::default();
+        }
+        // Past a quarter of the triangles, walking the paths up from each leaf costs
+        // more than one sweep over the whole tree.
+        if 4 * changed.len() >= self.triangles.len() {
+            let mut marked = vec![false; self.triangles.len()];
+            for &p in &changed {
+                marked[p as usize] = true;
+            }
+            let sorted: Vec<u32> = (0..marked.len() as u32).filter(|&p| marked[p as usize]).collect();
+            self.refit_all();
+            let whole_tree = 0..self.nodes.len() as u32;
+            return Refitted { nodes: std::iter::once(whole_tree).collect(), triangles: runs(&sorted) };
+        }
+        changed.sort_unstable();
+        let nodes = self.refit_paths(&changed);
+        Refitted { nodes: runs(&nodes), triangles: runs(&changed) }
+    }
+
+    /// Refits every leaf around its triangles, then every inner node around its
+    /// children, deepest first.
+    fn refit_all(&mut self) {
+        let (pad, triangles) = (self.shape.pad, &self.triangles);
+        self.nodes.par_iter_mut().filter(|n| n.count > 0).for_each(|node| {
+            let held = &triangles[node.first as usize..(node.first + node.count) as usize];
+            let bounds = leaf_box(held, pad);
+            (node.min, node.max) = (Vec3::from(bounds.min).to_array(), Vec3::from(bounds.max).to_array());
+        });
+        for &index in &self.shape.inner_deepest_first {
+            refit_inner(&mut self.nodes, index);
+        }
+    }
+
+    /// Refits the leaves holding the `changed` triangle positions around their
+    /// triangles, then their ancestors around their children, deepest first. Returns
+    /// the nodes refitted, sorted.
+    fn refit_paths(&mut self, changed: &[u32]) -> Vec<u32> {
+        let shape = &self.shape;
+        let mut dirty = vec![false; self.nodes.len()];
+        let mut leaves: Vec<u32> = Vec::new();
+        for &p in changed {
+            let leaf = shape.leaf_node[p as usize];
+            if !std::mem::replace(&mut dirty[leaf as usize], true) {
+                leaves.push(leaf);
+            }
+        }
+        let mut inner: Vec<u32> = Vec::new();
+        for &leaf in &leaves {
+            let mut node = shape.parent[leaf as usize];
+            while node != NO_PARENT && !std::mem::replace(&mut dirty[node as usize], true) {
+                inner.push(node);
+                node = shape.parent[node as usize];
+            }
+        }
+        let (pad, triangles) = (shape.pad, &self.triangles);
+        let boxes: Vec<(u32, Aabb)> = leaves
+            .par_iter()
+            .map(|&leaf| {
+                let node = &self.nodes[leaf as usize];
+                (leaf, leaf_box(&triangles[node.first as usize..(node.first + node.count) as usize], pad))
+            })
+            .collect();
+        for (leaf, bounds) in boxes {
+            let node = &mut self.nodes[leaf as usize];
+            (node.min, node.max) = (Vec3::from(bounds.min).to_array(), Vec3::from(bounds.max).to_array());
+        }
+        // A child is deeper than its parent: deepest first meets every child first.
+        inner.sort_unstable_by_key(|&n| std::cmp::Reverse(shape.depth[n as usize]));
+        for &index in &inner {
+            refit_inner(&mut self.nodes, index);
+        }
+        leaves.extend(inner);
+        leaves.sort_unstable();
+        leaves
     }
 
     /// Bytes of each buffer, named as the errors name them.
@@ -191,10 +345,53 @@ impl CasterBvh {
     }
 }
 
+/// A triangle's box, inflated by a hair as the CPU reference's are, so that the slab
+/// test stays conservative for rays grazing a box face (T. Ize, "Robust BVH Ray
+/// Traversal", JCGT 2(2), 2013, §3): `pad` plus four ulps of the largest coordinate.
+/// The triangles themselves are exact.
+fn triangle_box(t: &[Vec3A; 3], pad: f32) -> Aabb {
+    let (min, max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+    let pad = Vec3A::splat(pad) + min.abs().max(max.abs()) * 4.0 * f32::EPSILON;
+    Aabb::new(min - pad, max + pad)
+}
+
+/// Sets an inner node's box around its children's.
+fn refit_inner(nodes: &mut [NodeGpu], index: u32) {
+    let first = nodes[index as usize].first as usize;
+    let (a, b) = (nodes[first], nodes[first + 1]);
+    let node = &mut nodes[index as usize];
+    node.min = Vec3::from(a.min).min(Vec3::from(b.min)).to_array();
+    node.max = Vec3::from(a.max).max(Vec3::from(b.max)).to_array();
+}
+
+/// A leaf's box: around its triangles' padded boxes.
+fn leaf_box(held: &[TriangleGpu], pad: f32) -> Aabb {
+    held.iter().fold(Aabb::empty(), |b, t| b.union(&triangle_box(&[t.v0, t.v1, t.v2].map(Vec3A::from), pad)))
+}
+
+/// Sorted positions merged into runs, neighbours a few elements apart joined: fewer,
+/// slightly larger uploads.
+fn runs(sorted: &[u32]) -> Vec<Range<u32>> {
+    const JOIN_GAP: u32 = 16;
+    let mut out: Vec<Range<u32>> = Vec::new();
+    for &p in sorted {
+        match out.last_mut() {
+            Some(last) if p < last.end + JOIN_GAP => last.end = last.end.max(p + 1),
+            _ => out.push(p..p + 1),
+        }
+    }
+    out
+}
+
 /// Every casting instance's triangles in world space, with their alpha tests.
 fn gather(scene: &Scene, texture_slots: &[Option<u32>]) -> Gathered {
-    let mut out = Gathered { triangles: Vec::new(), alpha: Vec::new() };
-    for inst in scene.instances.iter().filter(|i| i.casts_shadow) {
+    let mut out = Gathered { triangles: Vec::new(), alpha: Vec::new(), instance_triangles: Vec::new() };
+    for inst in &scene.instances {
+        let first = out.triangles.len() as u32;
+        if !inst.casts_shadow {
+            out.instance_triangles.push(first..first);
+            continue;
+        }
         let mesh = &scene.meshes[inst.mesh];
         let material = &scene.materials[inst.material];
         let world: Vec<Vec3A> =
@@ -221,6 +418,7 @@ fn gather(scene: &Scene, texture_slots: &[Option<u32>]) -> Gathered {
                 AlphaMode::Opaque | AlphaMode::Blend => None,
             });
         }
+        out.instance_triangles.push(first..out.triangles.len() as u32);
     }
     out
 }
@@ -258,19 +456,26 @@ fn pack_alpha(texture: &Texture) -> Vec<u32> {
     alpha.chunks(4).map(|c| c.iter().rev().fold(0u32, |word, &a| (word << 8) | a as u32)).collect()
 }
 
-/// The depth of the deepest leaf, the root counting 1.
-fn tree_depth(nodes: &[NodeGpu]) -> u32 {
-    let mut deepest = 0;
-    let mut stack = vec![(0usize, 1u32)];
-    while let Some((index, depth)) = stack.pop() {
-        deepest = deepest.max(depth);
-        let node = &nodes[index];
-        if node.count == 0 {
-            stack.push((node.first as usize, depth + 1));
-            stack.push((node.first as usize + 1, depth + 1));
+/// Each node's parent and depth (the root's is 1), and for each triangle position,
+/// the leaf holding it.
+fn tree_links(nodes: &[NodeGpu], triangles: usize) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    let mut parent = vec![NO_PARENT; nodes.len()];
+    let mut depth = vec![1u32; nodes.len()];
+    let mut leaf_node = vec![0u32; triangles];
+    let mut stack = vec![0u32];
+    while let Some(index) = stack.pop() {
+        let node = nodes[index as usize];
+        if node.count > 0 {
+            leaf_node[node.first as usize..(node.first + node.count) as usize].fill(index);
+            continue;
+        }
+        for child in [node.first, node.first + 1] {
+            parent[child as usize] = index;
+            depth[child as usize] = depth[index as usize] + 1;
+            stack.push(child);
         }
     }
-    deepest
+    (parent, depth, leaf_node)
 }
 
 #[cfg(test)]
@@ -292,18 +497,10 @@ mod tests {
         scene
     }
 
-    #[test]
-    fn every_caster_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
-        let scene = builtin::spheres();
-        let bvh = CasterBvh::build(&scene);
-        let casters: usize = scene
-            .instances
-            .iter()
-            .filter(|i| i.casts_shadow)
-            .map(|i| scene.meshes[i.mesh].indices.len() / 3)
-            .sum();
-        assert_eq!(bvh.triangles.len(), casters);
-        let mut seen = vec![0u32; casters];
+    /// Checks that every triangle lies in one leaf, inside the boxes of all the nodes
+    /// above it.
+    fn assert_boxes_hold_their_triangles(bvh: &CasterBvh) {
+        let mut seen = vec![0u32; bvh.triangles.len()];
         let mut stack = vec![(0usize, Vec::<usize>::new())];
         while let Some((index, ancestors)) = stack.pop() {
             let node = bvh.nodes[index];
@@ -327,7 +524,99 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n == 1), "each triangle in one leaf");
+    }
+
+    fn caster_triangles(scene: &Scene) -> usize {
+        scene
+            .instances
+            .iter()
+            .filter(|i| i.casts_shadow)
+            .map(|i| scene.meshes[i.mesh].indices.len() / 3)
+            .sum()
+    }
+
+    #[test]
+    fn every_caster_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
+        let scene = builtin::spheres();
+        let bvh = CasterBvh::build(&scene);
+        assert_eq!(bvh.triangles.len(), caster_triangles(&scene));
+        assert_boxes_hold_their_triangles(&bvh);
         assert!(bvh.depth <= MAX_DEPTH && bvh.depth > 1);
+    }
+
+    /// Checks that `bvh`, refitted after moves, holds exactly the triangles a new
+    /// build of `scene` holds, each inside all of its boxes, and that every box is
+    /// tight: the refitted ones and those the refit left alone.
+    fn assert_refitted(bvh: &CasterBvh, scene: &Scene) {
+        assert_boxes_hold_their_triangles(bvh);
+        let pad = bvh.shape.pad;
+        for node in &bvh.nodes {
+            let (min, max) = if node.count > 0 {
+                let b =
+                    leaf_box(&bvh.triangles[node.first as usize..(node.first + node.count) as usize], pad);
+                (Vec3::from(b.min).to_array(), Vec3::from(b.max).to_array())
+            } else {
+                let (a, b) = (bvh.nodes[node.first as usize], bvh.nodes[node.first as usize + 1]);
+                (
+                    Vec3::from(a.min).min(b.min.into()).to_array(),
+                    Vec3::from(a.max).max(b.max.into()).to_array(),
+                )
+            };
+            assert_eq!((node.min, node.max), (min, max), "{node:?}");
+        }
+        let sorted = |b: &CasterBvh| {
+            let mut t: Vec<[u32; 9]> = b
+                .triangles
+                .iter()
+                .map(|t| {
+                    let v = [t.v0, t.v1, t.v2].concat();
+                    std::array::from_fn(|k| v[k].to_bits())
+                })
+                .collect();
+            t.sort_unstable();
+            t
+        };
+        assert_eq!(sorted(bvh), sorted(&CasterBvh::build(scene)));
+    }
+
+    #[test]
+    fn a_refit_holds_the_same_triangles_as_a_fresh_build_of_the_moved_scene() {
+        // Two casters move far (one out past the scene's old bounds): only their
+        // leaves' paths to the root are refitted.
+        let mut scene = builtin::columns();
+        let mut bvh = CasterBvh::build(&scene);
+        let moved = [1, scene.instances.len() / 2];
+        scene.instances[moved[0]].world_from_object =
+            Mat4::from_translation(Vec3::new(40.0, 3.0, -7.0)) * scene.instances[moved[0]].world_from_object;
+        scene.instances[moved[1]].world_from_object *= Mat4::from_rotation_y(0.7);
+        let changed = bvh.refit(&scene, &moved);
+        let moved_triangles: usize =
+            moved.iter().map(|&i| scene.meshes[scene.instances[i].mesh].indices.len() / 3).sum();
+        let covered = |runs: &[Range<u32>]| runs.iter().map(|r| r.end - r.start).sum::<u32>() as usize;
+        let disjoint = |runs: &[Range<u32>]| runs.windows(2).all(|w| w[0].end < w[1].start);
+        assert!(covered(&changed.triangles) >= moved_triangles && disjoint(&changed.triangles));
+        assert!(disjoint(&changed.nodes) && changed.nodes[0].start == 0, "the root is refitted");
+        assert!(covered(&changed.nodes) < bvh.nodes.len() / 2, "only the moved leaves' paths: {changed:?}");
+        assert_refitted(&bvh, &scene);
+        // The root grew to hold the caster moved out of the old bounds.
+        assert!(bvh.nodes[0].max[0] > 35.0, "{:?}", bvh.nodes[0]);
+        assert_eq!(bvh.refit(&scene, &[]), Refitted::default());
+        // Every instance moves: the whole tree is swept.
+        let all: Vec<usize> = (0..scene.instances.len()).collect();
+        for inst in &mut scene.instances {
+            inst.world_from_object = Mat4::from_rotation_y(0.3) * inst.world_from_object;
+        }
+        let changed = bvh.refit(&scene, &all);
+        let whole = |n: usize| std::iter::once(0..n as u32).collect::<Vec<_>>();
+        assert_eq!(changed.nodes, whole(bvh.nodes.len()));
+        assert_eq!(changed.triangles, whole(bvh.triangles.len()));
+        assert_refitted(&bvh, &scene);
+    }
+
+    #[test]
+    fn runs_join_near_neighbours() {
+        assert_eq!(runs(&[1, 2, 3, 10, 40, 41]), vec![1..11, 40..42]);
+        assert_eq!(runs(&[]), Vec::<Range<u32>>::new());
     }
 
     #[test]

@@ -151,13 +151,22 @@ fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RaysUnav
     Ok(())
 }
 
-/// A scene's casters on the GPU, bound for tracing.
+/// A scene's casters on the GPU, bound for tracing, with the CPU copy of its tree
+/// that a refit updates.
 pub(crate) struct GpuBvh {
     pub group: wgpu::BindGroup,
     /// Triangles in the tree: every casting instance's (0 when none casts).
     pub triangles: usize,
-    _buffers: Vec<wgpu::Buffer>,
+    /// The tree's nodes and triangles as uploaded (its alpha tests and textures,
+    /// which no move changes, are dropped after the upload).
+    tree: CasterBvh,
+    /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6.
+    buffers: Vec<wgpu::Buffer>,
 }
+
+/// Which of [`GpuBvh`]'s buffers holds what.
+const NODE_BUFFER: usize = 0;
+const TRIANGLE_BUFFER: usize = 1;
 
 impl GpuBvh {
     /// Builds the casters' BVH of `scene` and uploads it. The scene must be valid.
@@ -168,7 +177,7 @@ impl GpuBvh {
         scene: &gnomon_scene::Scene,
         layout: &wgpu::BindGroupLayout,
     ) -> Result<Self, RenderError> {
-        let bvh = CasterBvh::build(scene);
+        let mut bvh = CasterBvh::build(scene);
         check_limits(&bvh, &scene.name, storage_limit(gpu))?;
         // wgpu refuses a binding smaller than one element: an unused buffer holds one
         // zeroed element of the largest kind.
@@ -188,7 +197,8 @@ impl GpuBvh {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(name),
                     contents: &contents(bytes),
-                    usage: wgpu::BufferUsages::STORAGE,
+                    // A refit rewrites the nodes and triangles in place.
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 })
             })
             .collect();
@@ -205,8 +215,40 @@ impl GpuBvh {
                 layout,
                 entries: &entries,
             });
-            Self { group, triangles: bvh.casters, _buffers: buffers }
+            (bvh.alpha, bvh.textures, bvh.texels) = Default::default();
+            Self { group, triangles: bvh.casters, tree: bvh, buffers }
         })
+    }
+
+    /// Moves the triangles of the `moved` instances to where `scene` now places them
+    /// and refits the tree's boxes ([`CasterBvh::refit`]), uploading what changed:
+    /// the node buffer and the changed runs of triangles. `scene` must be the one
+    /// the tree was built from, with new transforms only, and `moved` valid indices.
+    pub fn refit(
+        &mut self,
+        gpu: &Gpu,
+        scene: &gnomon_scene::Scene,
+        moved: &[usize],
+    ) -> Result<(), RenderError> {
+        let changed = self.tree.refit(scene, moved);
+        gpu.checked("refitting the shadow casters' BVH", || {
+            write_runs(&gpu.queue, &self.buffers[NODE_BUFFER], &self.tree.nodes, &changed.nodes);
+            write_runs(&gpu.queue, &self.buffers[TRIANGLE_BUFFER], &self.tree.triangles, &changed.triangles);
+        })
+    }
+}
+
+/// Uploads the `runs` of `elements` to where they lie in `buffer`.
+fn write_runs<T: bytemuck::Pod>(
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    elements: &[T],
+    runs: &[std::ops::Range<u32>],
+) {
+    let size = std::mem::size_of::<T>() as u64;
+    for run in runs {
+        let slice = &elements[run.start as usize..run.end as usize];
+        queue.write_buffer(buffer, u64::from(run.start) * size, bytemuck::cast_slice(slice));
     }
 }
 

@@ -88,6 +88,19 @@ impl ShadowRays {
         Ok(Self { gpu: Gpu::clone(gpu), bvh, pipeline, io_layout })
     }
 
+    /// Follows instances that moved: `scene`, the one these rays were made for, holds
+    /// the new transforms of the instances numbered in `moved`. The tree is refitted,
+    /// not rebuilt ([`crate::Renderer::move_instances`] says more). An index out of
+    /// range or a non-finite transform is refused, naming it, before anything changes.
+    pub fn move_instances(
+        &mut self,
+        scene: &gnomon_scene::Scene,
+        moved: &[usize],
+    ) -> Result<(), RenderError> {
+        crate::gpu_scene::check_moved(scene, moved)?;
+        self.bvh.refit(&self.gpu, scene, moved)
+    }
+
     /// Triangles in the tree: every shadow-casting instance's.
     pub fn triangle_count(&self) -> usize {
         self.bvh.triangles
