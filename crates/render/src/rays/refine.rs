@@ -47,16 +47,18 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
         Refine::Auto | Refine::Rays => false,
         Refine::EveryPixel => true,
     };
-    let footprint = match lookup {
-        MapLookup::Map => include_str!("refine_map.wgsl"),
-        MapLookup::Cube | MapLookup::Paraboloid => include_str!("refine_omni.wgsl"),
+    let footprint: &[&str] = match lookup {
+        MapLookup::Map => &[include_str!("refine_footprint.wgsl"), include_str!("refine_map.wgsl")],
+        MapLookup::Cube => &[include_str!("refine_footprint.wgsl"), include_str!("refine_cube.wgsl")],
+        MapLookup::Paraboloid => &[include_str!("refine_omni.wgsl")],
     };
-    vec![
+    let mut parts = vec![
         format!("const REFINE_EVERY_PIXEL: bool = {every_pixel};\n"),
         list_wgsl(),
         include_str!("refine_classify.wgsl").to_owned(),
-        footprint.to_owned(),
-    ]
+    ];
+    parts.extend(footprint.iter().map(|s| s.to_string()));
+    parts
 }
 
 /// The trace pass's WGSL, composed.

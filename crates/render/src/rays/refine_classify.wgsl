@@ -7,7 +7,7 @@
 //
 // A pixel is unsure when its filtered visibility is strictly between 0 and 1 (the
 // taps disagree: the edge band), or when `map_unsure` (refine_map.wgsl,
-// refine_omni.wgsl) finds its footprint in the map ambiguous. `REFINE_EVERY_PIXEL`
+// refine_cube.wgsl, refine_omni.wgsl) finds its footprint in the map ambiguous. `REFINE_EVERY_PIXEL`
 // lists every pixel instead: the exact baseline.
 
 // The first three words are the trace pass's `dispatch_workgroups_indirect`

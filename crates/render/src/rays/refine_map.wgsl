@@ -20,19 +20,25 @@
 // What this cannot see: a caster thinner than a texel that the map's rasterization
 // missed altogether leaves no depth to disagree with.
 
-// Texels of ring around the bilinear footprint.
-const UNSURE_RING_TEXELS: i32 = 2;
-// The depth band, in texel world sizes along the light's ray, inside which a stored
-// depth is too close to the receiver's to trust.
-const UNSURE_DEPTH_TEXELS: f32 = 2.0;
+// A footprint past the map's edge: the map has nothing to say there.
+const FOOTPRINT_EDGE_UNSURE: bool = true;
 
-// The map's (u, v, depth) moved by a world-space step `t` from a point of clip-space
-// w `w` and normalized device coordinates `ndc` in a layer with `clip_from_world`,
-// to first order: clip moves by M·(t, 0), so NDC by the quotient rule's
-// (Δclip.xyz − ndc·Δclip.w) / w. Exact for orthographic maps, where w ≡ 1.
-fn map_step(clip_from_world: mat4x4<f32>, ndc: vec3<f32>, w: f32, t: vec3<f32>) -> vec3<f32> {
-    let d = clip_from_world * vec4<f32>(t, 0.0);
-    return (d.xyz - ndc * d.w) / w * vec3<f32>(0.5, -0.5, 1.0);
+// The receiver's plane in the map, for `footprint_receiver`: depth `depth` at texel
+// position `p` (texel centres at whole numbers), changing by `gradient` per texel. A
+// map's depth is affine across a plane in an orthographic map, and in a perspective
+// one too (z/w is), so this is exact up to rounding.
+struct MapPlane {
+    p: vec2<f32>,
+    depth: f32,
+    gradient: vec2<f32>,
+};
+var<private> map_plane: MapPlane;
+
+// The receiver's depth at the texels (x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y).
+fn footprint_receiver(x: i32, y: i32) -> vec4<f32> {
+    let g = map_plane.gradient;
+    let r = map_plane.depth + dot(g, vec2<f32>(f32(x), f32(y)) - map_plane.p);
+    return vec4<f32>(r + g.y, r + g.x + g.y, r + g.x, r);
 }
 
 // `layer` is the one the lookup shaded with; `n` is the normal it was offset along;
@@ -66,36 +72,8 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let tolerance = 0.5 * slope;
     let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.slope_bias + 1.0) * slope;
 
-    // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels; the receiver's
-    // plane there is c.z + gradient · ((i, j) − p).
-    let p = c.xy * size - vec2<f32>(0.5);
-    let base = vec2<i32>(floor(p));
-    let first = base - vec2<i32>(UNSURE_RING_TEXELS);
-    let end = base + vec2<i32>(2 + UNSURE_RING_TEXELS);
-    if any(first < vec2<i32>(0)) || any(end > vec2<i32>(i32(size))) {
-        return true;
-    }
-    var lit = false;
-    var shadowed = false;
-    // The footprint, 2 + 2 × UNSURE_RING_TEXELS texels a side, in 2×2 blocks, each
-    // gathered at its texels' shared corner (gather's order: (x, y+1), (x+1, y+1),
-    // (x+1, y), (x, y)).
-    for (var y = first.y; y < end.y; y += 2) {
-        for (var x = first.x; x < end.x; x += 2) {
-            let corner = vec2<f32>(f32(x + 1), f32(y + 1)) / size;
-            let stored = textureGather(shadow_map, shadow_gather, corner, layer);
-            let r = c.z + dot(gradient, vec2<f32>(f32(x), f32(y)) - p);
-            let receiver = vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
-            let is_lit = stored >= receiver - vec4<f32>(tolerance);
-            let is_shadowed = stored <= receiver - vec4<f32>(margin);
-            if !all(is_lit | is_shadowed) {
-                return true;
-            }
-            lit = lit || any(is_lit);
-            shadowed = shadowed || any(is_shadowed);
-        }
-    }
-    if lit && shadowed {
+    map_plane = MapPlane(c.xy * size - vec2<f32>(0.5), c.z, gradient);
+    if footprint_unsure(c.xy, tolerance, margin, layer) {
         return true;
     }
     return light.penumbra_rays > 0u && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
