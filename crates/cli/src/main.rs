@@ -139,6 +139,7 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::EmptyScene(_)
         | RenderError::SceneTooLarge { .. }
         | RenderError::UnknownInstance { .. }
+        | RenderError::InstancesChanged { .. }
         | RenderError::Gpu { .. } => None,
     }
 }

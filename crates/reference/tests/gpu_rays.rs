@@ -210,4 +210,7 @@ fn a_refitted_tree_answers_as_the_reference_of_the_moved_scene() {
     assert!(wrong <= 2, "{wrong} of {} rays answered differently after the refit", rays.len());
     let e = tracer.move_instances(&scene, &[99]).unwrap_err().to_string();
     assert!(e.contains("no instance 99"), "{e}");
+    scene.instances.pop();
+    let e = tracer.move_instances(&scene, &[0]).unwrap_err().to_string();
+    assert!(e.contains(&format!("uploaded with {}", scene.instances.len() + 1)), "{e}");
 }

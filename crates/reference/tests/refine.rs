@@ -1,6 +1,6 @@
 //! Shadows refined by GPU rays (`--refine`) against the reference: exact where the
 //! map alone is not, on the built-in scenes and on casters thinner than a texel, and
-//! after casters move.
+//! after casters move; and the view that shows which pixels rays decided.
 
 mod common;
 
@@ -10,10 +10,10 @@ use common::{
     reference, render,
 };
 use glam::{Mat4, Vec3};
-use gnomon_render::{OutputRequest, Renderer};
+use gnomon_render::{Frame, OutputRequest, Renderer};
 use gnomon_scene::{
     Camera, DirectionalLight, Instance, Material, Scene, Settings, builtin, geometry,
-    settings::{Refine, Technique},
+    settings::{DebugView, Refine, Technique},
     sun_direction,
 };
 
@@ -201,4 +201,36 @@ fn moved_casters_are_traced_where_they_now_stand() {
     scene.instances[laid].world_from_object.x_axis.y = f32::INFINITY;
     let e = renderer.move_instances(&mut uploaded, &scene, &[laid]).unwrap_err().to_string();
     assert!(e.contains("column L1") && e.contains("non-finite"), "{e}");
+}
+
+#[test]
+fn the_traced_view_tints_the_pixels_rays_decided_and_changes_no_shadow() {
+    // `--debug-view traced` marks each pixel rays decided, in the mask's layer: the
+    // image turns magenta there, and nowhere else, while the visibility stays as it
+    // was. A light whose shadow no ray decides tints nothing.
+    let scene = builtin::columns();
+    let plain = render(&scene, &settings(Refine::Rays));
+    let mut s = settings(Refine::Rays);
+    s.image.debug_view = DebugView::Traced;
+    let tinted = render(&scene, &s);
+    let traced = tinted.lights[0].traced_pixels.expect("a refined frame reports its rays") as usize;
+    let changed = |a: &Frame, b: &Frame| {
+        a.color
+            .chunks(4)
+            .zip(b.color.chunks(4))
+            .filter(|(p, q)| p.iter().zip(*q).any(|(x, y)| x.abs_diff(*y) > 2))
+            .count()
+    };
+    let magenta = changed(&plain, &tinted);
+    figure(
+        "columns, traced view: pixels tinted (of those rays decided)",
+        format!("{magenta} of {traced}"),
+        "within 2 %",
+    );
+    assert!(traced > 1000 && magenta.abs_diff(traced) * 50 <= traced, "{magenta} tinted, {traced} traced");
+    let moved =
+        plain.visibility.iter().zip(&tinted.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    assert_eq!(moved, 0, "the view must not change a shadow");
+    s.screen.refine = Refine::Off;
+    assert_eq!(changed(&render(&scene, &settings(Refine::Off)), &render(&scene, &s)), 0);
 }

@@ -187,7 +187,7 @@ impl GpuScene {
         scene: &Scene,
         moved: &[usize],
     ) -> Result<(), RenderError> {
-        check_moved(scene, moved)?;
+        check_moved(scene, self.slots.len(), moved)?;
         let size = std::mem::size_of::<InstanceGpu>() as u64;
         let mut refits: Vec<Vec<(u32, Aabb)>> = vec![Vec::new(); self.batches.len()];
         gpu.checked("moving instances", || {
@@ -480,11 +480,15 @@ fn instance_gpu(scene: &Scene, i: usize) -> InstanceGpu {
     }
 }
 
-/// Refuses a moved instance that is not `scene`'s, or whose new transform is not
+/// Refuses a move in a scene whose instance list is no longer the `uploaded` one's
+/// length, a moved instance that is not `scene`'s, or one whose new transform is not
 /// finite: what [`GpuScene::move_instances`] and [`crate::rays::ShadowRays`] check
 /// before they change anything.
-pub(crate) fn check_moved(scene: &Scene, moved: &[usize]) -> Result<(), RenderError> {
+pub(crate) fn check_moved(scene: &Scene, uploaded: usize, moved: &[usize]) -> Result<(), RenderError> {
     let count = scene.instances.len();
+    if count != uploaded {
+        return Err(RenderError::InstancesChanged { scene: scene.name.clone(), uploaded, now: count });
+    }
     for &index in moved {
         let Some(inst) = scene.instances.get(index) else {
             return Err(RenderError::UnknownInstance { scene: scene.name.clone(), index, count });

@@ -164,6 +164,20 @@ pub enum RenderError {
         /// How many instances the scene has.
         count: usize,
     },
+    /// Instances were added to or removed from a scene since it was uploaded: a move
+    /// cannot follow that.
+    #[error(
+        "scene `{scene}` has {now} instances but was uploaded with {uploaded}: moving instances \
+         changes transforms only; a scene whose instances were added or removed needs a new upload"
+    )]
+    InstancesChanged {
+        /// Name of the scene.
+        scene: String,
+        /// How many instances it had when uploaded.
+        uploaded: usize,
+        /// How many it has now.
+        now: usize,
+    },
     /// The GPU ray tracer cannot take the scene or the frame on this device
     /// ([`crate::rays::RaysUnavailable`]). A frame that asked for refinement by rays
     /// does not fail for it: it is drawn unrefined and reports why

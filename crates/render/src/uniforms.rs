@@ -204,8 +204,8 @@ pub struct CameraGpu {
     pub world_from_view: Mat4,
     /// Camera position in world space, for view vectors (specular highlights).
     pub eye: Vec3,
-    /// 1 to tint pixels by their cascade.
-    pub tint_cascades: u32,
+    /// The debug view ([`debug_view_code`]): `DEBUG_VIEW_*` in WGSL.
+    pub debug_view: u32,
     /// clip_from_view's x and y scales (a symmetric perspective).
     pub scale_x: f32,
     /// clip_from_view's y scale, 1 / tan(fov_y / 2).
@@ -225,8 +225,8 @@ pub struct CameraGpu {
 }
 
 impl CameraGpu {
-    /// The uniform for `camera` drawing a `width` × `height` image; `debug_view` turns on
-    /// the cascade tint.
+    /// The uniform for `camera` drawing a `width` × `height` image, with `debug_view`
+    /// over it.
     pub fn new(camera: &Camera, width: u32, height: u32, debug_view: DebugView) -> Self {
         let aspect = width as f32 / height as f32;
         let clip_from_view = camera.clip_from_view(aspect);
@@ -235,7 +235,7 @@ impl CameraGpu {
             view_from_world: camera.view_from_world(),
             world_from_view: camera.view_from_world().inverse(),
             eye: camera.eye,
-            tint_cascades: (debug_view == DebugView::Cascades).into(),
+            debug_view: debug_view_code(debug_view),
             scale_x: clip_from_view.x_axis.x,
             scale_y: clip_from_view.y_axis.y,
             near: camera.near,
@@ -248,6 +248,21 @@ impl CameraGpu {
     }
 }
 
+/// How the camera uniform names a debug view to the shaders.
+pub fn debug_view_code(view: DebugView) -> u32 {
+    match view {
+        DebugView::None => 0,
+        DebugView::Cascades => 1,
+        DebugView::Traced => 2,
+    }
+}
+
+/// Added to the map layer a pixel's mask stores (visibility + 2 × layer) when rays
+/// decided it and the traced view is on, for the lighting pass to tint it: above
+/// every layer index (cascades, cube faces).
+pub const TRACED_LAYER_FLAG: u32 = 16;
+const _: () = assert!(TRACED_LAYER_FLAG as usize >= MAX_CASCADES && TRACED_LAYER_FLAG >= 6);
+
 /// The WGSL declarations generated from Rust, composed before every shader: the
 /// shared limits and the light kinds, so that no number is written twice.
 pub fn wgsl_constants() -> String {
@@ -255,6 +270,12 @@ pub fn wgsl_constants() -> String {
     s += &format!("const MAX_CASCADES: u32 = {MAX_CASCADES}u;\n");
     s += &format!("const POISSON_DISK_SIZE: u32 = {}u;\n", techniques::POISSON_DISK_SIZE);
     s += &format!("const MAX_KERNEL_TEXELS: f32 = {:?};\n", gnomon_scene::settings::MAX_KERNEL_TEXELS);
+    s += &format!("const TRACED_LAYER_FLAG: u32 = {TRACED_LAYER_FLAG}u;\n");
+    for (name, view) in
+        [("NONE", DebugView::None), ("CASCADES", DebugView::Cascades), ("TRACED", DebugView::Traced)]
+    {
+        s += &format!("const DEBUG_VIEW_{name}: u32 = {}u;\n", debug_view_code(view));
+    }
     for kind in LightKindGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind as u32);
     }
@@ -445,7 +466,7 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             texel_world, warp_step, split_start, split_end, warped, _pad0, _pad1, _pad2,
         }),
         struct_layout!(CameraGpu as "Camera" {
-            clip_from_world, view_from_world, world_from_view, eye, tint_cascades, scale_x, scale_y, near,
+            clip_from_world, view_from_world, world_from_view, eye, debug_view, scale_x, scale_y, near,
             far, width, height, inv_width, inv_height,
         }),
         struct_layout!(depth_reduce::BoundsParams as "BoundsParams" {

@@ -145,8 +145,9 @@ impl Renderer {
     /// BVH are refitted, not rebuilt: the next frame draws and traces the scene as it
     /// now stands, at a cost that follows what moved, not the scene's size. Anything
     /// else changed in `scene` (meshes, materials, which instances cast) needs a new
-    /// [`Renderer::upload`]. An index out of range or a non-finite transform is
-    /// refused, naming it, before anything changes.
+    /// [`Renderer::upload`]. An index out of range, a non-finite transform or an
+    /// instance list that grew or shrank is refused, naming it, before anything
+    /// changes.
     pub fn move_instances(
         &self,
         uploaded: &mut GpuScene,

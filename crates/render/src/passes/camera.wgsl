@@ -7,7 +7,7 @@ struct Camera {
     view_from_world: mat4x4<f32>,
     world_from_view: mat4x4<f32>,
     eye: vec3<f32>,
-    tint_cascades: u32,     // 1 to tint pixels by their cascade
+    debug_view: u32,        // DEBUG_VIEW_NONE, _CASCADES or _TRACED
     scale_x: f32,           // clip_from_view[0][0] and [1][1] (a symmetric perspective)
     scale_y: f32,
     near: f32,

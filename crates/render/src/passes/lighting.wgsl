@@ -39,7 +39,10 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
     let shadow = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
     let visibility = shadow.x;
-    let layer = u32(shadow.y);
+    // On the mask path with the traced view, a layer past TRACED_LAYER_FLAG marks a
+    // pixel whose shadow rays decided (shadow_mask.wgsl).
+    let traced = u32(shadow.y) >= TRACED_LAYER_FLAG;
+    let layer = u32(shadow.y) % TRACED_LAYER_FLAG;
 
     if alpha_cut(inst, in.uv) {
         discard;
@@ -51,8 +54,11 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let specular = inst.specular * pow(max(dot(n, h), 0.0), inst.shininess) * select(0.0, 1.0, n_dot_l > 0.0);
     let direct = light.radiance * cone * (albedo * n_dot_l + vec3<f32>(specular));
     var color = light.ambient * albedo + visibility * direct;
-    if camera.tint_cascades == 1u {
+    if camera.debug_view == DEBUG_VIEW_CASCADES {
         color *= CASCADE_TINTS[layer];
+    }
+    if camera.debug_view == DEBUG_VIEW_TRACED && traced {
+        color = mix(color, vec3<f32>(1.0, 0.0, 1.0), 0.6);
     }
 
     var out: FragmentOut;

@@ -1,7 +1,8 @@
 // The lighting pass's visibility on the mask path: what the shadow-mask pass stored
 // for this pixel and light (shadow_mask.wgsl), read instead of looked up again.
 
-// This light's layer of the mask: visibility + 2 × the shadow-map layer that shaded it.
+// This light's layer of the mask: visibility + 2 × the shadow-map layer that shaded it
+// (+ TRACED_LAYER_FLAG where rays decided the pixel, under the traced debug view).
 @group(2) @binding(7) var shadow_mask: texture_2d<f32>;
 
 fn pixel_visibility(

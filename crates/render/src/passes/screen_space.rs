@@ -17,7 +17,8 @@ pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba
 /// The prepass's linear view depth (0 where no surface is seen).
 pub(crate) const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// The mask, one array layer per light: visibility + 2 × the shadow-map layer that
-/// shaded it, per pixel. A 32-bit float keeps the visibility exact, where half floats
+/// shaded it, per pixel (that layer + `uniforms::TRACED_LAYER_FLAG` where rays decided
+/// the pixel, under the traced debug view). A 32-bit float keeps the visibility exact, where half floats
 /// would round it by up to 2.4e-4; packing the layer in keeps it 4 bytes a pixel.
 pub(crate) const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 

@@ -64,6 +64,11 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
         shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
     }
     if traced {
+        // The traced view marks the pixel in its layer, which the trace and filter
+        // passes carry over.
+        if camera.debug_view == DEBUG_VIEW_TRACED {
+            shadow.y += f32(TRACED_LAYER_FLAG);
+        }
         defer_to_ray(vec2<u32>(texel), u32(shadow.y));
     }
     return shadow.x + 2.0 * shadow.y;

@@ -232,6 +232,11 @@ impl CasterBvh {
         Self { nodes, triangles, alpha, textures, texels, depth, casters, shape }
     }
 
+    /// How many instances the scene the tree was built from had.
+    pub fn instance_count(&self) -> usize {
+        self.shape.instance_triangles.len()
+    }
+
     /// Moves the triangles of the `moved` instances to where `scene` now places them
     /// and refits the boxes above them, keeping the tree's shape: the leaves that hold
     /// a moved triangle and their ancestors, no other, so the cost follows what moved.

@@ -220,6 +220,11 @@ impl GpuBvh {
         })
     }
 
+    /// How many instances the scene the tree was built from had.
+    pub fn instance_count(&self) -> usize {
+        self.tree.instance_count()
+    }
+
     /// Moves the triangles of the `moved` instances to where `scene` now places them
     /// and refits the tree's boxes ([`CasterBvh::refit`]), uploading what changed:
     /// the node buffer and the changed runs of triangles. `scene` must be the one

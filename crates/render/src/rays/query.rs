@@ -97,7 +97,7 @@ impl ShadowRays {
         scene: &gnomon_scene::Scene,
         moved: &[usize],
     ) -> Result<(), RenderError> {
-        crate::gpu_scene::check_moved(scene, moved)?;
+        crate::gpu_scene::check_moved(scene, self.bvh.instance_count(), moved)?;
         self.bvh.refit(&self.gpu, scene, moved)
     }
 

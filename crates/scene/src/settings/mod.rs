@@ -100,6 +100,9 @@ pub enum DebugView {
     /// Tint each pixel by the cascade that shades it: red, green, blue, yellow,
     /// magenta, cyan, orange, violet for cascades 0 to 7.
     Cascades,
+    /// Tint magenta each pixel whose shadow rays decided (`screen.refine`): where the
+    /// map was unsure, or every pixel with `every-pixel`.
+    Traced,
 }
 
 /// The output image.

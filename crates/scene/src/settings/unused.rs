@@ -53,6 +53,14 @@ const RULES: &[(&str, Uses, &str)] = &[
     ("shadow.cascades.cascade_blend", uses_cascades, CASCADES),
     ("shadow.cascades.sdsm", uses_cascades, CASCADES),
     (
+        "image.debug_view",
+        |s, lights| {
+            s.image.debug_view != DebugView::Traced
+                || (s.screen.refine != Refine::Off && s.uses_shadow_mask(lights).unwrap_or(false))
+        },
+        "`screen.refine` other than off, on the mask path (for the traced view)",
+    ),
+    (
         "screen.penumbra_rays",
         |s, lights| {
             matches!(s.screen.refine, Refine::Rays | Refine::EveryPixel)

@@ -4,7 +4,7 @@
 use egui::RichText;
 use glam::Vec3;
 use gnomon_render::PassTimings;
-use gnomon_scene::Light;
+use gnomon_scene::{Light, settings::DebugView};
 
 use super::{Images, Model, vec3_drag};
 use crate::{Action, View};
@@ -55,13 +55,23 @@ impl Model {
         if view != self.view {
             self.pending.push(Action::Show(view));
         }
-        let cascades = self.settings.image.debug_view == gnomon_scene::settings::DebugView::Cascades;
-        let mut tint = cascades;
-        if ui.checkbox(&mut tint, "cascade colours").on_hover_text("--debug-view cascades").changed() {
-            self.pending.push(Action::Set {
-                id: "debug_view".into(),
-                value: Some(if tint { "cascades" } else { "none" }.into()),
-            });
+        // The two tints are values of one setting: ticking one unticks the other.
+        for (view, value, label, help) in [
+            (DebugView::Cascades, "cascades", "cascade colours", "--debug-view cascades"),
+            (
+                DebugView::Traced,
+                "traced",
+                "traced pixels",
+                "--debug-view traced: magenta where rays decided the shadow (--refine)",
+            ),
+        ] {
+            let mut tint = self.settings.image.debug_view == view;
+            if ui.checkbox(&mut tint, label).on_hover_text(help).changed() {
+                self.pending.push(Action::Set {
+                    id: "debug_view".into(),
+                    value: Some(if tint { value } else { "none" }.into()),
+                });
+            }
         }
         ui.checkbox(&mut self.show_maps, "shadow maps").on_hover_text(
             "The reported light's depth map, every cascade (or cube face) side by side; near is black.",
