@@ -13,7 +13,7 @@ use crate::{
     gpu_scene::Visible,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
-    rays::{ListAccess, RefineLists, TraceGroups},
+    rays::{ListAccess, RefineLists, TraceGroups, TraceStage},
     timing::PassKind,
 };
 use gnomon_scene::settings::Refine;
@@ -133,7 +133,7 @@ impl Renderer {
                     bvh: &bvh.group,
                     counters: &lists.counters,
                 };
-                self.record_trace(rec, &groups, index as u32);
+                self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
                 if light.light_gpu.penumbra_rays > 0 {
                     self.record_penumbra_filter(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
                 }
@@ -175,15 +175,16 @@ impl Renderer {
         rec.clock.end(gpu, rec.encoder, slot);
     }
 
-    /// Light `index`'s trace pass: a ray for each pixel its mask pass listed.
-    fn record_trace(&mut self, rec: &mut Recording, groups: &TraceGroups, index: u32) {
+    /// Light `index`'s `stage` over the pixels its mask pass listed (the trace: a ray
+    /// for each), timed as trace work.
+    fn record_trace(&mut self, rec: &mut Recording, stage: TraceStage, groups: &TraceGroups, index: u32) {
         let gpu = &self.gpu;
         let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Trace, Some(index), None);
         let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("shadow mask ray trace"),
+            label: Some(stage.label()),
             timestamp_writes: rec.clock.compute_writes(slot),
         });
-        self.passes.trace.record(&mut pass, groups, index);
+        self.passes.trace.record(&mut pass, stage, groups, index);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 4;
         drop(pass);
@@ -200,7 +201,6 @@ impl Renderer {
         copy: PenumbraCopy,
         index: u32,
     ) {
-        let gpu = &self.gpu;
         let (mask, traced) = (copy.layer.texture(), copy.traced.texture());
         rec.encoder.copy_texture_to_texture(
             wgpu::TexelCopyTextureInfo {
@@ -212,16 +212,7 @@ impl Renderer {
             traced.as_image_copy(),
             wgpu::Extent3d { width: traced.width(), height: traced.height(), depth_or_array_layers: 1 },
         );
-        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Trace, Some(index), None);
-        let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("penumbra filter"),
-            timestamp_writes: rec.clock.compute_writes(slot),
-        });
-        self.passes.trace.record_filter(&mut pass, groups, index);
-        rec.stats.pipeline_changes += 1;
-        rec.stats.bind_group_changes += 4;
-        drop(pass);
-        rec.clock.end(gpu, rec.encoder, slot);
+        self.record_trace(rec, TraceStage::PenumbraFilter, groups, index);
     }
 
     /// The camera's depth, normals and view depth.

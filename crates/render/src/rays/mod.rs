@@ -13,7 +13,7 @@ pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    ListAccess, RefineLists, TraceGroups, TracePass, classify_wgsl, refined_mask_layout,
+    ListAccess, RefineLists, TraceGroups, TracePass, TraceStage, classify_wgsl, refined_mask_layout,
     screen_layout as refine_screen_layout,
 };
 

@@ -185,17 +185,13 @@ impl TracePass {
         Self { trace: pipeline("cs_trace"), filter: pipeline("cs_filter_penumbra") }
     }
 
-    /// Records the trace pass of light `light`: its listed pixels' rays, written into
-    /// its layer of the mask (`groups.mask`).
-    pub fn record(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
-        self.dispatch(&self.trace, pass, groups, light);
-    }
-
-    /// Records the penumbra filter of light `light`, after its trace pass and a copy
-    /// of its layer of the mask into the group's `traced_mask`: each listed pixel
-    /// becomes an edge-aware average of its neighbours.
-    pub fn record_filter(&self, pass: &mut wgpu::ComputePass, groups: &TraceGroups, light: u32) {
-        self.dispatch(&self.filter, pass, groups, light);
+    /// Records `stage` of light `light` over its listed pixels.
+    pub fn record(&self, pass: &mut wgpu::ComputePass, stage: TraceStage, groups: &TraceGroups, light: u32) {
+        let pipeline = match stage {
+            TraceStage::Trace => &self.trace,
+            TraceStage::PenumbraFilter => &self.filter,
+        };
+        self.dispatch(pipeline, pass, groups, light);
     }
 
     fn dispatch(
@@ -211,6 +207,28 @@ impl TracePass {
         pass.set_bind_group(2, groups.mask, &[]);
         pass.set_bind_group(super::GROUP, groups.bvh, &[]);
         pass.dispatch_workgroups_indirect(groups.counters, u64::from(RefineLists::counter_offset(light)));
+    }
+}
+
+/// The two compute passes over a light's list of pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TraceStage {
+    /// The listed pixels' rays, written into the light's layer of the mask
+    /// (`groups.mask`).
+    Trace,
+    /// After the trace and a copy of the light's layer of the mask into the group's
+    /// `traced_mask`, under a light with an area: each listed pixel becomes an
+    /// edge-aware average of its neighbours.
+    PenumbraFilter,
+}
+
+impl TraceStage {
+    /// The pass's label.
+    pub fn label(self) -> &'static str {
+        match self {
+            TraceStage::Trace => "shadow mask ray trace",
+            TraceStage::PenumbraFilter => "penumbra filter",
+        }
     }
 }
 
