@@ -125,13 +125,16 @@ fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
     let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
     assert!(matches!(error, RenderError::ReceiverNeedsMapPath));
     assert!(error.to_string().contains("screen.shadow_path"), "{error}");
-    // Rays asked for by name need the prepass too; the default, auto, yields to the
-    // host's shader.
-    settings.screen.shadow_path = ShadowPath::Auto;
+    // Rays asked for by name are traced in Gnomon's own passes, on either path; the
+    // default, auto, yields to the host's shader.
     settings.screen.refine = Refine::Rays;
-    let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
-    assert!(matches!(error, RenderError::ReceiverNeedsMapPath));
-    assert!(error.to_string().contains("screen.refine"), "{error}");
+    for path in [ShadowPath::Auto, ShadowPath::Forward] {
+        settings.screen.shadow_path = path;
+        let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
+        assert!(matches!(error, RenderError::ReceiverNeedsMapPath), "{path:?}");
+        assert!(error.to_string().contains("screen.refine"), "{error}");
+    }
+    settings.screen.shadow_path = ShadowPath::Auto;
     settings.screen.refine = Refine::Auto;
     assert!(renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).is_ok());
 }

@@ -12,9 +12,8 @@ use common::{
 use glam::{Mat4, Vec3};
 use gnomon_render::{Frame, OutputRequest, Renderer};
 use gnomon_scene::{
-    Camera, DirectionalLight, Instance, Material, Scene, Settings, builtin, geometry,
+    Settings, builtin,
     settings::{DebugView, Refine, Technique},
-    sun_direction,
 };
 
 /// Issue 25's bound for `--refine rays` over `pcf2x2` on a single map: 0.02 % of
@@ -79,63 +78,9 @@ fn refined_and_traced_shadows_match_the_reference_on_the_built_in_scenes() {
     }
 }
 
-/// Width of the bars: a third of a texel of the 512² map that covers the view.
-const BAR_WIDTH: f32 = 0.004;
-
-/// A ground under a grid of bars 4 mm wide and a metre up, turned 30° about the
-/// vertical so that no bar follows the map's texel rows; the camera looks down at
-/// their shadows.
-fn thin_bars() -> Scene {
-    let mut scene = builtin::spheres();
-    scene.name = "thin bars".into();
-    scene.materials = vec![Material::new("grey", Vec3::splat(0.7))];
-    scene.meshes = vec![
-        geometry::plane(8.0, 8.0),
-        geometry::cuboid(Vec3::new(2.5, 0.5 * BAR_WIDTH, 0.5 * BAR_WIDTH)),
-        geometry::cuboid(Vec3::new(0.5 * BAR_WIDTH, 0.5 * BAR_WIDTH, 2.5)),
-    ];
-    let instance = |name: String, mesh, world_from_object| Instance {
-        name,
-        mesh,
-        material: 0,
-        world_from_object,
-        casts_shadow: true,
-    };
-    scene.instances = vec![instance("ground".into(), 0, Mat4::IDENTITY)];
-    let turn = Mat4::from_rotation_y(30f32.to_radians());
-    for k in -4..=4 {
-        let offset = 0.5 * k as f32;
-        scene.instances.push(instance(
-            format!("bar x {k}"),
-            1,
-            turn * Mat4::from_translation(Vec3::new(0.0, 1.0, offset)),
-        ));
-        scene.instances.push(instance(
-            format!("bar z {k}"),
-            2,
-            turn * Mat4::from_translation(Vec3::new(offset, 1.0, 0.0)),
-        ));
-    }
-    scene.sun = DirectionalLight {
-        direction: -sun_direction(60.0, 40.0),
-        color: Vec3::ONE,
-        intensity: 1.0,
-        angular_diameter_degrees: 0.0,
-    };
-    scene.camera = Camera {
-        eye: Vec3::new(0.3, 4.5, 2.5),
-        target: Vec3::new(-0.4, 0.0, -0.3),
-        up: Vec3::Y,
-        fov_y_degrees: 50.0,
-        near: 0.05,
-        far: 50.0,
-    };
-    scene
-}
-
 #[test]
 fn casters_thinner_than_a_texel_are_shadowed_exactly_only_with_rays() {
-    let scene = thin_bars();
+    let scene = common::thin_bars();
     let mut coarse = settings(Refine::Off);
     coarse.shadow.map.resolution = 512;
     let truth = reference(&scene, &coarse);

@@ -115,14 +115,15 @@ pub enum RenderError {
         adapter: String,
     },
     /// A host's shader reads each light's own shadow map ([`Renderer::record_shadows`]);
-    /// the mask path (a screen-space mask, contact shadows) needs Gnomon's depth prepass.
+    /// the mask path (a screen-space mask, contact shadows) needs Gnomon's depth
+    /// prepass, and rays asked for by name are traced in Gnomon's own passes.
     #[error(
         "the shadow receiver reads each light's shadow map, but these settings shade through \
-         Gnomon's screen-space mask (`screen.shadow_path = \"mask\"`, \
-         `shadow.contact.contact_shadows` on for a light, or `screen.refine` rays or \
-         every-pixel), which needs Gnomon's own depth prepass; set `screen.shadow_path` to \
-         forward or auto with contact shadows off and `screen.refine` auto or off, or let \
-         Gnomon draw the image"
+         Gnomon's own passes: its screen-space mask (`screen.shadow_path = \"mask\"`, or \
+         `shadow.contact.contact_shadows` on for a light), which needs Gnomon's own depth \
+         prepass, or shadow rays (`screen.refine` rays or every-pixel), which Gnomon traces in \
+         its mask or lighting pass; set `screen.shadow_path` to forward or auto with contact \
+         shadows off and `screen.refine` auto or off, or let Gnomon draw the image"
     )]
     ReceiverNeedsMapPath,
     /// A setting is out of its valid range.

@@ -129,8 +129,11 @@ impl Renderer {
                 // Ambient light is added once, by the first light's pass.
                 light_gpu.ambient = Vec3::ZERO;
             }
-            let refine =
-                if mask_path { rays::light_refine(settings.screen.refine, &r.light) } else { Refine::Off };
+            let refine = if mask_path {
+                rays::light_refine(settings.screen.refine, &r.light)
+            } else {
+                rays::forward_light_refine(settings.screen.refine)
+            };
             lights.push(LightPlan {
                 refine,
                 name: r.name,

@@ -84,8 +84,9 @@ impl Renderer {
     /// Nothing is submitted here, except SDSM's depth prepass, which needs the camera's
     /// depths before the maps are fitted.
     ///
-    /// The mask path (`screen.shadow_path = "mask"`, contact shadows, refinement by
-    /// rays asked for by name) needs Gnomon's own depth prepass: on it, this returns
+    /// The mask path (`screen.shadow_path = "mask"`, contact shadows) needs Gnomon's
+    /// own depth prepass, and rays asked for by name (on either path) are traced in
+    /// Gnomon's own passes: for those this returns
     /// [`RenderError::ReceiverNeedsMapPath`]. The default refinement, `auto`, runs only
     /// where Gnomon draws the image: here the maps' answer is the host's.
     pub fn record_shadows(
@@ -108,7 +109,7 @@ impl Renderer {
             Refine::Off | Refine::Rays | Refine::EveryPixel => settings,
         };
         let plan = self.plan_frame(uploaded, scene, settings, None)?;
-        if plan.mask_path {
+        if plan.mask_path || plan.lights.iter().any(|l| l.refine != Refine::Off) {
             return Err(RenderError::ReceiverNeedsMapPath);
         }
         let culled = cull(uploaded, &plan);

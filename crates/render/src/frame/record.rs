@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use gnomon_math::culling::Frustum;
-use gnomon_scene::{Scene, Settings};
+use gnomon_scene::{Scene, Settings, settings::Refine};
 
 use super::{
     Renderer,
@@ -26,6 +26,7 @@ use crate::{
         shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
     },
     pool::{Binding, ViewKey},
+    rays::{self, RefineLists},
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::{CameraGpu, LightGpu},
@@ -133,6 +134,9 @@ struct LightingTargets {
 struct SharedLighting<'a> {
     plan: &'a FramePlan,
     camera_group: &'a wgpu::BindGroup,
+    /// On the forward path, where a light traces rays in its lighting pass: the
+    /// camera's group with the casters' BVH.
+    tracing_group: Option<&'a wgpu::BindGroup>,
     targets: &'a LightingTargets,
     /// What the camera sees.
     visible: &'a Visible,
@@ -263,10 +267,24 @@ impl Renderer {
                 mask_layers: &mask_layers,
             };
             let lists = self.record_screen_space(rec, uploaded, plan, &lit, &screen);
-            readbacks.refine_counters = lists.map(|lists| lists.copy_counters(&mut self.pool, rec.encoder));
+            // Each light's count of the pixels its rays decided.
+            readbacks.refine_counters =
+                lists.map(|lists| RefineLists::copy_counters(&lists.counters, &mut self.pool, rec.encoder));
         }
-        let shared =
-            SharedLighting { plan, camera_group: &camera_group, targets: &targets, visible: &culled.camera };
+        // On the forward path, the lights that refine trace in their lighting pass
+        // (uncounted: rays/refine_forward.wgsl says why).
+        let refines = plan.lights.iter().any(|l| l.refine != Refine::Off);
+        let tracing = uploaded
+            .rays()
+            .filter(|_| !plan.mask_path && refines)
+            .map(|bvh| rays::forward_group(&mut self.pool, &self.layouts.forward_rays, &camera_buffer, bvh));
+        let shared = SharedLighting {
+            plan,
+            camera_group: &camera_group,
+            tracing_group: tracing.as_ref(),
+            targets: &targets,
+            visible: &culled.camera,
+        };
         for (index, bindings) in lit.iter().enumerate() {
             self.record_lighting(rec, uploaded, &shared, index, bindings);
         }
@@ -413,7 +431,7 @@ impl Renderer {
         index: usize,
         bindings: &LightBindings,
     ) {
-        let SharedLighting { plan, camera_group, targets, visible: camera_visible } = *shared;
+        let SharedLighting { plan, camera_group, tracing_group, targets, visible: camera_visible } = *shared;
         let light = &plan.lights[index];
         let first = index == 0;
         let last = index + 1 == plan.lights.len();
@@ -466,9 +484,12 @@ impl Renderer {
             } else {
                 LightingRole::Added { visibility: index == plan.shown }
             },
+            // Only a forward frame with the BVH built has a group to trace with.
+            refine: if tracing_group.is_some() { light.refine } else { Refine::Off },
         };
         pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));
         pass.set_bind_group(0, &bindings.scene, &[]);
+        let camera_group = tracing_group.filter(|_| key.refine != Refine::Off).unwrap_or(camera_group);
         pass.set_bind_group(1, camera_group, &[]);
         pass.set_bind_group(2, &bindings.lighting, &[]);
         rec.stats.pipeline_changes += 1;

@@ -1,5 +1,5 @@
 //! The Rust↔WGSL interface, checked without a device: every shader variant Gnomon can
-//! build (technique × light lookup × forward or mask path × role, the moment passes
+//! build (technique × light lookup × forward or mask path × role × refinement, the moment passes
 //! per format, and every fixed pass) composes and validates with naga, as wgpu would
 //! compile it; and every uniform struct's WGSL size and field offsets equal the Rust
 //! type's (`uniforms::struct_layouts`).
@@ -53,8 +53,15 @@ fn every_variant() -> Vec<(String, String)> {
                 LightingRole::Added { visibility: true },
                 LightingRole::Added { visibility: false },
             ] {
-                let key = LightingKey { technique, lookup, role };
+                let key = LightingKey { technique, lookup, role, refine: Refine::Off };
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+            }
+            // The forward path's lighting pass that traces rays where the map is unsure.
+            if let Lookup::Own(_) = lookup {
+                for refine in [Refine::Rays, Refine::EveryPixel] {
+                    let key = LightingKey { technique, lookup, role: LightingRole::First, refine };
+                    out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+                }
             }
             if let Lookup::Own(map) = lookup {
                 for refine in [Refine::Off, Refine::Rays, Refine::EveryPixel] {

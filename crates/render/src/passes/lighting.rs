@@ -8,8 +8,11 @@
 use std::collections::HashMap;
 
 use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
+use gnomon_scene::settings::Refine;
+
 use crate::{
     gpu_types::VertexStream,
+    rays,
     techniques::{self, TechniqueRef},
 };
 
@@ -45,6 +48,10 @@ pub(crate) struct LightingKey {
     pub technique: TechniqueRef,
     pub lookup: Lookup,
     pub role: LightingRole,
+    /// Which fragments trace shadow rays in the pass: on the forward path, as the
+    /// light's refinement says; always off on the mask path, whose mask holds the
+    /// rays' answers.
+    pub refine: Refine,
 }
 
 /// How the lighting pass finds a receiver's visibility.
@@ -124,41 +131,63 @@ pub(crate) const SURFACE_WGSL: &str = include_str!("surface.wgsl");
 pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     let mut parts = camera_shading_wgsl();
     parts.extend(visibility_wgsl(key.technique, key.lookup));
+    parts.extend(match key.lookup {
+        Lookup::Own(map) => rays::forward_refine_wgsl(key.refine, map),
+        Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map),
+    });
     parts.push(SURFACE_WGSL.to_owned());
     parts.push(include_str!("lighting.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
 }
 
-/// Lighting pipelines, one per technique, lookup and role, built on first use.
+/// Lighting pipelines, one per technique, lookup, role and refinement, built on
+/// first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
+    /// The layout of the pipelines that trace rays: the camera's group holds the
+    /// casters' BVH and the light's counters too.
+    tracing_layout: wgpu::PipelineLayout,
     pipelines: HashMap<LightingKey, wgpu::RenderPipeline>,
 }
 
 impl LightingPass {
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lighting"),
-            bind_group_layouts: &[
-                Some(&layouts.scene),
-                Some(&layouts.camera),
-                Some(&layouts.shadow),
-                Some(&layouts.material),
-            ],
-            immediate_size: 0,
-        });
-        Self { layout, pipelines: HashMap::new() }
+        let layout = |label, camera| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[
+                    Some(&layouts.scene),
+                    Some(camera),
+                    Some(&layouts.shadow),
+                    Some(&layouts.material),
+                ],
+                immediate_size: 0,
+            })
+        };
+        Self {
+            layout: layout("lighting", &layouts.camera),
+            tracing_layout: layout("lighting, tracing shadow rays", &layouts.forward_rays),
+            pipelines: HashMap::new(),
+        }
     }
 
+    /// The pipeline of `key`: groups 0 (scene and light), 1 (the camera; with the
+    /// casters' BVH and the light's counters where the key refines), 2 (the light's
+    /// shadow resources) and 3 (each draw's material).
     pub fn pipeline(&mut self, device: &wgpu::Device, key: LightingKey) -> &wgpu::RenderPipeline {
         // Reading the mask is the same shader whatever technique filled it: one
-        // pipeline serves them all.
+        // pipeline serves them all, and it traces nothing.
         let key = match key.lookup {
-            Lookup::Mask => LightingKey { technique: TechniqueRef::any_builtin(), ..key },
-            _ => key,
+            Lookup::Mask => {
+                LightingKey { technique: TechniqueRef::any_builtin(), refine: Refine::Off, ..key }
+            }
+            Lookup::Own(_) => key,
         };
-        let layout = &self.layout;
+        let layout = match key.refine {
+            Refine::Off => &self.layout,
+            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.tracing_layout,
+        };
         self.pipelines.entry(key).or_insert_with(|| {
             let source = lighting_wgsl(key);
             let label = key.technique.technique().to_string();

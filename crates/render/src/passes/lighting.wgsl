@@ -3,8 +3,9 @@
 // per-pixel visibility, world position, normal, view depth and object id.
 //
 // `pixel_visibility` comes from resolve_visibility.wgsl on the forward path (the
-// technique's lookup, per fragment) or from mask_lookup.wgsl on the mask path (what
-// the screen-space shadow mask stored for the pixel). Camera: camera.wgsl; the
+// technique's lookup, per fragment, which `refine_forward` refines by rays where
+// asked) or from mask_lookup.wgsl on the mask path (what the screen-space shadow
+// mask stored for the pixel). Camera: camera.wgsl; the
 // vertex stage and normals: surface.wgsl; the light's direction and cone:
 // shading.wgsl.
 
@@ -37,10 +38,13 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let world_dx = dpdx(in.world);
     let world_dy = dpdy(in.world);
     let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
-    let shadow = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
+    let looked_up = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
+    // Where the forward path refines and the map is unsure, the fragment's rays
+    // decide (rays/refine_forward.wgsl).
+    let shadow = refine_forward(looked_up, in.world, n, geometric_n, geometry, view_depth, in.clip.xy);
     let visibility = shadow.x;
-    // On the mask path with the traced view, a layer past TRACED_LAYER_FLAG marks a
-    // pixel whose shadow rays decided (shadow_mask.wgsl).
+    // Under the traced view, a layer past TRACED_LAYER_FLAG marks a pixel whose
+    // shadow rays decided (shadow_mask.wgsl, refine_forward.wgsl).
     let traced = u32(shadow.y) >= TRACED_LAYER_FLAG;
     let layer = u32(shadow.y) % TRACED_LAYER_FLAG;
 

@@ -112,6 +112,9 @@ pub(crate) struct Layouts {
     pub scene: wgpu::BindGroupLayout,
     /// Group 1 of the lighting pass and the prepass: the camera.
     pub camera: wgpu::BindGroupLayout,
+    /// Group 1 of a forward lighting pass that refines by rays: the camera, the
+    /// casters' BVH and the light's counters ([`crate::rays::forward_layout`]).
+    pub forward_rays: wgpu::BindGroupLayout,
     /// Group 1 of the shadow-mask pass: the camera and the prepass's view depth and
     /// normals.
     pub screen: wgpu::BindGroupLayout,
@@ -162,6 +165,7 @@ impl Layouts {
                 ],
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
+            forward_rays: crate::rays::forward_layout(device),
             shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(7)]].concat()),
             receiver: layout(
                 "shadow receiver",

@@ -50,7 +50,7 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());
-    parts.extend(crate::rays::classify_wgsl(key.refine, key.lookup));
+    parts.extend(crate::rays::mask_refine_wgsl(key.refine, key.lookup));
     parts.push(include_str!("shadow_mask.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)

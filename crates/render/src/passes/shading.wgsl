@@ -1,5 +1,6 @@
-// What the lighting pass and the shadow-mask pass share about a surface point and its
-// light: the light's direction and cone at the point, and the normal-offset floor.
+// What the passes that shade from the camera (lighting, shadow mask, ray trace) and the
+// shadow receiver share about a surface point and its light: the light's direction
+// and cone at the point, the normal-offset floor, and an orthonormal basis.
 
 // A surface facing the light keeps this fraction of the offset, against the depth
 // quantisation that the slope bias (zero for it) cannot cover.
@@ -30,4 +31,17 @@ fn light_geometry(world: vec3<f32>) -> vec4<f32> {
 // camera sees this way, not from the winding (see surface.wgsl).
 fn facing_side(n: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     return select(n, -n, dot(n, toward) < 0.0);
+}
+
+// An orthonormal pair perpendicular to unit `n`, the columns of the matrix; the cube
+// lookups and the light's samples share it (Duff et al., "Building an
+// orthonormal basis, revisited", JCGT 2017).
+fn orthonormal_pair(n: vec3<f32>) -> mat2x3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(
+        vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        vec3<f32>(b, sign + n.y * n.y * a, -n.y),
+    );
 }

@@ -7,7 +7,7 @@
 
 use std::collections::BTreeSet;
 
-use gnomon_scene::settings::{BiasSettings, CullMode, Technique};
+use gnomon_scene::settings::{BiasSettings, CullMode, Refine, Technique};
 
 use crate::techniques::TechniqueRegistry;
 use wgpu::naga;
@@ -159,7 +159,7 @@ fn no_geometry_vertex_stage_reads_a_storage_buffer() {
     for technique in [Technique::HARD, Technique::PCSS, Technique::VSM] {
         let technique = registry.get(&technique).expect("built in");
         for lookup in [Lookup::Own(MapLookup::Map), Lookup::Mask] {
-            let key = LightingKey { technique, lookup, role: LightingRole::First };
+            let key = LightingKey { technique, lookup, role: LightingRole::First, refine: Refine::Off };
             modules.push(("lighting", Reflected::new(&lighting::lighting_wgsl(key))));
         }
     }

@@ -123,18 +123,6 @@ fn concentric_disk(u: vec2<f32>) -> vec2<f32> {
     return r * vec2<f32>(cos(theta), sin(theta));
 }
 
-// Two unit vectors completing the unit `axis` to an orthonormal basis (Duff et al.,
-// "Building an Orthonormal Basis, Revisited", JCGT 2017).
-fn orthonormal_pair(axis: vec3<f32>) -> array<vec3<f32>, 2> {
-    let sign = select(-1.0, 1.0, axis.z >= 0.0);
-    let a = -1.0 / (sign + axis.z);
-    let b = axis.x * axis.y * a;
-    return array<vec3<f32>, 2>(
-        vec3<f32>(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x),
-        vec3<f32>(b, sign + axis.y * axis.y * a, -axis.y),
-    );
-}
-
 // The unit square to directions within `half_angle` of `axis`, uniform in solid
 // angle: cos θ = 1 − u (1 − cos θ_max), φ = 2π v.
 fn cone_direction(u: vec2<f32>, axis: vec3<f32>, half_angle: f32) -> vec3<f32> {

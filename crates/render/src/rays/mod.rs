@@ -6,14 +6,16 @@
 //! shadow.
 
 mod bvh;
+mod forward;
 mod query;
 mod refine;
 
+pub(crate) use forward::{forward_group, forward_layout, forward_refine_wgsl};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    ListAccess, RefineLists, TraceGroups, TracePass, TraceStage, classify_wgsl, refined_mask_layout,
+    ListAccess, RefineLists, TraceGroups, TracePass, TraceStage, mask_refine_wgsl, refined_mask_layout,
     screen_layout as refine_screen_layout,
 };
 
@@ -26,14 +28,15 @@ use bvh::CasterBvh;
 /// The bind group slot the tracer's buffers take in every pipeline that traces.
 pub(crate) const GROUP: u32 = 3;
 
-/// `trace.wgsl` with the constants it shares with [`bvh`].
-pub(crate) fn trace_wgsl() -> String {
+/// `trace.wgsl` with the constants it shares with [`bvh`], its buffers bound in
+/// `group` (bindings 2–6).
+pub(crate) fn trace_wgsl(group: u32) -> String {
     format!(
         "const TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}",
         bvh::MAX_DEPTH,
         bvh::NO_ALPHA,
         bvh::NO_TEXTURE,
-        include_str!("trace.wgsl")
+        include_str!("trace.wgsl").replace("TRACE_GROUP", &group.to_string())
     )
 }
 
@@ -48,13 +51,34 @@ pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
     }
 }
 
+/// The refinement a light gets on the forward path, where its lighting pass traces
+/// (`forward.rs`): only rays asked for by name. `auto` asks for rays where they run
+/// best, on the mask path, which `--shadow-path auto` then takes
+/// (`Settings::uses_shadow_mask`); a frame told to stay forward is drawn unrefined.
+pub(crate) fn forward_light_refine(refine: Refine) -> Refine {
+    match refine {
+        Refine::Auto | Refine::Off => Refine::Off,
+        Refine::Rays | Refine::EveryPixel => refine,
+    }
+}
+
 /// The layout of the tracer's group: bindings 2–6, read-only storage (0 and 1 stay
 /// free for the material texture that passes sharing `scene_common.wgsl` declare).
 pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let entries: Vec<wgpu::BindGroupLayoutEntry> = (2..7)
+    let entries = buffer_entries(wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE);
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("shadow rays"),
+        entries: &entries,
+    })
+}
+
+/// The entries of the tracer's five read-only buffers, at bindings 2–6, seen by
+/// `stages`.
+fn buffer_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
+    (FIRST_BINDING..FIRST_BINDING + 5)
         .map(|binding| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            visibility: stages,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only: true },
                 has_dynamic_offset: false,
@@ -62,11 +86,7 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             },
             count: None,
         })
-        .collect();
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("shadow rays"),
-        entries: &entries,
-    })
+        .collect()
 }
 
 /// Why the GPU ray tracer cannot take a scene or a frame on a device: each names the
@@ -164,6 +184,9 @@ pub(crate) struct GpuBvh {
     buffers: Vec<wgpu::Buffer>,
 }
 
+/// The first binding of the tracer's buffers in whichever group holds them.
+const FIRST_BINDING: u32 = 2;
+
 /// Which of [`GpuBvh`]'s buffers holds what.
 const NODE_BUFFER: usize = 0;
 const TRIANGLE_BUFFER: usize = 1;
@@ -204,7 +227,7 @@ impl GpuBvh {
             .collect();
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()
-                .zip(2..)
+                .zip(FIRST_BINDING..)
                 .map(|(buffer, binding)| wgpu::BindGroupEntry {
                     binding,
                     resource: buffer.as_entire_binding(),
@@ -218,6 +241,12 @@ impl GpuBvh {
             (bvh.alpha, bvh.textures, bvh.texels) = Default::default();
             Self { group, triangles: bvh.casters, tree: bvh, buffers }
         })
+    }
+
+    /// The tracer's buffers at their bindings (2–6), for a group that holds them
+    /// beside others.
+    pub(crate) fn bindings(&self) -> Vec<(u32, crate::pool::Binding)> {
+        (FIRST_BINDING..).zip(self.buffers.iter().map(|b| crate::pool::Binding::Buffer(b.clone()))).collect()
     }
 
     /// How many instances the scene the tree was built from had.

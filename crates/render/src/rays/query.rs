@@ -69,7 +69,7 @@ impl ShadowRays {
             });
             let source = format!(
                 "const QUERY_WORKGROUP: u32 = {WORKGROUP}u;\n{}\n{}",
-                super::trace_wgsl(),
+                super::trace_wgsl(GROUP),
                 include_str!("query.wgsl")
             );
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

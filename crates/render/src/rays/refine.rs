@@ -38,11 +38,22 @@ fn list_wgsl() -> String {
 
 /// The WGSL of `ray_decides` and `defer_to_ray`, which the shadow-mask pass calls
 /// with each pixel's map answer: never, when `refine` is off; otherwise the
+/// classification ([`classify_wgsl`]) and the list it appends to.
+pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
+    let Some(mut parts) = classify_wgsl(refine, lookup) else {
+        return vec![include_str!("refine_off.wgsl").to_owned()];
+    };
+    parts.push(list_wgsl());
+    parts.push(include_str!("refine_append.wgsl").to_owned());
+    parts
+}
+
+/// The WGSL of `ray_decides`, which says whether a ray decides a pixel: the
 /// classification (refine_classify.wgsl) with the footprint test of the light's kind
-/// of map, and the list it appends to.
-pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
+/// of map. `None` when `refine` is off.
+pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Option<Vec<String>> {
     let every_pixel = match refine {
-        Refine::Off => return vec![include_str!("refine_off.wgsl").to_owned()],
+        Refine::Off => return None,
         // The frame's plan resolves `auto` to `rays` (`super::light_refine`).
         Refine::Auto | Refine::Rays => false,
         Refine::EveryPixel => true,
@@ -54,11 +65,20 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
     };
     let mut parts = vec![
         format!("const REFINE_EVERY_PIXEL: bool = {every_pixel};\n"),
-        list_wgsl(),
         include_str!("refine_classify.wgsl").to_owned(),
     ];
     parts.extend(footprint.iter().map(|s| s.to_string()));
-    parts
+    Some(parts)
+}
+
+/// The shadow rays from surface points (surface_rays.wgsl) with what they need: the
+/// tracer, its buffers in `group`, and the light's samples.
+pub(crate) fn surface_rays_wgsl(group: u32) -> Vec<String> {
+    vec![
+        super::trace_wgsl(group),
+        include_str!("light_sample.wgsl").to_owned(),
+        include_str!("surface_rays.wgsl").to_owned(),
+    ]
 }
 
 /// The trace pass's WGSL, composed.
@@ -67,8 +87,7 @@ pub(crate) fn trace_pass_wgsl() -> String {
     parts.push(passes::OCTAHEDRON_WGSL.to_owned());
     parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
     parts.push(list_wgsl());
-    parts.push(super::trace_wgsl());
-    parts.push(include_str!("light_sample.wgsl").to_owned());
+    parts.extend(surface_rays_wgsl(super::GROUP));
     parts.push(include_str!("refine_trace.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -268,15 +287,19 @@ impl RefineLists {
     pub fn new(pool: &mut Pool, width: u32, height: u32, lights: usize) -> Self {
         let pixels =
             pool.buffer("unsure pixels", Self::list_bytes(width, height), wgpu::BufferUsages::STORAGE);
-        let counters = pool.buffer(
+        Self { pixels, counters: Self::counters(pool, lights) }
+    }
+
+    /// The counters of `lights` lights, [`COUNTER_STRIDE`] apart, from `pool`.
+    pub fn counters(pool: &mut Pool, lights: usize) -> wgpu::Buffer {
+        pool.buffer(
             "refinement counters",
             COUNTER_STRIDE * lights as u64,
             wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::INDIRECT
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
-        );
-        Self { pixels, counters }
+        )
     }
 
     /// The dynamic offset of light `light`'s counters.
@@ -326,12 +349,17 @@ impl RefineLists {
         )
     }
 
-    /// Records a copy of the counters into a mappable buffer, to read back.
-    pub fn copy_counters(&self, pool: &mut Pool, encoder: &mut wgpu::CommandEncoder) -> wgpu::Buffer {
-        let size = self.counters.size();
+    /// Records a copy of `counters` (the mask path's or the forward path's) into a
+    /// mappable buffer, to read back.
+    pub fn copy_counters(
+        counters: &wgpu::Buffer,
+        pool: &mut Pool,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> wgpu::Buffer {
+        let size = counters.size();
         let usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
         let copy = pool.buffer("refinement counters, read back", size, usage);
-        encoder.copy_buffer_to_buffer(&self.counters, 0, &copy, 0, size);
+        encoder.copy_buffer_to_buffer(counters, 0, &copy, 0, size);
         copy
     }
 

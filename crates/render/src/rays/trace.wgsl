@@ -5,8 +5,9 @@
 // alpha at mip 0, and the ray's origin moved off its surface by Wächter & Binder's
 // offset (Ray Tracing Gems, ch. 6).
 //
-// Group 3, bindings 2–6 (0 and 1 are the material texture, which passes sharing
-// scene_common.wgsl declare).
+// Bindings 2–6 of group TRACE_GROUP, which `trace_wgsl` sets: 3 in the compute
+// passes, where 0 and 1 are left to the material texture that passes sharing
+// scene_common.wgsl declare, and 1 in the forward lighting pass, beside the camera.
 
 struct BvhNode {
     min: vec3<f32>,
@@ -50,11 +51,11 @@ struct AlphaTexture {
     _pad1: u32,
 };
 
-@group(3) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
-@group(3) @binding(3) var<storage, read> bvh_triangles: array<BvhTriangle>;
-@group(3) @binding(4) var<storage, read> bvh_alpha: array<AlphaTest>;
-@group(3) @binding(5) var<storage, read> bvh_alpha_textures: array<AlphaTexture>;
-@group(3) @binding(6) var<storage, read> bvh_alpha_texels: array<u32>;
+@group(TRACE_GROUP) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(TRACE_GROUP) @binding(3) var<storage, read> bvh_triangles: array<BvhTriangle>;
+@group(TRACE_GROUP) @binding(4) var<storage, read> bvh_alpha: array<AlphaTest>;
+@group(TRACE_GROUP) @binding(5) var<storage, read> bvh_alpha_textures: array<AlphaTexture>;
+@group(TRACE_GROUP) @binding(6) var<storage, read> bvh_alpha_texels: array<u32>;
 
 // A texel index along an axis of `n` texels, wrapped as `mode` says.
 fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {

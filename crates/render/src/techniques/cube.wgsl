@@ -46,18 +46,6 @@ fn cube_tap_depth(q: CubeQuery, direction: vec3<f32>) -> f32 {
     return clamp(depth, q.depth - reach, q.depth + reach);
 }
 
-// An orthonormal pair perpendicular to unit `n` (Duff et al., "Building an
-// orthonormal basis, revisited", JCGT 2017).
-fn orthonormal_pair(n: vec3<f32>) -> mat2x3<f32> {
-    let sign = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    return mat2x3<f32>(
-        vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        vec3<f32>(b, sign + n.y * n.y * a, -n.y),
-    );
-}
-
 // World size of one cube texel across the ray to `offset`: a face texel at
 // major-axis distance m is 2m / resolution wide in the face plane, and m / |offset|
 // of that across the ray (gnomon_math::omni::cube_texel_world_size).

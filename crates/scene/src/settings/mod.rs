@@ -215,25 +215,16 @@ impl Settings {
 
     /// Whether a frame with these lights resolves its shadows in a screen-space mask:
     /// as --shadow-path says, and with `auto` when any light marches contact shadows
-    /// or any hard light's shadow is refined by rays (which `auto` refinement asks
-    /// for). Contact shadows, or rays asked for by name, with --shadow-path forward
-    /// are refused: they need the prepass.
+    /// or refines its shadow by rays (a hard light under `auto` refinement, or any
+    /// light under rays asked for by name), which run best on the mask path. Rays
+    /// asked for with --shadow-path forward are traced in the lighting pass instead;
+    /// contact shadows with it are refused: they march through the mask path's depth
+    /// prepass.
     pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
-        let refine = self.screen.refine;
-        let rays = match refine {
+        let rays = match self.screen.refine {
             Refine::Off => false,
             Refine::Auto => lights.iter().any(|l| l.light.is_hard()),
-            Refine::Rays | Refine::EveryPixel => {
-                if self.screen.shadow_path == ShadowPath::Forward {
-                    return Err(SettingsError {
-                        setting: "screen.refine",
-                        value: value_name(&refine),
-                        valid: "off or auto with --shadow-path forward: rays start from the mask path's depth prepass"
-                            .into(),
-                    });
-                }
-                true
-            }
+            Refine::Rays | Refine::EveryPixel => true,
         };
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {

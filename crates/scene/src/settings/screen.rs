@@ -9,10 +9,12 @@ use super::*;
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowPath {
     /// The mask when any light has contact shadows (which march through its depth) or
-    /// refines its shadow by rays (which start from it), forward otherwise.
+    /// refines its shadow by rays (traced there in a pass of their own), forward
+    /// otherwise.
     #[default]
     Auto,
-    /// In the lighting pass, once per fragment drawn.
+    /// In the lighting pass, once per fragment drawn; rays asked for by name are
+    /// traced there too, per fragment, without the mask path's penumbra filter.
     Forward,
     /// Screen-space shadows, as in Unity URP: a depth-and-normal prepass, then one
     /// full-screen pass per light that reconstructs each pixel's position from depth,
@@ -22,7 +24,10 @@ pub enum ShadowPath {
 
 /// Which pixels trace shadow rays on the GPU, over the casters' BVH, in place of
 /// their shadow-map answer (hybrid ray-traced shadows, after Story's HFTS and
-/// Unreal's shadow-map ray tracing). Needs the mask path. A hard light's pixel traces
+/// Unreal's shadow-map ray tracing). On the mask path the shadow-mask pass lists the
+/// pixels and a compute pass traces them; on the forward path (rays asked for by name
+/// with `--shadow-path forward`) the lighting pass traces each fragment's rays where it
+/// shades it. A hard light's pixel traces
 /// one ray to the light; a light with an area (a sun's angular diameter, a spot's or
 /// point's radius) traces `penumbra_rays` stratified rays over its area, then a small
 /// edge-aware filter smooths their noise.
@@ -39,7 +44,8 @@ pub enum ShadowPath {
 pub enum Refine {
     /// `rays` for every hard light when the frame takes the mask path (under
     /// --shadow-path auto, which then takes it for them, or mask); `off` for lights
-    /// with an area, and for every light with --shadow-path forward.
+    /// with an area, and for every light with --shadow-path forward (ask for `rays`
+    /// by name to trace there).
     #[default]
     Auto,
     /// Every pixel keeps its shadow map's answer.
@@ -68,7 +74,7 @@ pub struct ScreenSpaceSettings {
     pub shadow_path: ShadowPath,
     /// Which pixels trace a shadow ray instead of trusting the map: auto (rays, where
     /// the frame takes the mask path), off, rays (where the map is unsure) or
-    /// every-pixel (rays and every-pixel need --shadow-path auto or mask).
+    /// every-pixel, on either path.
     #[cfg_attr(
         feature = "cli",
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")

@@ -56,9 +56,14 @@ const RULES: &[(&str, Uses, &str)] = &[
         "image.debug_view",
         |s, lights| {
             s.image.debug_view != DebugView::Traced
-                || (s.screen.refine != Refine::Off && s.uses_shadow_mask(lights).unwrap_or(false))
+                || match s.screen.refine {
+                    Refine::Off => false,
+                    // `auto` traces on the mask path only.
+                    Refine::Auto => s.uses_shadow_mask(lights).unwrap_or(false),
+                    Refine::Rays | Refine::EveryPixel => true,
+                }
         },
-        "`screen.refine` other than off, on the mask path (for the traced view)",
+        "`screen.refine` rays or every-pixel, or auto on the mask path (for the traced view)",
     ),
     (
         "screen.penumbra_rays",

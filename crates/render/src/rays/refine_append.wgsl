@@ -1,0 +1,32 @@
+// The mask pass's list of the pixels it leaves to rays (refine_classify.wgsl decides
+// which), for the trace pass (refine_trace.wgsl).
+
+// The first three words are the trace pass's `dispatch_workgroups_indirect`
+// arguments: one workgroup per REFINE_GROUP_SIZE pixels listed (at most
+// REFINE_MAX_GROUPS, which then loop), by 1, by 1. All four start at zero, which
+// dispatches nothing.
+struct RefineCounters {
+    groups_x: atomic<u32>,
+    groups_y: u32,
+    groups_z: u32,
+    count: atomic<u32>,
+};
+
+@group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;
+@group(1) @binding(4) var<storage, read_write> refine_counters: RefineCounters;
+
+// Appends `pixel` to the list, and counts one more workgroup for the trace pass at
+// the start of every REFINE_GROUP_SIZE pixels.
+fn defer_to_ray(pixel: vec2<u32>, layer: u32) {
+    let index = atomicAdd(&refine_counters.count, 1u);
+    if index == 0u {
+        refine_counters.groups_y = 1u;
+        refine_counters.groups_z = 1u;
+    }
+    if index % REFINE_GROUP_SIZE == 0u && index / REFINE_GROUP_SIZE < REFINE_MAX_GROUPS {
+        atomicAdd(&refine_counters.groups_x, 1u);
+    }
+    // The list holds a pixel per pixel of the screen, and each pixel lists itself at
+    // most once per light: the index is in bounds.
+    unsure_pixels[index] = UnsurePixel(pixel.x | (pixel.y << 16u), layer);
+}
