@@ -10,13 +10,18 @@ use std::{collections::BTreeMap, path::PathBuf, time::Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use gnomon_render::{FrameCost, Gpu, GpuInfo, Renderer, timing::ClockChoice};
-use gnomon_scene::{Settings, settings::Technique};
+use gnomon_render::{
+    DepthBaselineScene, FrameCost, Gpu, GpuScene, Renderer,
+    timing::{ClockChoice, TimingSource},
+};
+use gnomon_scene::{Scene, Settings, settings::Technique};
 use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::Serialize;
 
-use crate::output::{self, Staged};
+use crate::{
+    bench_report::{ConfigReport, Report, Summary, markdown, summarize},
+    output::{self, Staged},
+};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -88,72 +93,12 @@ struct Config {
     settings: Settings,
 }
 
-/// The median and 95th percentile of one measured quantity, in milliseconds, and every
-/// frame's value in the order the frames were timed (for re-analysis: frame i of one
-/// quantity and frame i of another were measured in the same frame).
-#[derive(Serialize, Clone, Debug)]
-struct Summary {
-    name: String,
-    median_ms: f64,
-    p95_ms: f64,
-    samples: usize,
-    values_ms: Vec<f64>,
-}
-
-#[derive(Serialize, Debug)]
-struct ConfigReport {
-    technique: String,
-    sweep_value: Option<String>,
-    /// Per pass (shadow, filter, prepass, mask, lighting: every light together),
-    /// then the frame totals (GPU frame, CPU submission and its parts, wall clock).
-    passes: Vec<Summary>,
-    /// Each light's each layer: "shadow L0 layer 1".
-    layers: Vec<Summary>,
-    /// Instances and draw calls of one frame.
-    shadow_draws: u32,
-    shadow_instances: u32,
-    lighting_draws: u32,
-    lighting_instances: u32,
-    /// With --depth-only: the baseline's time, and the median over frames of the
-    /// shadow pass's time over the baseline's (lights the baseline can draw).
-    depth_only: Option<Summary>,
-    shadow_over_depth_only: Option<f64>,
-    /// With refinement by rays, in the last frame: the pixels traced as a share of
-    /// the screen (every refining light together, in %), and the rays cast.
-    traced_percent: Option<f64>,
-    rays: Option<u64>,
-}
-
-#[derive(Serialize, Debug)]
-struct Report {
-    adapter: String,
-    backend: String,
-    device_type: String,
-    driver: String,
-    driver_info: String,
-    timing: &'static str,
-    scene: String,
-    instances: usize,
-    triangles: usize,
-    width: u32,
-    height: u32,
-    warmup: u32,
-    frames: u32,
-    sweep: Option<String>,
-    /// With --moving: how many instances moved every frame, and the time to build
-    /// the casters' BVH afresh, for scale against the refits in `CPU move`.
-    moving: Option<usize>,
-    rebuild_ms: Option<f64>,
-    command: String,
-    configs: Vec<ConfigReport>,
-}
-
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!((1..=100_000).contains(&args.frames), "--frames {}: give 1 to 100000", args.frames);
     anyhow::ensure!(args.warmup <= 10_000, "--warmup {}: give 0 to 10000", args.warmup);
     args.settings.validate()?;
     output::check_dir(&args.out, "--out")?;
-    let (mut scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
+    let (scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
     let mover = args.moving.map(|count| crate::bench_moving::Mover::new(&scene, count)).transpose()?;
     if let Some((width, height)) = args.size {
         base.image.width = width;
@@ -166,17 +111,18 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.verbose {
         eprintln!("gnomon: {}", gpu.info);
     }
-    let mut renderer = Renderer::new(&gpu)?;
+    let renderer = Renderer::new(&gpu)?;
     // Every configuration must fit the device before any is timed.
     for config in &configs {
         renderer.check_limits(&config.settings).with_context(|| config_name(args, config))?;
     }
-    let mut uploaded = renderer.upload(&scene)?;
+    let uploaded = renderer.upload(&scene)?;
     let baseline = if args.depth_only { Some(renderer.upload_depth_baseline(&scene)?) } else { None };
     let clock = match args.clock {
         ClockArg::Auto => ClockChoice::Auto,
         ClockArg::Cpu => ClockChoice::Cpu,
     };
+    let mut bench = Bench { args, renderer, uploaded, scene, baseline, mover, clock, source: None };
 
     let per_config = u64::from(args.warmup + args.frames);
     let progress = ProgressBar::new(per_config * configs.len() as u64);
@@ -186,115 +132,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             .progress_chars("=> "),
     );
     let mut reports = Vec::with_capacity(configs.len());
-    let mut source = None;
     for config in &configs {
         progress.set_prefix(config_name(args, config));
-        let settings = &config.settings;
-        let mut frame = 0;
-        for _ in 0..args.warmup {
-            if let Some(mover) = &mover {
-                mover.step(&renderer, &mut uploaded, &mut scene, frame)?;
-                frame += 1;
-            }
-            renderer.time_passes(&uploaded, &scene, settings, clock)?;
-            if let Some(baseline) = &baseline {
-                renderer.time_depth_baseline(baseline, &uploaded, &scene, settings, clock)?;
-            }
-            progress.inc(1);
-        }
-        let mut series: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-        let mut order: Vec<String> = Vec::new();
-        let mut push = |name: String, ms: f64| {
-            if !series.contains_key(&name) {
-                order.push(name.clone());
-            }
-            series.entry(name).or_default().push(ms);
-        };
-        let mut last: Option<FrameCost> = None;
-        for _ in 0..args.frames {
-            if let Some(mover) = &mover {
-                push("CPU move".into(), mover.step(&renderer, &mut uploaded, &mut scene, frame)?);
-                frame += 1;
-            }
-            let started = Instant::now();
-            let cost = renderer.time_passes(&uploaded, &scene, settings, clock)?;
-            let wall_ms = started.elapsed().as_secs_f64() * 1e3;
-            let timings = cost.timings.context("the frame was not timed")?;
-            source = Some(timings.source);
-            push("shadow".into(), timings.shadow_ms);
-            if let Some(ms) = timings.filter_ms {
-                push("filter".into(), ms);
-            }
-            if let Some(ms) = timings.prepass_ms {
-                push("prepass".into(), ms);
-            }
-            if let Some(ms) = timings.mask_ms {
-                push("mask".into(), ms);
-            }
-            if let Some(ms) = timings.trace_ms {
-                push("trace".into(), ms);
-            }
-            push("lighting".into(), timings.lighting_ms);
-            push("GPU frame".into(), timings.frame_ms);
-            push("CPU submit".into(), cost.cpu.submit_ms);
-            push("CPU fit".into(), cost.cpu.plan_ms);
-            push("CPU cull".into(), cost.cpu.cull_ms);
-            push("CPU record".into(), cost.cpu.record_ms);
-            push("wall frame".into(), wall_ms);
-            // What the frame costs beyond its GPU work and the CPU's submission: resource
-            // creation, stalls and readback waits. 1 means nothing is wasted.
-            push("wall ÷ (GPU + CPU)".into(), wall_ms / (timings.frame_ms + cost.cpu.submit_ms));
-            for (light, stats) in cost.lights.iter().enumerate() {
-                for (layer, ms) in stats.layer_ms.iter().enumerate() {
-                    push(format!("shadow L{light} layer {layer}"), *ms);
-                }
-            }
-            if let Some(baseline) = &baseline {
-                let times = renderer.time_depth_baseline(baseline, &uploaded, &scene, settings, clock)?;
-                // Only lights the baseline can draw (not dual-paraboloid maps) compare.
-                let drawn: Vec<usize> = (0..times.len()).filter(|&i| times[i].is_some()).collect();
-                let baseline_ms: f64 = drawn.iter().filter_map(|&i| times[i]).sum();
-                let ours_ms: f64 = drawn.iter().filter_map(|&i| cost.lights[i].shadow_ms).sum();
-                push("depth-only".into(), baseline_ms);
-                // The ratio frame by frame: both were timed back to back, so a slow
-                // spell of the machine affects both alike.
-                push("shadow ÷ depth-only".into(), ours_ms / baseline_ms);
-            }
-            last = Some(cost);
-            progress.inc(1);
-        }
-        let summary = |name: &str| series.get(name).map(|values| summarize(name, values));
-        let last = last.expect("at least one frame");
-        crate::render_cmd::warn_unrefined(&last.lights);
-        let is_layer = |name: &String| name.starts_with("shadow L");
-        let depth_only = summary("depth-only");
-        let ratio = summary("shadow ÷ depth-only").map(|r| r.median_ms);
-        let refined: Vec<&gnomon_render::LightStats> =
-            last.lights.iter().filter(|l| l.traced_pixels.is_some()).collect();
-        let traced = (!refined.is_empty())
-            .then(|| refined.iter().filter_map(|l| l.traced_pixels).map(u64::from).sum::<u64>());
-        let rays = (!refined.is_empty()).then(|| refined.iter().filter_map(|l| l.traced_rays()).sum::<u64>());
-        let pixels = f64::from(settings.image.width) * f64::from(settings.image.height);
-        reports.push(ConfigReport {
-            technique: config.technique.name().to_string(),
-            sweep_value: config.sweep_value.clone(),
-            passes: order
-                .iter()
-                .filter(|n| !is_layer(n) && !n.contains("depth-only"))
-                .filter_map(|n| summary(n))
-                .collect(),
-            layers: order.iter().filter(|n| is_layer(n)).filter_map(|n| summary(n)).collect(),
-            shadow_draws: last.stats.shadow_draws,
-            shadow_instances: last.stats.shadow_instances,
-            lighting_draws: last.stats.lighting_draws,
-            lighting_instances: last.stats.lighting_instances,
-            depth_only,
-            shadow_over_depth_only: ratio,
-            traced_percent: traced.map(|t| 100.0 * t as f64 / pixels),
-            rays,
-        });
+        reports.push(bench.config(config, &progress)?);
     }
     progress.finish_and_clear();
+    let Bench { scene, uploaded, mover, source, .. } = bench;
 
     let report = Report {
         adapter: gpu.info.adapter.clone(),
@@ -303,7 +146,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         driver: gpu.info.driver.clone(),
         driver_info: gpu.info.driver_info.clone(),
         timing: match source {
-            Some(gnomon_render::timing::TimingSource::GpuTimestamps) => "GPU timestamps",
+            Some(TimingSource::GpuTimestamps) => "GPU timestamps",
             _ => "CPU wall clock (each pass submitted and waited for alone)",
         },
         scene: scene.name.clone(),
@@ -333,6 +176,169 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         eprintln!("gnomon: wrote {}", path.display());
     }
     Ok(())
+}
+
+/// What every configuration's frames are drawn with.
+struct Bench<'a> {
+    args: &'a BenchArgs,
+    renderer: Renderer,
+    uploaded: GpuScene,
+    scene: Scene,
+    baseline: Option<DepthBaselineScene>,
+    /// With --moving: what sways the instances every frame.
+    mover: Option<crate::bench_moving::Mover>,
+    clock: ClockChoice,
+    /// How the last timed frame was timed.
+    source: Option<TimingSource>,
+}
+
+/// One configuration's measured quantities, each frame's value in order, listed in
+/// the order they were first measured.
+#[derive(Default)]
+struct Series {
+    values: BTreeMap<String, Vec<f64>>,
+    order: Vec<String>,
+}
+
+impl Series {
+    fn push(&mut self, name: impl Into<String>, ms: f64) {
+        let name = name.into();
+        if !self.values.contains_key(&name) {
+            self.order.push(name.clone());
+        }
+        self.values.entry(name).or_default().push(ms);
+    }
+
+    fn summary(&self, name: &str) -> Option<Summary> {
+        self.values.get(name).map(|values| summarize(name, values))
+    }
+}
+
+impl Bench<'_> {
+    /// Warms up, then times `--frames` frames of one configuration.
+    fn config(&mut self, config: &Config, progress: &ProgressBar) -> anyhow::Result<ConfigReport> {
+        let settings = &config.settings;
+        let mut frame = 0;
+        for _ in 0..self.args.warmup {
+            if let Some(mover) = &self.mover {
+                mover.step(&self.renderer, &mut self.uploaded, &mut self.scene, frame)?;
+                frame += 1;
+            }
+            self.renderer.time_passes(&self.uploaded, &self.scene, settings, self.clock)?;
+            if let Some(baseline) = &self.baseline {
+                self.renderer.time_depth_baseline(
+                    baseline,
+                    &self.uploaded,
+                    &self.scene,
+                    settings,
+                    self.clock,
+                )?;
+            }
+            progress.inc(1);
+        }
+        let mut series = Series::default();
+        let mut last: Option<FrameCost> = None;
+        for _ in 0..self.args.frames {
+            if let Some(mover) = &self.mover {
+                series.push(
+                    "CPU move",
+                    mover.step(&self.renderer, &mut self.uploaded, &mut self.scene, frame)?,
+                );
+                frame += 1;
+            }
+            last = Some(self.timed_frame(settings, &mut series)?);
+            progress.inc(1);
+        }
+        let last = last.expect("at least one frame");
+        crate::render_cmd::warn_unrefined(&last.lights);
+        Ok(config_report(config, &series, &last))
+    }
+
+    /// One timed frame, its quantities pushed onto `series`.
+    fn timed_frame(&mut self, settings: &Settings, series: &mut Series) -> anyhow::Result<FrameCost> {
+        let started = Instant::now();
+        let cost = self.renderer.time_passes(&self.uploaded, &self.scene, settings, self.clock)?;
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+        let timings = cost.timings.context("the frame was not timed")?;
+        self.source = Some(timings.source);
+        series.push("shadow", timings.shadow_ms);
+        let optional = [
+            ("filter", timings.filter_ms),
+            ("prepass", timings.prepass_ms),
+            ("mask", timings.mask_ms),
+            ("trace", timings.trace_ms),
+        ];
+        for (name, ms) in optional {
+            if let Some(ms) = ms {
+                series.push(name, ms);
+            }
+        }
+        series.push("lighting", timings.lighting_ms);
+        series.push("GPU frame", timings.frame_ms);
+        series.push("CPU submit", cost.cpu.submit_ms);
+        series.push("CPU fit", cost.cpu.plan_ms);
+        series.push("CPU cull", cost.cpu.cull_ms);
+        series.push("CPU record", cost.cpu.record_ms);
+        series.push("wall frame", wall_ms);
+        // What the frame costs beyond its GPU work and the CPU's submission: resource
+        // creation, stalls and readback waits. 1 means nothing is wasted.
+        series.push("wall ÷ (GPU + CPU)", wall_ms / (timings.frame_ms + cost.cpu.submit_ms));
+        for (light, stats) in cost.lights.iter().enumerate() {
+            for (layer, ms) in stats.layer_ms.iter().enumerate() {
+                series.push(format!("shadow L{light} layer {layer}"), *ms);
+            }
+        }
+        if let Some(baseline) = &self.baseline {
+            let times = self.renderer.time_depth_baseline(
+                baseline,
+                &self.uploaded,
+                &self.scene,
+                settings,
+                self.clock,
+            )?;
+            // Only lights the baseline can draw (not dual-paraboloid maps) compare.
+            let drawn: Vec<usize> = (0..times.len()).filter(|&i| times[i].is_some()).collect();
+            let baseline_ms: f64 = drawn.iter().filter_map(|&i| times[i]).sum();
+            let ours_ms: f64 = drawn.iter().filter_map(|&i| cost.lights[i].shadow_ms).sum();
+            series.push("depth-only", baseline_ms);
+            // The ratio frame by frame: both were timed back to back, so a slow spell
+            // of the machine affects both alike.
+            series.push("shadow ÷ depth-only", ours_ms / baseline_ms);
+        }
+        Ok(cost)
+    }
+}
+
+/// One configuration's report, from its series and its last frame (for the draws
+/// and the pixels traced).
+fn config_report(config: &Config, series: &Series, last: &FrameCost) -> ConfigReport {
+    let is_layer = |name: &&String| name.starts_with("shadow L");
+    let refined: Vec<&gnomon_render::LightStats> =
+        last.lights.iter().filter(|l| l.traced_pixels.is_some()).collect();
+    let traced = (!refined.is_empty())
+        .then(|| refined.iter().filter_map(|l| l.traced_pixels).map(u64::from).sum::<u64>());
+    let rays = (!refined.is_empty()).then(|| refined.iter().filter_map(|l| l.traced_rays()).sum::<u64>());
+    let image = &config.settings.image;
+    let pixels = f64::from(image.width) * f64::from(image.height);
+    ConfigReport {
+        technique: config.technique.name().to_string(),
+        sweep_value: config.sweep_value.clone(),
+        passes: series
+            .order
+            .iter()
+            .filter(|n| !is_layer(n) && !n.contains("depth-only"))
+            .filter_map(|n| series.summary(n))
+            .collect(),
+        layers: series.order.iter().filter(is_layer).filter_map(|n| series.summary(n)).collect(),
+        shadow_draws: last.stats.shadow_draws,
+        shadow_instances: last.stats.shadow_instances,
+        lighting_draws: last.stats.lighting_draws,
+        lighting_instances: last.stats.lighting_instances,
+        depth_only: series.summary("depth-only"),
+        shadow_over_depth_only: series.summary("shadow ÷ depth-only").map(|r| r.median_ms),
+        traced_percent: traced.map(|t| 100.0 * t as f64 / pixels),
+        rays,
+    }
 }
 
 /// The techniques × sweep values to time, each with its settings checked.
@@ -399,165 +405,9 @@ fn config_name(args: &BenchArgs, config: &Config) -> String {
     }
 }
 
-/// Median and 95th percentile (nearest rank) of `values`.
-fn summarize(name: &str, values: &[f64]) -> Summary {
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let rank = |q: f64| sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
-    let median = if sorted.len() % 2 == 1 {
-        sorted[sorted.len() / 2]
-    } else {
-        0.5 * (sorted[sorted.len() / 2 - 1] + sorted[sorted.len() / 2])
-    };
-    Summary {
-        name: name.to_string(),
-        median_ms: median,
-        p95_ms: rank(0.95),
-        samples: sorted.len(),
-        values_ms: values.to_vec(),
-    }
-}
-
-/// The report as markdown: the device, then a table of passes per configuration,
-/// then each layer's time where a light has several.
-fn markdown(report: &Report, info: &GpuInfo) -> String {
-    use std::fmt::Write;
-    let mut md = String::new();
-    let _ = writeln!(md, "# gnomon bench: {}\n", report.scene);
-    let _ = writeln!(
-        md,
-        "- adapter: {} ({}, {}), driver: {} {}\n- timing: {}\n- {} instances{}, {} triangles; image {}×{}; \
-         {} warm-up and {} timed frames per row; times in ms, median (p95)\n- command: `{}`\n",
-        info.adapter,
-        info.device_type,
-        info.backend,
-        info.driver,
-        info.driver_info,
-        report.timing,
-        report.instances,
-        match (report.moving, report.rebuild_ms) {
-            (Some(n), Some(ms)) => format!(
-                " ({n} moving every frame: `CPU move`; building the casters' BVH afresh takes {ms:.1} ms)"
-            ),
-            _ => String::new(),
-        },
-        report.triangles,
-        report.width,
-        report.height,
-        report.warmup,
-        report.frames,
-        report.command,
-    );
-    let mut columns: Vec<String> = Vec::new();
-    for config in &report.configs {
-        for pass in &config.passes {
-            if !columns.contains(&pass.name) {
-                columns.push(pass.name.clone());
-            }
-        }
-    }
-    // In frame order, whichever configurations have them.
-    const ORDER: [&str; 14] = [
-        "shadow",
-        "filter",
-        "prepass",
-        "mask",
-        "trace",
-        "lighting",
-        "GPU frame",
-        "CPU move",
-        "CPU submit",
-        "CPU fit",
-        "CPU cull",
-        "CPU record",
-        "wall frame",
-        "wall ÷ (GPU + CPU)",
-    ];
-    columns.sort_by_key(|c| ORDER.iter().position(|o| o == c).unwrap_or(ORDER.len()));
-    let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));
-    let has_baseline = report.configs.iter().any(|c| c.depth_only.is_some());
-    let has_rays = report.configs.iter().any(|c| c.rays.is_some());
-    let _ = write!(md, "| technique |");
-    if let Some(flag) = sweep {
-        let _ = write!(md, " {flag} |");
-    }
-    for c in &columns {
-        let _ = write!(md, " {c} |");
-    }
-    if has_baseline {
-        let _ = write!(md, " depth-only | shadow ÷ depth-only |");
-    }
-    if has_rays {
-        let _ = write!(md, " traced, % of screen (rays) |");
-    }
-    let _ = writeln!(md, " shadow draws (instances) | lighting draws (instances) |");
-    let cells = columns.len()
-        + 3
-        + usize::from(sweep.is_some())
-        + 2 * usize::from(has_baseline)
-        + usize::from(has_rays);
-    let _ = writeln!(md, "|{}", "---|".repeat(cells));
-    let cell = |s: Option<&Summary>| {
-        s.map_or("–".to_string(), |s| format!("{:.3} ({:.3})", s.median_ms, s.p95_ms))
-    };
-    for config in &report.configs {
-        let _ = write!(md, "| {} |", config.technique);
-        if sweep.is_some() {
-            let _ = write!(md, " {} |", config.sweep_value.as_deref().unwrap_or(""));
-        }
-        for c in &columns {
-            let _ = write!(md, " {} |", cell(config.passes.iter().find(|p| &p.name == c)));
-        }
-        if has_baseline {
-            let ratio = config.shadow_over_depth_only.map_or("–".into(), |r| format!("{r:.3}"));
-            let _ = write!(md, " {} | {ratio} |", cell(config.depth_only.as_ref()));
-        }
-        if has_rays {
-            let traced = match (config.traced_percent, config.rays) {
-                (Some(percent), Some(rays)) => format!("{percent:.2} ({rays})"),
-                _ => "–".into(),
-            };
-            let _ = write!(md, " {traced} |");
-        }
-        let _ = writeln!(
-            md,
-            " {} ({}) | {} ({}) |",
-            config.shadow_draws, config.shadow_instances, config.lighting_draws, config.lighting_instances
-        );
-    }
-    if report.configs.iter().any(|c| c.layers.len() > 1) {
-        let _ = writeln!(md, "\nEach shadow-map layer (light L, layer: cascade or cube face):\n");
-        let _ = writeln!(md, "| technique | layer | median (p95) |\n|---|---|---|");
-        for config in &report.configs {
-            let label = match &config.sweep_value {
-                Some(v) => format!("{} {}={v}", config.technique, sweep.unwrap_or("")),
-                None => config.technique.clone(),
-            };
-            for layer in &config.layers {
-                let _ = writeln!(
-                    md,
-                    "| {label} | {} | {} |",
-                    layer.name.trim_start_matches("shadow "),
-                    cell(Some(layer))
-                );
-            }
-        }
-    }
-    md
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn summaries_take_the_median_and_the_nearest_rank_p95() {
-        let values: Vec<f64> = (1..=100).map(f64::from).collect();
-        let s = summarize("x", &values);
-        assert_eq!((s.median_ms, s.p95_ms, s.samples), (50.5, 95.0, 100));
-        let s = summarize("x", &[3.0, 1.0, 2.0]);
-        assert_eq!((s.median_ms, s.p95_ms), (2.0, 3.0));
-    }
 
     #[test]
     fn sizes_and_sweeps_parse_or_say_what_is_valid() {

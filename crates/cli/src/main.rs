@@ -3,6 +3,7 @@
 
 mod bench_cmd;
 mod bench_moving;
+mod bench_report;
 mod cache;
 mod calibrate;
 mod compare_cmd;
