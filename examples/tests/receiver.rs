@@ -11,7 +11,7 @@ use gnomon_examples::host::{self, HostMesh, HostRenderer, HostTargets};
 use gnomon_render::{Gpu, OutputRequest, RenderError, Renderer, read_texture, wgpu};
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{LightKind, OmniMap, Refine, ShadowPath, Technique},
+    settings::{LightKind, OmniMap, RayUse, Refine, ShadowPath, Technique},
 };
 
 // Wide enough that the sky shows beside the ground: background pixels are compared too.
@@ -73,7 +73,9 @@ fn a_hosts_shader_sees_gnomons_shadows_for_every_technique_and_light() {
     let mut renderer = Renderer::new(&gpu).unwrap();
     let scene = builtin::spheres();
     let (mut worst, mut cases) = (0.0f64, 0);
-    let registered: Vec<_> = renderer.techniques().iter().collect();
+    // A technique that is rays leaves no map for a host to read (refused below).
+    let registered: Vec<_> =
+        renderer.techniques().iter().filter(|t| t.rays() == RayUse::AsSettingsSay).collect();
     for technique in registered {
         let mut lights = vec![(LightKind::Sun, OmniMap::Cube), (LightKind::Spot, OmniMap::Cube)];
         if technique.cube_wgsl().is_some() {
@@ -137,4 +139,21 @@ fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
     settings.screen.shadow_path = ShadowPath::Auto;
     settings.screen.refine = Refine::Auto;
     assert!(renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).is_ok());
+}
+
+#[test]
+fn a_technique_that_is_rays_is_refused_by_name() {
+    let gpu = Gpu::new_headless().unwrap();
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let scene = builtin::spheres();
+    let uploaded = renderer.upload(&scene).unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    for path in [ShadowPath::Auto, ShadowPath::Forward] {
+        let mut settings = settings(Technique::RAYTRACED, LightKind::Sun, OmniMap::Cube);
+        settings.screen.shadow_path = path;
+        let error = renderer.record_shadows(&mut encoder, &uploaded, &scene, &settings).err().unwrap();
+        assert!(matches!(error, RenderError::ReceiverCannotTrace { .. }), "{path:?}: {error}");
+        let message = error.to_string();
+        assert!(message.contains("`raytraced`") && message.contains("shadow.filter.technique"), "{message}");
+    }
 }

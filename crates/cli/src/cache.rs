@@ -15,8 +15,9 @@ const MAGIC: &[u8; 8] = b"GNOMREF1";
 /// Part of every key: bump it whenever the tracer's results change, so that caches
 /// written by an older tracer are not served. 2: hit points from the barycentrics and
 /// the t error bound (false self-shadowing on large, distant triangles). 3: each
-/// pixel says whether its surface faces the light.
-const TRACER_REVISION: u32 = 3;
+/// pixel says whether its surface faces the light. 4: camera rays through the f32
+/// camera matrix inverted in f64 (the f32 inverse bent them by up to 1/25 px).
+const TRACER_REVISION: u32 = 4;
 
 pub fn cache_dir() -> Option<PathBuf> {
     if let Some(d) = std::env::var_os("GNOMON_CACHE_DIR") {

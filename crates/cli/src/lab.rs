@@ -59,7 +59,8 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
     }
     // A setting this render ignores is said, not silently dropped (an unresolvable
     // light is reported by the command itself).
-    if let Ok(lights) = settings.resolve_lights(&scene) {
+    let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
+    if let Ok(lights) = techniques.resolve_lights(&settings, &scene) {
         for unused in settings.unused(&lights) {
             eprintln!("gnomon: warning: {}", gnomon_scene::settings::in_flags(&unused.to_string()));
         }

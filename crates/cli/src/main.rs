@@ -135,6 +135,8 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::ImageTooLarge { .. }
         | RenderError::AttachmentsTooLarge { .. }
         | RenderError::ReceiverNeedsMapPath
+        | RenderError::ReceiverCannotTrace { .. }
+        | RenderError::TechniqueNeedsRays { .. }
         | RenderError::Settings(_)
         | RenderError::Scene(_)
         | RenderError::EmptyScene(_)

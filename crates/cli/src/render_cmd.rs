@@ -150,7 +150,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             eprintln!("gnomon: {}", light_line(i, light));
             if light.traced_pixels.is_some() {
                 eprintln!("gnomon: {}", traced_line(i, light, frame.pixel_count()));
-            } else if forward_rays(settings) && light.refine_fallback.is_none() {
+            } else if light.refine != gnomon_scene::settings::Refine::Off {
                 // The forward path counts nothing (rays/refine_forward.wgsl says why).
                 eprintln!(
                     "gnomon: light {i}: refined by rays in the lighting pass (forward path: not counted)"
@@ -225,14 +225,6 @@ pub(crate) fn warn_unrefined(lights: &[gnomon_render::LightStats]) {
             said.push(why);
         }
     }
-}
-
-/// Whether these settings trace rays in the lighting pass (the forward path), where
-/// the rays are not counted.
-fn forward_rays(settings: &gnomon_scene::Settings) -> bool {
-    use gnomon_scene::settings::{Refine, ShadowPath};
-    settings.screen.shadow_path == ShadowPath::Forward
-        && matches!(settings.screen.refine, Refine::Rays | Refine::EveryPixel)
 }
 
 /// `--verbose`'s line on a light refined by rays: the pixels that traced a ray, as a

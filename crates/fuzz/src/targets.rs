@@ -178,7 +178,8 @@ fn gltf_target(input: &[u8], workdir: &Path) -> Result<(), String> {
 fn resolve(settings: &Settings, scene: &gnomon_scene::Scene) -> Result<(), String> {
     settings.validate().map_err(|e| e.to_string())?;
     settings.resolve_camera(scene).map_err(|e| e.to_string())?;
-    let lights = settings.resolve_lights(scene).map_err(|e| e.to_string())?;
+    let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
+    let lights = techniques.resolve_lights(settings, scene).map_err(|e| e.to_string())?;
     settings.uses_shadow_mask(&lights).map_err(|e| e.to_string())?;
     let _ = settings.unused(&lights);
     Ok(())

@@ -2,7 +2,7 @@
 //! rasterizer's camera, then shadow rays to the light: one exact ray for a point or
 //! directional light, or N stratified samples of an area light.
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{DVec2, DVec4, Vec2, Vec3};
 use gnomon_scene::{Camera, Light};
 use rayon::prelude::*;
 
@@ -179,7 +179,11 @@ pub fn reference_visibility(
 ) -> ReferenceImage {
     let (w, h) = (options.width, options.height);
     let aspect = w as f32 / h as f32;
-    let world_from_clip = camera.clip_from_world(aspect).inverse();
+    // The inverse, in f64, of the very f32 matrix the rasterizer projects with. An f32
+    // inverse of a perspective matrix bent the rays by up to 1/25 px at the edges of a
+    // 1280-pixel image (Sponza's far-to-near ratio), which flipped the shadow of a pixel
+    // whose edge passed that close to its centre.
+    let world_from_clip = camera.clip_from_world(aspect).as_dmat4().inverse();
     let view_from_world = camera.view_from_world();
     let emitter = Emitter::new(light);
     let samples = if emitter.is_point() { 1 } else { options.samples.max(BATCHES) };
@@ -191,16 +195,17 @@ pub fn reference_visibility(
             let row = (0..w)
                 .map(|x| {
                     // The same pixel centre and camera as the rasterizer: NDC y up, row 0 at the top.
-                    let ndc = Vec2::new(
-                        (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-                        1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                    let ndc = DVec2::new(
+                        (f64::from(x) + 0.5) / f64::from(w) * 2.0 - 1.0,
+                        1.0 - (f64::from(y) + 0.5) / f64::from(h) * 2.0,
                     );
-                    let near = world_from_clip * Vec4::new(ndc.x, ndc.y, 0.0, 1.0);
-                    let far = world_from_clip * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+                    let near = world_from_clip * DVec4::new(ndc.x, ndc.y, 0.0, 1.0);
+                    let far = world_from_clip * DVec4::new(ndc.x, ndc.y, 1.0, 1.0);
                     let (near, far) = (near.truncate() / near.w, far.truncate() / far.w);
-                    let dir = (far - near).normalize();
+                    let dir = (far - near).normalize().as_vec3();
                     // Start on the near plane and stop at the far one, as the rasterizer clips.
-                    let Some(hit) = traced.intersect(near, dir, 0.0, (far - near).length()) else {
+                    let length = (far - near).length() as f32;
+                    let Some(hit) = traced.intersect(near.as_vec3(), dir, 0.0, length) else {
                         return PixelResult::MISS;
                     };
                     let pixel_seed = hash(y * w + x);

@@ -126,6 +126,36 @@ pub enum RenderError {
          shadows off and `screen.refine` auto or off, or let Gnomon draw the image"
     )]
     ReceiverNeedsMapPath,
+    /// A host's shader reads shadow maps ([`Renderer::record_shadows`]), and a
+    /// technique that is rays ([`techniques::ShadowTechnique::rays`]) has none to read.
+    #[error(
+        "the shadow receiver reads each light's shadow map, but light `{light}`'s technique \
+         `{technique}` (`shadow.filter.technique`) traces a shadow ray at every pixel in \
+         Gnomon's own passes and leaves no map to read; choose a shadow-map technique for a \
+         host's shader, or let Gnomon draw the image"
+    )]
+    ReceiverCannotTrace {
+        /// The light, by its name in the render's list.
+        light: String,
+        /// Its technique.
+        technique: String,
+    },
+    /// A technique that is rays ([`techniques::ShadowTechnique::rays`]) on a device
+    /// that cannot trace this scene or image: unlike refinement, it has no map to fall
+    /// back to.
+    #[error(
+        "light `{light}`'s technique `{technique}` (`shadow.filter.technique`) traces a shadow \
+         ray at every pixel, but {why}; choose a shadow-map technique, which falls back to its \
+         map where rays cannot run"
+    )]
+    TechniqueNeedsRays {
+        /// The light, by its name in the render's list.
+        light: String,
+        /// Its technique.
+        technique: String,
+        /// Why the device cannot trace.
+        why: rays::RaysUnavailable,
+    },
     /// A setting is out of its valid range.
     #[error(transparent)]
     Settings(#[from] SettingsError),

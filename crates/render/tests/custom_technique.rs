@@ -112,7 +112,10 @@ fn a_registered_technique_is_checked_from_the_facts_it_states() {
     let point = renderer.render(&scene, &with(CROSS, LightKind::Point), &OutputRequest::default());
     let Err(RenderError::Settings(e)) = point else { panic!("a point light with pcf-cross: {point:?}") };
     assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "pcf-cross"));
-    assert!(e.valid.ends_with("(a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"), "{e}");
+    assert!(
+        e.valid.ends_with("(a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson, pcss or raytraced"),
+        "{e}"
+    );
 
     // It reads any map: a warped one is accepted, and it is listed among those that do
     // when another technique is refused one.
@@ -121,7 +124,10 @@ fn a_registered_technique_is_checked_from_the_facts_it_states() {
     renderer.render(&scene, &warped, &OutputRequest::default()).unwrap();
     warped.shadow.filter.technique = Technique::VSM;
     let Err(RenderError::Settings(e)) = renderer.check_limits(&warped) else { panic!("VSM warped") };
-    assert!(e.valid.contains("takes hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcf-cross"), "{e}");
+    assert!(
+        e.valid.contains("takes hard, pcf2x2, pcf, pcf-tent, pcf-poisson, raytraced or pcf-cross"),
+        "{e}"
+    );
 
     // Its name is the registry's, and the registry's alone.
     assert!(renderer.techniques().choices().iter().any(|(name, _)| name == "pcf-cross"));

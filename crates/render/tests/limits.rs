@@ -77,3 +77,29 @@ fn refined_frames_fit_webgpu_default_limits() {
         assert!(frame.lights[0].traced_pixels.is_some_and(|p| p > 0), "{sun_disk:?}");
     }
 }
+
+/// Where the device cannot trace (here, too small a storage buffer for the list of
+/// pixels to trace), refinement falls back to the map and says why; the `raytraced`
+/// technique, which has no map to fall back to, is an error that names the limit.
+#[test]
+fn refinement_falls_back_and_raytraced_is_refused_where_rays_cannot_run() {
+    const LIMIT: u64 = 4096;
+    let gpu = Gpu::new_headless_with(|l| l.max_storage_buffer_binding_size = LIMIT).expect("adapter");
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let scene = builtin::spheres();
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (160, 90);
+    s.screen.refine = Refine::Rays;
+    let frame = renderer.render(&scene, &s, &OutputRequest::default()).unwrap();
+    let light = &frame.lights[0];
+    let why = light.refine_fallback.as_ref().expect("the fallback says why").to_string();
+    assert!(why.contains(&LIMIT.to_string()), "{why}");
+    assert_eq!(light.refine, Refine::Off, "drawn unrefined");
+    assert_eq!(light.traced_pixels, None);
+    s.shadow.filter.technique = Technique::RAYTRACED;
+    let err = renderer.render(&scene, &s, &OutputRequest::default()).unwrap_err();
+    assert!(matches!(err, RenderError::TechniqueNeedsRays { .. }), "{err:?}");
+    let message = err.to_string();
+    assert!(message.contains("`raytraced`") && message.contains(&LIMIT.to_string()), "{message}");
+    assert!(!message.contains("--"), "{message}");
+}

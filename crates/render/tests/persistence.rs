@@ -15,7 +15,7 @@ use gnomon_render::{
 };
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{LightKind, OmniMap, Partition, Refine, ShadowPath, Technique},
+    settings::{LightKind, OmniMap, Partition, RayUse, Refine, ShadowPath, Technique},
 };
 
 /// Frames checked after the warm-up.
@@ -55,7 +55,10 @@ fn created_in_steady_state(renderer: &mut Renderer, scene: &Scene, settings: &Se
     });
     let host_view = host_texture.create_view(&Default::default());
     let target = HostTarget::new(&host_texture, &host_view);
-    let receives = settings.screen.shadow_path != ShadowPath::Mask;
+    // A host's shader reads maps: not on the mask path, nor from a technique that is rays.
+    let technique = renderer.techniques().get(&settings.shadow.filter.technique).unwrap();
+    let receives =
+        settings.screen.shadow_path != ShadowPath::Mask && technique.rays() == RayUse::AsSettingsSay;
     let frame_through = |renderer: &mut Renderer, entry: Entry| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         match entry {

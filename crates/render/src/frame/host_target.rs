@@ -6,7 +6,8 @@ use gnomon_scene::{Scene, Settings};
 
 use super::{
     DrawStats, Renderer,
-    record::{Readback, Recording, cull},
+    cull::cull,
+    record::{Readback, Recording},
 };
 use crate::{GpuScene, RenderError, passes::blit::HostTarget, timing::PassClock};
 

@@ -6,6 +6,7 @@
 
 mod baseline;
 mod bindings;
+mod cull;
 mod host_target;
 mod late;
 mod outputs;

@@ -156,8 +156,11 @@ pub struct LightStats {
     pub mask_ms: Option<f64>,
     /// GPU time of its trace pass, where it refines its shadow by rays.
     pub trace_ms: Option<f64>,
-    /// Pixels its shadow was refined at, where it refines by rays and the frame was
-    /// waited for (not a live frame's).
+    /// The refinement by rays it got: `auto` resolved, `off` where it fell back.
+    pub refine: gnomon_scene::settings::Refine,
+    /// Pixels its shadow was refined at, where it refines by rays on the mask path and
+    /// the frame was waited for (not a live frame's). The forward path traces in the
+    /// lighting pass and counts nothing (`rays/refine_forward.wgsl` says why).
     pub traced_pixels: Option<u32>,
     /// Shadow rays each refined pixel asks for: 1 under a hard light, the settings'
     /// `penumbra_rays` under a light with an area (a sample below the surface's
@@ -466,7 +469,7 @@ pub(super) struct TimedLights {
 
 impl TimedLights {
     /// What each light drew (its culled casters per layer), not yet timed.
-    pub fn untimed(plan: &super::plan::FramePlan, culled: &super::record::Culled) -> Self {
+    pub fn untimed(plan: &super::plan::FramePlan, culled: &super::cull::Culled) -> Self {
         let lights = plan
             .lights
             .iter()
@@ -484,6 +487,7 @@ impl TimedLights {
                 lighting_ms: None,
                 mask_ms: None,
                 trace_ms: None,
+                refine: light.refine,
                 traced_pixels: None,
                 rays_per_pixel: 1,
                 refine_fallback: None,

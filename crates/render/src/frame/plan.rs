@@ -97,7 +97,7 @@ impl Renderer {
         fixed_layout: Option<&ShadowLayout>,
     ) -> Result<FramePlan, RenderError> {
         let camera = settings.resolve_camera(scene)?;
-        let resolved = settings.resolve_lights(scene)?;
+        let resolved = self.techniques.resolve_lights(settings, scene)?;
         let mask_path = settings.uses_shadow_mask(&resolved)?;
         let shown = if settings.light.kind == LightKind::All { settings.light.light_index } else { 0 };
         let aspect = settings.image.width as f32 / settings.image.height as f32;
@@ -130,9 +130,9 @@ impl Renderer {
                 light_gpu.ambient = Vec3::ZERO;
             }
             let refine = if mask_path {
-                rays::light_refine(settings.screen.refine, &r.light)
+                rays::light_refine(settings.light_refine(&r), &r.light)
             } else {
-                rays::forward_light_refine(settings.screen.refine)
+                rays::forward_light_refine(settings.light_refine(&r))
             };
             lights.push(LightPlan {
                 refine,
@@ -231,7 +231,8 @@ impl Renderer {
                     CascadeSelection::Projection => 0.0,
                 };
                 let request = BoundsRequest {
-                    world_from_clip: clip_from_world.inverse(),
+                    // In f64: an f32 inverse of a perspective matrix bends rays by parts in 10⁵.
+                    world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
                     light_from_world: directional_light_view(sun_direction, &uploaded.bounds),
                     near: camera.near,
                     far: camera.far,

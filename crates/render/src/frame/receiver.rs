@@ -5,14 +5,10 @@
 
 use gnomon_scene::{
     Light, Scene, Settings,
-    settings::{Refine, ScreenSpaceSettings, Technique},
+    settings::{RayUse, Refine, ScreenSpaceSettings, Technique},
 };
 
-use super::{
-    Renderer,
-    bindings::ReceiverUniforms,
-    record::{Recording, cull},
-};
+use super::{Renderer, bindings::ReceiverUniforms, cull::cull, record::Recording};
 use crate::{
     GpuScene, RenderError,
     frame::DrawStats,
@@ -87,8 +83,10 @@ impl Renderer {
     /// The mask path (`screen.shadow_path = "mask"`, contact shadows) needs Gnomon's
     /// own depth prepass, and rays asked for by name (on either path) are traced in
     /// Gnomon's own passes: for those this returns
-    /// [`RenderError::ReceiverNeedsMapPath`]. The default refinement, `auto`, runs only
-    /// where Gnomon draws the image: here the maps' answer is the host's.
+    /// [`RenderError::ReceiverNeedsMapPath`]; a technique that is rays (`raytraced`)
+    /// has no map for the host to read ([`RenderError::ReceiverCannotTrace`]). The
+    /// default refinement, `auto`, runs only where Gnomon draws the image: here the
+    /// maps' answer is the host's.
     pub fn record_shadows(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -109,6 +107,12 @@ impl Renderer {
             Refine::Off | Refine::Rays | Refine::EveryPixel => settings,
         };
         let plan = self.plan_frame(uploaded, scene, settings, None)?;
+        if let Some(light) = plan.lights.iter().find(|l| l.technique.rays() == RayUse::EveryPixel) {
+            return Err(RenderError::ReceiverCannotTrace {
+                light: light.name.clone(),
+                technique: light.technique.technique().to_string(),
+            });
+        }
         if plan.mask_path || plan.lights.iter().any(|l| l.refine != Refine::Off) {
             return Err(RenderError::ReceiverNeedsMapPath);
         }

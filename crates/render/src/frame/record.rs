@@ -5,18 +5,21 @@
 
 use std::time::Instant;
 
-use gnomon_math::culling::Frustum;
-use gnomon_scene::{Scene, Settings, settings::Refine};
+use gnomon_scene::{
+    Scene, Settings,
+    settings::{RayUse, Refine},
+};
 
 use super::{
     Renderer,
     bindings::{ShadowViews, scene_group},
+    cull::{Culled, cull},
     outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
 };
 use crate::{
     GpuScene, RenderError,
-    gpu_scene::{CullView, Visible},
+    gpu_scene::Visible,
     gpu_types::VertexStream,
     layout::ShadowLayout,
     passes::{
@@ -71,13 +74,6 @@ pub(super) struct Recording<'e> {
     pub encoder: &'e mut wgpu::CommandEncoder,
     pub clock: PassClock,
     pub stats: DrawStats,
-}
-
-/// Which casters each layer of each light draws, and what the camera sees.
-pub(super) struct Culled {
-    pub camera: Visible,
-    /// Per light, per layer.
-    pub layers: Vec<Vec<Visible>>,
 }
 
 /// A light's groups for its passes from the camera.
@@ -339,6 +335,10 @@ impl Renderer {
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
         );
+        if light.technique.rays() == RayUse::EveryPixel {
+            // Its map is never read (`techniques/raytraced.rs`): no pass clears it.
+            return map;
+        }
         for (layer, visible) in layers.iter().enumerate() {
             let layer_view = self.pool.view(&map, ViewKey::layer(layer as u32));
             let layer_light = light.light_gpu.for_layer(layer);
@@ -578,30 +578,4 @@ pub(super) struct Recorded {
     pub color: wgpu::Texture,
     pub shadow_map: wgpu::Texture,
     pub submitted_at: Instant,
-}
-
-/// Culls for every layer of every light, and for the camera, in parallel.
-pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
-    let camera_view = CullView {
-        frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
-        near: true,
-        casters_only: false,
-    };
-    let layer_views = plan.lights.iter().flat_map(|light| {
-        light.layout.projections.iter().map(|projection| CullView {
-            frustum: Frustum::from_clip_from_world(projection.clip_from_world()),
-            // A pass that clamps depth draws the casters before its near plane too.
-            near: !light.layout.depth_clamp,
-            casters_only: true,
-        })
-    });
-    let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();
-    let mut culled = uploaded.cull(&views).into_iter();
-    let camera = culled.next().expect("the camera's view was culled");
-    let layers = plan
-        .lights
-        .iter()
-        .map(|light| culled.by_ref().take(light.layout.projections.len()).collect())
-        .collect();
-    Culled { camera, layers }
 }

@@ -3,7 +3,10 @@
 //! cannot trace the scene or the image; after, reporting per light the pixels traced
 //! or why it fell back.
 
-use gnomon_scene::{Scene, Settings, settings::Refine};
+use gnomon_scene::{
+    Scene, Settings,
+    settings::{RayUse, Refine},
+};
 
 use super::{Renderer, outputs::TimedLights, plan::FramePlan};
 use crate::{
@@ -22,7 +25,8 @@ impl Renderer {
     /// Builds the casters' BVH where a light of `plan` refines by rays. Where the device
     /// cannot trace the scene or an image of this size, every such light is drawn
     /// unrefined instead (its refinement turned off in `plan`), and the fallback says
-    /// why. Errs only on a failure of the device.
+    /// why. Errs on a failure of the device, and where a light's technique is rays
+    /// ([`RenderError::TechniqueNeedsRays`]).
     pub(super) fn prepare_rays(
         &self,
         uploaded: &GpuScene,
@@ -41,6 +45,16 @@ impl Renderer {
             Err(why) => Err(why),
         };
         let Err(why) = available else { return Ok(None) };
+        // A technique that is rays has no map to fall back to.
+        if let Some(light) =
+            asked.iter().map(|&i| &plan.lights[i]).find(|l| l.technique.rays() == RayUse::EveryPixel)
+        {
+            return Err(RenderError::TechniqueNeedsRays {
+                light: light.name.clone(),
+                technique: light.technique.technique().to_string(),
+                why,
+            });
+        }
         for &index in &asked {
             plan.lights[index].refine = Refine::Off;
         }

@@ -18,10 +18,11 @@ mod hard;
 mod msm;
 mod pcf;
 mod pcss;
+mod raytraced;
 mod registry;
 mod variance;
 
-use gnomon_scene::settings::{FilterSettings, SettingsError, Technique};
+use gnomon_scene::settings::{FilterSettings, RayUse, SettingsError, Technique};
 
 use crate::uniforms::TechniqueParams;
 pub use registry::{RegistryError, TechniqueRef, TechniqueRegistry};
@@ -42,6 +43,7 @@ pub static BUILTIN: &[&dyn ShadowTechnique] = &[
     &msm::HAMBURGER,
     &msm::HAUSDORFF,
     &convolution::Convolution,
+    &raytraced::Raytraced,
 ];
 
 /// A map of functions of depth that a filterable technique samples.
@@ -146,6 +148,16 @@ pub trait ShadowTechnique: Sync {
     /// The filterable map the technique samples, if any.
     fn filterable_map(&self, _settings: &FilterSettings) -> Option<FilterableMap> {
         None
+    }
+    /// How it uses shadow rays. A technique that answers from its map leaves them to
+    /// `screen.refine` (the default). One that is rays, [`RayUse::EveryPixel`], has
+    /// every pixel of its light traced: the frame takes the mask path under
+    /// `--shadow-path auto`, a host's shader cannot read it
+    /// ([`crate::RenderError::ReceiverCannotTrace`]), and a device that cannot trace
+    /// the scene is an error ([`crate::RenderError::TechniqueNeedsRays`]), not a
+    /// fallback to its map.
+    fn rays(&self) -> RayUse {
+        RayUse::AsSettingsSay
     }
     /// Checks the filter settings against what this technique needs beyond their
     /// own ranges (which [`gnomon_scene::Settings::validate`] checks).

@@ -7,8 +7,8 @@
 use std::hash::{Hash, Hasher};
 
 use gnomon_scene::{
-    Light,
-    settings::{OmniMap, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
+    Light, Scene, Settings,
+    settings::{OmniMap, ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
 };
 
 use super::{BUILTIN, ShadowTechnique};
@@ -168,6 +168,22 @@ impl TechniqueRegistry {
         }
     }
 
+    /// The render's lights ([`Settings::resolve_lights`]), each checked against its
+    /// technique ([`TechniqueRegistry::check_light`]) and told how the technique uses
+    /// rays ([`ShadowTechnique::rays`]), which decides its refinement
+    /// ([`Settings::light_refine`]) and the frame's path.
+    pub fn resolve_lights(
+        &self,
+        settings: &Settings,
+        scene: &Scene,
+    ) -> Result<Vec<ResolvedLight>, SettingsError> {
+        let mut lights = settings.resolve_lights(scene)?;
+        for light in &mut lights {
+            light.rays = self.check_light(&light.shadow, &light.light, &light.name)?.rays();
+        }
+        Ok(lights)
+    }
+
     /// The names of the techniques that `fits`, as a list for a message ("pcf,
     /// pcf-tent or pcf-poisson"; "none" when none fits).
     pub fn names(&self, fits: impl Fn(&TechniqueRef) -> bool) -> String {
@@ -209,7 +225,7 @@ mod tests {
     fn an_unknown_name_lists_the_registered_ones() {
         let e = TechniqueRegistry::builtin().get(&Technique::named("nope")).unwrap_err();
         assert_eq!(e.setting, "shadow.filter.technique");
-        assert!(e.valid.contains("hard, pcf2x2") && e.valid.ends_with("or convolution"), "{e}");
+        assert!(e.valid.contains("hard, pcf2x2") && e.valid.ends_with("convolution or raytraced"), "{e}");
     }
 
     fn point() -> Light {
@@ -235,12 +251,12 @@ mod tests {
         let cube = registry.check_light(&shadow(Technique::VSM), &point(), "lamp").unwrap_err();
         assert_eq!(
             cube.valid,
-            "for point light `lamp` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
+            "for point light `lamp` (a cube map): hard, pcf2x2, pcf, pcf-tent, pcf-poisson, pcss or raytraced"
         );
         let mut paraboloid = shadow(Technique::PCSS);
         paraboloid.map.omni = OmniMap::Paraboloid;
         let e = registry.check_light(&paraboloid, &point(), "lamp").unwrap_err();
-        assert!(e.valid.ends_with(": hard, pcf2x2, pcf, pcf-tent or pcf-poisson"), "{e}");
+        assert!(e.valid.ends_with(": hard, pcf2x2, pcf, pcf-tent, pcf-poisson or raytraced"), "{e}");
         paraboloid.filter.technique = Technique::PCF_POISSON;
         registry.check_light(&paraboloid, &point(), "lamp").unwrap();
 
@@ -248,7 +264,7 @@ mod tests {
         warped.map.warp = WarpKind::Lispsm;
         let e = registry.check(&warped).unwrap_err();
         assert_eq!((e.setting, e.value.as_str()), ("shadow.map.warp", "lispsm"));
-        assert!(e.valid.contains("takes hard, pcf2x2, pcf, pcf-tent or pcf-poisson"), "{e}");
+        assert!(e.valid.contains("takes hard, pcf2x2, pcf, pcf-tent, pcf-poisson or raytraced"), "{e}");
     }
 
     #[test]

@@ -44,6 +44,9 @@ impl Technique {
     /// Convolution shadow maps (Annen et al. 2007).
     pub const CONVOLUTION: Technique = Technique::named("convolution");
 
+    /// A shadow ray at every pixel over the scene's BVH: the exact upper baseline.
+    pub const RAYTRACED: Technique = Technique::named("raytraced");
+
     /// The most characters a technique's name has.
     pub const MAX_NAME_LENGTH: usize = 32;
 

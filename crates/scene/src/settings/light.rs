@@ -84,6 +84,9 @@ pub struct ResolvedLight {
     pub light: Light,
     /// The render's shadow settings with the light's own laid over them.
     pub shadow: ShadowSettings,
+    /// How its technique uses shadow rays: [`RayUse::AsSettingsSay`] as resolved
+    /// here; the renderer's technique registry states the technique's own.
+    pub rays: RayUse,
 }
 
 impl Settings {
@@ -170,6 +173,7 @@ impl Settings {
                 name: light.type_name().into(),
                 light,
                 shadow: self.shadow.clone(),
+                rays: RayUse::AsSettingsSay,
             }]);
         }
         self.resolve_light(scene)?;
@@ -186,7 +190,12 @@ impl Settings {
                         })?
                     }
                 };
-                Ok(ResolvedLight { name: entry.name.clone(), light: entry.light, shadow })
+                Ok(ResolvedLight {
+                    name: entry.name.clone(),
+                    light: entry.light,
+                    shadow,
+                    rays: RayUse::AsSettingsSay,
+                })
             })
             .collect()
     }

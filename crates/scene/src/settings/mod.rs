@@ -213,19 +213,29 @@ impl Settings {
         Ok(())
     }
 
+    /// The refinement by rays `light` asks for: `screen.refine`, or every pixel where
+    /// its technique is a ray at every pixel (`raytraced`, [`RayUse::EveryPixel`]).
+    pub fn light_refine(&self, light: &ResolvedLight) -> Refine {
+        match light.rays {
+            RayUse::AsSettingsSay => self.screen.refine,
+            RayUse::EveryPixel => Refine::EveryPixel,
+        }
+    }
+
     /// Whether a frame with these lights resolves its shadows in a screen-space mask:
     /// as --shadow-path says, and with `auto` when any light marches contact shadows
     /// or refines its shadow by rays (a hard light under `auto` refinement, or any
-    /// light under rays asked for by name), which run best on the mask path. Rays
+    /// light under rays asked for by name or traced by its technique), which run best
+    /// on the mask path. Rays
     /// asked for with --shadow-path forward are traced in the lighting pass instead;
     /// contact shadows with it are refused: they march through the mask path's depth
     /// prepass.
     pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
-        let rays = match self.screen.refine {
+        let rays = lights.iter().any(|l| match self.light_refine(l) {
             Refine::Off => false,
-            Refine::Auto => lights.iter().any(|l| l.light.is_hard()),
+            Refine::Auto => l.light.is_hard(),
             Refine::Rays | Refine::EveryPixel => true,
-        };
+        });
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {
             (ShadowPath::Forward, Some(light)) => Err(SettingsError {

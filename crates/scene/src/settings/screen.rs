@@ -59,6 +59,20 @@ pub enum Refine {
     EveryPixel,
 }
 
+/// How a light's technique uses shadow rays: a fact of the technique, which the
+/// renderer's technique registry states (`ShadowTechnique::rays`) and lays into each
+/// [`ResolvedLight`]. Most techniques answer from their map and leave rays to
+/// `screen.refine`; `raytraced` is a ray at every pixel whatever it says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum RayUse {
+    /// The light is refined as `screen.refine` says.
+    #[default]
+    AsSettingsSay,
+    /// Every pixel of the light traces its rays: `screen.refine` every-pixel for this
+    /// light alone.
+    EveryPixel,
+}
+
 /// How shadows are resolved on screen: the frame-wide choice of path (contact
 /// shadows, per light, are in the shadow settings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

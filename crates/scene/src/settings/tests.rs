@@ -312,6 +312,37 @@ fn refining_by_default_takes_the_mask_path_for_hard_lights_only() {
 }
 
 #[test]
+fn a_light_whose_technique_is_rays_is_traced_whatever_refine_says() {
+    let scene = crate::builtin::spheres();
+    let mut s = Settings::default();
+    s.screen.refine = Refine::Off;
+    s.light.sun_angular_diameter = Some(1.0);
+    let mut lights = s.resolve_lights(&scene).unwrap();
+    assert_eq!(lights[0].rays, RayUse::AsSettingsSay, "resolved lights leave rays to the settings");
+    assert_eq!(s.light_refine(&lights[0]), Refine::Off);
+    assert!(!s.uses_shadow_mask(&lights).unwrap());
+    lights[0].rays = RayUse::EveryPixel;
+    for refine in [Refine::Off, Refine::Auto, Refine::Rays] {
+        s.screen.refine = refine;
+        assert_eq!(s.light_refine(&lights[0]), Refine::EveryPixel, "{refine:?}");
+        assert!(
+            s.uses_shadow_mask(&lights).unwrap(),
+            "{refine:?}: auto takes the mask, even for an area light"
+        );
+    }
+    s.screen.shadow_path = ShadowPath::Forward;
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "forward traces it in its lighting pass");
+    // Its penumbra rays and the traced view are used though `screen.refine` is off.
+    s.screen.refine = Refine::Off;
+    s.screen.penumbra_rays = 32;
+    s.image.debug_view = DebugView::Traced;
+    assert!(s.unused(&lights).is_empty(), "{:?}", s.unused(&lights));
+    lights[0].rays = RayUse::AsSettingsSay;
+    let unused: Vec<&str> = s.unused(&lights).iter().map(|u| u.setting).collect();
+    assert_eq!(unused, ["image.debug_view", "screen.penumbra_rays"]);
+}
+
+#[test]
 fn contact_shadows_choose_the_mask_path_and_are_checked() {
     let scene = crate::builtin::lamps();
     let mut s = Settings {

@@ -56,22 +56,23 @@ const RULES: &[(&str, Uses, &str)] = &[
         "image.debug_view",
         |s, lights| {
             s.image.debug_view != DebugView::Traced
-                || match s.screen.refine {
+                || lights.iter().any(|l| match s.light_refine(l) {
                     Refine::Off => false,
                     // `auto` traces on the mask path only.
                     Refine::Auto => s.uses_shadow_mask(lights).unwrap_or(false),
                     Refine::Rays | Refine::EveryPixel => true,
-                }
+                })
         },
-        "`screen.refine` rays or every-pixel, or auto on the mask path (for the traced view)",
+        "`screen.refine` rays or every-pixel, or auto on the mask path, or the raytraced technique (for the traced view)",
     ),
     (
         "screen.penumbra_rays",
         |s, lights| {
-            matches!(s.screen.refine, Refine::Rays | Refine::EveryPixel)
-                && lights.iter().any(|l| !l.light.is_hard())
+            lights
+                .iter()
+                .any(|l| matches!(s.light_refine(l), Refine::Rays | Refine::EveryPixel) && !l.light.is_hard())
         },
-        "`screen.refine` rays or every-pixel and a light with an area",
+        "`screen.refine` rays or every-pixel, or the raytraced technique, and a light with an area",
     ),
 ];
 

@@ -1,0 +1,53 @@
+//! Culling for a frame: which casters each layer of each light draws, and which
+//! instances the camera sees, every view culled in one parallel sweep.
+
+use gnomon_math::culling::Frustum;
+use gnomon_scene::settings::RayUse;
+
+use super::plan::FramePlan;
+use crate::{
+    GpuScene,
+    gpu_scene::{CullView, Visible},
+};
+
+/// Which casters each layer of each light draws, and what the camera sees.
+pub(super) struct Culled {
+    pub camera: Visible,
+    /// Per light, per layer.
+    pub layers: Vec<Vec<Visible>>,
+}
+
+/// Culls for every layer of every light, and for the camera, in parallel.
+pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
+    let camera_view = CullView {
+        frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
+        near: true,
+        casters_only: false,
+    };
+    // A light whose technique is rays reads no map (`techniques/raytraced.rs`):
+    // nothing is culled for its layers, nor drawn into them.
+    let reads_map = plan.lights.iter().filter(|light| light.technique.rays() == RayUse::AsSettingsSay);
+    let layer_views = reads_map.flat_map(|light| {
+        light.layout.projections.iter().map(|projection| CullView {
+            frustum: Frustum::from_clip_from_world(projection.clip_from_world()),
+            // A pass that clamps depth draws the casters before its near plane too.
+            near: !light.layout.depth_clamp,
+            casters_only: true,
+        })
+    });
+    let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();
+    let mut culled = uploaded.cull(&views).into_iter();
+    let camera = culled.next().expect("the camera's view was culled");
+    let layers = plan
+        .lights
+        .iter()
+        .map(|light| {
+            let layers = light.layout.projections.len();
+            match light.technique.rays() {
+                RayUse::AsSettingsSay => culled.by_ref().take(layers).collect(),
+                RayUse::EveryPixel => vec![Visible::default(); layers],
+            }
+        })
+        .collect();
+    Culled { camera, layers }
+}
