@@ -16,5 +16,5 @@ pub mod texture;
 mod tracer;
 mod visibility;
 
-pub use tracer::{Hit, TracedScene};
+pub use tracer::{Hit, TracedScene, offset_ray_origin};
 pub use visibility::{ReferenceImage, ReferenceOptions, reference_visibility};
