@@ -56,6 +56,7 @@ fn raytraced_agrees_with_the_reference_for_every_light_on_both_paths() {
             let case = format!("{light:?}, {path:?} path");
             assert_eq!(stats.refine, Refine::EveryPixel, "{case}: traced though refinement is off");
             assert_eq!(stats.shadow_draws(), 0, "{case}: no map is drawn");
+            assert_eq!(stats.resolution, 1, "{case}: nor held beyond a texel a layer");
             match path {
                 // `auto` takes the mask path, which counts the pixels it traces.
                 ShadowPath::Auto | ShadowPath::Mask => {

@@ -136,7 +136,7 @@ pub struct LightStats {
     pub kind: &'static str,
     /// The shadow technique the light was drawn with (its own settings, with `--light all`).
     pub technique: Technique,
-    /// Texels per side of each of its layers.
+    /// Texels per side of each of its layers (1 for a technique that reads no map).
     pub resolution: u32,
     /// Draw calls into each layer of its map (one per cascade, six for a cube): the
     /// casters that survived culling against that layer's frustum.
@@ -354,7 +354,7 @@ impl Submitted {
             lights: timed.lights,
             camera,
             light: shown.light,
-            resolution: shown.settings.shadow.map.resolution,
+            resolution: shown.map_resolution(),
             layout: shown.layout,
             moment_format: shown.filterable_map.is_some().then_some(shown.moment_format),
             shadow_mask: mask_path,
@@ -478,7 +478,7 @@ impl TimedLights {
                 name: light.name.clone(),
                 kind: light.light.type_name(),
                 technique: light.technique.technique(),
-                resolution: light.settings.shadow.map.resolution,
+                resolution: light.map_resolution(),
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
                 layer_instances: layers.iter().map(Visible::instances).collect(),
                 layer_ms: Vec::new(),

@@ -6,7 +6,7 @@ use glam::Vec3;
 use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition, Refine},
+    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition, RayUse, Refine},
 };
 
 use super::Renderer;
@@ -78,9 +78,19 @@ impl LightPlan {
         self.layout.projections.len() as u32
     }
 
-    /// Its map's size: resolution² texels, one array layer per layout layer.
+    /// Its map's resolution: the settings', or one texel where the technique is rays
+    /// and reads no map (`techniques/raytraced.rs`), which keeps its bindings valid
+    /// without holding `resolution`² texels per layer for nothing.
+    pub fn map_resolution(&self) -> u32 {
+        match self.technique.rays() {
+            RayUse::AsSettingsSay => self.settings.shadow.map.resolution,
+            RayUse::EveryPixel => 1,
+        }
+    }
+
+    /// Its map's size: [`Self::map_resolution`]² texels, one array layer per layout layer.
     pub fn map_size(&self) -> wgpu::Extent3d {
-        let resolution = self.settings.shadow.map.resolution;
+        let resolution = self.map_resolution();
         wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: self.layers() }
     }
 }
