@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use gnomon_render::techniques::TechniqueRegistry;
 use gnomon_scene::{
     Scene,
-    settings::{LightKind, Settings, Technique},
+    settings::{LightKind, RayUse, Settings, Technique},
 };
 use support::*;
 
@@ -19,6 +19,11 @@ const RESOLUTION: u32 = 1024;
 /// kernel half-width, the bilinear tap, and the texel itself, in texels.
 fn footprint_texels(s: &Settings) -> f32 {
     let f = &s.shadow.filter;
+    let technique = TechniqueRegistry::builtin().get(&f.technique).expect("a built-in technique");
+    if technique.rays() == RayUse::EveryPixel {
+        // It reads no map (one texel a layer): no texel blurs its edge.
+        return 0.0;
+    }
     if f.technique == Technique::PCSS {
         // Its reach is the widest penumbra it may filter; its estimate of this one is
         // analytic, but its blocker search and taps add noise.
@@ -26,7 +31,6 @@ fn footprint_texels(s: &Settings) -> f32 {
     }
     // The reach each technique states (a PCF kernel's half-width, a moment map's
     // blur radius), plus the bilinear tap and the texel itself.
-    let technique = TechniqueRegistry::builtin().get(&f.technique).expect("a built-in technique");
     technique.filter_reach_texels(f, f.pcf_kernel) + 1.5
 }
 
