@@ -2,6 +2,7 @@
 # Installs the system packages Gnomon needs, where they are missing (Debian/Ubuntu):
 # - a Vulkan driver: on a machine without a GPU, Mesa's CPU driver lavapipe
 #   (mesa-vulkan-drivers);
+# - a C++ compiler, for meshoptimizer (the `meshopt` crate builds its C++ source);
 # - with --tests, an X server for the viewer's window test when there is no display
 #   (xvfb, whose xvfb-run the test starts itself).
 # Does nothing when everything is already there.
@@ -24,6 +25,10 @@ if [ "$have_icd" = no ] || [ "$have_loader" = no ]; then
     echo "install-system-deps: no Vulkan driver found; installing lavapipe (mesa-vulkan-drivers)" >&2
     packages="mesa-vulkan-drivers libvulkan1"
 fi
+if ! command -v c++ >/dev/null 2>&1 && ! command -v g++ >/dev/null 2>&1; then
+    echo "install-system-deps: no C++ compiler; installing g++ for meshoptimizer" >&2
+    packages="$packages g++"
+fi
 if [ "$want_tests" = yes ] && ! command -v xvfb-run >/dev/null 2>&1; then
     echo "install-system-deps: no xvfb-run; installing xvfb for the viewer's window test" >&2
     packages="$packages xvfb xauth"
@@ -31,7 +36,7 @@ fi
 [ -z "$packages" ] && exit 0
 
 if ! command -v apt-get >/dev/null 2>&1; then
-    echo "install-system-deps: missing $packages and no apt-get; install your platform's Vulkan driver (on Mesa systems: lavapipe) and, for the tests, an X server such as Xvfb" >&2
+    echo "install-system-deps: missing $packages and no apt-get; install your platform's Vulkan driver (on Mesa systems: lavapipe), a C++ compiler and, for the tests, an X server such as Xvfb" >&2
     exit 1
 fi
 

@@ -19,7 +19,7 @@ use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::{
-    bench_report::{ConfigReport, Report, Summary, markdown, summarize},
+    bench_report::{ConfigReport, LayerDrawn, Report, Summary, markdown, summarize},
     output::{self, Staged},
 };
 
@@ -332,6 +332,19 @@ fn config_report(config: &Config, series: &Series, last: &FrameCost) -> ConfigRe
         layers: series.order.iter().filter(is_layer).filter_map(|n| series.summary(n)).collect(),
         shadow_draws: last.stats.shadow_draws,
         shadow_instances: last.stats.shadow_instances,
+        shadow_triangles: last.stats.shadow_triangles,
+        layer_drawn: last
+            .lights
+            .iter()
+            .filter(|light| !light.layer_ms.is_empty())
+            .flat_map(|light| {
+                light
+                    .layer_draws
+                    .iter()
+                    .zip(&light.layer_triangles)
+                    .map(|(&draws, &triangles)| LayerDrawn { draws, triangles })
+            })
+            .collect(),
         lighting_draws: last.stats.lighting_draws,
         lighting_instances: last.stats.lighting_instances,
         depth_only: series.summary("depth-only"),

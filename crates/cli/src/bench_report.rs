@@ -16,6 +16,13 @@ pub(crate) struct Summary {
     pub(crate) values_ms: Vec<f64>,
 }
 
+/// What one shadow-map layer drew in a frame.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub(crate) struct LayerDrawn {
+    pub(crate) draws: u32,
+    pub(crate) triangles: u64,
+}
+
 #[derive(Serialize, Debug)]
 pub(crate) struct ConfigReport {
     pub(crate) technique: String,
@@ -25,9 +32,12 @@ pub(crate) struct ConfigReport {
     pub(crate) passes: Vec<Summary>,
     /// Each light's each layer: "shadow L0 layer 1".
     pub(crate) layers: Vec<Summary>,
-    /// Instances and draw calls of one frame.
+    /// Draw calls, instances and triangles of one frame.
     pub(crate) shadow_draws: u32,
     pub(crate) shadow_instances: u32,
+    pub(crate) shadow_triangles: u64,
+    /// What each of `layers` drew in the last frame, in the same order.
+    pub(crate) layer_drawn: Vec<LayerDrawn>,
     pub(crate) lighting_draws: u32,
     pub(crate) lighting_instances: u32,
     /// With --depth-only: the baseline's time, and the median over frames of the
@@ -155,7 +165,7 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
     if has_rays {
         let _ = write!(md, " traced, % of screen (rays) |");
     }
-    let _ = writeln!(md, " shadow draws (instances) | lighting draws (instances) |");
+    let _ = writeln!(md, " shadow draws (instances, triangles) | lighting draws (instances) |");
     let cells = columns.len()
         + 3
         + usize::from(sweep.is_some())
@@ -186,24 +196,33 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
         let _ = writeln!(
             md,
-            " {} ({}) | {} ({}) |",
-            config.shadow_draws, config.shadow_instances, config.lighting_draws, config.lighting_instances
+            " {} ({}, {}) | {} ({}) |",
+            config.shadow_draws,
+            config.shadow_instances,
+            config.shadow_triangles,
+            config.lighting_draws,
+            config.lighting_instances
         );
     }
     if report.configs.iter().any(|c| c.layers.len() > 1) {
         let _ = writeln!(md, "\nEach shadow-map layer (light L, layer: cascade or cube face):\n");
-        let _ = writeln!(md, "| technique | layer | median (p95) |\n|---|---|---|");
+        let _ =
+            writeln!(md, "| technique | layer | median (p95) | draws | triangles |\n|---|---|---|---|---|");
         for config in &report.configs {
             let label = match &config.sweep_value {
                 Some(v) => format!("{} {}={v}", config.technique, sweep.unwrap_or("")),
                 None => config.technique.clone(),
             };
-            for layer in &config.layers {
+            for (index, layer) in config.layers.iter().enumerate() {
+                let drawn = config.layer_drawn.get(index);
+                let count = |n: Option<u64>| n.map_or("–".to_string(), |n| n.to_string());
                 let _ = writeln!(
                     md,
-                    "| {label} | {} | {} |",
+                    "| {label} | {} | {} | {} | {} |",
                     layer.name.trim_start_matches("shadow "),
-                    cell(Some(layer))
+                    cell(Some(layer)),
+                    count(drawn.map(|d| u64::from(d.draws))),
+                    count(drawn.map(|d| d.triangles)),
                 );
             }
         }

@@ -252,14 +252,17 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         format!("{}²", light.resolution)
     };
     let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
+    let triangles: Vec<String> = light.layer_triangles.iter().map(u64::to_string).collect();
     let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
     format!(
-        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}]{}{}{}{}{}",
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}] of {} triangles [{}]{}{}{}{}{}",
         light.name,
         light.kind,
         light.technique.name(),
         light.shadow_draws(),
         per_layer.join(" "),
+        light.layer_triangles.iter().sum::<u64>(),
+        triangles.join(" "),
         ms("shadow", light.shadow_ms),
         ms("moments", light.filter_ms),
         ms("mask", light.mask_ms),

@@ -3,7 +3,8 @@
 //! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
 //! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
 //! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]);
-//! whether a mesh is closed, for face culling in the shadow pass ([`topology`]).
+//! whether a mesh is closed, for face culling in the shadow pass ([`topology`]); and
+//! which way a projection winds a triangle or a cluster of them ([`facing`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -18,6 +19,7 @@
 mod aabb;
 pub mod cascades;
 pub mod culling;
+pub mod facing;
 pub mod fitting;
 pub mod kernels;
 mod light;

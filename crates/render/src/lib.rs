@@ -14,6 +14,7 @@
 
 #![warn(missing_docs)]
 
+mod clusters;
 mod device;
 mod frame;
 mod gpu_scene;

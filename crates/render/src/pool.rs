@@ -390,7 +390,8 @@ mod tests {
         let allowed = [
             "pool.rs",
             "frame/bindings.rs",
-            "gpu_scene.rs",
+            "gpu_scene/mod.rs",
+            "gpu_scene/materials.rs",
             "passes/depth_baseline.rs",
             "rays/mod.rs",
             "rays/query.rs",

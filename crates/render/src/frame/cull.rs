@@ -2,12 +2,12 @@
 //! instances the camera sees, every view culled in one parallel sweep.
 
 use gnomon_math::culling::Frustum;
-use gnomon_scene::settings::RayUse;
+use gnomon_scene::settings::{CasterCulling, RayUse};
 
 use super::plan::FramePlan;
 use crate::{
     GpuScene,
-    gpu_scene::{CullView, Visible},
+    gpu_scene::{CullView, Granularity, LayerFaces, Visible},
 };
 
 /// Which casters each layer of each light draws, and what the camera sees.
@@ -23,16 +23,28 @@ pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
         frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
         near: true,
         casters_only: false,
+        // The passes from the camera draw meshes whole, in their own triangle order.
+        granularity: Granularity::Instances,
     };
     // A light whose technique is rays reads no map (`techniques/raytraced.rs`):
     // nothing is culled for its layers, nor drawn into them.
     let reads_map = plan.lights.iter().filter(|light| light.technique.rays() == RayUse::AsSettingsSay);
     let layer_views = reads_map.flat_map(|light| {
-        light.layout.projections.iter().map(|projection| CullView {
-            frustum: Frustum::from_clip_from_world(projection.clip_from_world()),
-            // A pass that clamps depth draws the casters before its near plane too.
-            near: !light.layout.depth_clamp,
-            casters_only: true,
+        let shadow = &light.settings.shadow;
+        light.layout.projections.iter().map(move |projection| {
+            let clip_from_world = projection.clip_from_world();
+            CullView {
+                frustum: Frustum::from_clip_from_world(clip_from_world),
+                // A pass that clamps depth draws the casters before its near plane too.
+                near: !light.layout.depth_clamp,
+                casters_only: true,
+                granularity: match shadow.map.caster_culling {
+                    CasterCulling::Clusters => Granularity::Clusters {
+                        faces: LayerFaces::of(clip_from_world, light.depth_target(), shadow.bias.cull),
+                    },
+                    CasterCulling::Instances => Granularity::Instances,
+                },
+            }
         })
     });
     let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();

@@ -143,6 +143,10 @@ pub struct LightStats {
     pub layer_draws: Vec<u32>,
     /// Instances drawn into each layer: those whose bounds reach into its frustum.
     pub layer_instances: Vec<u32>,
+    /// Triangles drawn into each layer: every triangle of those instances, less the
+    /// clusters of large meshes outside its frustum or turned the way it culls
+    /// (`--caster-culling`).
+    pub layer_triangles: Vec<u64>,
     /// The time of each layer's shadow pass, where the frame was timed.
     pub layer_ms: Vec<f64>,
     /// Time of its shadow passes (every layer), moment pass and lighting pass, where
@@ -199,6 +203,8 @@ pub struct DrawStats {
     pub bind_group_changes: u32,
     /// Instances drawn into shadow maps, every layer of every light together.
     pub shadow_instances: u32,
+    /// Triangles drawn into shadow maps, every layer of every light together.
+    pub shadow_triangles: u64,
     /// Instances the camera sees, drawn by the lighting pass.
     pub lighting_instances: u32,
 }
@@ -211,6 +217,7 @@ impl DrawStats {
         self.pipeline_changes += other.pipeline_changes;
         self.bind_group_changes += other.bind_group_changes;
         self.shadow_instances += other.shadow_instances;
+        self.shadow_triangles += other.shadow_triangles;
         self.lighting_instances += other.lighting_instances;
     }
 }
@@ -481,6 +488,7 @@ impl TimedLights {
                 resolution: light.map_resolution(),
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
                 layer_instances: layers.iter().map(Visible::instances).collect(),
+                layer_triangles: layers.iter().map(Visible::triangles).collect(),
                 layer_ms: Vec::new(),
                 shadow_ms: None,
                 filter_ms: None,

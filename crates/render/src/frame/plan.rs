@@ -12,7 +12,7 @@ use gnomon_scene::{
 use super::Renderer;
 use crate::{
     GpuScene, RenderError,
-    gpu_scene::CullView,
+    gpu_scene::{CullView, Granularity},
     layout::{MapDrawing, SampleDistribution, ShadowLayout, cascade_splits, shadow_layout},
     passes::{
         SHADOW_FORMAT,
@@ -214,6 +214,7 @@ impl Renderer {
                 frustum: Frustum::from_clip_from_world(clip_from_world),
                 near: true,
                 casters_only: false,
+                granularity: Granularity::Instances,
             }]);
             let view = self.pool.view(&depth, ViewKey::default());
             let pass = super::record::DepthPass {

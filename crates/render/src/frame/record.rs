@@ -19,7 +19,7 @@ use super::{
 };
 use crate::{
     GpuScene, RenderError,
-    gpu_scene::Visible,
+    gpu_scene::{IndexOrder, Visible},
     gpu_types::VertexStream,
     layout::ShadowLayout,
     passes::{
@@ -526,8 +526,8 @@ impl Renderer {
         let mut pipeline: Option<ShadowPipelineKey> = None;
         let mut stream: Option<VertexStream> = None;
         let mut bound = None;
-        for (batch, run) in &depth.visible.runs {
-            let batch = &uploaded.batches[*batch as usize];
+        for run in &depth.visible.runs {
+            let batch = &uploaded.batches[run.batch as usize];
             let key = ShadowPipelineKey::new(
                 bias,
                 batch.sides,
@@ -538,7 +538,7 @@ impl Renderer {
             if pipeline != Some(key) {
                 let wanted = ShadowPipelineShape::of(&key).stream;
                 match stream {
-                    None => uploaded.bind_geometry(&mut pass, wanted),
+                    None => uploaded.bind_geometry(&mut pass, wanted, IndexOrder::Clusters),
                     Some(bound_stream) if bound_stream != wanted => uploaded.bind_stream(&mut pass, wanted),
                     Some(_) => {}
                 }
@@ -552,10 +552,11 @@ impl Renderer {
                 bound = Some(batch.material_group);
                 stats.bind_group_changes += 1;
             }
-            GpuScene::draw_run(&mut pass, batch, run.clone());
+            GpuScene::draw_run(&mut pass, batch, run);
             stats.shadow_draws += 1;
-            stats.shadow_instances += run.end - run.start;
         }
+        stats.shadow_instances = depth.visible.instances();
+        stats.shadow_triangles = depth.visible.triangles();
         stats
     }
 }

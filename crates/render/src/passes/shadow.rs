@@ -31,6 +31,17 @@ pub(crate) enum DepthTarget {
     Paraboloid,
 }
 
+impl DepthTarget {
+    /// The winding its pipelines call front: a cube face's and a paraboloid's views
+    /// are mirrored (`gnomon_math::omni`).
+    pub fn front_face(self) -> wgpu::FrontFace {
+        match self {
+            DepthTarget::Projected => wgpu::FrontFace::Ccw,
+            DepthTarget::CubeFace | DepthTarget::Paraboloid => wgpu::FrontFace::Cw,
+        }
+    }
+}
+
 /// Whether a caster's surface is cut by its texture's alpha.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum Coverage {
@@ -66,8 +77,8 @@ pub(crate) struct ShadowPipelineKey {
 }
 
 impl ShadowPipelineKey {
-    /// The key for casters of `sides` drawn with `bias`: double-sided casters are never
-    /// culled, and `cull auto` culls back faces of closed meshes only.
+    /// The key for casters of `sides` drawn with `bias` (its cull mode as
+    /// [`Sides::culled_face`] resolves it).
     pub fn new(
         bias: &BiasSettings,
         sides: Sides,
@@ -76,15 +87,7 @@ impl ShadowPipelineKey {
         target: DepthTarget,
     ) -> Self {
         Self {
-            cull: match (sides, bias.cull) {
-                (Sides::Double, _)
-                | (Sides::Open | Sides::Closed, CullMode::None)
-                | (Sides::Open, CullMode::Auto) => None,
-                (Sides::Closed, CullMode::Auto) | (Sides::Open | Sides::Closed, CullMode::Back) => {
-                    Some(wgpu::Face::Back)
-                }
-                (Sides::Open | Sides::Closed, CullMode::Front) => Some(wgpu::Face::Front),
-            },
+            cull: sides.culled_face(bias.cull),
             depth_bias: bias.depth_bias,
             slope_bias_bits: bias.slope_bias.to_bits(),
             coverage,
@@ -112,6 +115,21 @@ pub(crate) enum Sides {
 }
 
 impl Sides {
+    /// The faces the shadow pass culls on casters of these sides under `mode`:
+    /// double-sided casters are never culled, and `cull auto` culls back faces of
+    /// closed meshes only.
+    pub fn culled_face(self, mode: CullMode) -> Option<wgpu::Face> {
+        match (self, mode) {
+            (Sides::Double, _)
+            | (Sides::Open | Sides::Closed, CullMode::None)
+            | (Sides::Open, CullMode::Auto) => None,
+            (Sides::Closed, CullMode::Auto) | (Sides::Open | Sides::Closed, CullMode::Back) => {
+                Some(wgpu::Face::Back)
+            }
+            (Sides::Open | Sides::Closed, CullMode::Front) => Some(wgpu::Face::Front),
+        }
+    }
+
     /// The faces of `instance` that can block light; `closed` says per mesh whether
     /// it is closed ([`Scene::closed_meshes`]).
     pub fn of(scene: &Scene, instance: &Instance, closed: &[bool]) -> Sides {
@@ -171,8 +189,7 @@ impl ShadowPipelineShape {
             } else {
                 VertexStream::Full
             },
-            // A cube face's and a paraboloid's views are mirrored (`gnomon_math::omni`).
-            front_face: if writes_distance { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+            front_face: key.target.front_face(),
             cull_mode: key.cull,
             unclipped_depth: key.depth_range == DepthRange::Clamped,
             // The clamp stays 0: wgpu 30 does not enable the Vulkan feature

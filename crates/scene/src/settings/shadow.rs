@@ -149,6 +149,10 @@ pub struct MapSettings {
     /// How a point light's map covers every direction.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub omni: OmniMap,
+    /// How finely the casters are culled against each layer of the map. The map is the
+    /// same either way: this only changes what it costs.
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
+    pub caster_culling: CasterCulling,
 }
 
 impl Default for MapSettings {
@@ -160,8 +164,25 @@ impl Default for MapSettings {
             warp: WarpKind::default(),
             depth_clamp: true,
             omni: OmniMap::default(),
+            caster_culling: CasterCulling::default(),
         }
     }
+}
+
+/// How finely a shadow layer's casters are culled against its frustum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum CasterCulling {
+    /// Each instance, and each cluster of about a hundred triangles of a large mesh
+    /// drawn once: a layer skips the clusters outside its frustum and those whose every
+    /// face the pass would cull (by their cone of normals). A cascade a few metres
+    /// wide then draws a few metres of a large mesh, not all of it.
+    #[default]
+    Clusters,
+    /// Each instance as a whole, by its bounds: a large mesh is drawn whole into every
+    /// layer that it reaches. The baseline that clusters are measured against.
+    Instances,
 }
 
 /// The parametrization of a point light's map.

@@ -55,6 +55,8 @@ fn flags_and_toml_agree() {
         "0.5",
         "--contact-steps",
         "24",
+        "--caster-culling",
+        "instances",
     ])
     .unwrap()
     .settings;
@@ -78,6 +80,7 @@ fn flags_and_toml_agree() {
         cull = "front"
         [shadow.map]
         resolution = 1024
+        caster_culling = "instances"
         [shadow.contact]
         contact_shadows = true
         contact_length = 0.5

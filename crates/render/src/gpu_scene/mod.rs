@@ -5,65 +5,31 @@
 //! [`CullTree`] and stored in its order, so that culling a batch against a frustum
 //! yields runs of consecutive instances: instanced draws, whatever the instance count.
 
-use std::ops::Range;
+mod batches;
+mod materials;
 
-use gnomon_math::{
-    Aabb,
-    culling::{CullTree, Frustum},
-};
-use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
+use gnomon_math::Aabb;
+use gnomon_scene::{AlphaMode, Scene};
 use rayon::prelude::*;
 use wgpu::util::DeviceExt;
 
+pub(crate) use batches::{Batch, CullView, Granularity, LayerFaces, Run, Visible};
+use batches::{MeshRange, batch_instances};
+
 use crate::{
     Gpu, RenderError,
+    clusters::{MeshClusters, cluster_mesh, place_clusters},
     gpu_types::{INSTANCE_SLOT, InstanceGpu, VertexGpu, VertexStream},
-    passes::{Layouts, shadow::Sides},
+    passes::Layouts,
 };
 
-/// Instances that share a mesh, a material texture and the state their draws need:
-/// `first_instance .. first_instance + tree.len()` in the instance buffer.
-#[derive(Debug)]
-pub(crate) struct Batch {
-    pub first_index: u32,
-    pub index_count: u32,
-    pub base_vertex: i32,
-    pub first_instance: u32,
-    pub casts_shadow: bool,
-    /// Alpha-tested (glTF MASK): the shadow pass must sample the texture.
-    pub masked: bool,
-    /// Which faces can block light: a double-sided material, or a closed or an
-    /// open mesh (what `cull auto` culls by).
-    pub sides: Sides,
-    /// Index into [`GpuScene::material_groups`]: the texture this batch samples.
-    pub material_group: usize,
-    /// The batch's instances, in the order the instance buffer holds them.
-    tree: CullTree,
-}
-
-/// What a view draws: the runs of instances of each batch that survive culling, in
-/// drawing order.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Visible {
-    /// (batch index, instance range in the instance buffer).
-    pub runs: Vec<(u32, Range<u32>)>,
-}
-
-impl Visible {
-    /// How many instances the runs hold.
-    pub fn instances(&self) -> u32 {
-        self.runs.iter().map(|(_, r)| r.end - r.start).sum()
-    }
-}
-
-/// One view to cull for: the casters seen by a shadow-map layer, or every instance
-/// seen by the camera.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct CullView {
-    pub frustum: Frustum,
-    /// Whether the frustum's near plane counts (not for a pass that clamps depth).
-    pub near: bool,
-    pub casters_only: bool,
+/// Which index buffer a pass draws from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum IndexOrder {
+    /// The meshes' own triangle order: the passes from the camera.
+    Scene,
+    /// Large meshes in cluster order (`crate::clusters`): the shadow passes.
+    Clusters,
 }
 
 /// The GPU copy of a [`Scene`]'s geometry, instances and textures.
@@ -72,6 +38,9 @@ pub struct GpuScene {
     /// The vertices' positions alone, for the shadow pass's position-only stream.
     pub(crate) positions: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
+    /// The same triangles, with each clustered mesh's in cluster order: what the
+    /// shadow passes draw from.
+    shadow_indices: wgpu::Buffer,
     pub(crate) instances: wgpu::Buffer,
     /// Batches sorted by material group, so a bind group changes only between groups.
     pub(crate) batches: Vec<Batch>,
@@ -91,6 +60,8 @@ pub struct GpuScene {
     slots: Vec<Option<u32>>,
     /// Each mesh's bounds in its own space, for a moved instance's new box.
     mesh_bounds: Vec<Aabb>,
+    /// Each mesh's clusters, where a batch of one instance draws a large mesh.
+    mesh_clusters: Vec<Option<MeshClusters>>,
 }
 
 impl GpuScene {
@@ -117,7 +88,26 @@ impl GpuScene {
         let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
 
         let closed = scene.closed_meshes();
-        let (batches, order) = batch_instances(scene, &ranges, &mesh_bounds, &closed);
+        let (mut batches, order) = batch_instances(scene, &ranges, &mesh_bounds, &closed);
+        let mesh_clusters = cluster_meshes(scene, &batches);
+        let mut shadow_indices = indices.clone();
+        for (range, clusters) in ranges.iter().zip(&mesh_clusters) {
+            if let Some(clusters) = clusters {
+                let start = range.first_index as usize;
+                shadow_indices[start..start + clusters.indices.len()].copy_from_slice(&clusters.indices);
+            }
+        }
+        for batch in batches.iter_mut().filter(|b| b.tree.len() == 1) {
+            if let Some(clusters) = &mesh_clusters[batch.mesh] {
+                let placed = &scene.instances[order[batch.first_instance as usize]];
+                batch.clusters = place_clusters(
+                    &scene.meshes[batch.mesh],
+                    clusters,
+                    batch.first_index,
+                    placed.world_from_object,
+                );
+            }
+        }
         let mut shadow_order: Vec<u32> = (0..batches.len() as u32).collect();
         shadow_order.sort_by_key(|&b| {
             let b = &batches[b as usize];
@@ -157,6 +147,11 @@ impl GpuScene {
                 wgpu::BufferUsages::VERTEX,
             ),
             indices: buffer("scene indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX),
+            shadow_indices: buffer(
+                "scene indices, clustered",
+                bytemuck::cast_slice(&shadow_indices),
+                wgpu::BufferUsages::INDEX,
+            ),
             // Vertex stages read the matrices as per-instance attributes, fragment
             // stages the materials from storage (`InstanceGpu`).
             instances: buffer(
@@ -168,10 +163,11 @@ impl GpuScene {
             batches,
             rays: std::sync::OnceLock::new(),
             shadow_order,
-            material_groups: material_groups(gpu, scene, layouts),
+            material_groups: materials::material_groups(gpu, scene, layouts),
             bounds,
             slots,
             mesh_bounds,
+            mesh_clusters,
         })
     }
 
@@ -206,8 +202,19 @@ impl GpuScene {
             }
         })?;
         for (batch, moved) in self.batches.iter_mut().zip(refits) {
-            if !moved.is_empty() {
-                batch.tree.refit(moved);
+            if moved.is_empty() {
+                continue;
+            }
+            batch.tree.refit(moved);
+            if let Some(clusters) = &self.mesh_clusters[batch.mesh]
+                && !batch.clusters.is_empty()
+            {
+                let slot = batch.first_instance;
+                let index =
+                    self.slots.iter().position(|&s| s == Some(slot)).expect("every slot is an instance's");
+                let world_from_object = scene.instances[index].world_from_object;
+                batch.clusters =
+                    place_clusters(&scene.meshes[batch.mesh], clusters, batch.first_index, world_from_object);
             }
         }
         self.bounds = self.batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
@@ -269,16 +276,24 @@ impl GpuScene {
             }
             runs.clear();
             batch.tree.cull(&view.frustum, view.near, &mut runs);
-            let first = batch.first_instance;
-            visible.runs.extend(runs.iter().map(|r| (index, first + r.start..first + r.end)));
+            batch.push_runs(index, &runs, view, &mut visible);
         }
         visible
     }
 
     /// Binds the shared index buffer, the instance transforms and `stream`: what
     /// every pipeline declaring [`VertexStream::buffers`] reads.
-    pub(crate) fn bind_geometry(&self, pass: &mut wgpu::RenderPass<'_>, stream: VertexStream) {
-        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+    pub(crate) fn bind_geometry(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        stream: VertexStream,
+        order: IndexOrder,
+    ) {
+        let indices = match order {
+            IndexOrder::Scene => &self.indices,
+            IndexOrder::Clusters => &self.shadow_indices,
+        };
+        pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.set_vertex_buffer(INSTANCE_SLOT, self.instances.slice(..));
         self.bind_stream(pass, stream);
     }
@@ -300,161 +315,42 @@ impl GpuScene {
         visible: &Visible,
         material_group: u32,
     ) -> (u32, u32) {
-        self.bind_geometry(pass, VertexStream::Full);
+        self.bind_geometry(pass, VertexStream::Full, IndexOrder::Scene);
         let (mut draws, mut binds) = (0, 0);
         let mut bound = None;
-        for (batch, run) in &visible.runs {
-            let batch = &self.batches[*batch as usize];
+        for run in &visible.runs {
+            let batch = &self.batches[run.batch as usize];
             if bound != Some(batch.material_group) {
                 pass.set_bind_group(material_group, &self.material_groups[batch.material_group], &[]);
                 bound = Some(batch.material_group);
                 binds += 1;
             }
-            Self::draw_run(pass, batch, run.clone());
+            Self::draw_run(pass, batch, run);
             draws += 1;
         }
         (draws, binds)
     }
 
-    /// Issues one instanced draw of a batch's mesh.
-    pub(crate) fn draw_run(pass: &mut wgpu::RenderPass<'_>, batch: &Batch, instances: Range<u32>) {
-        pass.draw_indexed(
-            batch.first_index..batch.first_index + batch.index_count,
-            batch.base_vertex,
-            instances,
-        );
+    /// Issues one instanced draw of `run`, of `batch`.
+    pub(crate) fn draw_run(pass: &mut wgpu::RenderPass<'_>, batch: &Batch, run: &Run) {
+        pass.draw_indexed(run.indices.clone(), batch.base_vertex, run.instances.clone());
     }
 }
 
-/// A bind group per texture (after a white 1×1 default at index 0), each texture
-/// with the sampler its glTF sampler asks for.
-fn material_groups(gpu: &Gpu, scene: &Scene, layouts: &Layouts) -> Vec<wgpu::BindGroup> {
-    let device = &gpu.device;
-    let white = Texture {
-        name: "white".into(),
-        width: 1,
-        height: 1,
-        rgba8: vec![255; 4],
-        wrap_u: Wrap::Repeat,
-        wrap_v: Wrap::Repeat,
-        nearest: true,
-    };
-    std::iter::once(&white)
-        .chain(&scene.textures)
-        .map(|t| {
-            let texture = device.create_texture_with_data(
-                &gpu.queue,
-                &wgpu::TextureDescriptor {
-                    label: Some(&t.name),
-                    size: wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                },
-                wgpu::util::TextureDataOrder::LayerMajor,
-                &t.rgba8,
-            );
-            let address = |w: Wrap| match w {
-                Wrap::Repeat => wgpu::AddressMode::Repeat,
-                Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
-                Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
-            };
-            let filter = if t.nearest { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
-            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some(&t.name),
-                address_mode_u: address(t.wrap_u),
-                address_mode_v: address(t.wrap_v),
-                mag_filter: filter,
-                min_filter: filter,
-                ..Default::default()
-            });
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(&t.name),
-                layout: &layouts.material,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(
-                            &texture.create_view(&Default::default()),
-                        ),
-                    },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
-                ],
-            })
-        })
+/// The clusters of each mesh that a batch of one shadow-casting instance draws
+/// (meshes drawn by several instances are culled instance by instance), built in
+/// parallel.
+fn cluster_meshes(scene: &Scene, batches: &[Batch]) -> Vec<Option<MeshClusters>> {
+    let mut wanted = vec![false; scene.meshes.len()];
+    for batch in batches.iter().filter(|b| b.casts_shadow && b.tree.len() == 1) {
+        wanted[batch.mesh] = true;
+    }
+    scene
+        .meshes
+        .par_iter()
+        .zip(wanted)
+        .map(|(mesh, wanted)| if wanted { cluster_mesh(mesh) } else { None })
         .collect()
-}
-
-/// Where a mesh lies in the shared vertex and index buffers.
-#[derive(Clone, Copy, Debug)]
-struct MeshRange {
-    first_index: u32,
-    index_count: u32,
-    base_vertex: i32,
-}
-
-/// What the instances of one batch share: one draw covers them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-struct BatchKey {
-    /// The base-colour texture's bind group (0 for none).
-    material_group: usize,
-    masked: bool,
-    sides: Sides,
-    casts_shadow: bool,
-    mesh: usize,
-}
-
-/// Groups the instances into batches by everything a draw of them shares, each with
-/// its culling tree; returns the batches and the instances in buffer order.
-/// `closed` says, per mesh, whether it is closed ([`Scene::closed_meshes`]).
-fn batch_instances(
-    scene: &Scene,
-    ranges: &[MeshRange],
-    mesh_bounds: &[Aabb],
-    closed: &[bool],
-) -> (Vec<Batch>, Vec<usize>) {
-    let key_of = |i: usize| {
-        let inst = &scene.instances[i];
-        let material = &scene.materials[inst.material];
-        BatchKey {
-            material_group: material.base_color_texture.map_or(0, |t| t + 1),
-            masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
-            sides: Sides::of(scene, inst, closed),
-            casts_shadow: inst.casts_shadow,
-            mesh: inst.mesh,
-        }
-    };
-    let mut members: Vec<usize> = (0..scene.instances.len())
-        .filter(|&i| !scene.meshes[scene.instances[i].mesh].indices.is_empty())
-        .collect();
-    members.sort_by_key(|&i| (key_of(i), i));
-    let mut order: Vec<usize> = Vec::with_capacity(members.len());
-    let mut batches = Vec::new();
-    for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
-        let BatchKey { material_group, masked, sides, casts_shadow, mesh } = key_of(group[0]);
-        let bounds: Vec<Aabb> = group
-            .iter()
-            .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
-            .collect();
-        let (tree, tree_order) = CullTree::build(&bounds);
-        let MeshRange { first_index, index_count, base_vertex } = ranges[mesh];
-        batches.push(Batch {
-            first_index,
-            index_count,
-            base_vertex,
-            first_instance: order.len() as u32,
-            casts_shadow,
-            masked,
-            sides,
-            material_group,
-            tree,
-        });
-        order.extend(tree_order.iter().map(|&k| group[k as usize]));
-    }
-    (batches, order)
 }
 
 /// The GPU record of the scene's instance `i`.
