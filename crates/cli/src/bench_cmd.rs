@@ -11,10 +11,14 @@ use std::{collections::BTreeMap, path::PathBuf, time::Instant};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use gnomon_render::{
-    DepthBaselineScene, FrameCost, Gpu, GpuScene, Renderer,
+    DepthBaselineScene, FrameCost, Gpu, GpuScene, LayerCache, Renderer,
     timing::{ClockChoice, TimingSource},
 };
-use gnomon_scene::{Scene, Settings, settings::Technique};
+use gnomon_scene::{
+    Scene, Settings,
+    camera_path::{CameraPathKind, camera_on_path},
+    settings::Technique,
+};
 use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -52,9 +56,20 @@ pub struct BenchArgs {
     pub depth_only: bool,
     /// Sway N instances (spread over the scene's list) by a hundredth of the scene's
     /// size every frame, and time how long the renderer takes to follow them (`CPU
-    /// move`: transforms, culling trees and, with rays, the BVH refitted).
+    /// move`: transforms, culling trees and, with rays, the BVH refitted). They are
+    /// declared moving (`Motion::Dynamic`), so kept shadow maps draw them over their
+    /// still casters every frame.
     #[arg(long, value_name = "N", help_heading = "Benchmark")]
     pub moving: Option<usize>,
+    /// Move the camera along this path over the warm-up and timed frames (the scene
+    /// and light still), to time what a moving view costs: with `--map-cache`, the
+    /// layers whose projection moved are drawn again, the others kept.
+    #[arg(long, value_enum, help_heading = "Benchmark")]
+    pub camera_path: Option<CameraPathKind>,
+    /// How far the eye travels over the whole path, as a fraction of its distance to
+    /// the target (an orbit's arc: that angle in radians); in (0, 1].
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.05, help_heading = "Benchmark")]
+    pub path_travel: f32,
     /// How to time passes: GPU timestamps where the adapter has them (else the CPU
     /// wall clock), or the CPU wall clock always.
     #[arg(long, value_enum, default_value_t = ClockArg::Auto, help_heading = "Benchmark")]
@@ -96,10 +111,20 @@ struct Config {
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!((1..=100_000).contains(&args.frames), "--frames {}: give 1 to 100000", args.frames);
     anyhow::ensure!(args.warmup <= 10_000, "--warmup {}: give 0 to 10000", args.warmup);
+    anyhow::ensure!(
+        args.path_travel > 0.0 && args.path_travel <= 1.0,
+        "--path-travel = {} is invalid: a fraction in (0, 1]",
+        args.path_travel
+    );
     args.settings.validate()?;
     output::check_dir(&args.out, "--out")?;
-    let (scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
+    let (mut scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
     let mover = args.moving.map(|count| crate::bench_moving::Mover::new(&scene, count)).transpose()?;
+    if let Some(mover) = &mover {
+        // Declared as an application would before it uploads: kept shadow maps draw
+        // them over their still casters every frame.
+        mover.declare_dynamic(&mut scene);
+    }
     if let Some((width, height)) = args.size {
         base.image.width = width;
         base.image.height = height;
@@ -217,9 +242,23 @@ impl Series {
 impl Bench<'_> {
     /// Warms up, then times `--frames` frames of one configuration.
     fn config(&mut self, config: &Config, progress: &ProgressBar) -> anyhow::Result<ConfigReport> {
-        let settings = &config.settings;
+        let mut settings = config.settings.clone();
+        let start = settings.resolve_camera(&self.scene)?;
+        let frames = self.args.warmup + self.args.frames;
+        let path = self.args.camera_path;
+        let travel = self.args.path_travel;
+        // The camera of frame `i` of the warm-up and timed frames together.
+        let place = |settings: &mut Settings, i: u32| {
+            if let Some(kind) = path {
+                let camera = camera_on_path(&start, kind, travel, i as f32 / (frames - 1).max(1) as f32);
+                settings.camera.eye = Some(camera.eye);
+                settings.camera.target = Some(camera.target);
+            }
+        };
+        let settings = &mut settings;
         let mut frame = 0;
-        for _ in 0..self.args.warmup {
+        for i in 0..self.args.warmup {
+            place(settings, i);
             if let Some(mover) = &self.mover {
                 mover.step(&self.renderer, &mut self.uploaded, &mut self.scene, frame)?;
                 frame += 1;
@@ -238,7 +277,8 @@ impl Bench<'_> {
         }
         let mut series = Series::default();
         let mut last: Option<FrameCost> = None;
-        for _ in 0..self.args.frames {
+        for i in 0..self.args.frames {
+            place(settings, self.args.warmup + i);
             if let Some(mover) = &self.mover {
                 series.push(
                     "CPU move",
@@ -283,6 +323,14 @@ impl Bench<'_> {
         // What the frame costs beyond its GPU work and the CPU's submission: resource
         // creation, stalls and readback waits. 1 means nothing is wasted.
         series.push("wall ÷ (GPU + CPU)", wall_ms / (timings.frame_ms + cost.cpu.submit_ms));
+        // With kept maps: how many layers each frame kept, scrolled or drew again.
+        let uses: Vec<LayerCache> = cost.lights.iter().flat_map(|l| l.layer_cache.iter().copied()).collect();
+        if uses.iter().any(|&u| u != LayerCache::Off) {
+            let count = |state: LayerCache| uses.iter().filter(|&&u| u == state).count() as f64;
+            series.push("layers kept", count(LayerCache::Kept));
+            series.push("layers scrolled", count(LayerCache::Scrolled));
+            series.push("layers drawn", count(LayerCache::Drawn));
+        }
         for (light, stats) in cost.lights.iter().enumerate() {
             for (layer, ms) in stats.layer_ms.iter().enumerate() {
                 series.push(format!("shadow L{light} layer {layer}"), *ms);

@@ -35,6 +35,14 @@ impl Mover {
         Ok(Self { chosen, original, amplitude })
     }
 
+    /// Marks the instances it moves as moving (`Motion::Dynamic`) in `scene`, before
+    /// the scene is uploaded.
+    pub fn declare_dynamic(&self, scene: &mut Scene) {
+        for &i in &self.chosen {
+            scene.instances[i].motion = gnomon_scene::Motion::Dynamic;
+        }
+    }
+
     /// For scale: the time to build the casters' BVH afresh and upload it (what a
     /// refit saves), in milliseconds.
     pub fn rebuild_ms(gpu: &gnomon_render::Gpu, scene: &Scene) -> anyhow::Result<f64> {

@@ -102,7 +102,7 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
     let _ = writeln!(
         md,
         "- adapter: {} ({}, {}), driver: {} {}\n- timing: {}\n- {} instances{}, {} triangles; image {}×{}; \
-         {} warm-up and {} timed frames per row; times in ms, median (p95)\n- command: `{}`\n",
+         {} warm-up and {} timed frames per row; times in ms (the layer counts of kept maps in layers), median (p95)\n- command: `{}`\n",
         info.adapter,
         info.device_type,
         info.backend,
@@ -132,7 +132,7 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
     }
     // In frame order, whichever configurations have them.
-    const ORDER: [&str; 14] = [
+    const ORDER: [&str; 17] = [
         "shadow",
         "filter",
         "prepass",
@@ -147,6 +147,9 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         "CPU record",
         "wall frame",
         "wall ÷ (GPU + CPU)",
+        "layers kept",
+        "layers scrolled",
+        "layers drawn",
     ];
     columns.sort_by_key(|c| ORDER.iter().position(|o| o == c).unwrap_or(ORDER.len()));
     let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use gnomon_render::{Gpu, OutputRequest, Renderer};
+use gnomon_render::{Gpu, LayerCache, OutputRequest, Renderer};
 use gnomon_scene::{
     Scene, Settings,
     settings::{CullMode, value_name},
@@ -254,8 +254,13 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
     let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
     let triangles: Vec<String> = light.layer_triangles.iter().map(u64::to_string).collect();
     let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
+    let count = |state: LayerCache| light.layer_cache.iter().filter(|&&s| s == state).count();
+    let cache = match (count(LayerCache::Kept), count(LayerCache::Drawn)) {
+        (0, 0) => String::new(),
+        (kept, drawn) => format!(" (cache: {kept} layers kept, {drawn} drawn)"),
+    };
     format!(
-        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}] of {} triangles [{}]{}{}{}{}{}",
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}] of {} triangles [{}]{cache}{}{}{}{}{}",
         light.name,
         light.kind,
         light.technique.name(),

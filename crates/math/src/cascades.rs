@@ -56,6 +56,42 @@ pub fn frustum_slice(view_frustum: &Hexahedron, near: f32, far: f32, from: f32, 
     view_frustum.slice(t(from), t(to))
 }
 
+/// A perspective view, for [`view_slice`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PerspectiveView {
+    /// The eye, in world space.
+    pub eye: Vec3,
+    /// A point it looks at.
+    pub target: Vec3,
+    /// Up, roughly: the view's y axis is made orthogonal to the view direction.
+    pub up: Vec3,
+    /// The full vertical field of view, in radians.
+    pub fov_y: f32,
+    /// Width over height.
+    pub aspect: f32,
+}
+
+/// The slice of a perspective view between view depths `from` and `to`, with
+/// [`Hexahedron`]'s corner order, built from the view's eye, axes and field of view
+/// in f64 instead of interpolated between the faces of its frustum. An f32 frustum
+/// whose far plane is 10⁴ times its near one has corners off by about 10⁻⁴ of their
+/// distance, enough to change a stable cascade's size from one frame to the next.
+pub fn view_slice(view: &PerspectiveView, from: f32, to: f32) -> Hexahedron {
+    let eye = view.eye.as_dvec3();
+    let forward = (view.target.as_dvec3() - eye).normalize();
+    let right = forward.cross(view.up.as_dvec3()).normalize();
+    let up = right.cross(forward);
+    let tan_y = (0.5 * f64::from(view.fov_y)).tan();
+    let tan_x = tan_y * f64::from(view.aspect);
+    let corners = std::array::from_fn(|k| {
+        let depth = f64::from(if k & 4 == 0 { from } else { to });
+        let sx = if k & 1 == 0 { -1.0 } else { 1.0 };
+        let sy = if k & 2 == 0 { -1.0 } else { 1.0 };
+        (eye + depth * (forward + sx * tan_x * right + sy * tan_y * up)).as_vec3()
+    });
+    Hexahedron { corners }
+}
+
 /// A cascade's projection fitted tightly: the light's map covers exactly the slice's
 /// potential receivers (the slice ∩ the scene). With `depth_clamp` its depth range
 /// starts at the nearest of them ([`LightProjection::pancaked`]).
@@ -262,6 +298,20 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_view_slice_is_the_frustum_slice() {
+        let eye = Vec3::new(3.0, 2.0, -1.0);
+        let target = Vec3::new(-2.0, 0.5, 4.0);
+        let view = PerspectiveView { eye, target, up: Vec3::Y, fov_y: 0.9, aspect: 1.7 };
+        let clip =
+            crate::camera_clip_from_view(0.9, 1.7, 0.1, 50.0) * view_from_world_look_at(eye, target, Vec3::Y);
+        let frustum = Hexahedron::from_clip_from_world(clip);
+        let (a, b) = (frustum_slice(&frustum, 0.1, 50.0, 2.0, 9.0), view_slice(&view, 2.0, 9.0));
+        for (p, q) in a.corners.iter().zip(&b.corners) {
+            assert!(p.distance(*q) < 1e-3, "{p} vs {q}");
         }
     }
 

@@ -292,6 +292,7 @@ mod tests {
             material: 0,
             world_from_object: Mat4::IDENTITY,
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         }];
         let traced = TracedScene::build(&scene);
         let eye = Vec3::new(150.0, 220.0, 380.0);
@@ -320,6 +321,7 @@ mod tests {
                 material: 0,
                 world_from_object: Mat4::IDENTITY,
                 casts_shadow: true,
+                motion: gnomon_scene::Motion::Static,
             },
             Instance {
                 name: "b".into(),
@@ -327,6 +329,7 @@ mod tests {
                 material: 0,
                 world_from_object: Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0)),
                 casts_shadow: false,
+                motion: gnomon_scene::Motion::Static,
             },
         ];
         let traced = TracedScene::build(&scene);
@@ -372,6 +375,7 @@ mod tests {
             material: 0,
             world_from_object: Mat4::IDENTITY,
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         }];
         let traced = TracedScene::build(&scene);
         let brute = targets

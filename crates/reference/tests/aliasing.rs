@@ -362,6 +362,7 @@ fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
         material: 0,
         world_from_object: glam::Mat4::from_translation(at),
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     };
     scene.instances = vec![instance("ground", 0, Vec3::ZERO), instance("box", 1, Vec3::new(0.0, 8.0, 0.0))];
     scene.sun.direction = Vec3::new(0.3, -1.0, 0.2).normalize();

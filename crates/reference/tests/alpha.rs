@@ -55,6 +55,7 @@ fn checker_scene() -> Scene {
             material: 0,
             world_from_object: Mat4::IDENTITY,
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         },
         Instance {
             name: "checker".into(),
@@ -62,6 +63,7 @@ fn checker_scene() -> Scene {
             material: 1,
             world_from_object: Mat4::from_translation(QUAD_CENTER),
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         },
     ];
     scene.sun.direction = -gnomon_scene::sun_direction(60.0, 20.0);

@@ -28,6 +28,7 @@ fn scene_with(meshes: Vec<(Mesh, Mat4)>) -> Scene {
             material: 0,
             world_from_object: *t,
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         })
         .collect();
     scene

@@ -116,6 +116,7 @@ fn cutout_scene(nearest: bool, wrap: Wrap) -> Scene {
         material: 0,
         world_from_object: Mat4::from_rotation_x(0.3),
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     }];
     scene
 }

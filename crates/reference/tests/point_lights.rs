@@ -94,6 +94,7 @@ fn seam_scene() -> Scene {
         material: 0,
         world_from_object: Mat4::IDENTITY,
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     }];
     // Posts at 45° steps around the light's foot, some on the seam lines, some
     // across them, so that their shadows run over the seams.
@@ -107,6 +108,7 @@ fn seam_scene() -> Scene {
             material: 1,
             world_from_object: Mat4::from_translation(p),
             casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
         });
     }
     scene.point = PointLight { position: Vec3::new(0.0, 2.0, 0.0), range: 30.0, ..scene.point };
@@ -251,6 +253,7 @@ fn casters_outside_a_face_are_not_drawn_into_it() {
         material: 1,
         world_from_object: Mat4::from_translation(Vec3::new(4.0, 2.0, 0.0)),
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     });
     let s = point_settings(Technique::PCF2X2, 512, 480, 320);
     let frame = render(&scene, &s);

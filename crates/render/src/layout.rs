@@ -122,6 +122,13 @@ pub fn shadow_layout(
     let c = &settings.shadow.cascades;
     let bounds = *scene_bounds;
     let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
+    let view = cascades::PerspectiveView {
+        eye: camera.eye,
+        target: camera.target,
+        up: camera.up,
+        fov_y: camera.fov_y_degrees.to_radians(),
+        aspect,
+    };
     let resolution = settings.shadow.map.resolution;
     // With selection by depth, the lighting pass blends the far end of each cascade
     // into the next one, so each slice starts at its predecessor's blend band.
@@ -134,6 +141,9 @@ pub fn shadow_layout(
         .map(|i| {
             let from = if i == 0 { splits[0] } else { splits[i] - blend * (splits[i] - splits[i - 1]) };
             let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
+            // A stable cascade's size follows its slice's: built exactly, so that it
+            // stays put while the camera moves (`cascades::view_slice`).
+            let exact_slice = || cascades::view_slice(&view, from, splits[i + 1]);
             match c.cascade_fit {
                 CascadeFit::Tight => {
                     let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice, pancake);
@@ -148,7 +158,7 @@ pub fn shadow_layout(
                     }
                 }
                 CascadeFit::Stable => {
-                    cascades::fit_cascade_stable(sun.direction, &bounds, &slice, resolution)
+                    cascades::fit_cascade_stable(sun.direction, &bounds, &exact_slice(), resolution)
                 }
             }
         })
@@ -185,12 +195,11 @@ pub(crate) fn cascade_splits(
     };
     let far = far.min(c.shadow_distance.unwrap_or(f32::INFINITY)).max(near * 1.001);
     // Stable cascades split a range that moves in steps, so that their slices do not
-    // change size with every move of the camera.
+    // change size with every move of the camera. Not clamped to the camera's planes:
+    // those follow the eye's distance to the scene, and would move the splits with
+    // every step (a slice that starts before the near plane covers a little more).
     let (near, far) = match c.cascade_fit {
-        CascadeFit::Stable => {
-            let (n, f) = cascades::quantized_depth_range(near, far);
-            (n.max(camera.near), f.min(camera.far))
-        }
+        CascadeFit::Stable => cascades::quantized_depth_range(near, far),
         CascadeFit::Tight => (near, far),
     };
     let scheme = match c.split {

@@ -30,8 +30,8 @@ pub mod uniforms;
 
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
-    CpuTimings, Creations, DrawStats, Frame, FrameCost, LightShadows, LightStats, LiveFrame, OutputRequest,
-    PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
+    CpuTimings, Creations, DrawStats, Frame, FrameCost, LayerCache, LightShadows, LightStats, LiveFrame,
+    OutputRequest, PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
 };
 pub use gpu_scene::GpuScene;
 pub use layout::{ShadowLayout, light_projection};

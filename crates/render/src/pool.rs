@@ -390,6 +390,7 @@ mod tests {
         let allowed = [
             "pool.rs",
             "frame/bindings.rs",
+            "frame/map_cache.rs",
             "gpu_scene/mod.rs",
             "gpu_scene/materials.rs",
             "passes/depth_baseline.rs",

@@ -72,6 +72,19 @@ pub struct PassTime {
     pub ms: f64,
 }
 
+/// Which of a slot's timestamps a pass writes: a slot may time several commands,
+/// from the beginning of its opening pass to the end of its closing one (a copy
+/// between them included).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SlotPart {
+    /// The slot's one pass: both timestamps.
+    Whole,
+    /// The first of its passes: the beginning timestamp.
+    Opening,
+    /// The last of its passes: the end timestamp.
+    Closing,
+}
+
 /// A pass's place in the clock: its label and, for timestamps, its query pair.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Slot(usize);
@@ -156,26 +169,43 @@ impl PassClock {
 
     /// The timestamp writes for a render pass in `slot`.
     pub fn render_writes(&self, slot: Slot) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        match &self.mode {
-            Mode::Gpu { query_set, .. } => Some(wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(2 * slot.0 as u32),
-                end_of_pass_write_index: Some(2 * slot.0 as u32 + 1),
-            }),
-            _ => None,
-        }
+        self.render_part(slot, SlotPart::Whole)
+    }
+
+    /// The timestamp writes for a render pass that is `part` of what `slot` times.
+    pub fn render_part(&self, slot: Slot, part: SlotPart) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let (query_set, beginning, end) = self.indices(slot, part)?;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: beginning,
+            end_of_pass_write_index: end,
+        })
     }
 
     /// The timestamp writes for a compute pass in `slot`.
     pub fn compute_writes(&self, slot: Slot) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        match &self.mode {
-            Mode::Gpu { query_set, .. } => Some(wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(2 * slot.0 as u32),
-                end_of_pass_write_index: Some(2 * slot.0 as u32 + 1),
-            }),
-            _ => None,
-        }
+        self.compute_part(slot, SlotPart::Whole)
+    }
+
+    /// The timestamp writes for a compute pass that is `part` of what `slot` times.
+    pub fn compute_part(&self, slot: Slot, part: SlotPart) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let (query_set, beginning, end) = self.indices(slot, part)?;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: beginning,
+            end_of_pass_write_index: end,
+        })
+    }
+
+    /// The query set and the timestamps a pass that is `part` of `slot` writes.
+    fn indices(&self, slot: Slot, part: SlotPart) -> Option<(&wgpu::QuerySet, Option<u32>, Option<u32>)> {
+        let Mode::Gpu { query_set, .. } = &self.mode else { return None };
+        let (beginning, end) = (2 * slot.0 as u32, 2 * slot.0 as u32 + 1);
+        Some(match part {
+            SlotPart::Whole => (query_set, Some(beginning), Some(end)),
+            SlotPart::Opening => (query_set, Some(beginning), None),
+            SlotPart::Closing => (query_set, None, Some(end)),
+        })
     }
 
     /// Records the copy of the timestamps out of the query set, at the frame's end.

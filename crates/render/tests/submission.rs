@@ -69,6 +69,7 @@ fn thousands_of_distinct_meshes_add_no_state_changes() {
                 material: 1 + k % 3,
                 world_from_object: Mat4::from_translation(Vec3::new(x, h, z)),
                 casts_shadow: true,
+                motion: gnomon_scene::Motion::Static,
             });
         }
         let mut renderer = Renderer::new(&gpu).unwrap();

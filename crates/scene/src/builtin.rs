@@ -123,6 +123,7 @@ impl SceneBuilder {
             material,
             world_from_object,
             casts_shadow: true,
+            motion: crate::Motion::Static,
         });
     }
 
@@ -376,6 +377,7 @@ pub fn instances(count: usize) -> Scene {
             material: materials[(i / 3) % 3],
             world_from_object,
             casts_shadow: true,
+            motion: crate::Motion::Static,
         });
     }
     let camera = Camera {

@@ -17,8 +17,8 @@ pub mod settings;
 
 pub use casters::OpenCasters;
 pub use model::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight,
-    SpotLight, Texture, Wrap, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, Motion, PointLight, Scene,
+    SceneLight, SpotLight, Texture, Wrap, sun_direction,
 };
 pub use scene_error::SceneError;
 pub use settings::Settings;

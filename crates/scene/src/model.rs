@@ -131,6 +131,26 @@ pub struct Instance {
     pub world_from_object: Mat4,
     /// Whether the instance is drawn into shadow maps. Every instance receives shadows.
     pub casts_shadow: bool,
+    /// Whether it is expected to move: what a shadow map's cache of still casters
+    /// leaves out.
+    pub motion: Motion,
+}
+
+/// Whether an instance is expected to move, frame after frame.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Motion {
+    /// It stays where the scene placed it. Shadow maps keep it in their cache of still
+    /// casters, and draw it again only when the light, the layer or such an instance
+    /// changes. It may still be moved (`Renderer::move_instances`), at the cost of
+    /// those redraws.
+    #[default]
+    Static,
+    /// It may move in any frame: shadow maps draw it over their cached still casters
+    /// every frame.
+    Dynamic,
 }
 
 /// A perspective camera.
@@ -369,6 +389,7 @@ impl Scene {
             material: self.materials.len() - 1,
             world_from_object,
             casts_shadow: true,
+            motion: crate::Motion::Static,
         });
     }
 
@@ -424,6 +445,7 @@ impl Scene {
             material: self.materials.len() - 1,
             world_from_object: Mat4::from_translation(Vec3::new(b.center().x, b.min.y, b.center().z)),
             casts_shadow: true,
+            motion: crate::Motion::Static,
         });
         let reach = self.camera.eye.distance(b.center()) + 2.0 * size;
         self.camera.far = self.camera.far.max(reach);

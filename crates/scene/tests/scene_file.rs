@@ -291,3 +291,46 @@ fn a_bad_file_setting_is_blamed_on_the_file_not_on_a_flag() {
     let e = merged.validate().unwrap_err();
     assert!(loaded.blame(&e, &flags).is_none(), "the flag set it: the flag is to blame");
 }
+
+#[test]
+fn a_model_or_a_gltf_node_may_be_marked_as_moving() {
+    use gnomon_scene::Motion;
+    let temp = temp_dir("scene-file-motion");
+    let dir = temp.path();
+    // A glTF whose parent node says it moves: its child, the mesh, moves with it.
+    let moving_json = hierarchy_json(None).replacen(
+        r#""name": "parent","#,
+        r#""name": "parent", "extras": {"motion": "dynamic", "note": "another tool's"},"#,
+        1,
+    );
+    std::fs::write(dir.join("moving.glb"), glb(&moving_json, &triangle_bytes())).unwrap();
+    let text = r#"
+[[model]]
+file = "tri.glb"
+
+[[model]]
+file = "tri.glb"
+motion = "dynamic"
+
+[[model]]
+file = "moving.glb"
+"#;
+    let path = write_scene(dir, text);
+    let scene = scene_file::load(&path, None).unwrap().scene;
+    let motions: Vec<Motion> = scene.instances.iter().map(|i| i.motion).collect();
+    assert_eq!(motions, [Motion::Static, Motion::Dynamic, Motion::Dynamic]);
+
+    // Anything else is refused, naming the node, or the entry and its value.
+    let bad_json = hierarchy_json(None).replacen(
+        r#""name": "child","#,
+        r#""name": "child", "extras": {"motion": "fast"},"#,
+        1,
+    );
+    std::fs::write(dir.join("bad.glb"), glb(&bad_json, &triangle_bytes())).unwrap();
+    let message = gnomon_scene::gltf_loader::load(&dir.join("bad.glb")).unwrap_err().to_string();
+    assert!(message.contains("node 1") && message.contains("motion"), "{message}");
+    let path = write_scene(dir, "[[model]]\nfile = \"tri.glb\"\nmotion = \"fast\"\n");
+    let Err(error) = scene_file::load(&path, None) else { panic!("motion = \"fast\" was taken") };
+    let message = error.to_string();
+    assert!(message.contains("fast") && message.contains("dynamic"), "{message}");
+}

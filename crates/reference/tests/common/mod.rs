@@ -100,6 +100,7 @@ pub fn thin_bars() -> Scene {
         material: 0,
         world_from_object,
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     };
     scene.instances = vec![instance("ground".into(), 0, Mat4::IDENTITY)];
     let turn = Mat4::from_rotation_y(30f32.to_radians());

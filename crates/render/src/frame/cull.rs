@@ -4,7 +4,7 @@
 use gnomon_math::culling::Frustum;
 use gnomon_scene::settings::{CasterCulling, RayUse};
 
-use super::plan::FramePlan;
+use super::plan::{FramePlan, LightPlan};
 use crate::{
     GpuScene,
     gpu_scene::{CullView, Granularity, LayerFaces, Visible},
@@ -30,22 +30,7 @@ pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
     // nothing is culled for its layers, nor drawn into them.
     let reads_map = plan.lights.iter().filter(|light| light.technique.rays() == RayUse::AsSettingsSay);
     let layer_views = reads_map.flat_map(|light| {
-        let shadow = &light.settings.shadow;
-        light.layout.projections.iter().map(move |projection| {
-            let clip_from_world = projection.clip_from_world();
-            CullView {
-                frustum: Frustum::from_clip_from_world(clip_from_world),
-                // A pass that clamps depth draws the casters before its near plane too.
-                near: !light.layout.depth_clamp,
-                casters_only: true,
-                granularity: match shadow.map.caster_culling {
-                    CasterCulling::Clusters => Granularity::Clusters {
-                        faces: LayerFaces::of(clip_from_world, light.depth_target(), shadow.bias.cull),
-                    },
-                    CasterCulling::Instances => Granularity::Instances,
-                },
-            }
-        })
+        light.layout.projections.iter().map(move |projection| layer_view(light, projection.clip_from_world()))
     });
     let views: Vec<CullView> = std::iter::once(camera_view).chain(layer_views).collect();
     let mut culled = uploaded.cull(&views).into_iter();
@@ -62,4 +47,22 @@ pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
         })
         .collect();
     Culled { camera, layers }
+}
+
+/// What a shadow pass of `light` through `clip_from_world` (a layer, or a part of
+/// one) culls its casters against.
+pub(super) fn layer_view(light: &LightPlan, clip_from_world: glam::Mat4) -> CullView {
+    let shadow = &light.settings.shadow;
+    CullView {
+        frustum: Frustum::from_clip_from_world(clip_from_world),
+        // A pass that clamps depth draws the casters before its near plane too.
+        near: !light.layout.depth_clamp,
+        casters_only: true,
+        granularity: match shadow.map.caster_culling {
+            CasterCulling::Clusters => Granularity::Clusters {
+                faces: LayerFaces::of(clip_from_world, light.depth_target(), shadow.bias.cull),
+            },
+            CasterCulling::Instances => Granularity::Instances,
+        },
+    }
 }

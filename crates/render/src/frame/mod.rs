@@ -9,16 +9,19 @@ mod bindings;
 mod cull;
 mod host_target;
 mod late;
+mod map_cache;
 mod outputs;
 mod plan;
 mod receiver;
 mod record;
 mod refine;
 mod screen;
+mod shadow_maps;
 
 use gnomon_scene::{Scene, Settings, settings::MomentFormat};
 
 pub use crate::pool::Creations;
+pub use map_cache::LayerCache;
 pub use outputs::{
     CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
     ShadowMapImage,
@@ -29,7 +32,7 @@ use crate::{
     Gpu, GpuScene, RenderError,
     passes::{
         Layouts, blit::BlitPass, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass, lighting,
-        lighting::LightingPass, map_preview::MapPreviewPass, moments::MomentPass,
+        lighting::LightingPass, map_preview::MapPreviewPass, map_scroll::MapScrollPass, moments::MomentPass,
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
@@ -50,6 +53,7 @@ struct Passes {
     moments: MomentPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
+    map_scroll: MapScrollPass,
     depth_baseline: DepthBaselinePass,
     blit: BlitPass,
 }
@@ -67,6 +71,8 @@ pub struct Renderer {
     late_times: LateTimes,
     /// The techniques its settings may name.
     techniques: TechniqueRegistry,
+    /// Each light's map as its still casters drew it, kept across frames.
+    map_cache: map_cache::MapCache,
 }
 
 impl Renderer {
@@ -90,6 +96,7 @@ impl Renderer {
                 moments: MomentPass::new(device, &gpu.queue),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
+                map_scroll: MapScrollPass::new(device),
                 depth_baseline: DepthBaselinePass::new(device),
                 blit: BlitPass::new(device),
             };
@@ -98,6 +105,7 @@ impl Renderer {
                 fixed: FixedBindings::new(device),
                 pool: Pool::new(device),
                 late_times: LateTimes::default(),
+                map_cache: map_cache::MapCache::default(),
                 techniques,
                 layouts,
                 passes,

@@ -147,6 +147,9 @@ pub struct LightStats {
     /// clusters of large meshes outside its frustum or turned the way it culls
     /// (`--caster-culling`).
     pub layer_triangles: Vec<u64>,
+    /// What each layer did with its kept map (`--map-cache`): a kept layer without
+    /// moving casters draws nothing, and has no time in [`LightStats::layer_ms`].
+    pub layer_cache: Vec<super::map_cache::LayerCache>,
     /// The time of each layer's shadow pass, where the frame was timed.
     pub layer_ms: Vec<f64>,
     /// Time of its shadow passes (every layer), moment pass and lighting pass, where
@@ -476,12 +479,17 @@ pub(super) struct TimedLights {
 
 impl TimedLights {
     /// What each light drew (its culled casters per layer), not yet timed.
-    pub fn untimed(plan: &super::plan::FramePlan, culled: &super::cull::Culled) -> Self {
+    pub fn untimed(
+        plan: &super::plan::FramePlan,
+        culled: &super::cull::Culled,
+        cache_uses: &[Vec<super::map_cache::LayerCache>],
+    ) -> Self {
         let lights = plan
             .lights
             .iter()
             .zip(&culled.layers)
-            .map(|(light, layers)| LightStats {
+            .zip(cache_uses)
+            .map(|((light, layers), cache)| LightStats {
                 name: light.name.clone(),
                 kind: light.light.type_name(),
                 technique: light.technique.technique(),
@@ -489,6 +497,7 @@ impl TimedLights {
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
                 layer_instances: layers.iter().map(Visible::instances).collect(),
                 layer_triangles: layers.iter().map(Visible::triangles).collect(),
+                layer_cache: cache.clone(),
                 layer_ms: Vec::new(),
                 shadow_ms: None,
                 filter_ms: None,

@@ -224,6 +224,8 @@ impl Renderer {
                 visible: &seen[0],
                 target: DepthTarget::Projected,
                 unclipped: false,
+                start: super::record::DepthStart::Clear,
+                area: super::record::DepthArea::Whole,
             };
             self.record_depth_pass(&mut encoder, uploaded, &pass, None);
             let planes = Planes::new(camera.near, camera.far);

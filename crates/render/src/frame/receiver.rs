@@ -124,6 +124,7 @@ impl Renderer {
             let camera_gpu = CameraGpu::new(&plan.camera, width, height, settings.image.debug_view);
             let camera = self.pool.uniform(&gpu.queue, "camera", &camera_gpu);
             let mut lights = Vec::with_capacity(plan.lights.len());
+            self.map_cache.begin_frame(plan.lights.len());
             for (index, light) in plan.lights.iter().enumerate() {
                 let map =
                     self.record_shadow_maps(&mut rec, uploaded, light, &culled.layers[index], index as u32);

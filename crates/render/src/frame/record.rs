@@ -5,10 +5,7 @@
 
 use std::time::Instant;
 
-use gnomon_scene::{
-    Scene, Settings,
-    settings::{RayUse, Refine},
-};
+use gnomon_scene::{Scene, Settings, settings::Refine};
 
 use super::{
     Renderer,
@@ -23,7 +20,7 @@ use crate::{
     gpu_types::VertexStream,
     layout::ShadowLayout,
     passes::{
-        SHADOW_FORMAT, begin_depth_pass,
+        begin_depth_pass,
         lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
         moments::MomentInput,
         shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
@@ -116,6 +113,61 @@ pub(super) struct DepthPass<'a> {
     pub target: DepthTarget,
     /// Clamp depth instead of clipping it.
     pub unclipped: bool,
+    /// What the pass starts from.
+    pub start: DepthStart,
+    /// Where it draws.
+    pub area: DepthArea,
+}
+
+/// Where a depth pass draws.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(super) enum DepthArea {
+    /// The whole target.
+    Whole,
+    /// These rectangles of it only: every run is drawn once into each.
+    Strips(Vec<ScissorRect>),
+}
+
+/// A rectangle of a target, in texels from its top-left corner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct ScissorRect {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl ScissorRect {
+    /// The projection of the part of a `resolution`² target that this rectangle
+    /// covers, widened by a texel each way, when the whole is `clip_from_world`: its
+    /// clip volume is the rectangle's, for culling what it may draw.
+    pub fn clip_from_world(&self, clip_from_world: glam::Mat4, resolution: u32) -> glam::Mat4 {
+        let r = resolution as f32;
+        // NDC x runs with texel columns; NDC y against texel rows.
+        let (x0, x1) = (self.x as f32 - 1.0, (self.x + self.width) as f32 + 1.0);
+        let (y0, y1) = (self.y as f32 - 1.0, (self.y + self.height) as f32 + 1.0);
+        let (left, right) = (2.0 * x0 / r - 1.0, 2.0 * x1 / r - 1.0);
+        let (bottom, top) = (1.0 - 2.0 * y1 / r, 1.0 - 2.0 * y0 / r);
+        let (cx, cy) = (0.5 * (left + right), 0.5 * (bottom + top));
+        let (hx, hy) = (0.5 * (right - left), 0.5 * (top - bottom));
+        // x' = (x − cx·w) / hx, y' = (y − cy·w) / hy: the rectangle's NDC onto [−1, 1].
+        let onto = glam::Mat4::from_cols(
+            glam::Vec4::new(1.0 / hx, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 1.0 / hy, 0.0, 0.0),
+            glam::Vec4::Z,
+            glam::Vec4::new(-cx / hx, -cy / hy, 0.0, 1.0),
+        );
+        onto * clip_from_world
+    }
+}
+
+/// What a depth pass starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum DepthStart {
+    /// Cleared to the far plane.
+    Clear,
+    /// What the target holds: a copy of a kept layer, to draw moving casters over.
+    Keep,
 }
 
 /// The camera-sized render targets of the lighting passes.
@@ -169,7 +221,7 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        let untimed = TimedLights::untimed(&plan, &culled);
+        let untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses());
         let times = recorded.times.take().map(PendingTimes::submitted);
         let mut timed = match (request.times, times) {
             (_, None) => untimed,
@@ -205,6 +257,7 @@ impl Renderer {
             clock: PassClock::new(&gpu, &mut self.pool, timed_passes, request.clock),
             stats: DrawStats::default(),
         };
+        self.map_cache.begin_frame(plan.lights.len());
         let drawn = self.record_passes(&mut rec, uploaded, settings, plan, culled, request.readback);
         let Recording { clock, stats, .. } = rec;
         let times = clock.resolve(&mut self.pool, &mut encoder);
@@ -313,55 +366,6 @@ impl Renderer {
         let depth = self.pool.texture("depth", size, lighting::DEPTH_FORMAT, attachment);
         let depth = self.pool.view(&depth, ViewKey::default());
         LightingTargets { textures, views, depth }
-    }
-
-    /// Draws a light's shadow map, one depth pass per layer (cascade or cube face),
-    /// each drawing the casters culled for that layer (`layers`), each timed alone.
-    /// Returns the map.
-    pub(super) fn record_shadow_maps(
-        &mut self,
-        rec: &mut Recording,
-        uploaded: &GpuScene,
-        light: &LightPlan,
-        layers: &[Visible],
-        light_index: u32,
-    ) -> wgpu::Texture {
-        debug_assert_eq!(layers.len() as u32, light.layers(), "one culled set per layer");
-        let map = self.pool.texture(
-            "shadow map",
-            light.map_size(),
-            SHADOW_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-        );
-        if light.technique.rays() == RayUse::EveryPixel {
-            // Its map is never read (`techniques/raytraced.rs`): no pass clears it.
-            return map;
-        }
-        for (layer, visible) in layers.iter().enumerate() {
-            let layer_view = self.pool.view(&map, ViewKey::layer(layer as u32));
-            let layer_light = light.light_gpu.for_layer(layer);
-            let pass = DepthPass {
-                settings: &light.settings,
-                light: &layer_light,
-                target_view: &layer_view,
-                visible,
-                target: light.depth_target(),
-                unclipped: light.layout.depth_clamp,
-            };
-            let slot = rec.clock.begin(
-                &self.gpu,
-                rec.encoder,
-                PassKind::Shadow,
-                Some(light_index),
-                Some(layer as u32),
-            );
-            let drawn = self.record_depth_pass(rec.encoder, uploaded, &pass, rec.clock.render_writes(slot));
-            rec.clock.end(&self.gpu, rec.encoder, slot);
-            rec.stats.add(&drawn);
-        }
-        map
     }
 
     /// A light's uniform and its maps as the passes from the camera read them: the
@@ -517,7 +521,11 @@ impl Renderer {
         let group = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
         let bias = &depth.settings.shadow.bias;
         let mut stats = DrawStats::default();
-        let mut pass = begin_depth_pass(encoder, "shadow", depth.target_view, timestamp_writes);
+        let load = match depth.start {
+            DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
+            DepthStart::Keep => wgpu::LoadOp::Load,
+        };
+        let mut pass = begin_depth_pass(encoder, "shadow", depth.target_view, load, timestamp_writes);
         pass.set_bind_group(0, &group, &[]);
         stats.bind_group_changes += 1;
         // The runs come opaque first (no bind group changes at all), then the
@@ -526,7 +534,17 @@ impl Renderer {
         let mut pipeline: Option<ShadowPipelineKey> = None;
         let mut stream: Option<VertexStream> = None;
         let mut bound = None;
-        for run in &depth.visible.runs {
+        let rects: Vec<Option<ScissorRect>> = match &depth.area {
+            DepthArea::Whole => vec![None],
+            DepthArea::Strips(strips) => strips.iter().copied().map(Some).collect(),
+        };
+        let runs = rects
+            .iter()
+            .flat_map(|rect| depth.visible.runs.iter().enumerate().map(move |(i, run)| (*rect, i, run)));
+        for (rect, index, run) in runs {
+            if let (Some(rect), 0) = (rect, index) {
+                pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
+            }
             let batch = &uploaded.batches[run.batch as usize];
             let key = ShadowPipelineKey::new(
                 bias,

@@ -10,7 +10,7 @@ use gnomon_math::{
     culling::{CullTree, Frustum},
     facing::{ProjectionCentre, Winding},
 };
-use gnomon_scene::{AlphaMode, Scene, settings::CullMode};
+use gnomon_scene::{AlphaMode, Motion, Scene, settings::CullMode};
 
 use crate::{
     clusters::{Cluster, WindingCull, visible_clusters},
@@ -35,6 +35,8 @@ pub(crate) struct Batch {
     pub material_group: usize,
     /// The scene's mesh its instances draw.
     pub mesh: usize,
+    /// Whether its instances are expected to move: a cached map leaves them out.
+    pub motion: Motion,
     /// The batch's instances, in the order the instance buffer holds them.
     pub(super) tree: CullTree,
     /// Its mesh's clusters placed by its one instance, for shadow layers to cull one
@@ -195,6 +197,7 @@ struct BatchKey {
     masked: bool,
     sides: Sides,
     casts_shadow: bool,
+    motion: Motion,
     mesh: usize,
 }
 
@@ -215,6 +218,7 @@ pub(super) fn batch_instances(
             masked: matches!(material.alpha_mode, AlphaMode::Mask { .. }),
             sides: Sides::of(scene, inst, closed),
             casts_shadow: inst.casts_shadow,
+            motion: inst.motion,
             mesh: inst.mesh,
         }
     };
@@ -225,7 +229,7 @@ pub(super) fn batch_instances(
     let mut order: Vec<usize> = Vec::with_capacity(members.len());
     let mut batches = Vec::new();
     for group in members.chunk_by(|&a, &b| key_of(a) == key_of(b)) {
-        let BatchKey { material_group, masked, sides, casts_shadow, mesh } = key_of(group[0]);
+        let BatchKey { material_group, masked, sides, casts_shadow, motion, mesh } = key_of(group[0]);
         let bounds: Vec<Aabb> = group
             .iter()
             .map(|&i| mesh_bounds[mesh].transformed(scene.instances[i].world_from_object))
@@ -242,6 +246,7 @@ pub(super) fn batch_instances(
             sides,
             material_group,
             mesh,
+            motion,
             tree,
             clusters: Vec::new(),
         });

@@ -9,7 +9,7 @@ mod batches;
 mod materials;
 
 use gnomon_math::Aabb;
-use gnomon_scene::{AlphaMode, Scene};
+use gnomon_scene::{AlphaMode, Motion, Scene};
 use rayon::prelude::*;
 use wgpu::util::DeviceExt;
 
@@ -62,6 +62,16 @@ pub struct GpuScene {
     mesh_bounds: Vec<Aabb>,
     /// Each mesh's clusters, where a batch of one instance draws a large mesh.
     mesh_clusters: Vec<Option<MeshClusters>>,
+    /// Names what the still casters (`Motion::Static`) look like: unique to this upload,
+    /// and renewed whenever one of them moves. A cached map drawn under another
+    /// generation is drawn again.
+    pub(crate) still_generation: u64,
+}
+
+/// The next [`GpuScene::still_generation`], unique in the process.
+fn next_generation() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl GpuScene {
@@ -168,6 +178,7 @@ impl GpuScene {
             slots,
             mesh_bounds,
             mesh_clusters,
+            still_generation: next_generation(),
         })
     }
 
@@ -201,6 +212,12 @@ impl GpuScene {
                 refits[batch].push((slot - self.batches[batch].first_instance, bounds));
             }
         })?;
+        // The upload's grouping decides: a batch of still casters that moved leaves
+        // every cached map stale.
+        if refits.iter().zip(&self.batches).any(|(moved, b)| !moved.is_empty() && b.motion == Motion::Static)
+        {
+            self.still_generation = next_generation();
+        }
         for (batch, moved) in self.batches.iter_mut().zip(refits) {
             if moved.is_empty() {
                 continue;

@@ -193,7 +193,13 @@ impl DepthBaselinePass {
             self.pipeline(device, raster.key(*sides));
         }
         // The same pass set-up (attachment, load and store) as the shadow pass's.
-        let mut pass = super::begin_depth_pass(encoder, "depth-only baseline", target, timestamp_writes);
+        let mut pass = super::begin_depth_pass(
+            encoder,
+            "depth-only baseline",
+            target,
+            wgpu::LoadOp::Clear(1.0),
+            timestamp_writes,
+        );
         pass.set_bind_group(0, &group, &[]);
         pass.set_vertex_buffer(0, scene.positions.slice(..));
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);

@@ -12,7 +12,7 @@ use wgpu::naga;
 use super::{
     blit, depth_reduce, lighting,
     lighting::{LightingKey, LightingRole, Lookup, MapLookup},
-    map_preview, moments, receiver, screen_space, shadow,
+    map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
 use crate::{
     techniques::{TechniqueRef, TechniqueRegistry},
@@ -91,6 +91,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("depth reduce".into(), depth_reduce::reduce_wgsl()));
     out.push(("sample bounds".into(), depth_reduce::bounds_wgsl()));
     out.push(("map preview".into(), map_preview::preview_wgsl()));
+    out.push(("map scroll".into(), map_scroll::scroll_wgsl()));
     out.push(("blit".into(), blit::blit_wgsl()));
     out.push(("ray trace".into(), crate::rays::trace_pass_wgsl()));
     out

@@ -44,31 +44,12 @@ pub(crate) struct MapPreviewPass {
 
 impl MapPreviewPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("map preview"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                super::uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
-            ],
-        });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("map preview"),
             source: wgpu::ShaderSource::Wgsl(preview_wgsl().into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("map preview"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let (layout, pipeline_layout) =
+            super::depth_reader_layouts(device, "map preview", wgpu::TextureViewDimension::D2Array);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("map preview"),
             layout: Some(&pipeline_layout),

@@ -6,6 +6,7 @@ pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
 pub(crate) mod lighting;
 pub(crate) mod map_preview;
+pub(crate) mod map_scroll;
 pub(crate) mod moments;
 pub(crate) mod screen_space;
 pub(crate) mod shadow;
@@ -16,11 +17,13 @@ mod interface_tests;
 /// The shadow map's texel format.
 pub(crate) const SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Begins a depth-only render pass into `target`, cleared to the far plane (1).
+/// Begins a depth-only render pass into `target`, starting from `load`: cleared to
+/// the far plane (1), or what it holds.
 pub(crate) fn begin_depth_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     target: &wgpu::TextureView,
+    load: wgpu::LoadOp<f32>,
     timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
 ) -> wgpu::RenderPass<'e> {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -28,7 +31,7 @@ pub(crate) fn begin_depth_pass<'e>(
         color_attachments: &[],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: target,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
             stencil_ops: None,
         }),
         timestamp_writes,
@@ -217,6 +220,29 @@ fn texture(
 
 fn fragment_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::FRAGMENT, ty, count: None }
+}
+
+/// The layout and pipeline layout of a full-screen pass that reads a depth texture
+/// of `dimension` (binding 0) and a uniform (binding 1) in its fragment stage: the map
+/// preview and the map scroll.
+fn depth_reader_layouts(
+    device: &wgpu::Device,
+    label: &str,
+    dimension: wgpu::TextureViewDimension,
+) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            fragment_entry(0, texture(wgpu::TextureSampleType::Depth, dimension)),
+            uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    (layout, pipeline_layout)
 }
 
 fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {

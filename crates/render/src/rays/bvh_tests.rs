@@ -15,6 +15,7 @@ fn one_instance(mesh: gnomon_scene::Mesh, casts_shadow: bool) -> Scene {
         material: 0,
         world_from_object: Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)),
         casts_shadow,
+        motion: gnomon_scene::Motion::Static,
     }];
     scene
 }

@@ -48,6 +48,7 @@ pub fn ground_scene(name: &str, size: f32) -> Scene {
         material: 0,
         world_from_object: Mat4::IDENTITY,
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     }];
     scene
 }
@@ -61,6 +62,7 @@ pub fn add(scene: &mut Scene, name: &str, mesh: gnomon_scene::Mesh, world_from_o
         material: 1,
         world_from_object,
         casts_shadow: true,
+        motion: gnomon_scene::Motion::Static,
     });
 }
 

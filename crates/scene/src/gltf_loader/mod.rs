@@ -12,12 +12,15 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Vec3};
 use gltf::image::Format;
 
+use node_extras::node_motion;
+
 use crate::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, PointLight, Scene, SceneLight, SpotLight,
-    Texture, Wrap, sun_direction,
+    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Motion, PointLight, Scene, SceneLight,
+    SpotLight, Texture, Wrap, sun_direction,
 };
 
 mod images;
+mod node_extras;
 mod primitives;
 
 /// A glTF file that could not be loaded.
@@ -383,11 +386,11 @@ fn build(
     // Lights as the nodes place them, with the index of the file's light each is.
     let mut found: Vec<(usize, SceneLight)> = Vec::new();
     let mut extras = FileExtras::default();
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(gltf::Node, Mat4, usize, Motion)> =
+        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0, Motion::Static)).collect();
     let mut visits = 0usize;
     let mut singular_nodes = 0usize;
-    while let Some((node, parent, depth)) = stack.pop() {
+    while let Some((node, parent, depth, parent_motion)) = stack.pop() {
         visits += 1;
         // A node graph with a cycle would expand forever; glTF requires a forest.
         if depth > 256 || visits > 4 * document.nodes().len() + 16 {
@@ -401,6 +404,8 @@ fn build(
             return Err(format!("node {} has a non-finite transform", node.index()));
         }
         let world = parent * local;
+        // A node that moves carries its children along.
+        let motion = parent_motion.max(node_motion(&node)?);
         if let Some(mesh) = node.mesh() {
             if world.determinant() == 0.0 {
                 singular_nodes += 1;
@@ -412,6 +417,7 @@ fn build(
                     material,
                     world_from_object: world,
                     casts_shadow: materials[material].alpha_mode != AlphaMode::Blend,
+                    motion,
                 });
             }
         }
@@ -483,7 +489,7 @@ fn build(
             }
         }
         for child in node.children() {
-            stack.push((child, world, depth + 1));
+            stack.push((child, world, depth + 1, motion));
         }
     }
     if let Some(skipped) = modes.skipped() {

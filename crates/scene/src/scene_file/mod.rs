@@ -102,6 +102,9 @@ struct ModelEntry {
     rotation_degrees: [f32; 3],
     #[serde(default = "one")]
     scale: f32,
+    /// "dynamic" for a model expected to move: drawn over the shadow maps' cache of
+    /// still casters every frame. Overrides what the glTF's nodes say.
+    motion: Option<crate::Motion>,
 }
 
 fn one() -> f32 {
@@ -260,6 +263,10 @@ fn start_scene(file: &SceneFile, source: &Source) -> Result<(Scene, Vec<String>)
                 limits::check_vec3(&limits::ANGLE, "rotation_degrees", Vec3::from(model.rotation_degrees))
             })
             .map_err(|e| source.fail_at(&at(e.quantity), format!("model `{}`: {e}", model.file.display())))?;
+        let mut loaded = loaded;
+        if let Some(motion) = model.motion {
+            loaded.instances.iter_mut().for_each(|inst| inst.motion = motion);
+        }
         match &mut scene {
             None => {
                 let mut first = loaded;

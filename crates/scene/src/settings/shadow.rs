@@ -153,6 +153,13 @@ pub struct MapSettings {
     /// same either way: this only changes what it costs.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub caster_culling: CasterCulling,
+    /// What the map keeps across frames. The map is the same either way: this only
+    /// changes what it costs.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "map-cache", value_enum, default_value_t, help_heading = "Shadow map")
+    )]
+    pub cache: MapCache,
 }
 
 impl Default for MapSettings {
@@ -165,8 +172,24 @@ impl Default for MapSettings {
             depth_clamp: true,
             omni: OmniMap::default(),
             caster_culling: CasterCulling::default(),
+            cache: MapCache::default(),
         }
     }
+}
+
+/// What a shadow map keeps across frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum MapCache {
+    /// Each layer keeps what its still casters (`Motion::Static`) drew, and draws
+    /// them again only when its projection, the light, the bias or a still caster
+    /// changes; the casters that move (`Motion::Dynamic`) are drawn over a copy of it
+    /// every frame. A still scene under a still light then draws no shadow pass.
+    #[default]
+    StillCasters,
+    /// Every layer draws every caster every frame.
+    Off,
 }
 
 /// How finely a shadow layer's casters are culled against its frustum.

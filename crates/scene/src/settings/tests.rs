@@ -57,6 +57,8 @@ fn flags_and_toml_agree() {
         "24",
         "--caster-culling",
         "instances",
+        "--map-cache",
+        "off",
     ])
     .unwrap()
     .settings;
@@ -81,6 +83,7 @@ fn flags_and_toml_agree() {
         [shadow.map]
         resolution = 1024
         caster_culling = "instances"
+        cache = "off"
         [shadow.contact]
         contact_shadows = true
         contact_length = 0.5
