@@ -106,9 +106,12 @@ fn timing_alone_submits_the_same_frame_as_a_full_render() {
     let mut renderer = Renderer::new(&gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
-    let frame = renderer.render_uploaded(&uploaded, &scene, &small(), &OutputRequest::default()).unwrap();
+    // Both frames draw their maps: the second would keep the first's otherwise.
+    let mut settings = small();
+    settings.shadow.map.cache = gnomon_scene::settings::MapCache::Off;
+    let frame = renderer.render_uploaded(&uploaded, &scene, &settings, &OutputRequest::default()).unwrap();
     let started = Instant::now();
-    let cost = renderer.time_passes(&uploaded, &scene, &small(), ClockChoice::Auto).unwrap();
+    let cost = renderer.time_passes(&uploaded, &scene, &settings, ClockChoice::Auto).unwrap();
     let wall_ms = started.elapsed().as_secs_f64() * 1e3;
     assert_eq!(cost.stats, frame.stats);
     let t = cost.timings.expect("timing always times, on the CPU clock at worst");
@@ -143,6 +146,11 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
     cascaded.shadow.cascades.count = 3;
     let mut all = small();
     all.light.kind = LightKind::All;
+    // Every frame draws every layer, to have its time: a kept map would draw none
+    // after the first frame (`map_cache.rs` tests that).
+    for settings in [&mut cascaded, &mut all] {
+        settings.shadow.map.cache = gnomon_scene::settings::MapCache::Off;
+    }
     for (scene, settings) in [(builtin::spheres(), cascaded), (builtin::lamps(), all)] {
         let uploaded = renderer.upload(&scene).unwrap();
         for clock in [ClockChoice::Auto, ClockChoice::Cpu] {

@@ -137,6 +137,8 @@ pub(super) struct MapCache {
     lights: Vec<Option<CachedMap>>,
     /// What the last recorded frame did with each light's layers.
     uses: Vec<Vec<LayerCache>>,
+    /// Cache textures created, for [`super::Renderer::creations`].
+    created: u64,
 }
 
 impl MapCache {
@@ -166,24 +168,13 @@ impl MapCache {
         let fits = |kept: &CachedMap| kept.texture.size() == size;
         let cached = match self.lights[index].take() {
             Some(kept) if fits(&kept) => kept,
-            _ => CachedMap {
-                // Kept across frames, made again only when the map's size changes:
-                // not a per-frame resource, so not the pool's.
-                texture: device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("shadow map cache"),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: SHADOW_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::TEXTURE_BINDING
-                        | wgpu::TextureUsages::COPY_SRC
-                        | wgpu::TextureUsages::COPY_DST,
-                    view_formats: &[],
-                }),
-                keys: vec![None; size.depth_or_array_layers as usize],
-            },
+            _ => {
+                self.created += 1;
+                CachedMap {
+                    texture: create_cache(device, size),
+                    keys: vec![None; size.depth_or_array_layers as usize],
+                }
+            }
         };
         let plans: Vec<LayerPlan> = keys
             .iter()
@@ -205,6 +196,30 @@ impl MapCache {
     pub fn uses(&self) -> &[Vec<LayerCache>] {
         &self.uses
     }
+
+    /// How many cache textures it has created.
+    pub fn created(&self) -> u64 {
+        self.created
+    }
+}
+
+/// A cache texture: kept across frames, made again only when the map's size changes,
+/// so not a per-frame resource of the pool's (but counted in the renderer's
+/// creations).
+fn create_cache(device: &wgpu::Device, size: wgpu::Extent3d) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("shadow map cache"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: SHADOW_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
 }
 
 #[cfg(test)]

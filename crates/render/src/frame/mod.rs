@@ -126,7 +126,11 @@ impl Renderer {
     /// How many GPU resources the renderer's frames have created so far: after the
     /// first frame of given settings, the same frame again adds none.
     pub fn creations(&self) -> Creations {
-        self.pool.creations()
+        let mut creations = self.pool.creations();
+        // The kept maps' textures live outside the pool, made again only when a map's
+        // size changes (`map_cache.rs`).
+        creations.textures += self.map_cache.created();
+        creations
     }
 
     /// Uploads `scene` and renders it. To render one scene many times, upload it once
