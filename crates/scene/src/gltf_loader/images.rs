@@ -1,8 +1,13 @@
 //! A glTF file's images, each one's size read from its header and checked before it
 //! is decoded: a small PNG that declares 20000² pixels would otherwise take gigabytes
-//! before anything could refuse it.
+//! before anything could refuse it. Then their pixels converted to RGBA8, and their
+//! samplers' wrapping.
 
 use std::path::Path;
+
+use gltf::image::Format;
+
+use crate::Wrap;
 
 /// The largest texture side Gnomon loads: what WebGPU devices commonly bind
 /// (`max_texture_dimension_2d` is 16384 on lavapipe and on desktop GPUs).
@@ -60,4 +65,32 @@ fn encoded_bytes(
                 .map_err(|e| format!("cannot read `{uri}`: {e}"))
         }
     }
+}
+
+/// The sampler's wrapping mode as Gnomon's.
+pub(super) fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+    }
+}
+
+/// Converts a decoded glTF image to RGBA8.
+pub(super) fn to_rgba8(image: &gltf::image::Data) -> Result<Vec<u8>, String> {
+    let p = &image.pixels;
+    let n = (image.width as usize) * (image.height as usize);
+    let rgba: Vec<u8> = match image.format {
+        Format::R8 => p.iter().flat_map(|&r| [r, r, r, 255]).collect(),
+        Format::R8G8 => p.chunks_exact(2).flat_map(|c| [c[0], c[0], c[0], c[1]]).collect(),
+        Format::R8G8B8 => p.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
+        Format::R8G8B8A8 => p.clone(),
+        Format::R16G16B16A16 => p.chunks_exact(2).map(|c| c[1]).collect(),
+        Format::R16G16B16 => p.chunks_exact(6).flat_map(|c| [c[1], c[3], c[5], 255]).collect(),
+        other => return Err(format!("an image in the unsupported pixel format {other:?}")),
+    };
+    if rgba.len() != 4 * n {
+        return Err(format!("an image of {}×{} with {} bytes of pixels", image.width, image.height, p.len()));
+    }
+    Ok(rgba)
 }

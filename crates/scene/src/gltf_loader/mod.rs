@@ -10,13 +10,12 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
-use gltf::image::Format;
 
 use node_extras::node_motion;
 
 use crate::{
     AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Motion, PointLight, Scene, SceneLight,
-    SpotLight, Texture, Wrap, sun_direction,
+    SpotLight, Texture, sun_direction,
 };
 
 mod images;
@@ -270,33 +269,6 @@ fn describe(e: &gltf::Error) -> String {
     }
 }
 
-fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
-    match mode {
-        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-        gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
-    }
-}
-
-/// Converts a decoded glTF image to RGBA8.
-fn to_rgba8(image: &gltf::image::Data) -> Result<Vec<u8>, String> {
-    let p = &image.pixels;
-    let n = (image.width as usize) * (image.height as usize);
-    let rgba: Vec<u8> = match image.format {
-        Format::R8 => p.iter().flat_map(|&r| [r, r, r, 255]).collect(),
-        Format::R8G8 => p.chunks_exact(2).flat_map(|c| [c[0], c[0], c[0], c[1]]).collect(),
-        Format::R8G8B8 => p.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
-        Format::R8G8B8A8 => p.clone(),
-        Format::R16G16B16A16 => p.chunks_exact(2).map(|c| c[1]).collect(),
-        Format::R16G16B16 => p.chunks_exact(6).flat_map(|c| [c[1], c[3], c[5], 255]).collect(),
-        other => return Err(format!("an image in the unsupported pixel format {other:?}")),
-    };
-    if rgba.len() != 4 * n {
-        return Err(format!("an image of {}×{} with {} bytes of pixels", image.width, image.height, p.len()));
-    }
-    Ok(rgba)
-}
-
 fn build(
     path: &Path,
     document: &gltf::Document,
@@ -315,9 +287,9 @@ fn build(
             name: t.name().unwrap_or("texture").to_string(),
             width: image.width,
             height: image.height,
-            rgba8: to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
-            wrap_u: wrap(sampler.wrap_s()),
-            wrap_v: wrap(sampler.wrap_t()),
+            rgba8: images::to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
+            wrap_u: images::wrap(sampler.wrap_s()),
+            wrap_v: images::wrap(sampler.wrap_t()),
             nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
         });
     }
