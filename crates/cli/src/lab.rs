@@ -95,7 +95,9 @@ pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
             "unknown scene `{name}`: give a scene file (.toml), a glTF file (.gltf or .glb) or one of the built-in scenes {}",
             builtin::names().join(", ")
         ),
-        out_of_range @ builtin::BuiltinError::InstancesOutOfRange(_) => out_of_range.into(),
+        out_of_range @ (builtin::BuiltinError::InstancesOutOfRange(_) | builtin::BuiltinError::LampsOutOfRange(_)) => {
+            out_of_range.into()
+        }
     })
 }
 

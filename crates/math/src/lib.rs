@@ -4,7 +4,8 @@
 //! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
 //! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]);
 //! whether a mesh is closed, for face culling in the shadow pass ([`topology`]); and
-//! which way a projection winds a triangle or a cluster of them ([`facing`]).
+//! which way a projection winds a triangle or a cluster of them ([`facing`]); and the
+//! pixels a light's range can reach on screen ([`screen_bounds`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -25,6 +26,7 @@ pub mod kernels;
 mod light;
 pub mod omni;
 mod projection;
+pub mod screen_bounds;
 pub mod solar;
 #[cfg(test)]
 mod test_rng;

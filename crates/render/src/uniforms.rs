@@ -271,6 +271,8 @@ pub fn wgsl_constants() -> String {
     s += &format!("const POISSON_DISK_SIZE: u32 = {}u;\n", techniques::POISSON_DISK_SIZE);
     s += &format!("const MAX_KERNEL_TEXELS: f32 = {:?};\n", gnomon_scene::settings::MAX_KERNEL_TEXELS);
     s += &format!("const TRACED_LAYER_FLAG: u32 = {TRACED_LAYER_FLAG}u;\n");
+    s += &format!("const LIGHT_TILE: u32 = {}u;\n", crate::passes::light_list::LIGHT_TILE);
+    s += &format!("const LIGHT_WORDS: u32 = {}u;\n", crate::passes::light_list::LIGHT_WORDS);
     for (name, view) in
         [("NONE", DebugView::None), ("CASCADES", DebugView::Cascades), ("TRACED", DebugView::Traced)]
     {
@@ -446,7 +448,7 @@ macro_rules! struct_layout {
 /// Every uniform struct shared with WGSL.
 #[cfg(test)]
 pub(crate) fn struct_layouts() -> Vec<StructLayout> {
-    use crate::passes::{depth_reduce, map_preview, moments};
+    use crate::passes::{depth_reduce, light_list, map_preview, moments};
     vec![
         struct_layout!(LightGpu as "Light" {
             clip_from_world, light_from_world, radiance, kind, direction, range, position, layer_count,
@@ -458,6 +460,12 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             cascades,
         }),
         struct_layout!(TechniqueParams as "TechniqueParams" { reals, integers }),
+        struct_layout!(light_list::EmitterGpu as "Emitter" {
+            radiance, kind, direction, range, position, cos_inner, cos_outer, _pad0, _pad1, _pad2,
+        }),
+        struct_layout!(light_list::LightListGpu as "LightList" {
+            ambient, shown, tiles_x, count, _pad0, _pad1,
+        }),
         struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
             world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,
             _pad2,

@@ -10,7 +10,7 @@ use gnomon_render::{
 };
 use gnomon_scene::{
     Instance, Settings, builtin, geometry,
-    settings::{LightKind, Partition},
+    settings::{LightKind, Lighting, Partition},
 };
 
 fn small() -> Settings {
@@ -137,8 +137,9 @@ fn timing_alone_submits_the_same_frame_as_a_full_render() {
 #[test]
 fn every_cascade_and_every_light_is_timed_on_either_clock() {
     // Three cascades of a sun, then the eight lights of `lamps` (cube faces, spots):
-    // one shadow time per layer, one lighting time per light, on GPU timestamps and on
-    // the CPU wall clock, with the layer times summing to the light's shadow time.
+    // one shadow time per layer, one lighting time per light (or one for them all,
+    // from the light list), on GPU timestamps and on the CPU wall clock, with the
+    // layer times summing to the light's shadow time.
     let gpu = Gpu::new_headless().unwrap();
     let mut renderer = Renderer::new(&gpu).unwrap();
     let mut cascaded = small();
@@ -151,7 +152,12 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
     for settings in [&mut cascaded, &mut all] {
         settings.shadow.map.cache = gnomon_scene::settings::MapCache::Off;
     }
-    for (scene, settings) in [(builtin::spheres(), cascaded), (builtin::lamps(), all)] {
+    let mut listed = all.clone();
+    all.screen.lighting = Lighting::PerLight;
+    listed.screen.lighting = Lighting::LightList;
+    for (scene, settings) in
+        [(builtin::spheres(), cascaded), (builtin::lamps(), all), (builtin::lamps(), listed)]
+    {
         let uploaded = renderer.upload(&scene).unwrap();
         for clock in [ClockChoice::Auto, ClockChoice::Cpu] {
             let started = Instant::now();
@@ -174,6 +180,8 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
                     t.frame_ms
                 );
             }
+            // Several lights under the light list share one lighting pass.
+            let one_pass = settings.screen.lighting == Lighting::LightList && cost.lights.len() > 1;
             for (index, light) in cost.lights.iter().enumerate() {
                 let layers: Vec<&PassTime> = cost
                     .passes
@@ -186,8 +194,19 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
                 assert_eq!(light.layer_ms, listed, "{}: the layer times, in layer order", light.name);
                 let total: f64 = listed.iter().sum();
                 assert!((total - light.shadow_ms.unwrap()).abs() < 1e-9, "{}: {total}", light.name);
-                assert!(light.lighting_ms.unwrap() > 0.0);
+                if one_pass {
+                    // One pass for them all, timed for no light in particular.
+                    assert_eq!(light.lighting_ms, None, "{}", light.name);
+                } else {
+                    assert!(light.lighting_ms.unwrap() > 0.0, "{}", light.name);
+                }
             }
+            let lighting: Vec<&PassTime> =
+                cost.passes.iter().filter(|p| p.kind == PassKind::Lighting).collect();
+            let expected = if one_pass { 1 } else { cost.lights.len() };
+            assert_eq!(lighting.len(), expected, "{:?}", settings.screen.lighting);
+            let total: f64 = lighting.iter().map(|p| p.ms).sum();
+            assert!(total > 0.0 && (total - t.lighting_ms).abs() < 1e-9, "{total} vs {t:?}");
             assert!(t.frame_ms >= t.shadow_ms, "{t:?}");
         }
     }

@@ -9,6 +9,7 @@ mod bindings;
 mod cull;
 mod host_target;
 mod late;
+mod light_passes;
 mod map_cache;
 mod outputs;
 mod plan;
@@ -31,9 +32,9 @@ pub use receiver::{LightShadows, ReceiverVariant, Shadows};
 use crate::{
     Gpu, GpuScene, RenderError,
     passes::{
-        Layouts, blit::BlitPass, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass, lighting,
-        lighting::LightingPass, map_preview::MapPreviewPass, map_scroll::MapScrollPass, moments::MomentPass,
-        screen_space::ScreenSpacePass, shadow::ShadowPass,
+        Layouts, blit::BlitPass, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass,
+        light_list::LightListPass, lighting, lighting::LightingPass, map_preview::MapPreviewPass,
+        map_scroll::MapScrollPass, moments::MomentPass, screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
     rays::TracePass,
@@ -48,6 +49,7 @@ use record::{Readback, SubmitRequest, TimesWanted};
 struct Passes {
     shadow: ShadowPass,
     lighting: LightingPass,
+    light_list: LightListPass,
     screen_space: ScreenSpacePass,
     trace: TracePass,
     moments: MomentPass,
@@ -91,6 +93,7 @@ impl Renderer {
             let passes = Passes {
                 shadow: ShadowPass::new(device, &layouts),
                 lighting: LightingPass::new(device, &layouts),
+                light_list: LightListPass::new(device, &layouts),
                 screen_space: ScreenSpacePass::new(device, &layouts),
                 trace: TracePass::new(device, &layouts),
                 moments: MomentPass::new(device, &gpu.queue),

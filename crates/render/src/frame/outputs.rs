@@ -535,7 +535,8 @@ impl TimedLights {
         self.timings = Some(PassTimings {
             shadow_ms: sum_of(lights, |l| l.shadow_ms).unwrap_or(0.0),
             filter_ms: sum_of(lights, |l| l.filter_ms),
-            lighting_ms: sum_of(lights, |l| l.lighting_ms).unwrap_or(0.0),
+            // Every lighting pass: each light's, or the light list's one for them all.
+            lighting_ms: times.passes.iter().filter(|p| p.kind == PassKind::Lighting).map(|p| p.ms).sum(),
             prepass_ms: times.passes.iter().find(|p| p.kind == PassKind::Prepass).map(|p| p.ms),
             mask_ms: sum_of(lights, |l| l.mask_ms),
             trace_ms: sum_of(lights, |l| l.trace_ms),

@@ -6,7 +6,7 @@ use glam::Vec3;
 use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{BiasSettings, CascadeSelection, LightKind, OmniMap, Partition, RayUse, Refine},
+    settings::{BiasSettings, CascadeSelection, LightKind, Lighting, OmniMap, Partition, RayUse, Refine},
 };
 
 use super::Renderer;
@@ -32,6 +32,9 @@ pub(super) struct FramePlan {
     pub aspect: f32,
     /// Whether the lights' shadows go through the screen-space mask path.
     pub mask_path: bool,
+    /// How the lights are lit: from a light list on the mask path when the settings
+    /// say so and there are several, one pass per light otherwise.
+    pub lighting: Lighting,
     /// The reported light's index.
     pub shown: usize,
     pub lights: Vec<LightPlan>,
@@ -156,7 +159,10 @@ impl Renderer {
                 light_gpu,
             });
         }
-        Ok(FramePlan { camera, aspect, mask_path, shown, lights })
+        // One light's own pass is its list: the list's walk would only add to it.
+        let lighting =
+            if mask_path && lights.len() > 1 { settings.screen.lighting } else { Lighting::PerLight };
+        Ok(FramePlan { camera, aspect, mask_path, lighting, shown, lights })
     }
 
     /// A light's layout fitted to the camera (and for a sun's SDSM cascades, to the

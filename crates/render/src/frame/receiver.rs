@@ -5,7 +5,7 @@
 
 use gnomon_scene::{
     Light, Scene, Settings,
-    settings::{RayUse, Refine, ScreenSpaceSettings, Technique},
+    settings::{Lighting, RayUse, Refine, ScreenSpaceSettings, Technique},
 };
 
 use super::{Renderer, bindings::ReceiverUniforms, cull::cull, record::Recording};
@@ -85,8 +85,8 @@ impl Renderer {
     /// Gnomon's own passes: for those this returns
     /// [`RenderError::ReceiverNeedsMapPath`]; a technique that is rays (`raytraced`)
     /// has no map for the host to read ([`RenderError::ReceiverCannotTrace`]). The
-    /// default refinement, `auto`, runs only where Gnomon draws the image: here the
-    /// maps' answer is the host's.
+    /// default refinement, `auto`, and the light list run only where Gnomon draws the
+    /// image: here the maps' answer is the host's, and so is the lighting.
     pub fn record_shadows(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -97,15 +97,14 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_map_limits(settings)?;
-        let unrefined;
-        let settings = match settings.screen.refine {
-            Refine::Auto => {
-                let screen = ScreenSpaceSettings { refine: Refine::Off, ..settings.screen.clone() };
-                unrefined = Settings { screen, ..settings.clone() };
-                &unrefined
-            }
-            Refine::Off | Refine::Rays | Refine::EveryPixel => settings,
+        // What only Gnomon's own frames do: the default refinement, and lighting from
+        // the light list (which would take the mask path); the host lights its pixels.
+        let refine = match settings.screen.refine {
+            Refine::Auto => Refine::Off,
+            named @ (Refine::Off | Refine::Rays | Refine::EveryPixel) => named,
         };
+        let screen = ScreenSpaceSettings { refine, lighting: Lighting::PerLight, ..settings.screen.clone() };
+        let settings = &Settings { screen, ..settings.clone() };
         let plan = self.plan_frame(uploaded, scene, settings, None)?;
         if let Some(light) = plan.lights.iter().find(|l| l.technique.rays() == RayUse::EveryPixel) {
             return Err(RenderError::ReceiverCannotTrace {

@@ -5,14 +5,20 @@
 
 use std::time::Instant;
 
-use gnomon_scene::{Scene, Settings, settings::Refine};
+use gnomon_math::screen_bounds::Viewport;
+use gnomon_scene::{
+    Scene, Settings,
+    settings::{Lighting, Refine},
+};
 
 use super::{
     Renderer,
     bindings::{ShadowViews, scene_group},
     cull::{Culled, cull},
+    light_passes::{MaskInputs, SharedLighting},
     outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
+    screen::MaskStart,
 };
 use crate::{
     GpuScene, RenderError,
@@ -21,7 +27,7 @@ use crate::{
     layout::ShadowLayout,
     passes::{
         begin_depth_pass,
-        lighting::{self, LightingKey, LightingRole, Lookup, MapLookup},
+        lighting::MapLookup,
         moments::MomentInput,
         shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
     },
@@ -170,29 +176,6 @@ pub(super) enum DepthStart {
     Keep,
 }
 
-/// The camera-sized render targets of the lighting passes.
-struct LightingTargets {
-    /// One per `lighting::TARGETS`, the colour image first.
-    textures: Vec<wgpu::Texture>,
-    views: Vec<wgpu::TextureView>,
-    depth: wgpu::TextureView,
-}
-
-/// What every light's lighting pass shares.
-struct SharedLighting<'a> {
-    plan: &'a FramePlan,
-    camera_group: &'a wgpu::BindGroup,
-    /// On the forward path, where a light traces rays in its lighting pass: the
-    /// camera's group with the casters' BVH.
-    tracing_group: Option<&'a wgpu::BindGroup>,
-    targets: &'a LightingTargets,
-    /// What the camera sees.
-    visible: &'a Visible,
-}
-
-/// Background colour of the image, linear RGB.
-const SKY: wgpu::Color = wgpu::Color { r: 0.42, g: 0.55, b: 0.72, a: 1.0 };
-
 impl Renderer {
     /// Plans, culls, records and submits a frame, and reads its pass times.
     pub(super) fn submit(
@@ -307,13 +290,24 @@ impl Renderer {
             lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
         }
         let targets = self.lighting_targets(width, height);
-        if plan.mask_path {
+        let viewport = Viewport { width, height };
+        let tiles = plan.mask_path.then(|| plan.light_tiles(viewport));
+        let mask = mask_layers.first().map(|layer| {
+            self.pool.view(layer.texture(), ViewKey::whole(wgpu::TextureViewDimension::D2Array))
+        });
+        if let Some(tiles) = &tiles {
+            let mask_rects = (0..plan.lights.len()).map(|i| plan.mask_rect(tiles, i, viewport)).collect();
             let screen = super::screen::ScreenInputs {
                 camera_visible: &culled.camera,
                 camera_buffer: &camera_buffer,
                 camera_group: &camera_group,
                 depth: &targets.depth,
                 mask_layers: &mask_layers,
+                mask_rects,
+                mask_start: match plan.lighting {
+                    Lighting::LightList => MaskStart::Keep,
+                    Lighting::PerLight => MaskStart::Clear,
+                },
             };
             let lists = self.record_screen_space(rec, uploaded, plan, &lit, &screen);
             // Each light's count of the pixels its rays decided.
@@ -333,10 +327,9 @@ impl Renderer {
             tracing_group: tracing.as_ref(),
             targets: &targets,
             visible: &culled.camera,
+            masks: mask.as_ref().zip(tiles.as_ref()).map(|(mask, tiles)| MaskInputs { mask, tiles }),
         };
-        for (index, bindings) in lit.iter().enumerate() {
-            self.record_lighting(rec, uploaded, &shared, index, bindings);
-        }
+        self.record_lights(rec, uploaded, &shared, &lit);
         if readback.images {
             readbacks.targets = targets
                 .textures
@@ -349,23 +342,6 @@ impl Renderer {
             color: targets.textures[0].clone(),
             shadow_map: shown_map.expect("the reported light is one of the lights"),
         }
-    }
-
-    /// The colour and data targets of the lighting passes, and their depth buffer.
-    fn lighting_targets(&mut self, width: u32, height: u32) -> LightingTargets {
-        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
-        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let textures: Vec<wgpu::Texture> = lighting::TARGETS
-            .iter()
-            .map(|&format| {
-                let usage = attachment | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING;
-                self.pool.texture("render target", size, format, usage)
-            })
-            .collect();
-        let views = textures.iter().map(|t| self.pool.view(t, ViewKey::default())).collect();
-        let depth = self.pool.texture("depth", size, lighting::DEPTH_FORMAT, attachment);
-        let depth = self.pool.view(&depth, ViewKey::default());
-        LightingTargets { textures, views, depth }
     }
 
     /// A light's uniform and its maps as the passes from the camera read them: the
@@ -423,87 +399,6 @@ impl Renderer {
         let mask =
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
-    }
-
-    /// One light's lighting pass, adding its light to the targets (the first light
-    /// clears them).
-    fn record_lighting(
-        &mut self,
-        rec: &mut Recording,
-        uploaded: &GpuScene,
-        shared: &SharedLighting,
-        index: usize,
-        bindings: &LightBindings,
-    ) {
-        let SharedLighting { plan, camera_group, tracing_group, targets, visible: camera_visible } = *shared;
-        let light = &plan.lights[index];
-        let first = index == 0;
-        let last = index + 1 == plan.lights.len();
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = targets
-            .views
-            .iter()
-            .enumerate()
-            .map(|(i, view)| {
-                // The colour image gets an opaque sky; the data targets zero (object
-                // id 0 marks background). Later lights add to them.
-                let clear = if i == 0 { SKY } else { wgpu::Color::TRANSPARENT };
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: if first { wgpu::LoadOp::Clear(clear) } else { wgpu::LoadOp::Load },
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            })
-            .collect();
-        let gpu = &self.gpu;
-        let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Lighting, Some(index as u32), None);
-        let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lighting"),
-            color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &targets.depth,
-                depth_ops: Some(wgpu::Operations {
-                    // The mask path's prepass has drawn the depth already.
-                    load: if first && !plan.mask_path {
-                        wgpu::LoadOp::Clear(1.0)
-                    } else {
-                        wgpu::LoadOp::Load
-                    },
-                    store: if last { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: rec.clock.render_writes(slot),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        let key = LightingKey {
-            technique: light.technique,
-            lookup: if plan.mask_path { Lookup::Mask } else { Lookup::Own(bindings.lookup) },
-            role: if first {
-                LightingRole::First
-            } else {
-                LightingRole::Added { visibility: index == plan.shown }
-            },
-            // Only a forward frame with the BVH built has a group to trace with.
-            refine: if tracing_group.is_some() { light.refine } else { Refine::Off },
-        };
-        pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));
-        pass.set_bind_group(0, &bindings.scene, &[]);
-        let camera_group = tracing_group.filter(|_| key.refine != Refine::Off).unwrap_or(camera_group);
-        pass.set_bind_group(1, camera_group, &[]);
-        pass.set_bind_group(2, &bindings.lighting, &[]);
-        rec.stats.pipeline_changes += 1;
-        rec.stats.bind_group_changes += 3;
-        let (draws, binds) = uploaded.draw_visible(&mut pass, camera_visible, 3);
-        rec.stats.lighting_draws += draws;
-        rec.stats.lighting_instances += camera_visible.instances();
-        rec.stats.bind_group_changes += binds;
-        drop(pass);
-        rec.clock.end(gpu, rec.encoder, slot);
     }
 
     /// Records a depth-only pass with the shadow pipelines, drawing the runs

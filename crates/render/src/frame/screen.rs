@@ -16,6 +16,7 @@ use crate::{
     rays::{ListAccess, RefineLists, TraceGroups, TraceStage},
     timing::PassKind,
 };
+use gnomon_math::screen_bounds::PixelRect;
 use gnomon_scene::settings::Refine;
 
 /// What the screen-space passes draw into and read.
@@ -27,6 +28,9 @@ pub(super) struct ScreenInputs<'a> {
     pub depth: &'a wgpu::TextureView,
     /// One layer of the mask per light.
     pub mask_layers: &'a [wgpu::TextureView],
+    /// The pixels each light's mask pass covers; `None` for none.
+    pub mask_rects: Vec<Option<PixelRect>>,
+    pub mask_start: MaskStart,
 }
 
 /// Group 1 of a light's mask pass.
@@ -44,6 +48,25 @@ struct Refining {
     append: wgpu::BindGroup,
     read: wgpu::BindGroup,
     traced: wgpu::TextureView,
+}
+
+/// Where a light's mask pass draws: its layer of the mask and the pixels of it that
+/// the pass covers.
+struct MaskTarget<'a> {
+    layer: &'a wgpu::TextureView,
+    rect: Option<PixelRect>,
+    start: MaskStart,
+}
+
+/// What a light's layer of the mask holds outside the pixels its pass covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum MaskStart {
+    /// Lit: the per-light lighting passes read every pixel of every layer.
+    Clear,
+    /// Whatever it held: the light list reads a layer only in the tiles that list its
+    /// light, which the pass covers, so the clear would be wasted (a layer's worth of
+    /// writes per light).
+    Keep,
 }
 
 /// What a penumbra filter copies: the light's layer of the mask (a view of one layer
@@ -122,7 +145,14 @@ impl Renderer {
                 },
                 None => MaskScreen { group: &screen_group, counter_offset: None },
             };
-            self.record_mask(rec, light, bindings, layer, &screen, index as u32);
+            // A penumbra filter reads the neighbours of its pixels, which may lie
+            // outside the light's rectangle: they must hold this frame's values.
+            let start = match refined {
+                Some(_) if light.light_gpu.penumbra_rays > 0 => MaskStart::Clear,
+                Some(_) | None => inputs.mask_start,
+            };
+            let target = MaskTarget { layer, rect: inputs.mask_rects[index], start };
+            self.record_mask(rec, light, bindings, target, &screen, index as u32);
             if let Some(Refining { lists, read, traced, .. }) = refined {
                 let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer, traced);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
@@ -142,13 +172,15 @@ impl Renderer {
         refining.map(|refining| refining.lists)
     }
 
-    /// Light `index`'s mask pass into its `layer` of the mask, with group 1 `screen`.
+    /// Light `index`'s mask pass into its `target` layer of the mask, with group 1
+    /// `screen`. Pixels outside the target's rectangle are not the light's to shade:
+    /// it cannot reach them.
     fn record_mask(
         &mut self,
         rec: &mut Recording,
         light: &LightPlan,
         bindings: &LightBindings,
-        layer: &wgpu::TextureView,
+        target: MaskTarget,
         screen: &MaskScreen,
         index: u32,
     ) {
@@ -157,7 +189,18 @@ impl Renderer {
         let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Mask, Some(index), None);
         let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shadow mask"),
-            color_attachments: &[cleared(layer, wgpu::Color::WHITE)],
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target.layer,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: match target.start {
+                        MaskStart::Clear => wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        MaskStart::Keep => wgpu::LoadOp::Load,
+                    },
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
             depth_stencil_attachment: None,
             timestamp_writes: rec.clock.render_writes(slot),
             occlusion_query_set: None,
@@ -170,7 +213,10 @@ impl Renderer {
         pass.set_bind_group(2, mask_group, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 3;
-        pass.draw(0..3, 0..1);
+        if let Some(rect) = target.rect {
+            pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
+            pass.draw(0..3, 0..1);
+        }
         drop(pass);
         rec.clock.end(gpu, rec.encoder, slot);
     }

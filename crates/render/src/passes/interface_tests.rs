@@ -10,7 +10,7 @@ use gnomon_scene::settings::Refine;
 use wgpu::naga;
 
 use super::{
-    blit, depth_reduce, lighting,
+    blit, depth_reduce, light_list, lighting,
     lighting::{LightingKey, LightingRole, Lookup, MapLookup},
     map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
@@ -88,6 +88,7 @@ fn every_variant() -> Vec<(String, String)> {
     }
     out.push(("shadow".into(), shadow::shadow_wgsl()));
     out.push(("prepass".into(), screen_space::prepass_wgsl()));
+    out.push(("light list".into(), light_list::light_list_wgsl()));
     out.push(("depth reduce".into(), depth_reduce::reduce_wgsl()));
     out.push(("sample bounds".into(), depth_reduce::bounds_wgsl()));
     out.push(("map preview".into(), map_preview::preview_wgsl()));

@@ -127,6 +127,68 @@ pub(crate) fn camera_shading_wgsl() -> Vec<String> {
 /// from the camera: the lighting pass and the prepass.
 pub(crate) const SURFACE_WGSL: &str = include_str!("surface.wgsl");
 
+/// What the lighting passes share: their outputs and the cascade view's tints.
+pub(crate) const LIGHTING_COMMON_WGSL: &str = include_str!("lighting_common.wgsl");
+
+/// How a pass that draws the scene from the camera tests and writes depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SurfaceDepth {
+    /// Draws the nearest surfaces and writes their depths: the prepass, and the first
+    /// lighting pass on the forward path.
+    Nearest,
+    /// Shades exactly the surfaces an earlier pass drew, on its depths: the same
+    /// vertex transform, its position invariant, gives the same depths.
+    Equal,
+}
+
+/// A pipeline that draws the scene from the camera with `vs_surface`, both sides of
+/// every triangle (as a ray tracer sees them; the shaders flip back faces' normals).
+pub(crate) struct SurfacePipeline<'a> {
+    pub label: &'a str,
+    pub layout: &'a wgpu::PipelineLayout,
+    pub module: &'a wgpu::ShaderModule,
+    pub fragment_entry: &'a str,
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    pub depth: SurfaceDepth,
+}
+
+impl SurfacePipeline<'_> {
+    pub fn create(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let nearest = self.depth == SurfaceDepth::Nearest;
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(self.layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some("vs_surface"),
+                compilation_options: Default::default(),
+                buffers: &VertexStream::Full.buffers(),
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(nearest),
+                depth_compare: Some(if nearest {
+                    wgpu::CompareFunction::Less
+                } else {
+                    wgpu::CompareFunction::Equal
+                }),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment_entry),
+                compilation_options: Default::default(),
+                targets: self.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
 /// The lighting pass's WGSL for `key`, composed.
 pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     let mut parts = camera_shading_wgsl();
@@ -136,6 +198,7 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
         Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map),
     });
     parts.push(SURFACE_WGSL.to_owned());
+    parts.push(LIGHTING_COMMON_WGSL.to_owned());
     parts.push(include_str!("lighting.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -220,44 +283,18 @@ impl LightingPass {
                     Some(target)
                 })
                 .collect();
-            // The first light's pass draws the depths, unless the prepass has.
+            // The first light's pass draws the depths, unless the prepass has; later
+            // lights shade exactly the surfaces it (or the prepass) found.
             let first = key.role == LightingRole::First && key.lookup != Lookup::Mask;
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("lighting"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_surface"),
-                    compilation_options: Default::default(),
-                    buffers: &VertexStream::Full.buffers(),
-                },
-                // Both sides are drawn, as a ray tracer sees them; the shader flips the
-                // normal of back faces.
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                // Later lights shade exactly the surfaces the first one (or the
-                // prepass) found: the same vertex transform, its position invariant,
-                // gives the same depths.
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(first),
-                    depth_compare: Some(if first {
-                        wgpu::CompareFunction::Less
-                    } else {
-                        wgpu::CompareFunction::Equal
-                    }),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &targets,
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            SurfacePipeline {
+                label: "lighting",
+                layout,
+                module: &module,
+                fragment_entry: "fs_main",
+                targets: &targets,
+                depth: if first { SurfaceDepth::Nearest } else { SurfaceDepth::Equal },
+            }
+            .create(device)
         })
     }
 }

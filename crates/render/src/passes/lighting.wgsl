@@ -7,21 +7,7 @@
 // asked) or from mask_lookup.wgsl on the mask path (what the screen-space shadow
 // mask stored for the pixel). Camera: camera.wgsl; the
 // vertex stage and normals: surface.wgsl; the light's direction and cone:
-// shading.wgsl.
-
-// Cascade tints of the debug view.
-const CASCADE_TINTS: array<vec3<f32>, MAX_CASCADES> = array<vec3<f32>, MAX_CASCADES>(
-    vec3<f32>(1.0, 0.35, 0.35), vec3<f32>(0.35, 1.0, 0.35), vec3<f32>(0.4, 0.5, 1.0), vec3<f32>(1.0, 1.0, 0.3),
-    vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
-);
-
-struct FragmentOut {
-    @location(0) color: vec4<f32>,
-    @location(1) visibility: f32,
-    @location(2) position: vec4<f32>,
-    @location(3) normal: vec4<f32>,
-    @location(4) object_id: u32,
-};
+// shading.wgsl; their outputs and tints: lighting_common.wgsl.
 
 @fragment
 fn fs_main(in: SurfaceVertex) -> FragmentOut {
@@ -52,11 +38,8 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
         discard;
     }
     let albedo = base_color_of(inst, in.uv).rgb;
-    let n_dot_l = max(dot(n, l), 0.0);
     let v = normalize(camera.eye - in.world);
-    let h = normalize(l + v);
-    let specular = inst.specular * pow(max(dot(n, h), 0.0), inst.shininess) * select(0.0, 1.0, n_dot_l > 0.0);
-    let direct = light.radiance * cone * (albedo * n_dot_l + vec3<f32>(specular));
+    let direct = light.radiance * cone * blinn_phong(albedo, inst.specular, inst.shininess, n, l, v);
     var color = light.ambient * albedo + visibility * direct;
     if camera.debug_view == DEBUG_VIEW_CASCADES {
         color *= CASCADE_TINTS[layer];

@@ -4,6 +4,7 @@
 pub(crate) mod blit;
 pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
+pub(crate) mod light_list;
 pub(crate) mod lighting;
 pub(crate) mod map_preview;
 pub(crate) mod map_scroll;

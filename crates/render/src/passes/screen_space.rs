@@ -9,7 +9,7 @@ use super::{
     Layouts, compose_wgsl,
     lighting::{self, Lookup, MapLookup},
 };
-use crate::{gpu_types::VertexStream, techniques::TechniqueRef};
+use crate::techniques::TechniqueRef;
 use gnomon_scene::settings::Refine;
 
 /// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
@@ -75,34 +75,15 @@ impl ScreenSpacePass {
             label: Some("prepass"),
             source: wgpu::ShaderSource::Wgsl(prepass_wgsl().into()),
         });
-        let prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("prepass"),
-            layout: Some(&prepass_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_surface"),
-                compilation_options: Default::default(),
-                buffers: &VertexStream::Full.buffers(),
-            },
-            // Both sides, as the lighting pass draws them.
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: lighting::DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_prepass"),
-                compilation_options: Default::default(),
-                targets: &[Some(NORMALS_FORMAT.into()), Some(VIEW_DEPTH_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let prepass = lighting::SurfacePipeline {
+            label: "prepass",
+            layout: &prepass_layout,
+            module: &module,
+            fragment_entry: "fs_prepass",
+            targets: &[Some(NORMALS_FORMAT.into()), Some(VIEW_DEPTH_FORMAT.into())],
+            depth: lighting::SurfaceDepth::Nearest,
+        }
+        .create(device);
         let mask_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow mask"),
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.screen), Some(&layouts.shadow)],

@@ -6,24 +6,62 @@
 // quantisation that the slope bias (zero for it) cannot cover.
 const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 
-// Fraction of the light arriving at `world` before shadowing: 1 for the sun, the
-// cone and range test for a spot (0 outside the outer cone or beyond the range), the
-// range test for a point light.
+// What shading needs of a light: the light uniform's emission fields, and an element
+// of the light-list pass's array (`EmitterGpu` in passes/light_list.rs).
+struct Emitter {
+    radiance: vec3<f32>,
+    kind: u32,
+    direction: vec3<f32>,
+    range: f32,
+    position: vec3<f32>,
+    cos_inner: f32,
+    cos_outer: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+// The light uniform's emitter.
+fn light_emitter() -> Emitter {
+    return Emitter(
+        light.radiance, light.kind, light.direction, light.range,
+        light.position, light.cos_inner, light.cos_outer, 0u, 0u, 0u,
+    );
+}
+
+// Fraction of emitter `e`'s light arriving at `world` before shadowing: 1 for the sun,
+// the cone and range test for a spot (0 outside the outer cone or beyond the range),
+// the range test for a point light.
 // Returns (unit direction to the light, cone factor in [0, 1]).
-fn light_geometry(world: vec3<f32>) -> vec4<f32> {
-    if light.kind == LIGHT_SUN {
-        return vec4<f32>(-light.direction, 1.0);
+fn emitter_geometry(e: Emitter, world: vec3<f32>) -> vec4<f32> {
+    if e.kind == LIGHT_SUN {
+        return vec4<f32>(-e.direction, 1.0);
     }
-    let to_light = light.position - world;
+    let to_light = e.position - world;
     let dist = length(to_light);
     let l = to_light / dist;
-    if light.kind == LIGHT_POINT {
-        return vec4<f32>(l, select(0.0, 1.0, dist <= light.range));
+    if e.kind == LIGHT_POINT {
+        return vec4<f32>(l, select(0.0, 1.0, dist <= e.range));
     }
-    let cos_angle = dot(-l, light.direction);
-    let inside = cos_angle >= light.cos_outer && dist <= light.range;
-    let falloff = smoothstep(light.cos_outer, light.cos_inner, cos_angle);
+    let cos_angle = dot(-l, e.direction);
+    let inside = cos_angle >= e.cos_outer && dist <= e.range;
+    let falloff = smoothstep(e.cos_outer, e.cos_inner, cos_angle);
     return vec4<f32>(l, select(0.0, falloff, inside));
+}
+
+// `emitter_geometry` of the light uniform's light.
+fn light_geometry(world: vec3<f32>) -> vec4<f32> {
+    return emitter_geometry(light_emitter(), world);
+}
+
+// The light a surface reflects toward `v` per unit of arriving radiance: Lambert
+// diffuse and a Blinn-Phong lobe of weight `specular` and exponent `shininess`, with
+// no highlight on the side facing away from the light.
+fn blinn_phong(albedo: vec3<f32>, specular: f32, shininess: f32, n: vec3<f32>, l: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let n_dot_l = max(dot(n, l), 0.0);
+    let h = normalize(l + v);
+    let highlight = specular * pow(max(dot(n, h), 0.0), shininess) * select(0.0, 1.0, n_dot_l > 0.0);
+    return albedo * n_dot_l + vec3<f32>(highlight);
 }
 
 // `n` turned into the hemisphere of `toward`: the side of a surface a given

@@ -220,5 +220,6 @@ impl Settings {
     }
 }
 
-/// The most lights one render draws.
-pub const MAX_LIGHTS: usize = 32;
+/// The most lights one render draws: the lighting pass's tile lists hold a bit per
+/// light, in `MAX_LIGHTS / 32` words per tile.
+pub const MAX_LIGHTS: usize = 64;

@@ -226,7 +226,7 @@ impl Settings {
     /// as --shadow-path says, and with `auto` when any light marches contact shadows
     /// or refines its shadow by rays (a hard light under `auto` refinement, or any
     /// light under rays asked for by name or traced by its technique), which run best
-    /// on the mask path. Rays
+    /// on the mask path, and when several lights are lit from a light list. Rays
     /// asked for with --shadow-path forward are traced in the lighting pass instead;
     /// contact shadows with it are refused: they march through the mask path's depth
     /// prepass.
@@ -246,7 +246,10 @@ impl Settings {
             }),
             (ShadowPath::Forward, None) => Ok(false),
             (ShadowPath::Mask, _) => Ok(true),
-            (ShadowPath::Auto, contact) => Ok(contact.is_some() || rays),
+            (ShadowPath::Auto, contact) => {
+                let listed = lights.len() > 1 && self.screen.lighting == Lighting::LightList;
+                Ok(contact.is_some() || rays || listed)
+            }
         }
     }
 

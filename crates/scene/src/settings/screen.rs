@@ -8,9 +8,10 @@ use super::*;
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowPath {
-    /// The mask when any light has contact shadows (which march through its depth) or
-    /// refines its shadow by rays (traced there in a pass of their own), forward
-    /// otherwise.
+    /// The mask when any light has contact shadows (which march through its depth),
+    /// refines its shadow by rays (traced there in a pass of their own), or when the
+    /// frame has more than one light and lights them from a light list (one lighting
+    /// pass for them all reads their mask layers); forward otherwise.
     #[default]
     Auto,
     /// In the lighting pass, once per fragment drawn; rays asked for by name are
@@ -20,6 +21,24 @@ pub enum ShadowPath {
     /// full-screen pass per light that reconstructs each pixel's position from depth,
     /// looks its shadow up once and stores it in a mask the lighting pass reads.
     Mask,
+}
+
+/// How a frame of several lights is lit on the mask path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Lighting {
+    /// One lighting pass for every light (tiled forward shading, after Olsson &
+    /// Assarsson, "Tiled shading", 2011): the scene is drawn once, and each pixel sums
+    /// the lights whose range reaches its 16 × 16 tile, reading each one's visibility
+    /// from its layer of the mask. Each light's mask pass covers only the tiles its
+    /// range can reach. A frame of one light draws that light's own pass.
+    #[default]
+    LightList,
+    /// One lighting pass per light, each drawing the scene again and adding its light:
+    /// the cost grows with the number of lights. For comparison, and the only way on the
+    /// forward path.
+    PerLight,
 }
 
 /// Which pixels trace shadow rays on the GPU, over the casters' BVH, in place of
@@ -94,6 +113,13 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub refine: Refine,
+    /// How several lights are lit on the mask path: light-list (one pass over a tiled
+    /// list of the lights) or per-light (one pass each).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
+    )]
+    pub lighting: Lighting,
     /// Shadow rays per refined pixel under a light with an area, stratified over the
     /// light's disk, cone or sphere as the CPU reference samples it: 1 to 256. 16
     /// rays and an edge-aware filter take PCSS's penumbra error to 0.25–0.53× on the
@@ -110,7 +136,12 @@ pub const MAX_PENUMBRA_RAYS: u32 = 256;
 
 impl Default for ScreenSpaceSettings {
     fn default() -> Self {
-        Self { shadow_path: ShadowPath::Auto, refine: Refine::Auto, penumbra_rays: 16 }
+        Self {
+            shadow_path: ShadowPath::Auto,
+            refine: Refine::Auto,
+            lighting: Lighting::LightList,
+            penumbra_rays: 16,
+        }
     }
 }
 

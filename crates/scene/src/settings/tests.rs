@@ -297,6 +297,23 @@ fn refining_by_rays_chooses_the_mask_path_and_forward_keeps_its_own() {
 }
 
 #[test]
+fn several_lights_take_the_mask_path_for_their_light_list_under_auto_only() {
+    let scene = crate::builtin::build("lamps:4").unwrap();
+    let mut s = Settings::default();
+    s.light.kind = LightKind::All;
+    s.screen.refine = Refine::Off;
+    assert_eq!(s.screen.lighting, Lighting::LightList, "the light list by default");
+    let lights = s.resolve_lights(&scene).unwrap();
+    assert!(s.uses_shadow_mask(&lights).unwrap(), "four lights: the mask, for the list");
+    assert!(!s.uses_shadow_mask(&lights[..1]).unwrap(), "one light, no rays: forward");
+    s.screen.lighting = Lighting::PerLight;
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "per-light passes need no mask");
+    s.screen.lighting = Lighting::LightList;
+    s.screen.shadow_path = ShadowPath::Forward;
+    assert!(!s.uses_shadow_mask(&lights).unwrap(), "forward by name stays forward");
+}
+
+#[test]
 fn refining_by_default_takes_the_mask_path_for_hard_lights_only() {
     let scene = crate::builtin::spheres();
     let mut s = Settings::default();

@@ -3,11 +3,12 @@
 
 use glam::{Mat4, Vec3};
 
+mod lamps;
+
+pub use lamps::{MAX_LAMPS, lamp_grid, lamps};
+
 use crate::{
-    Camera, DirectionalLight, Instance, Light, Material, Mesh, PointLight, Scene, SceneLight, SpotLight,
-    geometry,
-    settings::{FilterSettingsPatch, MapSettingsPatch, Partition, ShadowOverrides, Technique},
-    sun_direction,
+    Camera, DirectionalLight, Instance, Material, Mesh, PointLight, Scene, SpotLight, geometry, sun_direction,
 };
 
 /// A built-in scene: its name, what it shows, and how to build it.
@@ -44,7 +45,8 @@ pub const BUILTINS: &[Builtin] = &[
     },
     Builtin {
         name: "lamps",
-        description: "a courtyard lit by eight shadowed lights at once: a sun, three spots and four point lights",
+        description: "a courtyard lit by eight shadowed lights at once: a sun, three spots and four point lights; \
+                      `lamps:N` for a grid of N shadowed point lights on posts (1 to 64): lighting's cost per light",
         build: lamps,
     },
     Builtin {
@@ -74,13 +76,21 @@ pub enum BuiltinError {
          the renderer says how many when it cannot take them)"
     )]
     InstancesOutOfRange(String),
+    /// `lamps:N` with N not a count in range.
+    #[error("`lamps:{0}`: N must be a whole number from 1 to {MAX_LAMPS} (the most lights a frame takes)")]
+    LampsOutOfRange(String),
 }
 
-/// Builds the built-in scene called `name` (`instances:N` for N objects).
+/// Builds the built-in scene called `name` (`instances:N` for N objects, `lamps:N`
+/// for N lamps).
 pub fn build(name: &str) -> Result<Scene, BuiltinError> {
     if let Some(text) = name.strip_prefix("instances:") {
         let count = text.replace('_', "").parse::<usize>().ok().filter(|n| (10..=MAX_INSTANCES).contains(n));
         return count.map(instances).ok_or_else(|| BuiltinError::InstancesOutOfRange(text.into()));
+    }
+    if let Some(text) = name.strip_prefix("lamps:") {
+        let count = text.parse::<usize>().ok().filter(|n| (1..=MAX_LAMPS).contains(n));
+        return count.map(lamp_grid).ok_or_else(|| BuiltinError::LampsOutOfRange(text.into()));
     }
     BUILTINS
         .iter()
@@ -399,116 +409,6 @@ pub fn instances(count: usize) -> Scene {
     )
 }
 
-/// A 30 × 30 courtyard with a ring of 3 m pillars, crates and spheres, lit by eight
-/// shadowed lights of every type at once, each with its own shadow settings: a low
-/// sun with cascades, three spot lights and four coloured point lights (lamps) among
-/// the objects. The scene for many lights: `--light all`.
-pub fn lamps() -> Scene {
-    let mut b = SceneBuilder::new();
-    let ground = b.mesh(geometry::plane(30.0, 30.0));
-    let grey = b.material("ground", GROUND);
-    let stone = b.material("stone", Vec3::new(0.78, 0.74, 0.66));
-    let wood = b.material("wood", Vec3::new(0.7, 0.5, 0.3));
-    let blue = b.material("blue", Vec3::new(0.3, 0.45, 0.8));
-    b.place("ground", ground, grey, Mat4::IDENTITY);
-    let pillar = b.mesh(geometry::cuboid(Vec3::new(0.35, 1.5, 0.35)));
-    for i in 0..8 {
-        let angle = i as f32 * std::f32::consts::FRAC_PI_4;
-        let p = Vec3::new(7.0 * angle.cos(), 1.5, 7.0 * angle.sin());
-        b.place(&format!("pillar {i}"), pillar, stone, at(p));
-    }
-    let crate_mesh = b.mesh(geometry::cuboid(Vec3::splat(0.6)));
-    for (i, p) in [Vec3::new(-2.5, 0.6, 1.0), Vec3::new(2.0, 0.6, -2.5), Vec3::new(3.0, 0.6, 3.0)]
-        .into_iter()
-        .enumerate()
-    {
-        b.place(&format!("crate {i}"), crate_mesh, wood, at(p) * Mat4::from_rotation_y(0.4 * i as f32));
-    }
-    let ball = b.mesh(geometry::uv_sphere(0.8, 40, 20));
-    b.place("sphere 0", ball, blue, at(Vec3::new(0.0, 0.8, 0.0)));
-    b.place("sphere 1", ball, blue, at(Vec3::new(-4.0, 0.8, -3.0)));
-    let camera = Camera {
-        eye: Vec3::new(0.0, 11.0, 16.0),
-        target: Vec3::new(0.0, 0.5, 0.0),
-        up: Vec3::Y,
-        fov_y_degrees: 50.0,
-        near: 0.1,
-        far: 80.0,
-    };
-    let dim = |mut l: PointLight, color: Vec3| {
-        l.color = color;
-        l.intensity = 0.35;
-        l
-    };
-    // Each light's own technique, and map resolution when it has one.
-    let own = |technique: Technique, resolution: Option<u32>| ShadowOverrides {
-        filter: FilterSettingsPatch { technique: Some(technique), ..Default::default() },
-        map: MapSettingsPatch { resolution, ..Default::default() },
-        ..Default::default()
-    };
-    let mut sun_light = sun(25.0, 140.0);
-    sun_light.intensity = 0.35;
-    let spots = [
-        (Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), Vec3::new(1.0, 0.6, 0.6)),
-        (Vec3::new(8.0, 6.0, 8.0), Vec3::new(2.0, 0.0, -1.0), Vec3::new(0.6, 1.0, 0.6)),
-        (Vec3::new(0.0, 7.0, -9.0), Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.6, 0.7, 1.0)),
-    ];
-    let points = [
-        (Vec3::new(-3.0, 2.2, 3.5), Vec3::new(1.0, 0.75, 0.4)),
-        (Vec3::new(3.5, 2.0, 0.5), Vec3::new(0.5, 0.8, 1.0)),
-        (Vec3::new(0.5, 2.5, -4.0), Vec3::new(1.0, 0.5, 0.8)),
-        (Vec3::new(-5.0, 1.8, -0.5), Vec3::new(0.7, 1.0, 0.5)),
-    ];
-    let mut lights = vec![SceneLight {
-        name: "sun".into(),
-        light: Light::Directional(sun_light),
-        shadow: Some(ShadowOverrides {
-            partition: Some(Partition::Cascades),
-            ..own(Technique::PCF_POISSON, None)
-        }),
-    }];
-    for (i, (position, target, color)) in spots.into_iter().enumerate() {
-        let mut s = spot(position, target, 38.0, 25.0);
-        s.color = color;
-        s.intensity = 0.5;
-        let technique = [Technique::PCF, Technique::PCSS, Technique::HARD][i].clone();
-        let resolution = if technique == Technique::PCSS {
-            s.radius = 0.3;
-            None
-        } else {
-            Some(1024)
-        };
-        lights.push(SceneLight {
-            name: format!("spot {i}"),
-            light: Light::Spot(s),
-            shadow: Some(own(technique, resolution)),
-        });
-    }
-    for (i, (position, color)) in points.into_iter().enumerate() {
-        let technique =
-            [Technique::PCF2X2, Technique::PCF_POISSON, Technique::PCF, Technique::PCSS][i].clone();
-        let mut p = dim(point(position, 22.0), color);
-        if technique == Technique::PCSS {
-            p.radius = 0.15;
-        }
-        lights.push(SceneLight {
-            name: format!("lamp {i}"),
-            light: Light::Point(p),
-            shadow: Some(own(technique, Some(512))),
-        });
-    }
-    let mut scene = b.finish(
-        "lamps",
-        camera,
-        sun_light,
-        spot(Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), 38.0, 25.0),
-        dim(point(points[0].0, 22.0), points[0].1),
-    );
-    scene.ambient = Vec3::splat(0.06);
-    scene.lights = lights;
-    scene
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -554,6 +454,44 @@ mod tests {
             let e = build(bad).unwrap_err();
             assert!(matches!(e, BuiltinError::InstancesOutOfRange(_)), "{bad}: {e}");
             assert!(e.to_string().contains("10 to 4000000"), "{e}");
+        }
+    }
+
+    #[test]
+    fn lamps_n_lights_each_point_of_its_ground_by_the_same_few_lamps() {
+        for count in [1, 8, 32, 64] {
+            let scene = build(&format!("lamps:{count}")).unwrap();
+            scene.validate().unwrap();
+            assert_eq!(scene.name, format!("lamps:{count}"));
+            assert_eq!(scene.lights.len(), count);
+            let lamps: Vec<PointLight> = scene
+                .lights
+                .iter()
+                .map(|l| match l.light {
+                    crate::Light::Point(p) => p,
+                    other => panic!("{}: {other:?} is not a lamp", l.name),
+                })
+                .collect();
+            // Every point of the ground among the lamps sees a few of them, the same
+            // few whatever their number.
+            let (lo, hi) = lamps
+                .iter()
+                .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), l| (lo.min(l.position), hi.max(l.position)));
+            let mut seen = (usize::MAX, 0);
+            for i in 0..=40 {
+                for j in 0..=40 {
+                    let t = Vec3::new(i as f32 / 40.0, 0.0, j as f32 / 40.0);
+                    let p = Vec3::new(lo.x, 0.0, lo.z) + t * (hi - lo) * Vec3::new(1.0, 0.0, 1.0);
+                    let n = lamps.iter().filter(|l| l.position.distance(p) <= l.range).count();
+                    seen = (seen.0.min(n), seen.1.max(n));
+                }
+            }
+            assert!(seen.0 >= 1 && seen.1 <= 6, "lamps:{count}: ground points see {seen:?} lamps");
+        }
+        for bad in ["lamps:", "lamps:0", "lamps:65", "lamps:x"] {
+            let e = build(bad).unwrap_err();
+            assert!(matches!(e, BuiltinError::LampsOutOfRange(_)), "{bad}: {e}");
+            assert!(e.to_string().contains("1 to 64"), "{e}");
         }
     }
 

@@ -1,0 +1,84 @@
+// The light-list lighting pass (tiled forward shading, Olsson & Assarsson 2011): the
+// scene drawn once over the prepass's depths, each pixel summing the lights its
+// 16 × 16 tile lists. A light's visibility comes from its layer of the shadow mask,
+// which its own mask pass filled with its own technique (shadow_mask.wgsl), so lights
+// of every technique and kind share this one pipeline. The sum is the per-light
+// passes' sum, shaded by the same functions (shading.wgsl), quantised once. Under
+// the cascade view the sum is tinted by the reported light's layer (the per-light
+// passes tint each light's term by its own). Camera: camera.wgsl; vertex stage and
+// normals: surface.wgsl; their outputs and tints: lighting_common.wgsl.
+
+struct LightList {
+    ambient: vec3<f32>,
+    shown: u32,      // the reported light: its visibility goes to the visibility target
+    tiles_x: u32,    // tiles per row
+    count: u32,      // lights in the list
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(2) @binding(0) var<uniform> list: LightList;
+@group(2) @binding(1) var<storage, read> emitters: array<Emitter>;
+// LIGHT_WORDS words per tile, row by row: bit i of the tile's words is light i.
+@group(2) @binding(2) var<storage, read> tile_lights: array<u32>;
+// Layer i: light i's visibility + 2 × the shadow-map layer that shaded it.
+@group(2) @binding(3) var shadow_masks: texture_2d_array<f32>;
+
+// Light `i`'s mask at `texel`: (visibility, layer, traced flag).
+fn listed_visibility(texel: vec2<u32>, i: u32) -> vec3<f32> {
+    let packed = textureLoad(shadow_masks, texel, i, 0).x;
+    let layer = floor(packed * 0.5);
+    let flagged = u32(layer) >= TRACED_LAYER_FLAG;
+    return vec3<f32>(packed - 2.0 * layer, f32(u32(layer) % TRACED_LAYER_FLAG), select(0.0, 1.0, flagged));
+}
+
+@fragment
+fn fs_main(in: SurfaceVertex) -> FragmentOut {
+    let inst = instances[in.instance];
+    if alpha_cut(inst, in.uv) {
+        discard;
+    }
+    let n = surface_normals(in).shading;
+    let albedo = base_color_of(inst, in.uv).rgb;
+    let v = normalize(camera.eye - in.world);
+    let texel = vec2<u32>(in.clip.xy);
+    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
+
+    // The reported light's layer covers every pixel; the others only the tiles that
+    // list them.
+    let shown = listed_visibility(texel, list.shown);
+    var color = list.ambient * albedo;
+    var traced = false;
+    let tile = (texel.y / LIGHT_TILE) * list.tiles_x + texel.x / LIGHT_TILE;
+    for (var word = 0u; word < LIGHT_WORDS; word++) {
+        var bits = tile_lights[tile * LIGHT_WORDS + word];
+        while bits != 0u {
+            let i = word * 32u + firstTrailingBit(bits);
+            bits &= bits - 1u;
+            let e = emitters[i];
+            let geometry = emitter_geometry(e, in.world);
+            if geometry.w <= 0.0 {
+                continue;
+            }
+            let shadow = listed_visibility(texel, i);
+            let direct = e.radiance * geometry.w * blinn_phong(albedo, inst.specular, inst.shininess, n, geometry.xyz, v);
+            color += shadow.x * direct;
+            traced = traced || shadow.z > 0.0;
+        }
+    }
+    // The cascade view tints by the reported light's layers.
+    if camera.debug_view == DEBUG_VIEW_CASCADES {
+        color *= CASCADE_TINTS[u32(shown.y)];
+    }
+    if camera.debug_view == DEBUG_VIEW_TRACED && traced {
+        color = mix(color, vec3<f32>(1.0, 0.0, 1.0), 0.6);
+    }
+
+    var out: FragmentOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.visibility = shown.x;
+    out.position = vec4<f32>(in.world, view_depth);
+    out.normal = vec4<f32>(n, 0.0);
+    out.object_id = inst.object_id;
+    return out;
+}
