@@ -379,6 +379,7 @@ fn config_report(config: &Config, series: &Series, last: &FrameCost) -> ConfigRe
             .collect(),
         layers: series.order.iter().filter(is_layer).filter_map(|n| series.summary(n)).collect(),
         shadow_draws: last.stats.shadow_draws,
+        shadow_commands: last.stats.shadow_commands,
         shadow_instances: last.stats.shadow_instances,
         shadow_triangles: last.stats.shadow_triangles,
         layer_drawn: last
@@ -389,8 +390,9 @@ fn config_report(config: &Config, series: &Series, last: &FrameCost) -> ConfigRe
                 light
                     .layer_draws
                     .iter()
+                    .zip(&light.layer_commands)
                     .zip(&light.layer_triangles)
-                    .map(|(&draws, &triangles)| LayerDrawn { draws, triangles })
+                    .map(|((&draws, &commands), &triangles)| LayerDrawn { draws, commands, triangles })
             })
             .collect(),
         lighting_draws: last.stats.lighting_draws,

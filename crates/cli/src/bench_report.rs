@@ -20,6 +20,8 @@ pub(crate) struct Summary {
 #[derive(Clone, Copy, Debug, Serialize)]
 pub(crate) struct LayerDrawn {
     pub(crate) draws: u32,
+    /// Draw commands recorded for them: one per draw, or one per multi-draw.
+    pub(crate) commands: u32,
     pub(crate) triangles: u64,
 }
 
@@ -34,6 +36,7 @@ pub(crate) struct ConfigReport {
     pub(crate) layers: Vec<Summary>,
     /// Draw calls, instances and triangles of one frame.
     pub(crate) shadow_draws: u32,
+    pub(crate) shadow_commands: u32,
     pub(crate) shadow_instances: u32,
     pub(crate) shadow_triangles: u64,
     /// What each of `layers` drew in the last frame, in the same order.
@@ -168,9 +171,12 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
     if has_rays {
         let _ = write!(md, " traced, % of screen (rays) |");
     }
-    let _ = writeln!(md, " shadow draws (instances, triangles) | lighting draws (instances) |");
+    let _ = writeln!(
+        md,
+        " shadow draws (instances, triangles) | shadow draw commands | lighting draws (instances) |"
+    );
     let cells = columns.len()
-        + 3
+        + 4
         + usize::from(sweep.is_some())
         + 2 * usize::from(has_baseline)
         + usize::from(has_rays);
@@ -199,18 +205,21 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         }
         let _ = writeln!(
             md,
-            " {} ({}, {}) | {} ({}) |",
+            " {} ({}, {}) | {} | {} ({}) |",
             config.shadow_draws,
             config.shadow_instances,
             config.shadow_triangles,
+            config.shadow_commands,
             config.lighting_draws,
             config.lighting_instances
         );
     }
     if report.configs.iter().any(|c| c.layers.len() > 1) {
         let _ = writeln!(md, "\nEach shadow-map layer (light L, layer: cascade or cube face):\n");
-        let _ =
-            writeln!(md, "| technique | layer | median (p95) | draws | triangles |\n|---|---|---|---|---|");
+        let _ = writeln!(
+            md,
+            "| technique | layer | median (p95) | draws | commands | triangles |\n|---|---|---|---|---|---|"
+        );
         for config in &report.configs {
             let label = match &config.sweep_value {
                 Some(v) => format!("{} {}={v}", config.technique, sweep.unwrap_or("")),
@@ -221,10 +230,11 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
                 let count = |n: Option<u64>| n.map_or("–".to_string(), |n| n.to_string());
                 let _ = writeln!(
                     md,
-                    "| {label} | {} | {} | {} | {} |",
+                    "| {label} | {} | {} | {} | {} | {} |",
                     layer.name.trim_start_matches("shadow "),
                     cell(Some(layer)),
                     count(drawn.map(|d| u64::from(d.draws))),
+                    count(drawn.map(|d| u64::from(d.commands))),
                     count(drawn.map(|d| d.triangles)),
                 );
             }

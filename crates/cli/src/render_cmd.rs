@@ -122,8 +122,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             String::new()
         };
         eprintln!(
-            "gnomon: draws: {} in the shadow pass, {} in the lighting pass{prepass}; {} pipeline and {} bind group changes",
-            st.shadow_draws, st.lighting_draws, st.pipeline_changes, st.bind_group_changes
+            "gnomon: draws: {} in the shadow pass ({} draw commands), {} in the lighting pass{prepass}; {} pipeline and {} bind group changes",
+            st.shadow_draws,
+            st.shadow_commands,
+            st.lighting_draws,
+            st.pipeline_changes,
+            st.bind_group_changes
         );
         if let Some(format) = frame.moment_format {
             let why = match format {
@@ -252,6 +256,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         format!("{}²", light.resolution)
     };
     let per_layer: Vec<String> = light.layer_draws.iter().map(u32::to_string).collect();
+    let commands: Vec<String> = light.layer_commands.iter().map(u32::to_string).collect();
     let triangles: Vec<String> = light.layer_triangles.iter().map(u64::to_string).collect();
     let ms = |label: &str, t: Option<f64>| t.map(|t| format!(", {label} {t:.2} ms")).unwrap_or_default();
     let count = |state: LayerCache| light.layer_cache.iter().filter(|&&s| s == state).count();
@@ -260,12 +265,13 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         (kept, drawn) => format!(" (cache: {kept} layers kept, {drawn} drawn)"),
     };
     format!(
-        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}] of {} triangles [{}]{cache}{}{}{}{}{}",
+        "light {index} `{}` ({}, {}, map {map}): {} shadow draws [{}] in [{}] commands, of {} triangles [{}]{cache}{}{}{}{}{}",
         light.name,
         light.kind,
         light.technique.name(),
         light.shadow_draws(),
         per_layer.join(" "),
+        commands.join(" "),
         light.layer_triangles.iter().sum::<u64>(),
         triangles.join(" "),
         ms("shadow", light.shadow_ms),

@@ -57,6 +57,10 @@ pub struct Gpu {
     pub limits: wgpu::Limits,
     /// Nanoseconds per timestamp tick, when the device can time passes.
     pub timestamp_period_ns: Option<f32>,
+    /// Whether draws can come from a buffer of arguments with their own first
+    /// instance: indirect execution and `INDIRECT_FIRST_INSTANCE`. Without it, a
+    /// layer's draws are issued one by one (`DrawSubmission`).
+    pub indirect_draws: bool,
 }
 
 impl Gpu {
@@ -94,11 +98,15 @@ impl Gpu {
             // Timestamps time each pass where the adapter has them (lavapipe does);
             // 32-bit float filtering lets moment maps keep full precision; unclipped
             // depth lets a sun's map clamp casters in front of its near plane onto it
-            // ("pancaking"), so the depth range need only span the receivers.
+            // ("pancaking"), so the depth range need only span the receivers; a first
+            // instance in indirect draws lets a layer's draws be one multi-draw, and
+            // indirect count lets the backend issue it as one command.
             required_features: adapter.features()
                 & (wgpu::Features::TIMESTAMP_QUERY
                     | wgpu::Features::FLOAT32_FILTERABLE
-                    | wgpu::Features::DEPTH_CLIP_CONTROL),
+                    | wgpu::Features::DEPTH_CLIP_CONTROL
+                    | wgpu::Features::INDIRECT_FIRST_INSTANCE
+                    | wgpu::Features::MULTI_DRAW_INDIRECT_COUNT),
             required_limits: limits.clone(),
             ..Default::default()
         }))
@@ -108,7 +116,15 @@ impl Gpu {
         })?;
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
-        Ok(Self { device, queue, info: GpuInfo::of(adapter_info), limits, timestamp_period_ns })
+        let indirect_draws = indirect_draws(adapter, &device);
+        Ok(Self {
+            device,
+            queue,
+            info: GpuInfo::of(adapter_info),
+            limits,
+            timestamp_period_ns,
+            indirect_draws,
+        })
     }
 
     /// Wraps a device the host application already has, sharing it: Gnomon draws
@@ -125,6 +141,7 @@ impl Gpu {
             info: GpuInfo::of(adapter_info),
             limits: device.limits(),
             timestamp_period_ns,
+            indirect_draws: indirect_draws(adapter, device),
         }
     }
 
@@ -203,4 +220,12 @@ fn headless_adapter() -> Result<wgpu::Adapter, RenderError> {
             Err(RenderError::no_adapter_besides(gl.ok().map(|a| a.get_info()).as_ref()))
         }
     }
+}
+
+/// Whether `device` on `adapter` can draw from a buffer of arguments that each carry
+/// their first instance.
+fn indirect_draws(adapter: &wgpu::Adapter, device: &wgpu::Device) -> bool {
+    let execution =
+        adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION);
+    execution && device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
 }

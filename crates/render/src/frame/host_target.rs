@@ -34,7 +34,12 @@ impl Renderer {
         let culled = cull(uploaded, &plan);
         let gpu = self.gpu.clone();
         gpu.checked("rendering into the host's target", || {
-            let mut rec = Recording { encoder, clock: PassClock::off(), stats: DrawStats::default() };
+            let mut rec = Recording {
+                encoder,
+                clock: PassClock::off(),
+                stats: DrawStats::default(),
+                layer_commands: Default::default(),
+            };
             let drawn = self.record_passes(&mut rec, uploaded, &settings, &plan, &culled, Readback::NONE);
             self.passes.blit.record(&gpu.device, &mut self.pool, rec.encoder, &drawn.color, target);
             rec.stats

@@ -188,7 +188,7 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.passes.light_list.pipeline);
+        pass.set_pipeline(self.passes.light_list.pipeline(&gpu.device));
         pass.set_bind_group(0, &first.scene, &[]);
         pass.set_bind_group(1, shared.camera_group, &[]);
         pass.set_bind_group(2, &group, &[]);

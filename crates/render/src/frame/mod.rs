@@ -7,6 +7,7 @@
 mod baseline;
 mod bindings;
 mod cull;
+mod depth_pass;
 mod host_target;
 mod late;
 mod light_passes;

@@ -138,9 +138,13 @@ pub struct LightStats {
     pub technique: Technique,
     /// Texels per side of each of its layers (1 for a technique that reads no map).
     pub resolution: u32,
-    /// Draw calls into each layer of its map (one per cascade, six for a cube): the
+    /// Draws into each layer of its map (one per cascade, six for a cube): the
     /// casters that survived culling against that layer's frustum.
     pub layer_draws: Vec<u32>,
+    /// Draw commands this frame recorded into each layer: one per draw, or one per
+    /// multi-draw of draws that share a pipeline (`DrawSubmission::Indirect`); 0 for a
+    /// kept layer.
+    pub layer_commands: Vec<u32>,
     /// Instances drawn into each layer: those whose bounds reach into its frustum.
     pub layer_instances: Vec<u32>,
     /// Triangles drawn into each layer: every triangle of those instances, less the
@@ -194,8 +198,11 @@ impl LightStats {
 /// What a frame submitted: the CPU-side cost of drawing the scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct DrawStats {
-    /// Draw calls in the shadow pass.
+    /// Draws in the shadow passes, every layer of every light together.
     pub shadow_draws: u32,
+    /// Draw commands recorded into the shadow passes: one per draw, or one per
+    /// multi-draw where draws come from a buffer of arguments (`DrawSubmission`).
+    pub shadow_commands: u32,
     /// Draw calls in the lighting pass.
     pub lighting_draws: u32,
     /// Draw calls in the mask path's prepass.
@@ -215,6 +222,7 @@ pub struct DrawStats {
 impl DrawStats {
     pub(crate) fn add(&mut self, other: &DrawStats) {
         self.shadow_draws += other.shadow_draws;
+        self.shadow_commands += other.shadow_commands;
         self.lighting_draws += other.lighting_draws;
         self.prepass_draws += other.prepass_draws;
         self.pipeline_changes += other.pipeline_changes;
@@ -483,18 +491,21 @@ impl TimedLights {
         plan: &super::plan::FramePlan,
         culled: &super::cull::Culled,
         cache_uses: &[Vec<super::map_cache::LayerCache>],
+        commands: &super::record::LayerCommands,
     ) -> Self {
         let lights = plan
             .lights
             .iter()
             .zip(&culled.layers)
             .zip(cache_uses)
-            .map(|((light, layers), cache)| LightStats {
+            .enumerate()
+            .map(|(index, ((light, layers), cache))| LightStats {
                 name: light.name.clone(),
                 kind: light.light.type_name(),
                 technique: light.technique.technique(),
                 resolution: light.map_resolution(),
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
+                layer_commands: commands.of(index, layers.len()),
                 layer_instances: layers.iter().map(Visible::instances).collect(),
                 layer_triangles: layers.iter().map(Visible::triangles).collect(),
                 layer_cache: cache.clone(),

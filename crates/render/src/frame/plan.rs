@@ -223,15 +223,15 @@ impl Renderer {
                 granularity: Granularity::Instances,
             }]);
             let view = self.pool.view(&depth, ViewKey::default());
-            let pass = super::record::DepthPass {
+            let pass = super::depth_pass::DepthPass {
                 settings: &prepass,
                 light: &camera_as_light,
                 target_view: &view,
                 visible: &seen[0],
                 target: DepthTarget::Projected,
                 unclipped: false,
-                start: super::record::DepthStart::Clear,
-                area: super::record::DepthArea::Whole,
+                start: super::depth_pass::DepthStart::Clear,
+                area: super::depth_pass::DepthArea::Whole,
             };
             self.record_depth_pass(&mut encoder, uploaded, &pass, None);
             let planes = Planes::new(camera.near, camera.far);

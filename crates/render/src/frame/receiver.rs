@@ -118,7 +118,12 @@ impl Renderer {
         let culled = cull(uploaded, &plan);
         let gpu = self.gpu.clone();
         gpu.checked("recording the shadows for the host's shader", || {
-            let mut rec = Recording { encoder, clock: PassClock::off(), stats: DrawStats::default() };
+            let mut rec = Recording {
+                encoder,
+                clock: PassClock::off(),
+                stats: DrawStats::default(),
+                layer_commands: Default::default(),
+            };
             let (width, height) = (settings.image.width, settings.image.height);
             let camera_gpu = CameraGpu::new(&plan.camera, width, height, settings.image.debug_view);
             let camera = self.pool.uniform(&gpu.queue, "camera", &camera_gpu);

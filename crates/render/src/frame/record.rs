@@ -1,7 +1,7 @@
 //! Recording a frame: culling every layer and the camera, then each light's shadow
-//! maps (one depth pass per layer) and moment map, the screen-space passes on the
-//! mask path, and each light's lighting pass, into one command buffer. Every
-//! resource comes from the renderer's pool.
+//! maps (one depth pass per layer, `depth_pass.rs`) and moment map, the screen-space
+//! passes on the mask path, and the lighting (`light_passes.rs`), into one command
+//! buffer. Every resource comes from the renderer's pool.
 
 use std::time::Instant;
 
@@ -22,20 +22,13 @@ use super::{
 };
 use crate::{
     GpuScene, RenderError,
-    gpu_scene::{IndexOrder, Visible},
-    gpu_types::VertexStream,
     layout::ShadowLayout,
-    passes::{
-        begin_depth_pass,
-        lighting::MapLookup,
-        moments::MomentInput,
-        shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
-    },
+    passes::{lighting::MapLookup, moments::MomentInput},
     pool::{Binding, ViewKey},
     rays::{self, RefineLists},
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
-    uniforms::{CameraGpu, LightGpu},
+    uniforms::CameraGpu,
 };
 
 /// What a submission copies back.
@@ -77,6 +70,33 @@ pub(super) struct Recording<'e> {
     pub encoder: &'e mut wgpu::CommandEncoder,
     pub clock: PassClock,
     pub stats: DrawStats,
+    pub layer_commands: LayerCommands,
+}
+
+/// The draw commands recorded into each layer of each light, every pass of a layer
+/// together (its still casters, its strips, its moving casters).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct LayerCommands(Vec<Vec<u32>>);
+
+impl LayerCommands {
+    /// Counts `commands` more for layer `layer` of light `light`.
+    pub fn add(&mut self, light: usize, layer: usize, commands: u32) {
+        if self.0.len() <= light {
+            self.0.resize(light + 1, Vec::new());
+        }
+        let layers = &mut self.0[light];
+        if layers.len() <= layer {
+            layers.resize(layer + 1, 0);
+        }
+        layers[layer] += commands;
+    }
+
+    /// Light `light`'s count per layer, for its `layers` layers (0 for a layer that
+    /// recorded nothing).
+    pub fn of(&self, light: usize, layers: usize) -> Vec<u32> {
+        let recorded = self.0.get(light).map(Vec::as_slice).unwrap_or(&[]);
+        (0..layers).map(|l| recorded.get(l).copied().unwrap_or(0)).collect()
+    }
 }
 
 /// A light's groups for its passes from the camera.
@@ -109,73 +129,6 @@ impl LightMaps {
     }
 }
 
-/// One depth-only pass: a shadow-map layer, or SDSM's camera prepass.
-pub(super) struct DepthPass<'a> {
-    pub settings: &'a Settings,
-    /// The uniform whose `clip_from_world` projects the geometry.
-    pub light: &'a LightGpu,
-    pub target_view: &'a wgpu::TextureView,
-    pub visible: &'a Visible,
-    pub target: DepthTarget,
-    /// Clamp depth instead of clipping it.
-    pub unclipped: bool,
-    /// What the pass starts from.
-    pub start: DepthStart,
-    /// Where it draws.
-    pub area: DepthArea,
-}
-
-/// Where a depth pass draws.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) enum DepthArea {
-    /// The whole target.
-    Whole,
-    /// These rectangles of it only: every run is drawn once into each.
-    Strips(Vec<ScissorRect>),
-}
-
-/// A rectangle of a target, in texels from its top-left corner.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct ScissorRect {
-    pub x: u32,
-    pub y: u32,
-    pub width: u32,
-    pub height: u32,
-}
-
-impl ScissorRect {
-    /// The projection of the part of a `resolution`² target that this rectangle
-    /// covers, widened by a texel each way, when the whole is `clip_from_world`: its
-    /// clip volume is the rectangle's, for culling what it may draw.
-    pub fn clip_from_world(&self, clip_from_world: glam::Mat4, resolution: u32) -> glam::Mat4 {
-        let r = resolution as f32;
-        // NDC x runs with texel columns; NDC y against texel rows.
-        let (x0, x1) = (self.x as f32 - 1.0, (self.x + self.width) as f32 + 1.0);
-        let (y0, y1) = (self.y as f32 - 1.0, (self.y + self.height) as f32 + 1.0);
-        let (left, right) = (2.0 * x0 / r - 1.0, 2.0 * x1 / r - 1.0);
-        let (bottom, top) = (1.0 - 2.0 * y1 / r, 1.0 - 2.0 * y0 / r);
-        let (cx, cy) = (0.5 * (left + right), 0.5 * (bottom + top));
-        let (hx, hy) = (0.5 * (right - left), 0.5 * (top - bottom));
-        // x' = (x − cx·w) / hx, y' = (y − cy·w) / hy: the rectangle's NDC onto [−1, 1].
-        let onto = glam::Mat4::from_cols(
-            glam::Vec4::new(1.0 / hx, 0.0, 0.0, 0.0),
-            glam::Vec4::new(0.0, 1.0 / hy, 0.0, 0.0),
-            glam::Vec4::Z,
-            glam::Vec4::new(-cx / hx, -cy / hy, 0.0, 1.0),
-        );
-        onto * clip_from_world
-    }
-}
-
-/// What a depth pass starts from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum DepthStart {
-    /// Cleared to the far plane.
-    Clear,
-    /// What the target holds: a copy of a kept layer, to draw moving casters over.
-    Keep,
-}
-
 impl Renderer {
     /// Plans, culls, records and submits a frame, and reads its pass times.
     pub(super) fn submit(
@@ -204,7 +157,7 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        let untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses());
+        let untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
         let times = recorded.times.take().map(PendingTimes::submitted);
         let mut timed = match (request.times, times) {
             (_, None) => untimed,
@@ -239,16 +192,18 @@ impl Renderer {
             encoder: &mut encoder,
             clock: PassClock::new(&gpu, &mut self.pool, timed_passes, request.clock),
             stats: DrawStats::default(),
+            layer_commands: LayerCommands::default(),
         };
         self.map_cache.begin_frame(plan.lights.len());
         let drawn = self.record_passes(&mut rec, uploaded, settings, plan, culled, request.readback);
-        let Recording { clock, stats, .. } = rec;
+        let Recording { clock, stats, layer_commands, .. } = rec;
         let times = clock.resolve(&mut self.pool, &mut encoder);
         gpu.queue.submit([encoder.finish()]);
         Recorded {
             readbacks: drawn.readbacks,
             times: Some(times),
             stats,
+            layer_commands,
             color: drawn.color,
             shadow_map: drawn.shadow_map,
             submitted_at: Instant::now(),
@@ -400,78 +355,6 @@ impl Renderer {
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
-
-    /// Records a depth-only pass with the shadow pipelines, drawing the runs
-    /// `pass.visible` holds: a shadow-map layer's casters, or what the camera sees for
-    /// SDSM's prepass. Returns the stats of what it recorded.
-    pub(super) fn record_depth_pass(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        uploaded: &GpuScene,
-        depth: &DepthPass,
-        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
-    ) -> DrawStats {
-        let gpu = &self.gpu;
-        let light_buffer = self.pool.uniform(&gpu.queue, "light", depth.light);
-        let group = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
-        let bias = &depth.settings.shadow.bias;
-        let mut stats = DrawStats::default();
-        let load = match depth.start {
-            DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
-            DepthStart::Keep => wgpu::LoadOp::Load,
-        };
-        let mut pass = begin_depth_pass(encoder, "shadow", depth.target_view, load, timestamp_writes);
-        pass.set_bind_group(0, &group, &[]);
-        stats.bind_group_changes += 1;
-        // The runs come opaque first (no bind group changes at all), then the
-        // alpha-masked ones, texture by texture: the pipeline and the material's bind
-        // group change only between batches that need it.
-        let mut pipeline: Option<ShadowPipelineKey> = None;
-        let mut stream: Option<VertexStream> = None;
-        let mut bound = None;
-        let rects: Vec<Option<ScissorRect>> = match &depth.area {
-            DepthArea::Whole => vec![None],
-            DepthArea::Strips(strips) => strips.iter().copied().map(Some).collect(),
-        };
-        let runs = rects
-            .iter()
-            .flat_map(|rect| depth.visible.runs.iter().enumerate().map(move |(i, run)| (*rect, i, run)));
-        for (rect, index, run) in runs {
-            if let (Some(rect), 0) = (rect, index) {
-                pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
-            }
-            let batch = &uploaded.batches[run.batch as usize];
-            let key = ShadowPipelineKey::new(
-                bias,
-                batch.sides,
-                if batch.masked { Coverage::Masked } else { Coverage::Opaque },
-                DepthRange::clamped_if(depth.unclipped),
-                depth.target,
-            );
-            if pipeline != Some(key) {
-                let wanted = ShadowPipelineShape::of(&key).stream;
-                match stream {
-                    None => uploaded.bind_geometry(&mut pass, wanted, IndexOrder::Clusters),
-                    Some(bound_stream) if bound_stream != wanted => uploaded.bind_stream(&mut pass, wanted),
-                    Some(_) => {}
-                }
-                stream = Some(wanted);
-                pass.set_pipeline(self.passes.shadow.pipeline(&gpu.device, &key));
-                pipeline = Some(key);
-                stats.pipeline_changes += 1;
-            }
-            if batch.masked && bound != Some(batch.material_group) {
-                pass.set_bind_group(1, &uploaded.material_groups[batch.material_group], &[]);
-                bound = Some(batch.material_group);
-                stats.bind_group_changes += 1;
-            }
-            GpuScene::draw_run(&mut pass, batch, run);
-            stats.shadow_draws += 1;
-        }
-        stats.shadow_instances = depth.visible.instances();
-        stats.shadow_triangles = depth.visible.triangles();
-        stats
-    }
 }
 
 /// What a frame's passes drew.
@@ -489,6 +372,7 @@ pub(super) struct Recorded {
     /// Taken by the frame's timing once submitted.
     pub times: Option<PendingTimes>,
     pub stats: DrawStats,
+    pub layer_commands: LayerCommands,
     pub color: wgpu::Texture,
     pub shadow_map: wgpu::Texture,
     pub submitted_at: Instant,

@@ -12,9 +12,10 @@ use gnomon_scene::{
 use super::{
     Renderer,
     cull::layer_view,
+    depth_pass::{DepthArea, DepthPass, DepthStart, ScissorRect},
     map_cache::{LayerKey, LayerPlan},
     plan::LightPlan,
-    record::{DepthArea, DepthPass, DepthStart, Recording, ScissorRect},
+    record::Recording,
 };
 use crate::{
     GpuScene,
@@ -62,6 +63,8 @@ struct Timestamps {
 /// One layer's pass of a light's map.
 struct LayerPass<'a> {
     light: &'a LightPlan,
+    /// The light's index in the frame.
+    light_index: usize,
     layer: usize,
     visible: &'a Visible,
     casters: Casters,
@@ -104,6 +107,7 @@ impl Renderer {
             );
             let pass = LayerPass {
                 light,
+                light_index: light_index as usize,
                 layer,
                 visible,
                 casters: Casters::All,
@@ -149,6 +153,7 @@ impl Renderer {
             let cache_view = self.pool.view(&cache, ViewKey::layer(layer as u32));
             let still = |start, area| LayerPass {
                 light,
+                light_index: light_index as usize,
                 layer,
                 visible,
                 casters: Casters::Still,
@@ -182,6 +187,7 @@ impl Renderer {
                 let map_view = self.pool.view(&map, ViewKey::layer(layer as u32));
                 let pass = LayerPass {
                     light,
+                    light_index: light_index as usize,
                     layer,
                     visible,
                     casters: Casters::Moving,
@@ -248,6 +254,7 @@ impl Renderer {
         let writes = timed.and_then(|t| rec.clock.render_part(t.slot, t.part));
         let drawn = self.record_depth_pass(rec.encoder, uploaded, &pass, writes);
         rec.stats.add(&drawn);
+        rec.layer_commands.add(layer.light_index, layer.layer, drawn.shadow_commands);
     }
 }
 

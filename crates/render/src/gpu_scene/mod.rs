@@ -354,6 +354,37 @@ impl GpuScene {
     }
 }
 
+/// One draw's arguments as an indirect draw reads them (Vulkan's
+/// `VkDrawIndexedIndirectCommand`, wgpu's `DrawIndexedIndirectArgs`): what
+/// [`GpuScene::draw_run`] passes to `draw_indexed`, from a buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct DrawArgs {
+    pub index_count: u32,
+    pub instance_count: u32,
+    pub first_index: u32,
+    pub base_vertex: i32,
+    pub first_instance: u32,
+}
+
+impl DrawArgs {
+    /// Bytes from one draw's arguments to the next's.
+    pub const SIZE: u64 = std::mem::size_of::<DrawArgs>() as u64;
+
+    /// The arguments of `run`, of `batch`.
+    pub fn of(batch: &Batch, run: &Run) -> Self {
+        DrawArgs {
+            index_count: run.indices.end - run.indices.start,
+            instance_count: run.instances.end - run.instances.start,
+            first_index: run.indices.start,
+            base_vertex: batch.base_vertex,
+            first_instance: run.instances.start,
+        }
+    }
+}
+
+const _: () = assert!(DrawArgs::SIZE == 20, "tightly packed, as indirect draws read them");
+
 /// The clusters of each mesh that a batch of one shadow-casting instance draws
 /// (meshes drawn by several instances are culled instance by instance), built in
 /// parallel.

@@ -173,11 +173,14 @@ pub(crate) fn light_list_wgsl() -> String {
     compose_wgsl(&refs)
 }
 
-/// The light-list pipeline and the layout of its group 2.
+/// The light-list pipeline, built on first use (a host's device opened with wgpu's
+/// default limits has too few colour-attachment bytes for it, and never draws it), and
+/// the layout of its group 2.
 pub(crate) struct LightListPass {
     /// Group 2: the list's uniform, the emitters, the tiles' light bits and the mask.
     pub group_layout: wgpu::BindGroupLayout,
-    pub pipeline: wgpu::RenderPipeline,
+    layout: wgpu::PipelineLayout,
+    pipeline: Option<wgpu::RenderPipeline>,
 }
 
 impl LightListPass {
@@ -210,24 +213,32 @@ impl LightListPass {
             ],
             immediate_size: 0,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("light list"),
-            source: wgpu::ShaderSource::Wgsl(light_list_wgsl().into()),
-        });
-        let targets: Vec<Option<wgpu::ColorTargetState>> =
-            TARGETS.iter().map(|&format| Some(wgpu::ColorTargetState::from(format))).collect();
-        // The prepass drew the depths: each pixel shades exactly the surface the mask
-        // passes saw.
-        let pipeline = SurfacePipeline {
-            label: "light list",
-            layout: &layout,
-            module: &module,
-            fragment_entry: "fs_main",
-            targets: &targets,
-            depth: SurfaceDepth::Equal,
-        }
-        .create(device);
-        Self { group_layout, pipeline }
+        Self { group_layout, layout, pipeline: None }
+    }
+
+    /// The pipeline: groups 0 (the scene and the first light), 1 (the camera), 2
+    /// (`group_layout`) and 3 (each draw's material).
+    pub fn pipeline(&mut self, device: &wgpu::Device) -> &wgpu::RenderPipeline {
+        let layout = &self.layout;
+        self.pipeline.get_or_insert_with(|| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("light list"),
+                source: wgpu::ShaderSource::Wgsl(light_list_wgsl().into()),
+            });
+            let targets: Vec<Option<wgpu::ColorTargetState>> =
+                TARGETS.iter().map(|&format| Some(wgpu::ColorTargetState::from(format))).collect();
+            // The prepass drew the depths: each pixel shades exactly the surface the mask
+            // passes saw.
+            SurfacePipeline {
+                label: "light list",
+                layout,
+                module: &module,
+                fragment_entry: "fs_main",
+                targets: &targets,
+                depth: SurfaceDepth::Equal,
+            }
+            .create(device)
+        })
     }
 }
 

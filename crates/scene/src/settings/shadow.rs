@@ -153,6 +153,10 @@ pub struct MapSettings {
     /// same either way: this only changes what it costs.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
     pub caster_culling: CasterCulling,
+    /// How each layer's draws are submitted. The map is the same either way: this only
+    /// changes what it costs.
+    #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow map"))]
+    pub draw_submission: DrawSubmission,
     /// What the map keeps across frames. The map is the same either way: this only
     /// changes what it costs.
     #[cfg_attr(
@@ -172,6 +176,7 @@ impl Default for MapSettings {
             depth_clamp: true,
             omni: OmniMap::default(),
             caster_culling: CasterCulling::default(),
+            draw_submission: DrawSubmission::default(),
             cache: MapCache::default(),
         }
     }
@@ -206,6 +211,22 @@ pub enum CasterCulling {
     /// Each instance as a whole, by its bounds: a large mesh is drawn whole into every
     /// layer that it reaches. The baseline that clusters are measured against.
     Instances,
+}
+
+/// How a shadow layer's draws are submitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum DrawSubmission {
+    /// One multi-draw per run of draws that share their state (pipeline, material,
+    /// scissor), from a buffer of draw arguments: a layer costs one command per
+    /// pipeline however many meshes it draws. Where the device cannot (no first
+    /// instance in indirect draws), the draws are issued one by one.
+    #[default]
+    Indirect,
+    /// One command per draw: the fallback, and the baseline indirect draws are
+    /// measured and tested against.
+    Direct,
 }
 
 /// The parametrization of a point light's map.
