@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 use gnomon_render::{Frame, GpuScene, LayerCache, OutputRequest, Renderer};
 use gnomon_scene::{
     Motion, Scene, Settings, builtin,
-    settings::{LightKind, MapCache, Partition},
+    settings::{LightKind, MapCache, Partition, Technique},
 };
 
 fn settings(light: LightKind, partition: Partition) -> Settings {
@@ -186,4 +186,68 @@ fn a_cascade_that_moves_by_whole_texels_scrolls_its_kept_map() {
         assert!(flipped * 10_000 <= pixels, "frame {frame}: {flipped} of {pixels} pixels' shadow differs");
     }
     assert!(scrolled >= 4, "only {scrolled} layers scrolled over 5 moves");
+}
+
+/// A filterable technique's moment map is kept with its depth map: a frame whose
+/// depth map is kept whole filters nothing, and shades as a frame drawn from scratch;
+/// depths drawn again, or a moving caster drawn over a copy of them, are filtered
+/// again.
+#[test]
+fn a_kept_depth_map_keeps_its_moment_map() {
+    for technique in [Technique::VSM, Technique::MSM_HAMBURGER] {
+        let mut scene = builtin::spheres();
+        let mut s = settings(LightKind::Sun, Partition::Cascades);
+        s.shadow.filter.technique = technique.clone();
+        let filtered = |f: &Frame| f.lights[0].filter_ms.is_some();
+        let same_shading = |f: &Frame, scene: &Scene| {
+            let scratch = scratch_frame(scene, &s);
+            let worst = f
+                .visibility
+                .iter()
+                .zip(&scratch.visibility)
+                .filter(|(a, b)| a.is_finite() && b.is_finite())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max);
+            assert_eq!(worst, 0.0, "{technique:?}: the visibility differs from scratch by {worst}");
+        };
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let mut uploaded = renderer.upload(&scene).unwrap();
+        let first = with_map(&mut renderer, &uploaded, &scene, &s);
+        if first.timings.is_none() {
+            support::figures::skipped("kept moment maps", "the frame has no pass times to tell a filter by");
+            return;
+        }
+        assert!(filtered(&first), "{technique:?}: the first frame filters");
+
+        // Still: the depths are kept whole, and their moments with them.
+        let again = with_map(&mut renderer, &uploaded, &scene, &s);
+        assert_eq!(again.lights[0].layer_cache, vec![LayerCache::Kept; 4]);
+        assert!(!filtered(&again), "{technique:?}: a kept map filters nothing");
+        same_shading(&again, &scene);
+        let created = renderer.creations();
+        let third = with_map(&mut renderer, &uploaded, &scene, &s);
+        assert_eq!(renderer.creations(), created, "{technique:?}: steady frames create nothing");
+        assert!(!filtered(&third));
+
+        // A still caster moves: the depths are drawn again, and so are their moments.
+        let crate_box = named(&scene, "box");
+        scene.instances[crate_box].world_from_object *= Mat4::from_translation(Vec3::new(1.0, 0.0, 1.0));
+        renderer.move_instances(&mut uploaded, &scene, &[crate_box]).unwrap();
+        let redrawn = with_map(&mut renderer, &uploaded, &scene, &s);
+        assert_eq!(redrawn.lights[0].layer_cache, vec![LayerCache::Drawn; 4]);
+        assert!(filtered(&redrawn), "{technique:?}: depths drawn again are filtered");
+        same_shading(&redrawn, &scene);
+
+        // A moving caster is drawn over a copy of the kept depths every frame: the
+        // moments are filtered from that copy every frame.
+        let ball = named(&scene, "sphere 1,1");
+        scene.instances[ball].motion = Motion::Dynamic;
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let uploaded = renderer.upload(&scene).unwrap();
+        for frame in 0..2 {
+            let over = with_map(&mut renderer, &uploaded, &scene, &s);
+            assert!(filtered(&over), "{technique:?}, frame {frame}: depths drawn over are filtered");
+            same_shading(&over, &scene);
+        }
+    }
 }

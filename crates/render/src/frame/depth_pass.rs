@@ -7,7 +7,7 @@
 
 use gnomon_scene::{Settings, settings::DrawSubmission};
 
-use super::Renderer;
+use super::{Renderer, bindings::scene_group, outputs::DrawStats};
 use crate::{
     GpuScene,
     gpu_scene::{DrawArgs, IndexOrder, Run, Visible},
@@ -18,8 +18,6 @@ use crate::{
     },
     uniforms::LightGpu,
 };
-
-use super::{bindings::scene_group, outputs::DrawStats};
 
 /// One depth-only pass: a shadow-map layer, or SDSM's camera prepass.
 pub(super) struct DepthPass<'a> {

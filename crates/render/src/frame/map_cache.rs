@@ -16,7 +16,7 @@
 
 use gnomon_scene::settings::BiasSettings;
 
-use super::plan::LightPlan;
+use super::{moment_cache::MomentCache, plan::LightPlan};
 use crate::passes::SHADOW_FORMAT;
 
 /// Everything a layer's still casters' depth depends on: its projection, and the
@@ -137,15 +137,31 @@ pub(super) struct MapCache {
     lights: Vec<Option<CachedMap>>,
     /// What the last recorded frame did with each light's layers.
     uses: Vec<Vec<LayerCache>>,
+    /// Whether each light's map this frame is its kept map unchanged: every layer
+    /// kept, and no caster moving over it.
+    kept_whole: Vec<bool>,
     /// Cache textures created, for [`super::Renderer::creations`].
     created: u64,
+    /// The moment maps filtered from the kept maps.
+    pub moments: MomentCache,
 }
 
 impl MapCache {
     /// A new frame of `lights` lights: forgets what the last one did.
     pub fn begin_frame(&mut self, lights: usize) {
         self.uses = vec![Vec::new(); lights];
+        self.kept_whole = vec![false; lights];
         self.lights.resize_with(lights.max(self.lights.len()), || None);
+    }
+
+    /// Light `index`'s map this frame is its kept map unchanged.
+    pub fn mark_kept_whole(&mut self, index: usize) {
+        self.kept_whole[index] = true;
+    }
+
+    /// Whether light `index`'s map this frame is its kept map unchanged.
+    pub fn kept_whole(&self, index: usize) -> bool {
+        self.kept_whole.get(index).copied().unwrap_or(false)
     }
 
     /// Light `index` drew its `layers` layers without the cache: its kept map is
@@ -197,9 +213,9 @@ impl MapCache {
         &self.uses
     }
 
-    /// How many cache textures it has created.
+    /// How many cache textures it has created, moment maps included.
     pub fn created(&self) -> u64 {
-        self.created
+        self.created + self.moments.created()
     }
 }
 

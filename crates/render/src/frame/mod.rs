@@ -12,6 +12,7 @@ mod host_target;
 mod late;
 mod light_passes;
 mod map_cache;
+mod moment_cache;
 mod outputs;
 mod plan;
 mod receiver;
@@ -131,8 +132,8 @@ impl Renderer {
     /// first frame of given settings, the same frame again adds none.
     pub fn creations(&self) -> Creations {
         let mut creations = self.pool.creations();
-        // The kept maps' textures live outside the pool, made again only when a map's
-        // size changes (`map_cache.rs`).
+        // The kept maps' textures (depths and moments) live outside the pool, made
+        // again only when a map's size changes (`map_cache.rs`, `moment_cache.rs`).
         creations.textures += self.map_cache.created();
         creations
     }

@@ -8,7 +8,7 @@ use std::time::Instant;
 use gnomon_math::screen_bounds::Viewport;
 use gnomon_scene::{
     Scene, Settings,
-    settings::{Lighting, Refine},
+    settings::{Lighting, MapCache as MapCacheSetting, Refine},
 };
 
 use super::{
@@ -16,6 +16,7 @@ use super::{
     bindings::{ShadowViews, scene_group},
     cull::{Culled, cull},
     light_passes::{MaskInputs, SharedLighting},
+    moment_cache::{MomentKey, MomentPlan},
     outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
     screen::MaskStart,
@@ -23,7 +24,10 @@ use super::{
 use crate::{
     GpuScene, RenderError,
     layout::ShadowLayout,
-    passes::{lighting::MapLookup, moments::MomentInput},
+    passes::{
+        lighting::MapLookup,
+        moments::{MomentInput, MomentLayout, MomentTarget},
+    },
     pool::{Binding, ViewKey},
     rays::{self, RefineLists},
     readback,
@@ -323,10 +327,29 @@ impl Renderer {
                 depth_view: &map_view,
                 light_buffer: &light_buffer,
             };
+            // Kept across frames along with the depth map; filtered again only where
+            // the depths or what the filter reads changed (`moment_cache.rs`).
+            let kept = match shadow.map.cache {
+                MapCacheSetting::StillCasters => {
+                    let (key, layout) = (MomentKey::of(light, &input), MomentLayout::of(&input));
+                    let depths_kept = self.map_cache.kept_whole(index as usize);
+                    Some(self.map_cache.moments.plan(&gpu.device, index as usize, key, layout, depths_kept))
+                }
+                MapCacheSetting::Off => {
+                    self.map_cache.moments.forget(index as usize);
+                    None
+                }
+            };
+            let whole = ViewKey::whole(wgpu::TextureViewDimension::D2Array);
+            let target = match &kept {
+                Some(MomentPlan::Keep(texture)) => return self.pool.view(texture, whole),
+                Some(MomentPlan::Filter(texture)) => MomentTarget::Kept(texture),
+                None => MomentTarget::Pooled,
+            };
             let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
             let writes = rec.clock.compute_writes(slot);
             let moments =
-                self.passes.moments.record(&gpu.device, &mut self.pool, rec.encoder, &input, writes);
+                self.passes.moments.record(&gpu.device, &mut self.pool, rec.encoder, &input, target, writes);
             rec.clock.end(&gpu, rec.encoder, slot);
             moments.view
         });

@@ -142,6 +142,9 @@ impl Renderer {
             |v: &Visible| v.runs.iter().any(|r| uploaded.batches[r.batch as usize].motion == Motion::Dynamic);
         let moving = layers.iter().any(moves);
         let map = if moving { self.shadow_map_texture(light) } else { cache.clone() };
+        if !moving && plans.iter().all(|p| *p == LayerPlan::Keep) {
+            self.map_cache.mark_kept_whole(light_index as usize);
+        }
         for (layer, visible) in layers.iter().enumerate() {
             if plans[layer] == LayerPlan::Keep && !moving {
                 continue;

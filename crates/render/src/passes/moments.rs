@@ -65,6 +65,39 @@ pub(crate) struct MomentInput<'a> {
     pub light_buffer: &'a wgpu::Buffer,
 }
 
+/// Where the moment pass writes its map.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum MomentTarget<'a> {
+    /// A texture of the pool, for this frame.
+    Pooled,
+    /// A texture kept across frames, of [`MomentLayout::of`] the input.
+    Kept(&'a wgpu::Texture),
+}
+
+/// The texture a moment map needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct MomentLayout {
+    pub size: wgpu::Extent3d,
+    pub mip_levels: u32,
+    pub format: wgpu::TextureFormat,
+}
+
+impl MomentLayout {
+    /// The usages a moment map is written and read with.
+    pub const USAGE: wgpu::TextureUsages =
+        wgpu::TextureUsages::STORAGE_BINDING.union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+    /// The texture `input`'s moment map fills: the technique's layers for every
+    /// cascade, with a mip chain where the technique filters through one.
+    pub fn of(input: &MomentInput) -> Self {
+        let MomentInput { map, settings, format, resolution, cascades, .. } = *input;
+        let mip_levels = if settings.mipmaps && map.mipmapped { resolution.ilog2() + 1 } else { 1 };
+        let layers = map.layers * cascades;
+        let size = wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers };
+        MomentLayout { size, mip_levels, format }
+    }
+}
+
 /// A filtered moment map, ready to bind to the lighting pass.
 pub(crate) struct MomentMap {
     /// All layers and mip levels (the view keeps the texture alive).
@@ -229,25 +262,28 @@ impl MomentPass {
     }
 
     /// Records the encoding, blur and mipmaps of `input.technique`'s map from the
-    /// depth map into a pooled texture, in one compute pass.
+    /// depth map into `target`, in one compute pass.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
         pool: &mut Pool,
         encoder: &mut wgpu::CommandEncoder,
         input: &MomentInput,
+        target: MomentTarget,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
     ) -> MomentMap {
-        let MomentInput { technique, map, settings, format, resolution, cascades, .. } = *input;
+        let MomentInput { technique, map, settings, format, resolution, .. } = *input;
         self.format_pipelines(device, format);
         self.encode_pipeline(device, technique, format);
         let pipelines = &self.formats[&format];
-        let mip_levels = if settings.mipmaps && map.mipmapped { resolution.ilog2() + 1 } else { 1 };
+        let MomentLayout { size, mip_levels, .. } = MomentLayout::of(input);
         // The technique's layers, for every cascade in turn.
-        let layers = map.layers * cascades;
-        let size = wgpu::Extent3d { width: resolution, height: resolution, depth_or_array_layers: layers };
-        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
-        let moments = pool.texture_with_mips("moment map", size, mip_levels, format, usage);
+        let layers = size.depth_or_array_layers;
+        let usage = MomentLayout::USAGE;
+        let moments = match target {
+            MomentTarget::Pooled => pool.texture_with_mips("moment map", size, mip_levels, format, usage),
+            MomentTarget::Kept(texture) => texture.clone(),
+        };
         let level = |level: u32| ViewKey {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             base_mip: level,
