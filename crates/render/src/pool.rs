@@ -383,7 +383,8 @@ mod tests {
     /// The zero-creation test counts what the pool creates; it proves that a steady
     /// frame creates nothing only if every per-frame creation goes through the pool.
     /// Outside it, only the one-time uploads (the scene, the casters' BVH), the
-    /// renderer's fixed bindings, and `ShadowRays`' batch queries (no frame: buffers
+    /// renderer's fixed bindings, the kept depth and moment maps (counted in
+    /// `Renderer::creations`), and `ShadowRays`' batch queries (no frame: buffers
     /// sized to each batch) may create GPU resources.
     #[test]
     fn only_the_pool_creates_per_frame_resources() {
@@ -391,6 +392,7 @@ mod tests {
             "pool.rs",
             "frame/bindings.rs",
             "frame/map_cache.rs",
+            "frame/moment_cache.rs",
             "gpu_scene/mod.rs",
             "gpu_scene/materials.rs",
             "passes/depth_baseline.rs",
