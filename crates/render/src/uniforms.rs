@@ -464,7 +464,7 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             radiance, kind, direction, range, position, cos_inner, cos_outer, _pad0, _pad1, _pad2,
         }),
         struct_layout!(light_list::LightListGpu as "LightList" {
-            ambient, shown, tiles_x, count, _pad0, _pad1,
+            ambient, shown, tiles_x, _pad0, _pad1, _pad2,
         }),
         struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
             world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,

@@ -156,7 +156,6 @@ impl Renderer {
             ambient: plan.lights[0].light_gpu.ambient,
             shown: plan.shown as u32,
             tiles_x: masks.tiles.tiles_x,
-            count: plan.lights.len() as u32,
             ..Default::default()
         };
         let uniform = self.pool.uniform(&gpu.queue, "light list", &uniform);

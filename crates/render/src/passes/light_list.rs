@@ -74,12 +74,12 @@ pub struct LightListGpu {
     pub shown: u32,
     /// Tiles per row of the image.
     pub tiles_x: u32,
-    /// Lights in the list.
-    pub count: u32,
-    /// Padding.
+    /// Padding to WGSL's 16-byte struct alignment.
     pub _pad0: u32,
     /// Padding.
     pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// Where a light can reach: everywhere (a sun), or a ball (a spot's or point

@@ -12,9 +12,9 @@ struct LightList {
     ambient: vec3<f32>,
     shown: u32,      // the reported light: its visibility goes to the visibility target
     tiles_x: u32,    // tiles per row
-    count: u32,      // lights in the list
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 };
 
 @group(2) @binding(0) var<uniform> list: LightList;

@@ -42,25 +42,17 @@ pub fn lamp_grid(count: usize) -> Scene {
     let crate_mesh = b.mesh(geometry::cuboid(Vec3::splat(0.5)));
     // Warm and cool lamps in turn, so that overlapping pools stay distinguishable.
     let palette = [Vec3::new(1.0, 0.8, 0.55), Vec3::new(0.6, 0.8, 1.0), Vec3::new(0.9, 1.0, 0.7)];
-    let mut lights = Vec::with_capacity(count);
+    let mut lamps = Vec::with_capacity(count);
     for i in 0..count {
         let cell = Vec3::new((i % columns) as f32 + 0.5, 0.0, (i / columns) as f32 + 0.5);
         let base = cell * LAMP_SPACING - 0.5 * extent;
         b.place(&format!("post {i}"), post, stone, at(base + Vec3::new(0.0, 0.9, 0.0)));
         let beside = base + Vec3::new(0.3 * LAMP_SPACING, 0.5, 0.2 * LAMP_SPACING);
         b.place(&format!("crate {i}"), crate_mesh, wood, at(beside) * Mat4::from_rotation_y(0.37 * i as f32));
-        let lamp = PointLight {
+        lamps.push(PointLight {
             color: palette[i % palette.len()],
             intensity: 0.45,
             ..point(base + Vec3::new(0.0, 2.4, 0.0), LAMP_REACH * LAMP_SPACING)
-        };
-        lights.push(SceneLight {
-            name: format!("lamp {i}"),
-            light: Light::Point(lamp),
-            shadow: Some(ShadowOverrides {
-                map: MapSettingsPatch { resolution: Some(256), ..Default::default() },
-                ..Default::default()
-            }),
         });
     }
     let size = extent.x.max(extent.z);
@@ -72,10 +64,7 @@ pub fn lamp_grid(count: usize) -> Scene {
         near: 0.1,
         far: 4.0 * size + 40.0,
     };
-    let first = match lights[0].light {
-        Light::Point(p) => p,
-        Light::Directional(_) | Light::Spot(_) => unreachable!("every lamp is a point light"),
-    };
+    let first = lamps[0];
     let mut scene = b.finish(
         &format!("lamps:{count}"),
         camera,
@@ -84,7 +73,18 @@ pub fn lamp_grid(count: usize) -> Scene {
         first,
     );
     scene.ambient = Vec3::splat(0.05);
-    scene.lights = lights;
+    scene.lights = lamps
+        .into_iter()
+        .enumerate()
+        .map(|(i, lamp)| SceneLight {
+            name: format!("lamp {i}"),
+            light: Light::Point(lamp),
+            shadow: Some(ShadowOverrides {
+                map: MapSettingsPatch { resolution: Some(256), ..Default::default() },
+                ..Default::default()
+            }),
+        })
+        .collect();
     scene
 }
 
