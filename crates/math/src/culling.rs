@@ -169,6 +169,11 @@ impl CullTree {
         }
     }
 
+    /// Each instance's bounds, in the tree's order (the order it keeps them in).
+    pub fn instance_bounds(&self) -> &[Aabb] {
+        &self.bounds
+    }
+
     /// How many instances the tree holds.
     pub fn len(&self) -> usize {
         self.bounds.len()

@@ -42,6 +42,13 @@ pub struct ProjectionCentre {
 }
 
 impl ProjectionCentre {
+    /// The centre in homogeneous coordinates, (x, y, z, w): a point where w ≠ 0, a
+    /// direction where w = 0. Any positive multiple of it answers every winding the
+    /// same way, so a GPU culler may take it normalized.
+    pub fn homogeneous(&self) -> DVec4 {
+        self.h
+    }
+
     /// The centre of `clip_from_world`, computed in f64 from its x, y and w rows.
     pub fn of(clip_from_world: Mat4) -> ProjectionCentre {
         let m = clip_from_world.as_dmat4();
@@ -94,6 +101,16 @@ pub struct NormalCone {
 }
 
 impl NormalCone {
+    /// The cone's axis, unit length.
+    pub fn axis(&self) -> DVec3 {
+        self.axis
+    }
+
+    /// The sine of its half-angle, [`NormalCone::MARGIN`] included.
+    pub fn sin_half_angle(&self) -> f64 {
+        self.sin_half_angle
+    }
+
     /// The angle the cone is widened by, in radians (about 0.6°): a triangle within it
     /// of being seen edge-on may still cover a sample once its corners are snapped to
     /// the rasterizer's sub-pixel grid, so it is never the one that decides.

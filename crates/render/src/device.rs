@@ -61,6 +61,10 @@ pub struct Gpu {
     /// instance: indirect execution and `INDIRECT_FIRST_INSTANCE`. Without it, a
     /// layer's draws are issued one by one (`DrawSubmission`).
     pub indirect_draws: bool,
+    /// Whether, besides, a draw can take its count of draws from a buffer
+    /// (`MULTI_DRAW_INDIRECT_COUNT`): what lets a compute pass cull a layer's casters
+    /// and the layer draw what it kept (`DrawSubmission::GpuCulled`).
+    pub indirect_count: bool,
 }
 
 impl Gpu {
@@ -117,6 +121,7 @@ impl Gpu {
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let indirect_draws = indirect_draws(adapter, &device);
+        let indirect_count = indirect_count(indirect_draws, &device);
         Ok(Self {
             device,
             queue,
@@ -124,6 +129,7 @@ impl Gpu {
             limits,
             timestamp_period_ns,
             indirect_draws,
+            indirect_count,
         })
     }
 
@@ -142,6 +148,7 @@ impl Gpu {
             limits: device.limits(),
             timestamp_period_ns,
             indirect_draws: indirect_draws(adapter, device),
+            indirect_count: indirect_count(indirect_draws(adapter, device), device),
         }
     }
 
@@ -220,6 +227,12 @@ fn headless_adapter() -> Result<wgpu::Adapter, RenderError> {
             Err(RenderError::no_adapter_besides(gl.ok().map(|a| a.get_info()).as_ref()))
         }
     }
+}
+
+/// Whether `device`, which draws from buffers of arguments where `indirect_draws`, can
+/// also take the count of draws from a buffer.
+fn indirect_count(indirect_draws: bool, device: &wgpu::Device) -> bool {
+    indirect_draws && device.features().contains(wgpu::Features::MULTI_DRAW_INDIRECT_COUNT)
 }
 
 /// Whether `device` on `adapter` can draw from a buffer of arguments that each carry

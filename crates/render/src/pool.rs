@@ -382,7 +382,8 @@ impl Pool {
 mod tests {
     /// The zero-creation test counts what the pool creates; it proves that a steady
     /// frame creates nothing only if every per-frame creation goes through the pool.
-    /// Outside it, only the one-time uploads (the scene, the casters' BVH), the
+    /// Outside it, only the one-time uploads (the scene, the casters' BVH, the GPU
+    /// culler's shadow items), the
     /// renderer's fixed bindings, the kept depth and moment maps (counted in
     /// `Renderer::creations`), and `ShadowRays`' batch queries (no frame: buffers
     /// sized to each batch) may create GPU resources.
@@ -395,6 +396,7 @@ mod tests {
             "frame/moment_cache.rs",
             "gpu_scene/mod.rs",
             "gpu_scene/materials.rs",
+            "gpu_scene/shadow_items.rs",
             "passes/depth_baseline.rs",
             "rays/mod.rs",
             "rays/query.rs",

@@ -281,6 +281,10 @@ pub fn wgsl_constants() -> String {
     for kind in LightKindGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind as u32);
     }
+    s += &format!("const CULL_WORKGROUP: u32 = {}u;\n", crate::passes::gpu_cull::CULL_WORKGROUP);
+    for code in crate::passes::gpu_cull::WindingCode::ALL {
+        s += &format!("const {}: u32 = {}u;\n", code.wgsl_name(), code as u32);
+    }
     s
 }
 
@@ -448,7 +452,7 @@ macro_rules! struct_layout {
 /// Every uniform struct shared with WGSL.
 #[cfg(test)]
 pub(crate) fn struct_layouts() -> Vec<StructLayout> {
-    use crate::passes::{depth_reduce, light_list, map_preview, moments};
+    use crate::passes::{depth_reduce, gpu_cull, light_list, map_preview, moments};
     vec![
         struct_layout!(LightGpu as "Light" {
             clip_from_world, light_from_world, radiance, kind, direction, range, position, layer_count,
@@ -483,6 +487,15 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
         struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
         struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
+        struct_layout!(crate::gpu_scene::shadow_items::ItemGpu as "ShadowItem" {
+            min, bucket, max, has_cone, axis, sin_half_angle, index_count, first_index, base_vertex,
+            first_instance,
+        }),
+        struct_layout!(gpu_cull::CullViewGpu as "CullView" { planes, centre, item_count, near, _pad0, _pad1 }),
+        struct_layout!(gpu_cull::BucketGpu as "CullBucket" { first_slot, culled }),
+        struct_layout!(crate::gpu_scene::DrawArgs as "DrawArgs" {
+            index_count, instance_count, first_index, base_vertex, first_instance,
+        }),
         struct_layout!(moments::FilterParamsGpu as "FilterParams" {
             direction, radius, log_c, sigma, _pad0, _pad1, _pad2,
         }),

@@ -2,11 +2,14 @@
 //! instances the camera sees, every view culled in one parallel sweep.
 
 use gnomon_math::culling::Frustum;
-use gnomon_scene::settings::{CasterCulling, RayUse};
+use gnomon_scene::settings::{CasterCulling, DrawSubmission, RayUse};
 
-use super::plan::{FramePlan, LightPlan};
+use super::{
+    Renderer,
+    plan::{FramePlan, LightPlan},
+};
 use crate::{
-    GpuScene,
+    GpuScene, RenderError,
     gpu_scene::{CullView, Granularity, LayerFaces, Visible},
 };
 
@@ -64,5 +67,25 @@ pub(super) fn layer_view(light: &LightPlan, clip_from_world: glam::Mat4) -> Cull
             },
             CasterCulling::Instances => Granularity::Instances,
         },
+    }
+}
+
+impl Renderer {
+    /// Uploads the shadow items the GPU culler reads, once per scene, where a light
+    /// of `plan` culls its layers on the GPU and the device can draw what it kept
+    /// (`DrawSubmission::GpuCulled`). A scene the device cannot take this way is
+    /// culled on the CPU, the same map.
+    pub(super) fn prepare_gpu_culling(
+        &self,
+        uploaded: &GpuScene,
+        plan: &FramePlan,
+    ) -> Result<(), RenderError> {
+        let wanted =
+            plan.lights.iter().any(|l| l.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled);
+        if wanted && self.gpu.indirect_count {
+            // Ok(Err(why)): this device cannot; the passes then cull on the CPU.
+            let _unavailable = uploaded.shadow_items(&self.gpu)?;
+        }
+        Ok(())
     }
 }

@@ -1,20 +1,25 @@
 //! One depth-only pass with the shadow pipelines (a shadow-map layer, its strips, or
-//! SDSM's camera prepass), and how its draws are submitted: bucketed by the state they
-//! share (scissor, pipeline, material), each bucket one multi-draw from a buffer of
-//! draw arguments, or its draws one by one (`DrawSubmission`). Depth-only draws may
-//! go in any order: the nearest depth wins whichever comes first, so the map is the
-//! same either way.
+//! SDSM's camera prepass), and how its draws are submitted (`DrawSubmission`):
+//! culled on the GPU, each bucket of the shadow items one multi-draw whose count the
+//! culler wrote; or culled on the CPU and bucketed by the state they share (scissor,
+//! pipeline, material), each bucket one multi-draw from a buffer of draw arguments,
+//! or its draws one by one. Depth-only draws may go in any order: the nearest depth
+//! wins whichever comes first, so the map is the same either way.
 
-use gnomon_scene::{Settings, settings::DrawSubmission};
+use gnomon_scene::{Motion, Settings, settings::DrawSubmission};
 
 use super::{Renderer, bindings::scene_group, outputs::DrawStats};
 use crate::{
     GpuScene,
-    gpu_scene::{DrawArgs, IndexOrder, Run, Visible},
+    gpu_scene::{
+        CullView, DrawArgs, Granularity, IndexOrder, Run, Visible,
+        shadow_items::{BucketClass, ShadowItems},
+    },
     gpu_types::VertexStream,
     passes::{
         begin_depth_pass,
-        shadow::{Coverage, DepthRange, DepthTarget, ShadowPipelineKey, ShadowPipelineShape},
+        gpu_cull::{CullTarget, CulledDraws},
+        shadow::{Coverage, DepthRange, DepthTarget, ShadowPass, ShadowPipelineKey, ShadowPipelineShape},
     },
     uniforms::LightGpu,
 };
@@ -33,6 +38,49 @@ pub(super) struct DepthPass<'a> {
     pub start: DepthStart,
     /// Where it draws.
     pub area: DepthArea,
+    /// What a shadow layer's pass culls against, for the GPU culler; None for a pass
+    /// that draws only what the CPU culled (SDSM's prepass).
+    pub culling: Option<LayerCulling>,
+}
+
+/// What a shadow layer's pass draws, for the GPU culler to find.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LayerCulling {
+    /// The layer (or the strip of it drawn) its casters are culled against.
+    pub view: CullView,
+    pub casters: Casters,
+}
+
+/// Which of a layer's casters a pass draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Casters {
+    All,
+    /// Those that stay: what a kept layer holds.
+    Still,
+    /// Those that move: drawn over a kept layer's copy.
+    Moving,
+}
+
+impl Casters {
+    /// Whether casters of `motion` are among these.
+    pub fn take(self, motion: Motion) -> bool {
+        match self {
+            Casters::All => true,
+            Casters::Still => motion == Motion::Static,
+            Casters::Moving => motion == Motion::Dynamic,
+        }
+    }
+
+    /// The runs of `visible` these casters are.
+    pub fn of(self, uploaded: &GpuScene, visible: &Visible) -> Visible {
+        let runs = visible
+            .runs
+            .iter()
+            .filter(|r| self.take(uploaded.batches[r.batch as usize].motion))
+            .cloned()
+            .collect();
+        Visible { runs }
+    }
 }
 
 /// Where a depth pass draws.
@@ -86,6 +134,15 @@ pub(super) enum DepthStart {
     Keep,
 }
 
+impl DepthStart {
+    fn load(self) -> wgpu::LoadOp<f32> {
+        match self {
+            DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
+            DepthStart::Keep => wgpu::LoadOp::Load,
+        }
+    }
+}
+
 /// What a run of draws in a depth pass shares: the scissor, the pipeline and, for
 /// alpha-masked casters, the material texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,28 +153,87 @@ struct DrawState {
     material: Option<usize>,
 }
 
+impl DrawState {
+    /// The state of draws of `class` in `depth`'s pass, within `rect`.
+    fn of(depth: &DepthPass, rect: Option<ScissorRect>, class: &BucketClass) -> Self {
+        let coverage = if class.masked { Coverage::Masked } else { Coverage::Opaque };
+        let key = ShadowPipelineKey::new(
+            &depth.settings.shadow.bias,
+            class.sides,
+            coverage,
+            DepthRange::clamped_if(depth.unclipped),
+            depth.target,
+        );
+        DrawState { rect, key, material: class.material }
+    }
+}
+
+impl DepthArea {
+    /// The scissor rectangles it draws in: None for the whole target.
+    fn rects(&self) -> Vec<Option<ScissorRect>> {
+        match self {
+            DepthArea::Whole => vec![None],
+            DepthArea::Strips(strips) => strips.iter().copied().map(Some).collect(),
+        }
+    }
+}
+
+/// Sets what each draw of a depth pass needs as it changes: the scissor, the
+/// pipeline with its vertex stream, and an alpha-masked caster's material.
+#[derive(Default)]
+struct StateChanges {
+    current: Option<DrawState>,
+    stream: Option<VertexStream>,
+}
+
+impl StateChanges {
+    /// Moves `pass` to `state`, counting the changes in `stats`.
+    fn apply(
+        &mut self,
+        pass: &mut wgpu::RenderPass<'_>,
+        pipelines: (&mut ShadowPass, &wgpu::Device),
+        uploaded: &GpuScene,
+        state: &DrawState,
+        stats: &mut DrawStats,
+    ) {
+        let current = self.current;
+        if let Some(rect) = state.rect.filter(|_| current.map(|c| c.rect) != Some(state.rect)) {
+            pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
+        }
+        if current.map(|c| c.key) != Some(state.key) {
+            let wanted = ShadowPipelineShape::of(&state.key).stream;
+            match self.stream {
+                None => uploaded.bind_geometry(pass, wanted, IndexOrder::Clusters),
+                Some(bound) if bound != wanted => uploaded.bind_stream(pass, wanted),
+                Some(_) => {}
+            }
+            self.stream = Some(wanted);
+            let (shadow, device) = pipelines;
+            pass.set_pipeline(shadow.pipeline(device, &state.key));
+            stats.pipeline_changes += 1;
+        }
+        if let Some(material) = state.material.filter(|&m| current.and_then(|c| c.material) != Some(m)) {
+            pass.set_bind_group(1, &uploaded.material_groups[material], &[]);
+            stats.bind_group_changes += 1;
+        }
+        self.current = Some(*state);
+    }
+}
+
 /// A pass's draws bucketed by their state, buckets in order of first appearance
 /// (within each scissor rectangle, in the order of the rectangles).
 fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec<&'a Run>)> {
-    let bias = &depth.settings.shadow.bias;
-    let rects: Vec<Option<ScissorRect>> = match &depth.area {
-        DepthArea::Whole => vec![None],
-        DepthArea::Strips(strips) => strips.iter().copied().map(Some).collect(),
-    };
     let mut buckets: Vec<(DrawState, Vec<&Run>)> = Vec::new();
-    for rect in rects {
+    for rect in depth.area.rects() {
         for run in &depth.visible.runs {
             let batch = &uploaded.batches[run.batch as usize];
-            let coverage = if batch.masked { Coverage::Masked } else { Coverage::Opaque };
-            let key = ShadowPipelineKey::new(
-                bias,
-                batch.sides,
-                coverage,
-                DepthRange::clamped_if(depth.unclipped),
-                depth.target,
-            );
-            let material = batch.masked.then_some(batch.material_group);
-            let state = DrawState { rect, key, material };
+            let class = BucketClass {
+                sides: batch.sides,
+                masked: batch.masked,
+                material: batch.masked.then_some(batch.material_group),
+                motion: batch.motion,
+            };
+            let state = DrawState::of(depth, rect, &class);
             match buckets.iter_mut().find(|(s, _)| *s == state) {
                 Some((_, runs)) => runs.push(run),
                 None => buckets.push((state, vec![run])),
@@ -135,8 +251,9 @@ fn argument_slots(draws: usize) -> usize {
 
 impl Renderer {
     /// Records a depth-only pass with the shadow pipelines, drawing the runs
-    /// `depth.visible` holds: a shadow-map layer's casters, or what the camera sees for
-    /// SDSM's prepass. Returns the stats of what it recorded.
+    /// `depth.visible` holds (a shadow-map layer's casters, or what the camera sees for
+    /// SDSM's prepass), or, for a layer culled on the GPU, what the culler keeps.
+    /// Returns the stats of what it recorded.
     pub(super) fn record_depth_pass(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -145,13 +262,44 @@ impl Renderer {
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) -> DrawStats {
         let gpu = self.gpu.clone();
+        let culled_on_gpu = match (depth.settings.shadow.map.draw_submission, &depth.culling) {
+            (DrawSubmission::GpuCulled, Some(culling)) if gpu.indirect_count => {
+                uploaded.uploaded_shadow_items().map(|items| (items, culling))
+            }
+            _ => None,
+        };
         let light_buffer = self.pool.uniform(&gpu.queue, "light", depth.light);
         let group = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
+        let mut stats = match culled_on_gpu {
+            Some((items, culling)) => {
+                self.record_gpu_culled(encoder, uploaded, depth, (items, culling), (&group, timestamp_writes))
+            }
+            None => self.record_cpu_culled(encoder, uploaded, depth, &group, timestamp_writes),
+        };
+        // What the CPU culled, which the GPU culler keeps too (`render/tests/indirect.rs`
+        // holds their maps equal): the counts of a layer culled on the GPU stay on it.
+        stats.shadow_draws = depth.visible.runs.len() as u32 * depth.area.rects().len() as u32;
+        stats.shadow_instances = depth.visible.instances();
+        stats.shadow_triangles = depth.visible.triangles();
+        stats
+    }
+
+    /// The pass's draws as the CPU culled them: each bucket one multi-draw from
+    /// uploaded arguments, or its draws one by one.
+    fn record_cpu_culled(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        depth: &DepthPass,
+        group: &wgpu::BindGroup,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
+    ) -> DrawStats {
+        let gpu = self.gpu.clone();
         let buckets = buckets(uploaded, depth);
         let draws: usize = buckets.iter().map(|(_, runs)| runs.len()).sum();
         // Every bucket's arguments, one after another, in one buffer.
         let indirect = match depth.settings.shadow.map.draw_submission {
-            DrawSubmission::Indirect => gpu.indirect_draws && draws > 0,
+            DrawSubmission::GpuCulled | DrawSubmission::Indirect => gpu.indirect_draws && draws > 0,
             DrawSubmission::Direct => false,
         };
         let arguments = indirect.then(|| {
@@ -165,36 +313,14 @@ impl Renderer {
             self.pool.storage(&gpu.queue, "draw arguments", &args, wgpu::BufferUsages::INDIRECT)
         });
         let mut stats = DrawStats::default();
-        let load = match depth.start {
-            DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
-            DepthStart::Keep => wgpu::LoadOp::Load,
-        };
-        let mut pass = begin_depth_pass(encoder, "shadow", depth.target_view, load, timestamp_writes);
-        pass.set_bind_group(0, &group, &[]);
+        let mut pass =
+            begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), timestamp_writes);
+        pass.set_bind_group(0, group, &[]);
         stats.bind_group_changes += 1;
-        let mut current: Option<DrawState> = None;
-        let mut stream: Option<VertexStream> = None;
+        let mut changes = StateChanges::default();
         let mut first_argument = 0u64;
         for (state, runs) in &buckets {
-            if let Some(rect) = state.rect.filter(|_| current.map(|c| c.rect) != Some(state.rect)) {
-                pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
-            }
-            if current.map(|c| c.key) != Some(state.key) {
-                let wanted = ShadowPipelineShape::of(&state.key).stream;
-                match stream {
-                    None => uploaded.bind_geometry(&mut pass, wanted, IndexOrder::Clusters),
-                    Some(bound) if bound != wanted => uploaded.bind_stream(&mut pass, wanted),
-                    Some(_) => {}
-                }
-                stream = Some(wanted);
-                pass.set_pipeline(self.passes.shadow.pipeline(&gpu.device, &state.key));
-                stats.pipeline_changes += 1;
-            }
-            if let Some(material) = state.material.filter(|&m| current.and_then(|c| c.material) != Some(m)) {
-                pass.set_bind_group(1, &uploaded.material_groups[material], &[]);
-                stats.bind_group_changes += 1;
-            }
-            current = Some(*state);
+            changes.apply(&mut pass, (&mut self.passes.shadow, &gpu.device), uploaded, state, &mut stats);
             match &arguments {
                 Some(buffer) => {
                     let offset = first_argument * DrawArgs::SIZE;
@@ -209,10 +335,76 @@ impl Renderer {
                     stats.shadow_commands += runs.len() as u32;
                 }
             }
-            stats.shadow_draws += runs.len() as u32;
         }
-        stats.shadow_instances = depth.visible.instances();
-        stats.shadow_triangles = depth.visible.triangles();
+        stats
+    }
+
+    /// The pass's draws as the GPU culler keeps them: one dispatch culls every
+    /// shadow item for the layer, then each bucket of the casters drawn is one
+    /// multi-draw whose count the dispatch wrote.
+    fn record_gpu_culled(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        depth: &DepthPass,
+        (items, culling): (&ShadowItems, &LayerCulling),
+        (group, timestamp_writes): (&wgpu::BindGroup, Option<wgpu::RenderPassTimestampWrites>),
+    ) -> DrawStats {
+        let gpu = self.gpu.clone();
+        let target = CullTarget {
+            frustum: &culling.view.frustum,
+            near: culling.view.near,
+            faces: match culling.view.granularity {
+                Granularity::Clusters { faces } => faces,
+                Granularity::Instances => None,
+            },
+        };
+        // The layer's time runs from the dispatch's start to the draws' end.
+        let (cull_writes, draw_writes) = match timestamp_writes {
+            Some(w) => (
+                Some(wgpu::ComputePassTimestampWrites {
+                    query_set: w.query_set,
+                    beginning_of_pass_write_index: w.beginning_of_pass_write_index,
+                    end_of_pass_write_index: None,
+                }),
+                Some(wgpu::RenderPassTimestampWrites {
+                    query_set: w.query_set,
+                    beginning_of_pass_write_index: None,
+                    end_of_pass_write_index: w.end_of_pass_write_index,
+                }),
+            ),
+            None => (None, None),
+        };
+        let culled = self.passes.gpu_cull.record(&gpu, &mut self.pool, encoder, items, &target, cull_writes);
+        let mut stats = DrawStats::default();
+        let mut pass =
+            begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), draw_writes);
+        pass.set_bind_group(0, group, &[]);
+        stats.bind_group_changes += 1;
+        let mut changes = StateChanges::default();
+        for rect in depth.area.rects() {
+            for (index, bucket) in items.buckets.iter().enumerate() {
+                if !culling.casters.take(bucket.class.motion) {
+                    continue;
+                }
+                let state = DrawState::of(depth, rect, &bucket.class);
+                changes.apply(
+                    &mut pass,
+                    (&mut self.passes.shadow, &gpu.device),
+                    uploaded,
+                    &state,
+                    &mut stats,
+                );
+                pass.multi_draw_indexed_indirect_count(
+                    &culled.draws,
+                    CulledDraws::draw_offset(bucket.first_slot),
+                    &culled.counts,
+                    CulledDraws::count_offset(index),
+                    bucket.capacity,
+                );
+                stats.shadow_commands += 1;
+            }
+        }
         stats
     }
 }

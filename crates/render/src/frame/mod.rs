@@ -35,8 +35,9 @@ use crate::{
     Gpu, GpuScene, RenderError,
     passes::{
         Layouts, blit::BlitPass, depth_baseline::DepthBaselinePass, depth_reduce::DepthReducePass,
-        light_list::LightListPass, lighting, lighting::LightingPass, map_preview::MapPreviewPass,
-        map_scroll::MapScrollPass, moments::MomentPass, screen_space::ScreenSpacePass, shadow::ShadowPass,
+        gpu_cull::GpuCullPass, light_list::LightListPass, lighting, lighting::LightingPass,
+        map_preview::MapPreviewPass, map_scroll::MapScrollPass, moments::MomentPass,
+        screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
     rays::TracePass,
@@ -58,6 +59,7 @@ struct Passes {
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
     map_scroll: MapScrollPass,
+    gpu_cull: GpuCullPass,
     depth_baseline: DepthBaselinePass,
     blit: BlitPass,
 }
@@ -102,6 +104,7 @@ impl Renderer {
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
                 map_scroll: MapScrollPass::new(device),
+                gpu_cull: GpuCullPass::new(device),
                 depth_baseline: DepthBaselinePass::new(device),
                 blit: BlitPass::new(device),
             };

@@ -139,10 +139,15 @@ pub struct LightStats {
     /// Texels per side of each of its layers (1 for a technique that reads no map).
     pub resolution: u32,
     /// Draws into each layer of its map (one per cascade, six for a cube): the
-    /// casters that survived culling against that layer's frustum.
+    /// casters that survived the CPU's culling against that layer's frustum. A layer
+    /// culled on the GPU (`DrawSubmission::GpuCulled`) reports the CPU's count, whose
+    /// casters are the ones the GPU keeps (`render/tests/gpu_culling.rs` holds their
+    /// maps equal); the GPU issues one draw per kept cluster where the CPU merges
+    /// neighbouring ones.
     pub layer_draws: Vec<u32>,
     /// Draw commands this frame recorded into each layer: one per draw, or one per
-    /// multi-draw of draws that share a pipeline (`DrawSubmission::Indirect`); 0 for a
+    /// multi-draw of draws that share a pipeline (`DrawSubmission::Indirect`), or one
+    /// per bucket of shadow items whose count the GPU wrote (`GpuCulled`); 0 for a
     /// kept layer.
     pub layer_commands: Vec<u32>,
     /// Instances drawn into each layer: those whose bounds reach into its frustum.

@@ -232,6 +232,7 @@ impl Renderer {
                 unclipped: false,
                 start: super::depth_pass::DepthStart::Clear,
                 area: super::depth_pass::DepthArea::Whole,
+                culling: None,
             };
             self.record_depth_pass(&mut encoder, uploaded, &pass, None);
             let planes = Planes::new(camera.near, camera.far);

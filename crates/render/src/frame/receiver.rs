@@ -115,6 +115,7 @@ impl Renderer {
         if plan.mask_path || plan.lights.iter().any(|l| l.refine != Refine::Off) {
             return Err(RenderError::ReceiverNeedsMapPath);
         }
+        self.prepare_gpu_culling(uploaded, &plan)?;
         let culled = cull(uploaded, &plan);
         let gpu = self.gpu.clone();
         gpu.checked("recording the shadows for the host's shader", || {

@@ -149,6 +149,7 @@ impl Renderer {
         let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
         let fallback = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();
+        self.prepare_gpu_culling(uploaded, &plan)?;
         let culled = cull(uploaded, &plan);
         let cull_done = Instant::now();
         let gpu = self.gpu.clone();

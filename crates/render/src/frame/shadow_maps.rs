@@ -12,46 +12,18 @@ use gnomon_scene::{
 use super::{
     Renderer,
     cull::layer_view,
-    depth_pass::{DepthArea, DepthPass, DepthStart, ScissorRect},
+    depth_pass::{Casters, DepthArea, DepthPass, DepthStart, LayerCulling, ScissorRect},
     map_cache::{LayerKey, LayerPlan},
     plan::LightPlan,
     record::Recording,
 };
 use crate::{
     GpuScene,
-    gpu_scene::Visible,
+    gpu_scene::{CullView, Visible},
     passes::{SHADOW_FORMAT, map_scroll::ScrolledLayer},
     pool::ViewKey,
     timing::{PassKind, Slot, SlotPart},
 };
-
-/// Which of a layer's culled casters a pass draws.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Casters {
-    All,
-    /// Those that stay: what a kept layer holds.
-    Still,
-    /// Those that move: drawn over a kept layer's copy.
-    Moving,
-}
-
-impl Casters {
-    /// The runs of `visible` these casters are.
-    fn of(self, uploaded: &GpuScene, visible: &Visible) -> Visible {
-        let wanted = |motion: Motion| match self {
-            Casters::All => true,
-            Casters::Still => motion == Motion::Static,
-            Casters::Moving => motion == Motion::Dynamic,
-        };
-        let runs = visible
-            .runs
-            .iter()
-            .filter(|r| wanted(uploaded.batches[r.batch as usize].motion))
-            .cloned()
-            .collect();
-        Visible { runs }
-    }
-}
 
 /// The timestamps a pass writes: `part` of the clock's `slot`.
 #[derive(Clone, Copy)]
@@ -67,6 +39,8 @@ struct LayerPass<'a> {
     light_index: usize,
     layer: usize,
     visible: &'a Visible,
+    /// What `visible` was culled against: the layer, or the strip of it drawn.
+    culled_for: CullView,
     casters: Casters,
     view: &'a wgpu::TextureView,
     start: DepthStart,
@@ -110,6 +84,7 @@ impl Renderer {
                 light_index: light_index as usize,
                 layer,
                 visible,
+                culled_for: whole_layer(light, layer),
                 casters: Casters::All,
                 view: &view,
                 start: DepthStart::Clear,
@@ -159,6 +134,7 @@ impl Renderer {
                 light_index: light_index as usize,
                 layer,
                 visible,
+                culled_for: whole_layer(light, layer),
                 casters: Casters::Still,
                 view: &cache_view,
                 start,
@@ -179,6 +155,7 @@ impl Renderer {
                         let seen = uploaded.cull(&[view]).pop().unwrap_or_default();
                         let pass = LayerPass {
                             visible: &seen,
+                            culled_for: view,
                             ..still(DepthStart::Keep, DepthArea::Strips(vec![strip]))
                         };
                         self.record_layer(rec, uploaded, &pass, None);
@@ -193,6 +170,7 @@ impl Renderer {
                     light_index: light_index as usize,
                     layer,
                     visible,
+                    culled_for: whole_layer(light, layer),
                     casters: Casters::Moving,
                     view: &map_view,
                     start: DepthStart::Keep,
@@ -253,12 +231,19 @@ impl Renderer {
             unclipped: layer.light.layout.depth_clamp,
             start: layer.start,
             area: layer.area.clone(),
+            culling: Some(LayerCulling { view: layer.culled_for, casters: layer.casters }),
         };
         let writes = timed.and_then(|t| rec.clock.render_part(t.slot, t.part));
         let drawn = self.record_depth_pass(rec.encoder, uploaded, &pass, writes);
         rec.stats.add(&drawn);
         rec.layer_commands.add(layer.light_index, layer.layer, drawn.shadow_commands);
     }
+}
+
+/// What layer `layer` of `light` culls its casters against, whole (as `cull.rs` culls
+/// it for the frame).
+fn whole_layer(light: &LightPlan, layer: usize) -> CullView {
+    layer_view(light, light.layout.projections[layer].clip_from_world())
 }
 
 /// An empty pass that writes `part` of `slot`'s timestamps: it brackets a layer's

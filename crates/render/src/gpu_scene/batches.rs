@@ -130,8 +130,13 @@ impl LayerFaces {
         }
     }
 
+    /// The layer's centre of projection.
+    pub fn centre(&self) -> ProjectionCentre {
+        self.centre
+    }
+
     /// The winding the pass culls on casters of `sides`, if any.
-    fn culls(&self, sides: Sides) -> Option<WindingCull> {
+    pub fn culls(&self, sides: Sides) -> Option<WindingCull> {
         let face = sides.culled_face(self.mode)?;
         let (front, back) = match self.target.front_face() {
             wgpu::FrontFace::Ccw => (Winding::CounterClockwise, Winding::Clockwise),

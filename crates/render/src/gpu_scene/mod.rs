@@ -7,6 +7,7 @@
 
 mod batches;
 mod materials;
+pub(crate) mod shadow_items;
 
 use gnomon_math::Aabb;
 use gnomon_scene::{AlphaMode, Motion, Scene};
@@ -15,6 +16,7 @@ use wgpu::util::DeviceExt;
 
 pub(crate) use batches::{Batch, CullView, Granularity, LayerFaces, Run, Visible};
 use batches::{MeshRange, batch_instances};
+use shadow_items::{GpuCullUnavailable, ShadowItems};
 
 use crate::{
     Gpu, RenderError,
@@ -48,6 +50,9 @@ pub struct GpuScene {
     /// ([`GpuScene::build_rays`]).
     /// Or why the device cannot take it, kept so that it is not built again.
     rays: std::sync::OnceLock<Result<crate::rays::GpuBvh, crate::rays::RaysUnavailable>>,
+    /// The shadow casters as the GPU culler reads them, uploaded on first use
+    /// ([`GpuScene::shadow_items`]), or why the device cannot take them.
+    shadow_items: std::sync::OnceLock<Result<ShadowItems, GpuCullUnavailable>>,
     /// The batches in shadow-pass order: opaque before alpha-masked, then by cull
     /// state and texture, so that pipelines and bind groups change least.
     shadow_order: Vec<u32>,
@@ -172,6 +177,7 @@ impl GpuScene {
             ),
             batches,
             rays: std::sync::OnceLock::new(),
+            shadow_items: std::sync::OnceLock::new(),
             shadow_order,
             material_groups: materials::material_groups(gpu, scene, layouts),
             bounds,
@@ -218,6 +224,7 @@ impl GpuScene {
         {
             self.still_generation = next_generation();
         }
+        let moved_batches: Vec<usize> = (0..self.batches.len()).filter(|&b| !refits[b].is_empty()).collect();
         for (batch, moved) in self.batches.iter_mut().zip(refits) {
             if moved.is_empty() {
                 continue;
@@ -235,6 +242,13 @@ impl GpuScene {
             }
         }
         self.bounds = self.batches.iter().map(|b| b.tree.bounds()).fold(Aabb::EMPTY, Aabb::union);
+        if let Some(Ok(items)) = self.shadow_items.get() {
+            gpu.checked("moving the shadow items", || {
+                for &batch in &moved_batches {
+                    items.rewrite(&gpu.queue, &self.batches, batch);
+                }
+            })?;
+        }
         if let Some(Ok(bvh)) = self.rays.get_mut() {
             bvh.refit(gpu, scene, moved)?;
         }
@@ -261,6 +275,27 @@ impl GpuScene {
         }
         let built = self.rays.get().expect("set above");
         Ok(built.as_ref().map_err(Clone::clone))
+    }
+
+    /// The shadow casters as the GPU culler reads them, uploaded once. Ok(Err) says
+    /// why this device cannot cull them (the same answer every time); Err is a
+    /// failure of the device.
+    pub(crate) fn shadow_items(
+        &self,
+        gpu: &Gpu,
+    ) -> Result<Result<&ShadowItems, GpuCullUnavailable>, RenderError> {
+        if self.shadow_items.get().is_none() {
+            let uploaded = ShadowItems::upload(gpu, &self.batches, &self.shadow_order)?;
+            // Another thread may have uploaded them meanwhile: either is the same.
+            let _ = self.shadow_items.set(uploaded);
+        }
+        let uploaded = self.shadow_items.get().expect("set above");
+        Ok(uploaded.as_ref().map_err(Clone::clone))
+    }
+
+    /// The shadow items, if [`GpuScene::shadow_items`] has uploaded them.
+    pub(crate) fn uploaded_shadow_items(&self) -> Option<&ShadowItems> {
+        self.shadow_items.get().and_then(|uploaded| uploaded.as_ref().ok())
     }
 
     /// The casters' BVH, if [`GpuScene::build_rays`] has built it.

@@ -10,7 +10,7 @@ use gnomon_scene::settings::Refine;
 use wgpu::naga;
 
 use super::{
-    blit, depth_reduce, light_list, lighting,
+    blit, depth_reduce, gpu_cull, light_list, lighting,
     lighting::{LightingKey, LightingRole, Lookup, MapLookup},
     map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
@@ -94,6 +94,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("map preview".into(), map_preview::preview_wgsl()));
     out.push(("map scroll".into(), map_scroll::scroll_wgsl()));
     out.push(("blit".into(), blit::blit_wgsl()));
+    out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
     out.push(("ray trace".into(), crate::rays::trace_pass_wgsl()));
     out
 }

@@ -4,6 +4,7 @@
 pub(crate) mod blit;
 pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
+pub(crate) mod gpu_cull;
 pub(crate) mod light_list;
 pub(crate) mod lighting;
 pub(crate) mod map_preview;
@@ -244,6 +245,20 @@ fn depth_reader_layouts(
         immediate_size: 0,
     });
     (layout, pipeline_layout)
+}
+
+/// A storage buffer read (or, unless `read_only`, written) by a compute stage.
+pub(crate) fn compute_storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
 }
 
 fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {

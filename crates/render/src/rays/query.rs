@@ -47,19 +47,12 @@ impl ShadowRays {
         let device = &gpu.device;
         let rays_layout = super::layout(device);
         let bvh = GpuBvh::upload(gpu, scene, &rays_layout)?;
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow ray query"),
-            entries: &[storage(0, true), storage(1, false)],
+            entries: &[
+                crate::passes::compute_storage_entry(0, true),
+                crate::passes::compute_storage_entry(1, false),
+            ],
         });
         let pipeline = gpu.checked("building the shadow ray query", || {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -218,11 +218,18 @@ pub enum CasterCulling {
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum DrawSubmission {
-    /// One multi-draw per run of draws that share their state (pipeline, material,
-    /// scissor), from a buffer of draw arguments: a layer costs one command per
-    /// pipeline however many meshes it draws. Where the device cannot (no first
-    /// instance in indirect draws), the draws are issued one by one.
+    /// A compute pass culls the layer's casters (each instance, and each cluster of
+    /// a large mesh, against the layer's frustum and by its cone of normals) and
+    /// writes the draws it keeps and their count into buffers; the layer then draws
+    /// them with one multi-draw per pipeline whose count the GPU read. The CPU neither
+    /// culls nor uploads the layer's draws. Where the device cannot take a count
+    /// from a buffer, the CPU culls and the layer's draws are `indirect`.
     #[default]
+    GpuCulled,
+    /// The CPU culls, and each run of draws that share their state (pipeline,
+    /// material, scissor) is one multi-draw from a buffer of draw arguments: a layer
+    /// costs one command per pipeline however many meshes it draws. Where the device
+    /// cannot (no first instance in indirect draws), the draws are issued one by one.
     Indirect,
     /// One command per draw: the fallback, and the baseline indirect draws are
     /// measured and tested against.

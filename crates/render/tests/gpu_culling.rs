@@ -1,0 +1,149 @@
+//! GPU-driven submission (`DrawSubmission::GpuCulled`, `passes/gpu_cull.wgsl`): a
+//! compute pass culls every shadow item for each layer and the layer draws what it
+//! kept with one multi-draw per pipeline whose count the GPU wrote. Its maps are
+//! identical, texel for texel, to the CPU fallback's (the same setting on a device
+//! forced to lack indirect counts) and to the unculled maps drawn one by one, for
+//! every light kind, map layout and cull mode; and they follow a moved caster, kept
+//! map or not.
+
+mod support;
+
+use glam::{Mat4, Vec3};
+use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_scene::{
+    Motion, Scene, Settings, builtin,
+    settings::{
+        CasterCulling, CullMode, DrawSubmission, LightKind, MapCache, OmniMap, Partition, Refine, WarpKind,
+    },
+};
+use support::figures::skipped;
+
+/// The device as it is, or `None` (with a note) where it cannot cull on the GPU.
+fn culling_gpu() -> Option<&'static Gpu> {
+    let gpu = support::gpu();
+    if !gpu.indirect_count {
+        skipped("GPU culling", "the device cannot take a draw count from a buffer");
+        return None;
+    }
+    Some(gpu)
+}
+
+/// The same device, told it lacks indirect counts: the CPU fallback.
+fn fallback_gpu(gpu: &Gpu) -> Gpu {
+    Gpu { indirect_count: false, ..gpu.clone() }
+}
+
+fn with_map(renderer: &mut Renderer, uploaded: &GpuScene, scene: &Scene, s: &Settings) -> Frame {
+    let request = OutputRequest { shadow_map: true, ..Default::default() };
+    renderer.render_uploaded(uploaded, scene, s, &request).expect("render")
+}
+
+/// The reported light's map of `scene` drawn on `gpu` with `settings`.
+fn map(gpu: &Gpu, scene: &Scene, settings: &Settings) -> (Frame, Vec<f32>) {
+    let mut renderer = Renderer::new(gpu).expect("renderer");
+    let uploaded = renderer.upload(scene).expect("upload");
+    let mut frame = with_map(&mut renderer, &uploaded, scene, settings);
+    let depth = frame.shadow_map.take().expect("map").depth;
+    (frame, depth)
+}
+
+/// The map with nothing culled below whole instances, drawn one by one, from scratch.
+fn unculled(gpu: &Gpu, scene: &Scene, settings: &Settings) -> Vec<f32> {
+    let mut s = settings.clone();
+    s.shadow.map.caster_culling = CasterCulling::Instances;
+    s.shadow.map.draw_submission = DrawSubmission::Direct;
+    s.shadow.map.cache = MapCache::Off;
+    map(gpu, scene, &s).1
+}
+
+fn differing(a: &[f32], b: &[f32]) -> usize {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).filter(|(x, y)| x.to_bits() != y.to_bits()).count()
+}
+
+fn settings(light: LightKind, cull: CullMode) -> Settings {
+    let mut s = support::settings(160, 90, 512);
+    s.screen.refine = Refine::Off;
+    s.shadow.map.cache = MapCache::Off;
+    s.shadow.map.draw_submission = DrawSubmission::GpuCulled;
+    s.light.kind = light;
+    s.shadow.bias.cull = cull;
+    s
+}
+
+#[test]
+fn gpu_culled_maps_equal_the_cpu_fallback_and_the_unculled_maps() {
+    let Some(gpu) = culling_gpu() else { return };
+    let fallback = fallback_gpu(gpu);
+    let cascades = |cull| {
+        let mut s = settings(LightKind::Sun, cull);
+        s.shadow.partition = Partition::Cascades;
+        s
+    };
+    let mut paraboloid = settings(LightKind::Point, CullMode::Auto);
+    paraboloid.shadow.map.omni = OmniMap::Paraboloid;
+    let mut warped = settings(LightKind::Sun, CullMode::Auto);
+    warped.shadow.map.warp = WarpKind::Lispsm;
+    let cases = [
+        ("sun cascades, cull auto", cascades(CullMode::Auto)),
+        ("sun cascades, cull back", cascades(CullMode::Back)),
+        ("sun cascades, cull front", cascades(CullMode::Front)),
+        ("sun cascades, cull none", cascades(CullMode::None)),
+        ("sun, lispsm", warped),
+        ("spot", settings(LightKind::Spot, CullMode::Auto)),
+        ("point, cube", settings(LightKind::Point, CullMode::Auto)),
+        ("point, paraboloids", paraboloid),
+    ];
+    let scene = builtin::spheres();
+    for (name, s) in &cases {
+        let (on_gpu, gpu_map) = map(gpu, &scene, s);
+        let (on_cpu, cpu_map) = map(&fallback, &scene, s);
+        let whole = unculled(gpu, &scene, s);
+        assert_eq!(differing(&gpu_map, &cpu_map), 0, "{name}: GPU-culled against the CPU fallback");
+        assert_eq!(differing(&gpu_map, &whole), 0, "{name}: GPU-culled against the unculled map");
+        // The GPU culler's commands: one per bucket of items and layer, whatever
+        // the CPU would have drawn.
+        let layers = on_gpu.lights[0].layer_draws.len() as u32;
+        assert!(on_gpu.stats.shadow_commands <= 4 * layers, "{name}: {:?}", on_gpu.stats);
+        assert_eq!(on_gpu.stats.shadow_triangles, on_cpu.stats.shadow_triangles, "{name}");
+    }
+}
+
+#[test]
+fn a_moved_caster_moves_in_the_gpu_culled_map_kept_or_not() {
+    let Some(gpu) = culling_gpu() else { return };
+    let mut cascades = settings(LightKind::Sun, CullMode::Auto);
+    cascades.shadow.partition = Partition::Cascades;
+    let cases = [("spot", settings(LightKind::Spot, CullMode::Auto)), ("sun cascades", cascades)];
+    for ((name, base), cache) in cases.iter().flat_map(|c| [(c, MapCache::Off), (c, MapCache::StillCasters)])
+    {
+        let mut s = base.clone();
+        s.shadow.map.cache = cache;
+        let mut scene = builtin::spheres();
+        let named = |scene: &Scene, name: &str| scene.instances.iter().position(|i| i.name == name).unwrap();
+        let ball = named(&scene, "sphere 1,1");
+        let crate_box = named(&scene, "box");
+        scene.instances[ball].motion = Motion::Dynamic;
+        // The ball starts far outside every layer: its items must follow it in, or
+        // the culler would keep skipping it where it was.
+        let away = Vec3::new(60.0, 0.0, 60.0);
+        scene.instances[ball].world_from_object =
+            Mat4::from_translation(away) * scene.instances[ball].world_from_object;
+        let mut renderer = Renderer::new(gpu).unwrap();
+        let mut uploaded = renderer.upload(&scene).unwrap();
+        let first = with_map(&mut renderer, &uploaded, &scene, &s);
+        let first_map = &first.shadow_map.as_ref().unwrap().depth;
+        assert_eq!(differing(first_map, &unculled(gpu, &scene, &s)), 0, "{name}, {cache:?}: first frame");
+        for (moved, by) in [(ball, -away), (crate_box, Vec3::new(1.0, 0.0, 1.0))] {
+            let placed = &mut scene.instances[moved].world_from_object;
+            *placed = Mat4::from_translation(by) * *placed;
+            renderer.move_instances(&mut uploaded, &scene, &[moved]).unwrap();
+            let frame = with_map(&mut renderer, &uploaded, &scene, &s);
+            let after = &frame.shadow_map.as_ref().unwrap().depth;
+            let what = &scene.instances[moved].name;
+            assert!(differing(after, first_map) > 0, "{name}, {cache:?}: moving {what} changes the map");
+            let wrong = differing(after, &unculled(gpu, &scene, &s));
+            assert_eq!(wrong, 0, "{name}, {cache:?}: after {what} moved");
+        }
+    }
+}
