@@ -9,6 +9,7 @@
 
 pub mod camera_rig;
 mod debug_views;
+mod drag;
 mod reproduce;
 pub mod settings_form;
 mod ui;
@@ -19,6 +20,8 @@ use std::path::PathBuf;
 use gnomon_scene::{Scene, Settings};
 
 pub use debug_views::measure_aliasing;
+pub use drag::Grip;
+pub use gnomon_render::LayerCache;
 pub use reproduce::{SceneSource, scene_file_text};
 
 /// What the viewer opens and how it runs.
@@ -79,6 +82,16 @@ pub enum Action {
     CompareWithReference,
     /// Choose what the central view shows.
     Show(View),
+    /// Take hold of an instance to move it (Ctrl + left press on the view): it is a
+    /// moving caster until released.
+    Grab(Grip),
+    /// Carry the held instance to where a point of the view (fractions of its width
+    /// and height from its top-left corner) meets the plane it moves across.
+    DragTo([f32; 2]),
+    /// Move the held instance by a world-space offset (for scripts).
+    MoveHeldBy([f32; 3]),
+    /// Let go of the held instance.
+    Release,
 }
 
 /// What the central view shows.
@@ -105,6 +118,11 @@ pub struct RunReport {
     /// Where the scene's view sat in the window at the end: x, y, width, height in
     /// physical pixels (screenshots are the whole window).
     pub view_rect: [u32; 4],
+    /// The instances that were grabbed, by name, in order.
+    pub grabbed: Vec<String>,
+    /// For each frame drawn while an instance was held, what the first light's
+    /// layers did with their kept maps.
+    pub layer_cache_while_held: Vec<Vec<LayerCache>>,
 }
 
 /// Opens the window and runs until it is closed (or `frames` have been drawn).

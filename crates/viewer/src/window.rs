@@ -17,6 +17,7 @@ use winit::{
 use crate::{
     Action, RunReport, View, ViewerOptions,
     debug_views::{self, ErrorJob},
+    drag::{Hand, Reach},
     reproduce,
     ui::{Images, Model},
 };
@@ -61,6 +62,8 @@ struct Live {
 struct App {
     model: Model,
     live: Option<Live>,
+    /// The instance being moved, if any.
+    hand: Hand,
     frames: Option<u32>,
     screenshot: Option<std::path::PathBuf>,
     script: Vec<(u32, Action)>,
@@ -90,6 +93,7 @@ impl App {
         Ok(Self {
             model,
             live: None,
+            hand: Hand::default(),
             frames,
             screenshot,
             script,
@@ -180,6 +184,11 @@ impl App {
         let settings = self.model.frame_settings();
         match live.renderer.render_live(&live.uploaded, &self.model.scene, &settings) {
             Ok(frame) => {
+                if self.hand.held.is_some()
+                    && let Some(light) = frame.lights.first()
+                {
+                    self.report.layer_cache_while_held.push(light.layer_cache.clone());
+                }
                 show_live_frame(live, &frame, self.model.show_maps);
                 self.model.record_timings(frame.timings, frame.lights.clone());
             }
@@ -233,6 +242,16 @@ impl App {
             match action {
                 Action::Set { id, value } => self.model.set(&id, value.as_deref()),
                 Action::Show(view) => self.model.view = view,
+                Action::Grab(_) | Action::DragTo(_) | Action::MoveHeldBy(_) | Action::Release => {
+                    let reach = Reach {
+                        model: &mut self.model,
+                        renderer: &mut live.renderer,
+                        uploaded: &mut live.uploaded,
+                    };
+                    if let Some(name) = self.hand.act(&action, reach) {
+                        self.report.grabbed.push(name);
+                    }
+                }
                 Action::Screenshot(path) => screenshots.push(path),
                 Action::CopyCommand => {
                     let flags = self.model.form.flags(&self.model.frame_settings(), &self.model.baseline);

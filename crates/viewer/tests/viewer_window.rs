@@ -2,7 +2,9 @@
 //! renders frames on the GPU (lavapipe in CI), switches the technique through the
 //! same action the panel's technique box sends, and saves screenshots, which must
 //! show a picture and must change with the technique far more than between two
-//! frames of one technique.
+//! frames of one technique. Then it grabs a sphere, as Ctrl + drag does, and moves
+//! it: the sphere is a moving caster while held, so the kept shadow maps keep every
+//! layer and only the sphere is drawn over them.
 //!
 //! winit wants the main thread, so this test is its own `main` (`harness = false`).
 
@@ -10,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 use gnomon_scene::{Settings, builtin, settings::Technique};
-use gnomon_viewer::{Action, SceneSource, View, ViewerOptions};
+use gnomon_viewer::{Action, Grip, LayerCache, SceneSource, View, ViewerOptions};
 
 const UNDER_XVFB: &str = "GNOMON_TEST_UNDER_XVFB";
 
@@ -71,7 +73,7 @@ fn window_test() -> anyhow::Result<()> {
         .map_err(anyhow::Error::msg)?;
     let mut options = ViewerOptions::new(scene, settings, SceneSource::Builtin("spheres".into()));
     options.window_size = [1100, 700];
-    options.frames = Some(14);
+    options.frames = Some(21);
     let set = |id: &str, value: &str| Action::Set { id: id.into(), value: Some(value.into()) };
     options.script = vec![
         (3, Action::Screenshot(shot("hard"))),
@@ -81,11 +83,18 @@ fn window_test() -> anyhow::Result<()> {
         (10, Action::SaveSceneFile(dir.join("view.toml"))),
         (10, Action::Show(View::TexelDensity)),
         (12, Action::Screenshot(shot("density"))),
+        (13, Action::Show(View::Lit)),
+        (13, Action::Grab(Grip::Named("sphere 1,1".into()))),
+        (14, Action::Screenshot(shot("held"))),
+        (15, Action::MoveHeldBy([1.5, 0.0, 0.0])),
+        (16, Action::MoveHeldBy([0.0, 0.0, 1.0])),
+        (18, Action::Screenshot(shot("moved"))),
+        (19, Action::Release),
     ];
     let report = gnomon_viewer::run(options)?;
 
-    anyhow::ensure!(report.frames == 14, "drew {} frames, not 14", report.frames);
-    anyhow::ensure!(report.screenshots.len() == 4, "screenshots: {:?}", report.screenshots);
+    anyhow::ensure!(report.frames == 21, "drew {} frames, not 21", report.frames);
+    anyhow::ensure!(report.screenshots.len() == 6, "screenshots: {:?}", report.screenshots);
     anyhow::ensure!(
         report.settings.shadow.filter.technique == Technique::PCSS,
         "the technique action left {:?}",
@@ -118,6 +127,23 @@ fn window_test() -> anyhow::Result<()> {
     anyhow::ensure!(control * 1000 <= pixels, "one technique drew two different pictures ({control} pixels)");
     anyhow::ensure!(switched * 100 > pixels, "switching to PCSS changed only {switched} of {pixels} pixels");
     anyhow::ensure!(shown * 4 > pixels, "the texel-density view changed only {shown} of {pixels} pixels");
+
+    // The held sphere: after the first frame (the scene uploaded again with it moving),
+    // every layer keeps its map, and only the sphere is drawn over it.
+    anyhow::ensure!(report.grabbed == ["sphere 1,1"], "grabbed {:?}", report.grabbed);
+    let held = &report.layer_cache_while_held;
+    println!("layer caches while held: {held:?}");
+    anyhow::ensure!(held.len() >= 5, "{} frames drawn while held", held.len());
+    for (frame, layers) in held.iter().enumerate().skip(1) {
+        anyhow::ensure!(
+            layers.iter().all(|l| *l == LayerCache::Kept),
+            "frame {frame} while held redrew its layers: {layers:?}"
+        );
+    }
+    let (before, after) = (view(&load(&shot("held"))?), view(&load(&shot("moved"))?));
+    let moved = changed_pixels(&before, &after);
+    println!("pixels changed by moving the sphere: {moved} of {pixels}");
+    anyhow::ensure!(moved * 500 > pixels, "moving the sphere changed only {moved} of {pixels} pixels");
 
     // The saved scene file holds the view: the technique, the sun and the camera.
     let saved = gnomon_scene::scene_file::load(&dir.join("view.toml"), None)?;

@@ -54,6 +54,8 @@ pub(crate) struct Model {
     pub error: Option<Picture>,
     /// Actions the panels sent this frame, for the window to carry out.
     pub pending: Vec<Action>,
+    /// Whether a Ctrl + left drag is moving an instance.
+    moving: bool,
 }
 
 /// The sun's clock: hour of local solar time, latitude and day of the year.
@@ -104,6 +106,7 @@ impl Model {
             error_job: None,
             error: None,
             pending: Vec::new(),
+            moving: false,
         })
     }
 
@@ -201,7 +204,7 @@ impl Model {
                 CameraMode::Fly => "fly",
             };
             ui.label(format!(
-                "camera: {mode} (C switches) · left drag turns · right drag moves the light · middle drag pans · \
+                "camera: {mode} (C switches) · left drag turns · Ctrl + left drag moves an object · right drag moves the light · middle drag pans · \
                  scroll zooms{} · F1 panels · F12 screenshot",
                 if self.rig.mode == CameraMode::Fly { " · W A S D Q E fly" } else { "" }
             ));
@@ -295,7 +298,24 @@ impl Model {
             );
         }
         let delta = response.drag_delta() * ppp;
-        if response.dragged_by(egui::PointerButton::Primary) {
+        // Ctrl + left drag moves the instance under the cursor (`drag.rs`).
+        let ctrl = ui.input(|i| i.modifiers.command);
+        let at =
+            |pos: egui::Pos2| [(pos.x - rect.left()) / rect.width(), (pos.y - rect.top()) / rect.height()];
+        let pointer = response.interact_pointer_pos();
+        if ctrl && response.drag_started_by(egui::PointerButton::Primary) {
+            if let Some(pos) = pointer {
+                self.pending.push(Action::Grab(crate::Grip::At(at(pos))));
+                self.moving = true;
+            }
+        } else if self.moving && response.drag_stopped() {
+            self.pending.push(Action::Release);
+            self.moving = false;
+        } else if self.moving {
+            if let Some(pos) = pointer.filter(|_| delta != egui::Vec2::ZERO) {
+                self.pending.push(Action::DragTo(at(pos)));
+            }
+        } else if response.dragged_by(egui::PointerButton::Primary) {
             self.rig.turn(delta.x, delta.y);
         } else if response.dragged_by(egui::PointerButton::Secondary) {
             self.drag_light(delta.x, delta.y);
