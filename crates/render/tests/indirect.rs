@@ -3,13 +3,15 @@
 //! or one by one (`Direct`, the fallback for a device without first instances in
 //! indirect draws). Both draw the same map, texel for texel, for every light kind,
 //! and the indirect one records a handful of commands however many meshes it draws.
+//! The camera's passes (prepass, lighting) draw each texture's runs as one multi-draw
+//! too, unless `direct`: the images are identical, byte for byte.
 
 mod support;
 
 use gnomon_render::{Frame, OutputRequest, Renderer};
 use gnomon_scene::{
     Scene, Settings, builtin, geometry,
-    settings::{DrawSubmission, LightKind, MapCache, OmniMap, Partition, Refine},
+    settings::{DrawSubmission, LightKind, MapCache, OmniMap, Partition, Refine, ShadowPath},
 };
 use support::figures::{figure, skipped};
 
@@ -41,6 +43,12 @@ fn same_maps(name: &str, scene: &Scene, settings: &Settings) -> (Frame, Frame) {
     let differing = a.depth.iter().zip(&b.depth).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
     assert_eq!(differing, 0, "{name}: {differing} of {} texels differ", a.depth.len());
     assert_eq!(indirect.stats.shadow_draws, direct.stats.shadow_draws, "{name}: the same draws");
+    // The camera's passes draw the same runs in the same order: the same image.
+    let other_colour = indirect.color.iter().zip(&direct.color).filter(|(a, b)| a != b).count();
+    assert_eq!(other_colour, 0, "{name}: the camera's passes drew another image");
+    let other_surface = indirect.object_id.iter().zip(&direct.object_id).filter(|(a, b)| a != b).count();
+    assert_eq!(other_surface, 0, "{name}: the camera's passes saw other surfaces");
+    assert_eq!(indirect.stats.lighting_draws, direct.stats.lighting_draws, "{name}");
     assert_eq!(direct.stats.shadow_commands, direct.stats.shadow_draws, "{name}: one command a draw");
     for light in &direct.lights {
         assert_eq!(light.layer_commands, light.layer_draws, "{name}: {}", light.name);
@@ -69,6 +77,11 @@ fn indirect_and_direct_draws_give_the_same_map_for_every_light_kind() {
         let (indirect, _) = same_maps(name, &spheres, s);
         assert!(indirect.stats.shadow_commands <= indirect.stats.shadow_draws, "{name}");
     }
+    // Three lamps lit from the light list: the mask path, whose prepass draws too.
+    let mut lamps = settings(LightKind::All);
+    lamps.screen.shadow_path = ShadowPath::Mask;
+    let (listed, _) = same_maps("lamps:3, mask path", &builtin::build("lamps:3").expect("lamps"), &lamps);
+    assert!(listed.stats.prepass_draws > 0, "{:?}", listed.stats);
 }
 
 /// A ground and `count` boxes, each its own mesh (as a glTF file's nodes often are:

@@ -158,3 +158,34 @@ pub(crate) fn scene_group(
         &[Binding::Buffer(uploaded.instances.clone()), Binding::Buffer(light.clone())],
     )
 }
+
+/// What the camera sees, and the arguments its passes draw it from where they draw
+/// indirectly ([`camera_arguments`]).
+pub(crate) struct CameraDraws<'a> {
+    pub visible: &'a crate::gpu_scene::Visible,
+    pub arguments: Option<wgpu::Buffer>,
+}
+
+/// The draw arguments of what the camera sees (`visible`), for its passes (prepass,
+/// lighting) to draw each texture's runs as one multi-draw; None where they draw one
+/// by one: a device without first instances in indirect draws, or `submission`
+/// `direct`, the baseline.
+pub(crate) fn camera_arguments(
+    pool: &mut Pool,
+    gpu: &crate::Gpu,
+    uploaded: &GpuScene,
+    visible: &crate::gpu_scene::Visible,
+    submission: gnomon_scene::settings::DrawSubmission,
+) -> Option<wgpu::Buffer> {
+    use gnomon_scene::settings::DrawSubmission;
+    let indirect = match submission {
+        DrawSubmission::GpuCulled | DrawSubmission::Indirect => gpu.indirect_draws,
+        DrawSubmission::Direct => false,
+    };
+    if !indirect || visible.runs.is_empty() {
+        return None;
+    }
+    let mut args = uploaded.visible_arguments(visible);
+    args.resize(super::depth_pass::argument_slots(args.len()), Default::default());
+    Some(pool.storage(&gpu.queue, "camera draw arguments", &args, wgpu::BufferUsages::INDIRECT))
+}

@@ -245,7 +245,7 @@ fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec
 
 /// How many draw arguments an arguments buffer holds for `draws`: the next power of
 /// two (at least 64), so that the pool keeps reusing a buffer while the count moves.
-fn argument_slots(draws: usize) -> usize {
+pub(super) fn argument_slots(draws: usize) -> usize {
     draws.next_power_of_two().max(64)
 }
 
@@ -262,11 +262,15 @@ impl Renderer {
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) -> DrawStats {
         let gpu = self.gpu.clone();
+        // The GPU culls cluster by cluster: a pass asked to cull whole instances (the
+        // baseline clusters are measured against) is culled on the CPU.
         let culled_on_gpu = match (depth.settings.shadow.map.draw_submission, &depth.culling) {
-            (DrawSubmission::GpuCulled, Some(culling)) if gpu.indirect_count => {
+            (DrawSubmission::GpuCulled, Some(culling))
+                if gpu.indirect_count && matches!(culling.view.granularity, Granularity::Clusters { .. }) =>
+            {
                 uploaded.uploaded_shadow_items().map(|items| (items, culling))
             }
-            _ => None,
+            (DrawSubmission::GpuCulled | DrawSubmission::Indirect | DrawSubmission::Direct, _) => None,
         };
         let light_buffer = self.pool.uniform(&gpu.queue, "light", depth.light);
         let group = scene_group(&mut self.pool, &self.layouts, uploaded, &light_buffer);
@@ -356,6 +360,7 @@ impl Renderer {
             near: culling.view.near,
             faces: match culling.view.granularity {
                 Granularity::Clusters { faces } => faces,
+                // Not culled here (`record_depth_pass`).
                 Granularity::Instances => None,
             },
         };

@@ -9,12 +9,12 @@ use gnomon_scene::settings::{Lighting, Refine};
 
 use super::{
     Renderer,
+    bindings::CameraDraws,
     plan::FramePlan,
     record::{LightBindings, Recording},
 };
 use crate::{
     GpuScene,
-    gpu_scene::Visible,
     passes::{
         light_list::{EmitterGpu, LightListGpu, LightTiles, Reach},
         lighting::{self, LightingKey, LightingRole, Lookup},
@@ -39,8 +39,8 @@ pub(super) struct SharedLighting<'a> {
     /// camera's group with the casters' BVH.
     pub tracing_group: Option<&'a wgpu::BindGroup>,
     pub targets: &'a LightingTargets,
-    /// What the camera sees.
-    pub visible: &'a Visible,
+    /// What the camera sees, and how its draws go out.
+    pub camera: &'a CameraDraws<'a>,
     /// On the mask path: every light's layer of the mask, and the tiles' light lists.
     pub masks: Option<MaskInputs<'a>>,
 }
@@ -193,9 +193,10 @@ impl Renderer {
         pass.set_bind_group(2, &group, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 3;
-        let (draws, binds) = uploaded.draw_visible(&mut pass, shared.visible, 3);
+        let camera = shared.camera;
+        let (draws, binds) = uploaded.draw_visible(&mut pass, camera.visible, 3, camera.arguments.as_ref());
         rec.stats.lighting_draws += draws;
-        rec.stats.lighting_instances += shared.visible.instances();
+        rec.stats.lighting_instances += camera.visible.instances();
         rec.stats.bind_group_changes += binds;
         drop(pass);
         rec.clock.end(&gpu, rec.encoder, slot);
@@ -228,8 +229,7 @@ impl Renderer {
         index: usize,
         bindings: &LightBindings,
     ) {
-        let SharedLighting { plan, camera_group, tracing_group, targets, visible: camera_visible, .. } =
-            *shared;
+        let SharedLighting { plan, camera_group, tracing_group, targets, camera, .. } = *shared;
         let light = &plan.lights[index];
         let first = index == 0;
         let last = index + 1 == plan.lights.len();
@@ -275,9 +275,9 @@ impl Renderer {
         pass.set_bind_group(2, &bindings.lighting, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 3;
-        let (draws, binds) = uploaded.draw_visible(&mut pass, camera_visible, 3);
+        let (draws, binds) = uploaded.draw_visible(&mut pass, camera.visible, 3, camera.arguments.as_ref());
         rec.stats.lighting_draws += draws;
-        rec.stats.lighting_instances += camera_visible.instances();
+        rec.stats.lighting_instances += camera.visible.instances();
         rec.stats.bind_group_changes += binds;
         drop(pass);
         rec.clock.end(gpu, rec.encoder, slot);

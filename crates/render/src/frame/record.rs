@@ -13,7 +13,7 @@ use gnomon_scene::{
 
 use super::{
     Renderer,
-    bindings::{ShadowViews, scene_group},
+    bindings::{CameraDraws, ShadowViews, camera_arguments, scene_group},
     cull::{Culled, cull},
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
@@ -255,10 +255,15 @@ impl Renderer {
         let mask = mask_layers.first().map(|layer| {
             self.pool.view(layer.texture(), ViewKey::whole(wgpu::TextureViewDimension::D2Array))
         });
+        let submission = settings.shadow.map.draw_submission;
+        let camera = CameraDraws {
+            visible: &culled.camera,
+            arguments: camera_arguments(&mut self.pool, &gpu, uploaded, &culled.camera, submission),
+        };
         if let Some(tiles) = &tiles {
             let mask_rects = (0..plan.lights.len()).map(|i| plan.mask_rect(tiles, i, viewport)).collect();
             let screen = super::screen::ScreenInputs {
-                camera_visible: &culled.camera,
+                camera: &camera,
                 camera_buffer: &camera_buffer,
                 camera_group: &camera_group,
                 depth: &targets.depth,
@@ -286,7 +291,7 @@ impl Renderer {
             camera_group: &camera_group,
             tracing_group: tracing.as_ref(),
             targets: &targets,
-            visible: &culled.camera,
+            camera: &camera,
             masks: mask.as_ref().zip(tiles.as_ref()).map(|(mask, tiles)| MaskInputs { mask, tiles }),
         };
         self.record_lights(rec, uploaded, &shared, &lit);

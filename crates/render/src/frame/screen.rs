@@ -5,12 +5,12 @@
 
 use super::{
     Renderer,
+    bindings::CameraDraws,
     plan::{FramePlan, LightPlan},
     record::{LightBindings, Recording},
 };
 use crate::{
     GpuScene,
-    gpu_scene::Visible,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
     rays::{ListAccess, RefineLists, TraceGroups, TraceStage},
@@ -21,7 +21,8 @@ use gnomon_scene::settings::Refine;
 
 /// What the screen-space passes draw into and read.
 pub(super) struct ScreenInputs<'a> {
-    pub camera_visible: &'a Visible,
+    /// What the camera sees, and how its draws go out.
+    pub camera: &'a CameraDraws<'a>,
     pub camera_buffer: &'a wgpu::Buffer,
     pub camera_group: &'a wgpu::BindGroup,
     /// The lighting passes' depth buffer, which the prepass fills.
@@ -298,7 +299,8 @@ impl Renderer {
         pass.set_bind_group(1, inputs.camera_group, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 2;
-        let (draws, binds) = uploaded.draw_visible(&mut pass, inputs.camera_visible, 3);
+        let camera = inputs.camera;
+        let (draws, binds) = uploaded.draw_visible(&mut pass, camera.visible, 3, camera.arguments.as_ref());
         rec.stats.prepass_draws += draws;
         rec.stats.bind_group_changes += binds;
         drop(pass);

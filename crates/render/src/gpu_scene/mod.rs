@@ -359,28 +359,47 @@ impl GpuScene {
         pass.set_vertex_buffer(0, vertices.slice(..));
     }
 
+    /// The arguments of every run of `visible`, in order: what
+    /// [`GpuScene::draw_visible`] reads to draw them indirectly.
+    pub(crate) fn visible_arguments(&self, visible: &Visible) -> Vec<DrawArgs> {
+        visible.runs.iter().map(|run| DrawArgs::of(&self.batches[run.batch as usize], run)).collect()
+    }
+
     /// Binds the geometry and draws `visible`, each material's texture bound as group
-    /// `material_group` when it changes. Returns (draw calls, bind group changes).
+    /// `material_group` when it changes: each run of draws under one texture as one
+    /// multi-draw from `arguments` ([`GpuScene::visible_arguments`]) where given,
+    /// else one by one. Returns (draws, bind group changes).
     pub(crate) fn draw_visible(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         visible: &Visible,
         material_group: u32,
+        arguments: Option<&wgpu::Buffer>,
     ) -> (u32, u32) {
         self.bind_geometry(pass, VertexStream::Full, IndexOrder::Scene);
-        let (mut draws, mut binds) = (0, 0);
-        let mut bound = None;
-        for run in &visible.runs {
-            let batch = &self.batches[run.batch as usize];
-            if bound != Some(batch.material_group) {
-                pass.set_bind_group(material_group, &self.material_groups[batch.material_group], &[]);
-                bound = Some(batch.material_group);
-                binds += 1;
+        let mut binds = 0;
+        let texture = |run: &Run| self.batches[run.batch as usize].material_group;
+        let mut first = 0u32;
+        // The camera's view culls batches in their order, sorted by texture: each
+        // texture's runs come together.
+        for runs in visible.runs.chunk_by(|a, b| texture(a) == texture(b)) {
+            pass.set_bind_group(material_group, &self.material_groups[texture(&runs[0])], &[]);
+            binds += 1;
+            match arguments {
+                Some(buffer) => pass.multi_draw_indexed_indirect(
+                    buffer,
+                    u64::from(first) * DrawArgs::SIZE,
+                    runs.len() as u32,
+                ),
+                None => {
+                    for run in runs {
+                        Self::draw_run(pass, &self.batches[run.batch as usize], run);
+                    }
+                }
             }
-            Self::draw_run(pass, batch, run);
-            draws += 1;
+            first += runs.len() as u32;
         }
-        (draws, binds)
+        (visible.runs.len() as u32, binds)
     }
 
     /// Issues one instanced draw of `run`, of `batch`.

@@ -229,3 +229,60 @@ impl ShadowItems {
         queue.write_buffer(&self.buffer, offset, bytemuck::cast_slice(&items));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use gnomon_scene::builtin;
+
+    use super::*;
+    use crate::gpu_scene::batches::{MeshRange, batch_instances};
+
+    /// The batches of `scene`, as an upload groups them (without clusters).
+    fn batches_of(scene: &gnomon_scene::Scene) -> Vec<Batch> {
+        let mut first_index = 0;
+        let ranges: Vec<MeshRange> = scene
+            .meshes
+            .iter()
+            .map(|m| {
+                let range = MeshRange { first_index, index_count: m.indices.len() as u32, base_vertex: 0 };
+                first_index += m.indices.len() as u32;
+                range
+            })
+            .collect();
+        let bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
+        batch_instances(scene, &ranges, &bounds, &scene.closed_meshes()).0
+    }
+
+    #[test]
+    fn every_caster_is_one_item_and_the_buckets_tile_the_slots() {
+        let mut scene = builtin::columns();
+        // A moving caster and one that casts no shadow: their own bucket, and no item.
+        scene.instances[1].motion = Motion::Dynamic;
+        scene.instances[2].casts_shadow = false;
+        let batches = batches_of(&scene);
+        let order: Vec<u32> = (0..batches.len() as u32).collect();
+        let list = ItemList::of(&batches, &order);
+        let casters = scene.instances.iter().filter(|i| i.casts_shadow).count();
+        assert_eq!(list.items.len(), casters, "one item per casting instance (no clusters here)");
+        let mut next = 0;
+        for bucket in &list.buckets {
+            assert_eq!(bucket.first_slot, next, "the buckets' slots follow one another");
+            next += bucket.capacity;
+        }
+        assert_eq!(next as usize, list.items.len(), "and hold every item");
+        for (index, bucket) in list.buckets.iter().enumerate() {
+            let held = list.items.iter().filter(|i| i.bucket as usize == index).count();
+            assert_eq!(held as u32, bucket.capacity, "bucket {index}");
+        }
+        assert!(list.buckets.iter().any(|b| b.class.motion == Motion::Dynamic));
+        // Each batch's items carry its draw: its instances, its whole mesh.
+        for (batch, range) in batches.iter().zip(&list.batch_items) {
+            let items = &list.items[range.start as usize..range.end as usize];
+            assert_eq!(items.len(), if batch.casts_shadow { batch.tree.len() } else { 0 });
+            for (k, item) in items.iter().enumerate() {
+                assert_eq!(item.first_instance, batch.first_instance + k as u32);
+                assert_eq!((item.first_index, item.index_count), (batch.first_index, batch.index_count));
+            }
+        }
+    }
+}

@@ -213,7 +213,8 @@ pub enum CasterCulling {
     Instances,
 }
 
-/// How a shadow layer's draws are submitted.
+/// How a shadow layer's draws are submitted. Unless `direct`, the camera's passes
+/// (the prepass and lighting) draw each texture's run of meshes as one multi-draw too.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
@@ -231,8 +232,8 @@ pub enum DrawSubmission {
     /// costs one command per pipeline however many meshes it draws. Where the device
     /// cannot (no first instance in indirect draws), the draws are issued one by one.
     Indirect,
-    /// One command per draw: the fallback, and the baseline indirect draws are
-    /// measured and tested against.
+    /// One command per draw, in the shadow passes and the camera's alike: the
+    /// fallback, and the baseline indirect draws are measured and tested against.
     Direct,
 }
 
