@@ -120,8 +120,7 @@ impl Gpu {
         })?;
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
-        let indirect_draws = indirect_draws(adapter, &device);
-        let indirect_count = indirect_count(indirect_draws, &device);
+        let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, &device);
         Ok(Self {
             device,
             queue,
@@ -141,14 +140,15 @@ impl Gpu {
         let adapter_info = adapter.get_info();
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
+        let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, device);
         Self {
             device: device.clone(),
             queue: queue.clone(),
             info: GpuInfo::of(adapter_info),
             limits: device.limits(),
             timestamp_period_ns,
-            indirect_draws: indirect_draws(adapter, device),
-            indirect_count: indirect_count(indirect_draws(adapter, device), device),
+            indirect_draws,
+            indirect_count,
         }
     }
 
@@ -229,16 +229,21 @@ fn headless_adapter() -> Result<wgpu::Adapter, RenderError> {
     }
 }
 
-/// Whether `device`, which draws from buffers of arguments where `indirect_draws`, can
-/// also take the count of draws from a buffer.
-fn indirect_count(indirect_draws: bool, device: &wgpu::Device) -> bool {
-    indirect_draws && device.features().contains(wgpu::Features::MULTI_DRAW_INDIRECT_COUNT)
+/// What indirect drawing a device can do ([`Gpu::indirect_draws`], [`Gpu::indirect_count`]).
+struct IndirectDraws {
+    indirect_draws: bool,
+    indirect_count: bool,
 }
 
-/// Whether `device` on `adapter` can draw from a buffer of arguments that each carry
-/// their first instance.
-fn indirect_draws(adapter: &wgpu::Adapter, device: &wgpu::Device) -> bool {
-    let execution =
-        adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION);
-    execution && device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+impl IndirectDraws {
+    /// What `device` on `adapter` can do: draw from a buffer of arguments that each
+    /// carry their first instance, and besides take the count of draws from a buffer.
+    fn of(adapter: &wgpu::Adapter, device: &wgpu::Device) -> Self {
+        let execution =
+            adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION);
+        let indirect_draws = execution && device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE);
+        let indirect_count =
+            indirect_draws && device.features().contains(wgpu::Features::MULTI_DRAW_INDIRECT_COUNT);
+        Self { indirect_draws, indirect_count }
+    }
 }

@@ -101,10 +101,13 @@ fn gpu_culled_maps_equal_the_cpu_fallback_and_the_unculled_maps() {
         let whole = unculled(gpu, &scene, s);
         assert_eq!(differing(&gpu_map, &cpu_map), 0, "{name}: GPU-culled against the CPU fallback");
         assert_eq!(differing(&gpu_map, &whole), 0, "{name}: GPU-culled against the unculled map");
-        // The GPU culler's commands: one per bucket of items and layer, whatever
-        // the CPU would have drawn.
-        let layers = on_gpu.lights[0].layer_draws.len() as u32;
-        assert!(on_gpu.stats.shadow_commands <= 4 * layers, "{name}: {:?}", on_gpu.stats);
+        // The GPU culler's commands: one per bucket of items and layer, whatever the
+        // CPU would have drawn. `spheres` casts with two kinds of mesh, closed (the
+        // spheres, the box) and open (the ground), each its own pipeline.
+        const BUCKETS: u32 = 2;
+        let layers = on_gpu.lights[0].layer_commands.len() as u32;
+        println!("{name}: {} commands, {} draws", on_gpu.stats.shadow_commands, on_gpu.stats.shadow_draws);
+        assert_eq!(on_gpu.stats.shadow_commands, BUCKETS * layers, "{name}: {:?}", on_gpu.stats);
         assert_eq!(on_gpu.stats.shadow_triangles, on_cpu.stats.shadow_triangles, "{name}");
     }
 }
@@ -145,5 +148,53 @@ fn a_moved_caster_moves_in_the_gpu_culled_map_kept_or_not() {
             let wrong = differing(after, &unculled(gpu, &scene, &s));
             assert_eq!(wrong, 0, "{name}, {cache:?}: after {what} moved");
         }
+    }
+}
+
+/// `spheres` with an alpha-masked checkerboard quad hung over it: a bucket of its own,
+/// whose pipeline samples the quad's texture.
+fn with_cutout(mut scene: Scene) -> Scene {
+    use gnomon_scene::{AlphaMode, Material, Texture, Wrap, geometry};
+    let cells = 8u32;
+    let rgba8 = (0..cells * cells)
+        .flat_map(|k| [200, 180, 60, if (k % cells + k / cells).is_multiple_of(2) { 255 } else { 0 }]);
+    scene.textures.push(Texture {
+        name: "checker".into(),
+        width: cells,
+        height: cells,
+        rgba8: rgba8.collect(),
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        nearest: true,
+    });
+    let mut cutout = Material::new("cut-out", Vec3::ONE);
+    cutout.base_color_texture = Some(scene.textures.len() - 1);
+    cutout.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
+    cutout.double_sided = true;
+    scene.materials.push(cutout);
+    let material = scene.materials.len() - 1;
+    support::add(
+        &mut scene,
+        "checker",
+        geometry::plane(2.0, 2.0),
+        Mat4::from_translation(Vec3::new(0.3, 1.4, -0.2)),
+    );
+    scene.instances.last_mut().expect("added").material = material;
+    scene
+}
+
+#[test]
+fn an_alpha_masked_caster_is_culled_on_the_gpu_with_its_texture() {
+    let Some(gpu) = culling_gpu() else { return };
+    let scene = with_cutout(builtin::spheres());
+    let mut cascades = settings(LightKind::Sun, CullMode::Auto);
+    cascades.shadow.partition = Partition::Cascades;
+    for (name, s) in [("sun cascades", cascades), ("spot", settings(LightKind::Spot, CullMode::Auto))] {
+        let (frame, culled) = map(gpu, &scene, &s);
+        let whole = unculled(gpu, &scene, &s);
+        assert_eq!(differing(&culled, &whole), 0, "{name}: GPU-culled against the unculled map");
+        // The closed meshes, the ground, and the cut-out: three buckets a layer.
+        let layers = frame.lights[0].layer_commands.len() as u32;
+        assert_eq!(frame.stats.shadow_commands, 3 * layers, "{name}: {:?}", frame.stats);
     }
 }

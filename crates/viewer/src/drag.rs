@@ -126,6 +126,9 @@ impl Held {
     }
 }
 
+/// Gives instance `instance` `motion`, uploading the scene again (motion decides how
+/// instances are batched, `gpu_scene::batches`); where the upload fails, the scene
+/// keeps its motion, in step with what the GPU holds.
 fn set_motion(
     scene: &mut Scene,
     instance: usize,
@@ -133,12 +136,21 @@ fn set_motion(
     renderer: &Renderer,
     uploaded: &mut GpuScene,
 ) -> anyhow::Result<()> {
-    if scene.instances[instance].motion != motion {
-        scene.instances[instance].motion = motion;
-        // Motion decides how instances are batched (`gpu_scene::batches`).
-        *uploaded = renderer.upload(scene)?;
+    let before = scene.instances[instance].motion;
+    if before == motion {
+        return Ok(());
     }
-    Ok(())
+    scene.instances[instance].motion = motion;
+    match renderer.upload(scene) {
+        Ok(again) => {
+            *uploaded = again;
+            Ok(())
+        }
+        Err(e) => {
+            scene.instances[instance].motion = before;
+            Err(e.into())
+        }
+    }
 }
 
 /// The viewer's hand: what it holds, and the actions that grab, carry and release.
@@ -168,14 +180,25 @@ impl Hand {
             }
         };
         let aspect = settings.image.width as f32 / settings.image.height as f32;
+        // One object at a time: a new grab lets go of the one held.
+        if matches!(action, Action::Grab(_))
+            && let Some(held) = self.held.take()
+            && let Err(e) = held.release(&mut model.scene, renderer, uploaded)
+        {
+            model.say(format!("{e:#}"));
+        }
         let result = match (action, self.held.as_mut()) {
             (Action::Grab(grip), _) => match grab(&model.scene, &camera, aspect, grip) {
                 Ok(held) => {
                     let name = model.scene.instances[held.instance].name.clone();
-                    let taken = held.take(&mut model.scene, renderer, uploaded);
-                    self.held = Some(held);
-                    model.say(format!("moving {name}: a moving caster while held"));
-                    return taken.map(|()| name).map_err(|e| model.say(format!("{e:#}"))).ok();
+                    match held.take(&mut model.scene, renderer, uploaded) {
+                        Ok(()) => {
+                            self.held = Some(held);
+                            model.say(format!("moving {name}: a moving caster while held"));
+                            return Some(name);
+                        }
+                        Err(e) => Err(e),
+                    }
                 }
                 Err(why) => Err(anyhow::anyhow!(why)),
             },

@@ -176,7 +176,6 @@ impl App {
         }
         let Some(live) = self.live.as_mut() else { return Ok(()) };
         let gpu = live.gpu.clone();
-        let (device, queue) = (&gpu.device, &gpu.queue);
 
         // The scene, live, at the size the central view had last frame.
         self.model.settings.camera.eye = Some(self.model.rig.eye());
@@ -234,60 +233,14 @@ impl App {
         let model = &mut self.model;
         let images = &live.images;
         let mut output = ctx.run_ui(input, |ui| model.ui(ui, images));
-        live.egui.handle_platform_output(&live.window, output.platform_output);
+        live.egui.handle_platform_output(&live.window, std::mem::take(&mut output.platform_output));
 
         // What the panels asked for.
         let mut screenshots = Vec::new();
-        for action in std::mem::take(&mut self.model.pending) {
-            match action {
-                Action::Set { id, value } => self.model.set(&id, value.as_deref()),
-                Action::Show(view) => self.model.view = view,
-                Action::Grab(_) | Action::DragTo(_) | Action::MoveHeldBy(_) | Action::Release => {
-                    let reach = Reach {
-                        model: &mut self.model,
-                        renderer: &mut live.renderer,
-                        uploaded: &mut live.uploaded,
-                    };
-                    if let Some(name) = self.hand.act(&action, reach) {
-                        self.report.grabbed.push(name);
-                    }
-                }
-                Action::Screenshot(path) => screenshots.push(path),
-                Action::CopyCommand => {
-                    let flags = self.model.form.flags(&self.model.frame_settings(), &self.model.baseline);
-                    let command = reproduce::render_command(&self.model.source, &flags);
-                    ctx.copy_text(command.clone());
-                    self.model.say(format!("copied: {command}"));
-                }
-                Action::SaveSceneFile(path) => {
-                    let saved = reproduce::scene_file_text(&self.model.source, &self.model.frame_settings())
-                        .and_then(|text| {
-                            reproduce::write_whole(&path, |temporary| {
-                                std::fs::write(temporary, text)
-                                    .with_context(|| format!("{}: cannot write", path.display()))
-                            })
-                        });
-                    match saved {
-                        Ok(()) => self.model.say(format!("saved {}", path.display())),
-                        Err(e) => self.model.say(format!("{e:#}")),
-                    }
-                }
-                Action::CompareWithReference => {
-                    let request = OutputRequest::default();
-                    match live.renderer.render_uploaded(
-                        &live.uploaded,
-                        &self.model.scene,
-                        &settings,
-                        &request,
-                    ) {
-                        Ok(frame) => {
-                            self.model.say("tracing the reference for this view…");
-                            self.model.error_job =
-                                Some(ErrorJob::start(&self.model.scene, frame, settings.clone()));
-                        }
-                        Err(e) => self.model.say(e.to_string()),
-                    }
-                }
+        let mut panels = Panels { model: &mut self.model, hand: &mut self.hand, report: &mut self.report };
+        for action in std::mem::take(&mut panels.model.pending) {
+            if let Some(path) = panels.carry_out(action, live, &ctx, &settings) {
+                screenshots.push(path);
             }
         }
         let last = self.frames.is_some_and(|n| frame_index + 1 >= n);
@@ -296,81 +249,7 @@ impl App {
         }
 
         // Paint.
-        let jobs = ctx.tessellate(output.shapes, output.pixels_per_point);
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                live.painter.update_texture(device, queue, *id, delta);
-            }
-        }
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [live.config.width, live.config.height],
-            pixels_per_point: output.pixels_per_point,
-        };
-        let surface_texture = match live.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Some(t),
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                live.surface.configure(device, &live.config);
-                None
-            }
-            _ => None,
-        };
-        // Screenshots paint the same jobs into a texture that can be copied out.
-        let shot_texture = (!screenshots.is_empty()).then(|| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("screenshot"),
-                size: wgpu::Extent3d {
-                    width: screen.size_in_pixels[0],
-                    height: screen.size_in_pixels[1],
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: live.config.format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        let buffers = live.painter.update_buffers(device, queue, &mut encoder, &jobs, &screen);
-        let mut targets: Vec<wgpu::TextureView> = Vec::new();
-        if let Some(t) = &surface_texture {
-            targets.push(t.texture.create_view(&Default::default()));
-        }
-        if let Some(t) = &shot_texture {
-            targets.push(t.create_view(&Default::default()));
-        }
-        for view in &targets {
-            let mut pass = encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("egui"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.06, g: 0.06, b: 0.07, a: 1.0 }),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                })
-                .forget_lifetime();
-            live.painter.render(&mut pass, &jobs, &screen);
-        }
-        queue.submit(buffers.into_iter().chain([encoder.finish()]));
-        if let Some(t) = surface_texture {
-            live.window.pre_present_notify();
-            queue.present(t);
-        }
-        for id in &output.textures_delta.free {
-            live.painter.free_texture(id);
-        }
-        // Applied above; egui insists that they are drained.
-        output.textures_delta.clear();
+        let shot_texture = paint(live, &ctx, output, !screenshots.is_empty());
         if let Some(texture) = shot_texture {
             let texels: Vec<u8> = gnomon_render::read_texture(&gpu, &texture)?;
             let rgba = to_rgba(texels, texture.format());
@@ -511,4 +390,156 @@ impl ApplicationHandler for App {
             live.window.request_redraw();
         }
     }
+}
+
+/// What the panels' actions change: the model, the hand that moves objects, and the
+/// run's report.
+struct Panels<'a> {
+    model: &'a mut Model,
+    hand: &'a mut Hand,
+    report: &'a mut RunReport,
+}
+
+impl Panels<'_> {
+    /// Carries out one action of the panels (or the script) with the window's
+    /// renderer; returns the path of a screenshot it asks for.
+    fn carry_out(
+        &mut self,
+        action: Action,
+        live: &mut Live,
+        ctx: &egui::Context,
+        settings: &gnomon_scene::Settings,
+    ) -> Option<std::path::PathBuf> {
+        match action {
+            Action::Set { id, value } => self.model.set(&id, value.as_deref()),
+            Action::Show(view) => self.model.view = view,
+            Action::Grab(_) | Action::DragTo(_) | Action::MoveHeldBy(_) | Action::Release => {
+                let reach =
+                    Reach { model: self.model, renderer: &mut live.renderer, uploaded: &mut live.uploaded };
+                if let Some(name) = self.hand.act(&action, reach) {
+                    self.report.grabbed.push(name);
+                }
+            }
+            Action::Screenshot(path) => return Some(path),
+            Action::CopyCommand => {
+                let flags = self.model.form.flags(&self.model.frame_settings(), &self.model.baseline);
+                let command = reproduce::render_command(&self.model.source, &flags);
+                ctx.copy_text(command.clone());
+                self.model.say(format!("copied: {command}"));
+            }
+            Action::SaveSceneFile(path) => {
+                let saved = reproduce::scene_file_text(&self.model.source, &self.model.frame_settings())
+                    .and_then(|text| {
+                        reproduce::write_whole(&path, |temporary| {
+                            std::fs::write(temporary, text)
+                                .with_context(|| format!("{}: cannot write", path.display()))
+                        })
+                    });
+                match saved {
+                    Ok(()) => self.model.say(format!("saved {}", path.display())),
+                    Err(e) => self.model.say(format!("{e:#}")),
+                }
+            }
+            Action::CompareWithReference => {
+                let request = OutputRequest::default();
+                match live.renderer.render_uploaded(&live.uploaded, &self.model.scene, settings, &request) {
+                    Ok(frame) => {
+                        self.model.say("tracing the reference for this view…");
+                        self.model.error_job =
+                            Some(ErrorJob::start(&self.model.scene, frame, settings.clone()));
+                    }
+                    Err(e) => self.model.say(e.to_string()),
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Paints the panels' `output` into the window, and into a texture that can be copied
+/// out where `shoot` asks for a screenshot: returns that texture.
+fn paint(
+    live: &mut Live,
+    ctx: &egui::Context,
+    mut output: egui::FullOutput,
+    shoot: bool,
+) -> Option<wgpu::Texture> {
+    let gpu = live.gpu.clone();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let jobs = ctx.tessellate(output.shapes, output.pixels_per_point);
+    for (id, deltas) in &output.textures_delta.set {
+        for delta in deltas {
+            live.painter.update_texture(device, queue, *id, delta);
+        }
+    }
+    let screen = egui_wgpu::ScreenDescriptor {
+        size_in_pixels: [live.config.width, live.config.height],
+        pixels_per_point: output.pixels_per_point,
+    };
+    let surface_texture = match live.surface.get_current_texture() {
+        wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Some(t),
+        wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+            live.surface.configure(device, &live.config);
+            None
+        }
+        _ => None,
+    };
+    // Screenshots paint the same jobs into a texture that can be copied out.
+    let shot_texture = shoot.then(|| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("screenshot"),
+            size: wgpu::Extent3d {
+                width: screen.size_in_pixels[0],
+                height: screen.size_in_pixels[1],
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: live.config.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let buffers = live.painter.update_buffers(device, queue, &mut encoder, &jobs, &screen);
+    let mut targets: Vec<wgpu::TextureView> = Vec::new();
+    if let Some(t) = &surface_texture {
+        targets.push(t.texture.create_view(&Default::default()));
+    }
+    if let Some(t) = &shot_texture {
+        targets.push(t.create_view(&Default::default()));
+    }
+    for view in &targets {
+        let mut pass = encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.06, g: 0.06, b: 0.07, a: 1.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            })
+            .forget_lifetime();
+        live.painter.render(&mut pass, &jobs, &screen);
+    }
+    queue.submit(buffers.into_iter().chain([encoder.finish()]));
+    if let Some(t) = surface_texture {
+        live.window.pre_present_notify();
+        queue.present(t);
+    }
+    for id in &output.textures_delta.free {
+        live.painter.free_texture(id);
+    }
+    // Applied above; egui insists that they are drained.
+    output.textures_delta.clear();
+    shot_texture
 }

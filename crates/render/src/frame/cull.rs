@@ -21,7 +21,7 @@ pub(super) struct Culled {
 }
 
 /// Culls for every layer of every light, and for the camera, in parallel.
-pub(super) fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
+fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
     let camera_view = CullView {
         frustum: Frustum::from_clip_from_world(plan.camera.clip_from_world(plan.aspect)),
         near: true,
@@ -71,21 +71,18 @@ pub(super) fn layer_view(light: &LightPlan, clip_from_world: glam::Mat4) -> Cull
 }
 
 impl Renderer {
-    /// Uploads the shadow items the GPU culler reads, once per scene, where a light
-    /// of `plan` culls its layers on the GPU and the device can draw what it kept
-    /// (`DrawSubmission::GpuCulled`). A scene the device cannot take this way is
-    /// culled on the CPU, the same map.
-    pub(super) fn prepare_gpu_culling(
-        &self,
-        uploaded: &GpuScene,
-        plan: &FramePlan,
-    ) -> Result<(), RenderError> {
+    /// Culls for every layer of every light of `plan` and for the camera ([`cull`]),
+    /// first uploading the shadow items the GPU culler reads, once per scene, where a
+    /// light culls its layers on the GPU and the device can draw what it kept
+    /// (`DrawSubmission::GpuCulled`). A scene the device cannot take this way is culled
+    /// on the CPU, the same map.
+    pub(super) fn cull_frame(&self, uploaded: &GpuScene, plan: &FramePlan) -> Result<Culled, RenderError> {
         let wanted =
             plan.lights.iter().any(|l| l.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled);
         if wanted && self.gpu.indirect_count {
             // Ok(Err(why)): this device cannot; the passes then cull on the CPU.
             let _unavailable = uploaded.shadow_items(&self.gpu)?;
         }
-        Ok(())
+        Ok(cull(uploaded, plan))
     }
 }

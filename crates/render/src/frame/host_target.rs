@@ -6,7 +6,6 @@ use gnomon_scene::{Scene, Settings};
 
 use super::{
     DrawStats, Renderer,
-    cull::cull,
     record::{Readback, Recording},
 };
 use crate::{GpuScene, RenderError, passes::blit::HostTarget, timing::PassClock};
@@ -31,7 +30,7 @@ impl Renderer {
         settings.validate()?;
         self.check_limits(&settings)?;
         let plan = self.plan_frame(uploaded, scene, &settings, None)?;
-        let culled = cull(uploaded, &plan);
+        let culled = self.cull_frame(uploaded, &plan)?;
         let gpu = self.gpu.clone();
         gpu.checked("rendering into the host's target", || {
             let mut rec = Recording {

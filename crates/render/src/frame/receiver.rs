@@ -8,7 +8,7 @@ use gnomon_scene::{
     settings::{Lighting, RayUse, Refine, ScreenSpaceSettings, Technique},
 };
 
-use super::{Renderer, bindings::ReceiverUniforms, cull::cull, record::Recording};
+use super::{Renderer, bindings::ReceiverUniforms, record::Recording};
 use crate::{
     GpuScene, RenderError,
     frame::DrawStats,
@@ -115,8 +115,7 @@ impl Renderer {
         if plan.mask_path || plan.lights.iter().any(|l| l.refine != Refine::Off) {
             return Err(RenderError::ReceiverNeedsMapPath);
         }
-        self.prepare_gpu_culling(uploaded, &plan)?;
-        let culled = cull(uploaded, &plan);
+        let culled = self.cull_frame(uploaded, &plan)?;
         let gpu = self.gpu.clone();
         gpu.checked("recording the shadows for the host's shader", || {
             let mut rec = Recording {

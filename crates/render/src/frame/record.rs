@@ -14,7 +14,7 @@ use gnomon_scene::{
 use super::{
     Renderer,
     bindings::{CameraDraws, ShadowViews, camera_arguments, scene_group},
-    cull::{Culled, cull},
+    cull::Culled,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
     outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
@@ -149,8 +149,7 @@ impl Renderer {
         let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
         let fallback = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();
-        self.prepare_gpu_culling(uploaded, &plan)?;
-        let culled = cull(uploaded, &plan);
+        let culled = self.cull_frame(uploaded, &plan)?;
         let cull_done = Instant::now();
         let gpu = self.gpu.clone();
         let mut recorded = gpu.checked("rendering the frame", || {

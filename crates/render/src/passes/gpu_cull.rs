@@ -111,11 +111,11 @@ impl GpuCullPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gpu cull"),
             entries: &[
-                super::compute_storage_entry(0, true),
+                super::compute_storage_entry(0, crate::passes::StorageAccess::Read),
                 super::uniform_entry(1, wgpu::ShaderStages::COMPUTE),
-                super::compute_storage_entry(2, true),
-                super::compute_storage_entry(3, false),
-                super::compute_storage_entry(4, false),
+                super::compute_storage_entry(2, crate::passes::StorageAccess::Read),
+                super::compute_storage_entry(3, crate::passes::StorageAccess::ReadWrite),
+                super::compute_storage_entry(4, crate::passes::StorageAccess::ReadWrite),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -7,7 +7,7 @@
 //
 // The tests are the CPU culler's (`gnomon_math::culling::Frustum::classify`,
 // `gnomon_math::facing::NormalCone::winding`), in f32 where the CPU's cone test is in
-// f64, so the cone test here leaves a slack for rounding: it may keep a cluster the
+// f64, so both tests here leave a slack for rounding: they may keep a cluster the
 // CPU skips, never skip one the CPU keeps.
 
 struct ShadowItem {
@@ -58,7 +58,9 @@ struct DrawArgs {
 @group(0) @binding(4) var<storage, read_write> draws: array<DrawArgs>;
 
 // Whether the box lies wholly outside one plane: its corner farthest along the
-// plane's normal (the "p-vertex"; Greene, Graphics Gems IV, 1994) is outside.
+// plane's normal (the "p-vertex"; Greene, Graphics Gems IV, 1994) is outside by more
+// than rounding. The CPU's sum may be ordered or fused differently, so a box within a
+// few ulps of a plane is kept here: 1e-6 of the terms' magnitudes is over 10 ulps.
 fn outside_frustum(lo: vec3f, hi: vec3f) -> bool {
     if any(lo > hi) {
         return true;
@@ -69,7 +71,8 @@ fn outside_frustum(lo: vec3f, hi: vec3f) -> bool {
         }
         let plane = view.planes[i];
         let farthest = select(lo, hi, plane.xyz >= vec3f(0.0));
-        if dot(plane.xyz, farthest) + plane.w < 0.0 {
+        let magnitude = dot(abs(plane.xyz), abs(farthest)) + abs(plane.w);
+        if dot(plane.xyz, farthest) + plane.w < -1e-6 * magnitude {
             return true;
         }
     }

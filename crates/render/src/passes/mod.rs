@@ -247,13 +247,20 @@ fn depth_reader_layouts(
     (layout, pipeline_layout)
 }
 
-/// A storage buffer read (or, unless `read_only`, written) by a compute stage.
-pub(crate) fn compute_storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+/// Whether a shader may write a storage buffer it binds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum StorageAccess {
+    Read,
+    ReadWrite,
+}
+
+/// A storage buffer a compute stage reads, or reads and writes.
+pub(crate) fn compute_storage_entry(binding: u32, access: StorageAccess) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
+            ty: wgpu::BufferBindingType::Storage { read_only: access == StorageAccess::Read },
             has_dynamic_offset: false,
             min_binding_size: None,
         },

@@ -50,8 +50,8 @@ impl ShadowRays {
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow ray query"),
             entries: &[
-                crate::passes::compute_storage_entry(0, true),
-                crate::passes::compute_storage_entry(1, false),
+                crate::passes::compute_storage_entry(0, crate::passes::StorageAccess::Read),
+                crate::passes::compute_storage_entry(1, crate::passes::StorageAccess::ReadWrite),
             ],
         });
         let pipeline = gpu.checked("building the shadow ray query", || {

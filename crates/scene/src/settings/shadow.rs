@@ -222,8 +222,9 @@ pub enum DrawSubmission {
     /// A compute pass culls the layer's casters (each instance, and each cluster of
     /// a large mesh, against the layer's frustum and by its cone of normals) and
     /// writes the draws it keeps and their count into buffers; the layer then draws
-    /// them with one multi-draw per pipeline whose count the GPU read. The CPU neither
-    /// culls nor uploads the layer's draws. Where the device cannot take a count
+    /// them with one multi-draw per pipeline whose count the GPU read. The CPU uploads
+    /// no draw arguments (it still culls, for the frame's counts and to know which
+    /// layers hold moving casters). Where the device cannot take a count
     /// from a buffer, the CPU culls and the layer's draws are `indirect`.
     #[default]
     GpuCulled,

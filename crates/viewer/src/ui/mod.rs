@@ -298,22 +298,25 @@ impl Model {
             );
         }
         let delta = response.drag_delta() * ppp;
-        // Ctrl + left drag moves the instance under the cursor (`drag.rs`).
-        let ctrl = ui.input(|i| i.modifiers.command);
+        // Ctrl + left drag moves the instance under the cursor (`drag.rs`): it is
+        // grabbed where the button went down, not where the drag was recognized.
+        let (ctrl, press) = ui.input(|i| (i.modifiers.ctrl, i.pointer.press_origin()));
         let at =
             |pos: egui::Pos2| [(pos.x - rect.left()) / rect.width(), (pos.y - rect.top()) / rect.height()];
         let pointer = response.interact_pointer_pos();
         if ctrl && response.drag_started_by(egui::PointerButton::Primary) {
-            if let Some(pos) = pointer {
+            if let Some(pos) = press.or(pointer) {
                 self.pending.push(Action::Grab(crate::Grip::At(at(pos))));
                 self.moving = true;
             }
-        } else if self.moving && response.drag_stopped() {
-            self.pending.push(Action::Release);
-            self.moving = false;
         } else if self.moving {
-            if let Some(pos) = pointer.filter(|_| delta != egui::Vec2::ZERO) {
+            // The last movement too, on the frame the button comes up.
+            if let Some(pos) = pointer.or(response.hover_pos()) {
                 self.pending.push(Action::DragTo(at(pos)));
+            }
+            if response.drag_stopped() {
+                self.pending.push(Action::Release);
+                self.moving = false;
             }
         } else if response.dragged_by(egui::PointerButton::Primary) {
             self.rig.turn(delta.x, delta.y);
