@@ -177,7 +177,9 @@ impl GpuCullPass {
         let view_buffer = pool.uniform(&gpu.queue, "gpu cull view", &view);
         let bucket_buffer =
             pool.storage(&gpu.queue, "gpu cull buckets", &buckets, wgpu::BufferUsages::empty());
-        let indirect = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT;
+        // Copied out by the tests, which read what the culler kept.
+        let indirect =
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC;
         let counts = pool.buffer(
             "gpu cull counts",
             CulledDraws::count_offset(items.buckets.len()),
@@ -210,4 +212,82 @@ impl GpuCullPass {
 /// `gpu_cull.wgsl`, composed.
 pub(crate) fn gpu_cull_wgsl() -> String {
     super::compose_wgsl(&[include_str!("gpu_cull.wgsl")])
+}
+
+#[cfg(test)]
+mod tests {
+    //! Equal maps (`render/tests/gpu_culling.rs`) would not notice a culler that kept
+    //! everything: here the draws it keeps are read back and held to the CPU's.
+
+    use glam::{Mat4, Vec3};
+    use gnomon_math::culling::Frustum;
+    use gnomon_scene::{builtin, settings::CullMode};
+
+    use super::*;
+    use crate::{
+        Gpu, GpuScene,
+        gpu_scene::{CullView, Granularity},
+        passes::{Layouts, shadow::DepthTarget},
+    };
+
+    /// The triangles of the draws the GPU kept for `view`, read back.
+    fn gpu_triangles(gpu: &Gpu, pool: &mut Pool, items: &ShadowItems, view: &CullView) -> u64 {
+        let faces = match view.granularity {
+            Granularity::Clusters { faces } => faces,
+            Granularity::Instances => None,
+        };
+        let target = CullTarget { frustum: &view.frustum, near: view.near, faces };
+        let mut pass = GpuCullPass::new(&gpu.device);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let culled = pass.record(gpu, pool, &mut encoder, items, &target, None);
+        let read = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
+        let counts = pool.buffer("test counts", culled.counts.size(), read);
+        let draws = pool.buffer("test draws", culled.draws.size(), read);
+        encoder.copy_buffer_to_buffer(&culled.counts, 0, &counts, 0, None);
+        encoder.copy_buffer_to_buffer(&culled.draws, 0, &draws, 0, None);
+        gpu.queue.submit([encoder.finish()]);
+        let counts: Vec<u32> = crate::readback::read_buffer(gpu, &counts).unwrap();
+        let draws: Vec<DrawArgs> = crate::readback::read_buffer(gpu, &draws).unwrap();
+        let mut triangles = 0;
+        for (bucket, &count) in items.buckets.iter().zip(&counts) {
+            assert!(count <= bucket.capacity, "{count} draws kept in a bucket of {}", bucket.capacity);
+            let kept = &draws[bucket.first_slot as usize..(bucket.first_slot + count) as usize];
+            triangles += kept.iter().map(|d| u64::from(d.index_count / 3 * d.instance_count)).sum::<u64>();
+        }
+        triangles
+    }
+
+    #[test]
+    fn the_gpu_keeps_the_triangles_the_cpu_keeps() {
+        let gpu = Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)");
+        let scene = builtin::spheres();
+        let uploaded = GpuScene::upload(&gpu, &scene, &Layouts::new(&gpu.device)).unwrap();
+        let items = uploaded.shadow_items(&gpu).unwrap().expect("the device takes the items");
+        let mut pool = Pool::new(&gpu.device);
+        let look = |eye: Vec3, target: Vec3| gnomon_math::view_from_world_look_at(eye, target, Vec3::Z);
+        let ortho =
+            |half: f32| glam::camera::rh::proj::directx::orthographic(-half, half, -half, half, 0.1, 40.0);
+        let views = [
+            ("all of it, from above", ortho(20.0) * look(Vec3::new(0.0, 20.0, 0.0), Vec3::ZERO)),
+            ("a corner", ortho(1.5) * look(Vec3::new(1.0, 20.0, 1.0), Vec3::new(1.0, 0.0, 1.0))),
+            ("nothing", ortho(1.0) * look(Vec3::new(500.0, 20.0, 0.0), Vec3::new(500.0, 0.0, 0.0))),
+        ];
+        let total: u64 = scene.meshes.iter().map(|m| m.triangle_count() as u64).sum();
+        for (name, clip_from_world) in views {
+            for mode in [CullMode::None, CullMode::Back] {
+                let view = CullView {
+                    frustum: Frustum::from_clip_from_world(clip_from_world),
+                    near: true,
+                    casters_only: true,
+                    granularity: Granularity::Clusters {
+                        faces: LayerFaces::of(clip_from_world, DepthTarget::Projected, mode),
+                    },
+                };
+                let cpu = uploaded.cull(&[view])[0].triangles();
+                let on_gpu = gpu_triangles(&gpu, &mut pool, items, &view);
+                println!("{name}, cull {mode:?}: CPU {cpu}, GPU {on_gpu} of {total} triangles");
+                assert_eq!(on_gpu, cpu, "{name}, cull {mode:?}");
+            }
+        }
+    }
 }
