@@ -219,7 +219,7 @@ mod tests {
     //! Equal maps (`render/tests/gpu_culling.rs`) would not notice a culler that kept
     //! everything: here the draws it keeps are read back and held to the CPU's.
 
-    use glam::{Mat4, Vec3};
+    use glam::Vec3;
     use gnomon_math::culling::Frustum;
     use gnomon_scene::{builtin, settings::CullMode};
 
