@@ -227,13 +227,7 @@ fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec
     for rect in depth.area.rects() {
         for run in &depth.visible.runs {
             let batch = &uploaded.batches[run.batch as usize];
-            let class = BucketClass {
-                sides: batch.sides,
-                masked: batch.masked,
-                material: batch.masked.then_some(batch.material_group),
-                motion: batch.motion,
-            };
-            let state = DrawState::of(depth, rect, &class);
+            let state = DrawState::of(depth, rect, &BucketClass::of(batch));
             match buckets.iter_mut().find(|(s, _)| *s == state) {
                 Some((_, runs)) => runs.push(run),
                 None => buckets.push((state, vec![run])),
@@ -241,6 +235,21 @@ fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec
         }
     }
     buckets
+}
+
+/// Begins `depth`'s render pass with its scene group (instances and light) bound.
+fn open_depth_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    depth: &DepthPass,
+    group: &wgpu::BindGroup,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
+    stats: &mut DrawStats,
+) -> wgpu::RenderPass<'e> {
+    let mut pass =
+        begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), timestamp_writes);
+    pass.set_bind_group(0, group, &[]);
+    stats.bind_group_changes += 1;
+    pass
 }
 
 /// How many draw arguments an arguments buffer holds for `draws`: the next power of
@@ -317,10 +326,7 @@ impl Renderer {
             self.pool.storage(&gpu.queue, "draw arguments", &args, wgpu::BufferUsages::INDIRECT)
         });
         let mut stats = DrawStats::default();
-        let mut pass =
-            begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), timestamp_writes);
-        pass.set_bind_group(0, group, &[]);
-        stats.bind_group_changes += 1;
+        let mut pass = open_depth_pass(encoder, depth, group, timestamp_writes, &mut stats);
         let mut changes = StateChanges::default();
         let mut first_argument = 0u64;
         for (state, runs) in &buckets {
@@ -382,10 +388,7 @@ impl Renderer {
         };
         let culled = self.passes.gpu_cull.record(&gpu, &mut self.pool, encoder, items, &target, cull_writes);
         let mut stats = DrawStats::default();
-        let mut pass =
-            begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), draw_writes);
-        pass.set_bind_group(0, group, &[]);
-        stats.bind_group_changes += 1;
+        let mut pass = open_depth_pass(encoder, depth, group, draw_writes, &mut stats);
         let mut changes = StateChanges::default();
         for rect in depth.area.rects() {
             for (index, bucket) in items.buckets.iter().enumerate() {

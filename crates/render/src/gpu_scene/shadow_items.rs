@@ -52,6 +52,18 @@ pub(crate) struct BucketClass {
     pub motion: Motion,
 }
 
+impl BucketClass {
+    /// What the draws of `batch`'s casters share.
+    pub fn of(batch: &Batch) -> Self {
+        BucketClass {
+            sides: batch.sides,
+            masked: batch.masked,
+            material: batch.masked.then_some(batch.material_group),
+            motion: batch.motion,
+        }
+    }
+}
+
 /// A bucket: its class, and where its kept draws go in a layer's arguments.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ItemBucket {
@@ -109,12 +121,7 @@ impl ItemList {
             if !batch.casts_shadow {
                 continue;
             }
-            let class = BucketClass {
-                sides: batch.sides,
-                masked: batch.masked,
-                material: batch.masked.then_some(batch.material_group),
-                motion: batch.motion,
-            };
+            let class = BucketClass::of(batch);
             let bucket = match list.buckets.iter().position(|b| b.class == class) {
                 Some(found) => found,
                 None => {
