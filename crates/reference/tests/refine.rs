@@ -95,6 +95,41 @@ fn casters_thinner_than_a_texel_are_shadowed_exactly_only_with_rays() {
     assert!(refined.mismatch_rate <= REFINED_MISMATCH, "{refined:?}");
 }
 
+/// Suzanne under a sun 70° up, at its default view (`gnomon compare
+/// pmndrs/suzi.glb --sun-elevation 70 --refine rays`). Past the folds of her brows
+/// and ears she shades herself, and the caster there is seen almost edge-on from the
+/// light: its slope-scaled bias stores it behind the receiver it shadows, so the
+/// lookup reads light, and a footprint test that trusted the stored depths was sure
+/// of it. Measured on lavapipe: the map alone 0.401 %; refined, 0.056 % while the
+/// footprint test took the bilinear texels at their stored depths, 0.021 % since it
+/// takes the receiver's own bias off them (`FootprintBounds::own_bias` in
+/// refine_footprint.wgsl). Issue 25's 0.02 % is not met here; the bound is 1.4× the
+/// measurement, and the former test's 0.056 % fails it. Needs `../shared`.
+const SUZANNE_FOLDS_REFINED: f64 = 0.0003;
+
+#[test]
+fn folds_where_a_model_shades_itself_are_traced() {
+    let Some(path) = common::shared_scene("pmndrs/suzi.glb") else { return };
+    let (scene, _) = gnomon_scene::gltf_loader::load(&path).unwrap();
+    let mut s = settings(Refine::Off);
+    s.image.width = 1280;
+    s.image.height = 720;
+    s.light.sun_elevation = Some(70.0);
+    let truth = reference(&scene, &s);
+    let map = compare(&render(&scene, &s), &truth);
+    let refined =
+        compare(&render(&scene, &Settings { screen: settings(Refine::Rays).screen, ..s.clone() }), &truth);
+    figure("Suzanne, sun 70° up, pcf2x2: mismatch", percent(map.mismatch_rate), "> 0.2%");
+    figure(
+        "Suzanne, sun 70° up, refined by rays: mismatch",
+        percent(refined.mismatch_rate),
+        percent(SUZANNE_FOLDS_REFINED),
+    );
+    assert!(map.mismatch_rate > 0.002, "the map alone should be wrong past the folds: {map:?}");
+    assert!(refined.compared > 200_000, "{refined:?}");
+    assert!(refined.mismatch_rate <= SUZANNE_FOLDS_REFINED, "{refined:?}");
+}
+
 #[test]
 fn moved_casters_are_traced_where_they_now_stand() {
     // Issue 25: "the BVH refit follows a moved instance". One column is laid across

@@ -89,8 +89,8 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     // ∂(distance / range)/∂(u, v), by the 2×2 inverse, then per texel.
     let gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
     let slope = abs(gradient.x) + abs(gradient.y);
-    let tolerance = 0.5 * slope;
     let margin = UNSURE_DEPTH_TEXELS * texel_world / light.range + (light.slope_bias + 1.0) * slope;
+    let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), distance / light.range);
     cube_plane = CubePlane(geometric_n, dot(offset, geometric_n), face_directions(clip_from_world));
-    return footprint_unsure(uv, tolerance, margin, layer);
+    return footprint_unsure(uv, FootprintBounds(0.5 * slope, margin, own_bias), layer);
 }

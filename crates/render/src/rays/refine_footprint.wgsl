@@ -17,15 +17,50 @@ fn map_step(clip_from_world: mat4x4<f32>, ndc: vec3<f32>, w: f32, t: vec3<f32>) 
     return (d.xyz - ndc * d.w) / w * vec3<f32>(0.5, -0.5, 1.0);
 }
 
+// How far from the receiver's plane a stored depth may lie, in the map's depth
+// units, and what it then says (`footprint_unsure`).
+struct FootprintBounds {
+    // Within this in front of the plane, or anywhere behind it: the receiver itself
+    // or something behind it (half a texel of the receiver's depth slope, for the
+    // plane's fit to a curved surface).
+    tolerance: f32,
+    // More than this in front: a caster.
+    margin: f32,
+    // The bias the map was drawn with where the receiver itself is stored
+    // (`receiver_bias`): its own surface lies at least this far behind the plane.
+    own_bias: f32,
+};
+
+// The bias the map's rasterizer added to a surface of depth slope `slope` (its
+// largest depth change per texel) at depth `depth`: slope_bias × m + depth_bias × r,
+// r the depth's unit in the last place (Vulkan's depth bias; a distance pass writes
+// the same itself, shadow_depth.wgsl).
+fn receiver_bias(slope: f32, depth: f32) -> f32 {
+    let unit = exp2(floor(log2(max(depth, 1e-30))) - 23.0);
+    return light.slope_bias * slope + max(light.depth_bias, 0.0) * unit;
+}
+
 // Whether the footprint of a lookup at `uv` (in [0, 1]) in layer `layer` is unsure:
 // the bilinear 2×2 and a ring of UNSURE_RING_TEXELS texels, each texel's stored depth
 // against the receiver's plane there, which the including file's
 // `footprint_receiver(x, y)` gives for a 2×2 block of texels (in gather's order). A
-// texel within `tolerance` behind or in front of the plane, or farther behind, is
-// evidence of light; one more than `margin` in front, of a caster; one in between, or
-// both kinds together, make the pixel unsure. A footprint that leaves the layer is
-// `FOOTPRINT_EDGE_UNSURE`.
-fn footprint_unsure(uv: vec2<f32>, tolerance: f32, margin: f32, layer: u32) -> bool {
+// texel within `bounds.tolerance` behind or in front of the plane, or farther
+// behind, is evidence of light; one more than `bounds.margin` in front, of a caster;
+// one in between, or both kinds together, make the pixel unsure. A footprint that
+// leaves the layer is `FOOTPRINT_EDGE_UNSURE`.
+//
+// In the bilinear 2×2, the texels the lookup reads, a texel is evidence of light
+// only once the receiver's own bias is taken off it as well. The receiver is stored
+// that far behind its plane; a texel stored nearer than that is not the receiver
+// but a caster that its own, larger bias pushed back. That is what a surface seen
+// almost edge-on from the light looks like just before a fold turns it away: its
+// slope-scaled bias is many texels of depth, and stores it behind the receiver it
+// shadows just past the fold, where the lookup reads light. (Taking off the most
+// bias the block's own slopes allow instead, the largest difference between its
+// texels, caught more of them, but it also traced the lit sides of coarsely
+// tessellated columns whole: there adjacent facets' biases differ, and a facet's
+// edge against the ground beyond is a jump.)
+fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool {
     let size = light.resolution;
     // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels.
     let base = vec2<i32>(floor(uv * size - vec2<f32>(0.5)));
@@ -44,8 +79,12 @@ fn footprint_unsure(uv: vec2<f32>, tolerance: f32, margin: f32, layer: u32) -> b
             let corner = vec2<f32>(f32(x + 1), f32(y + 1)) / size;
             let stored = textureGather(shadow_map, shadow_gather, corner, layer);
             let receiver = footprint_receiver(x, y);
-            let is_lit = stored >= receiver - vec4<f32>(tolerance);
-            let is_shadowed = stored <= receiver - vec4<f32>(margin);
+            var lit_from = receiver - vec4<f32>(bounds.tolerance);
+            if all(vec2<i32>(x, y) == base) {
+                lit_from += vec4<f32>(bounds.own_bias);
+            }
+            let is_lit = stored >= lit_from;
+            let is_shadowed = stored <= receiver - vec4<f32>(bounds.margin);
             if !all(is_lit | is_shadowed) {
                 return true;
             }

@@ -11,6 +11,9 @@
 //   of shadow;
 // - in between: a caster touching the receiver, or the receiver's own surface bent
 //   toward the light. This is where light leaks and acne live: unsure.
+// In the bilinear 2×2 the lookup reads, evidence of light must also lie behind the
+// receiver's own bias: a steep caster's larger bias can store it behind a receiver
+// it shadows, as just past a fold (refine_footprint.wgsl).
 // The pixel is unsure when any texel is, or when the footprint holds both kinds.
 //
 // Under a light with an area (light.penumbra_rays > 0), the pixel is also unsure
@@ -69,11 +72,11 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
     let along_ray = abs(map_step(clip_from_world, ndc, w, -l * texel_world).z);
     let slope = abs(gradient.x) + abs(gradient.y);
-    let tolerance = 0.5 * slope;
     let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.slope_bias + 1.0) * slope;
+    let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), c.z);
 
     map_plane = MapPlane(c.xy * size - vec2<f32>(0.5), c.z, gradient);
-    if footprint_unsure(c.xy, tolerance, margin, layer) {
+    if footprint_unsure(c.xy, FootprintBounds(0.5 * slope, margin, own_bias), layer) {
         return true;
     }
     return light.penumbra_rays > 0u && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
