@@ -219,14 +219,21 @@ pub(crate) fn open_casters_line(scene: &Scene, cull: CullMode) -> String {
     )
 }
 
-/// Warns, once per reason, of lights drawn unrefined though `--refine` asked for rays:
-/// the device cannot trace the scene or an image this large.
+/// Warns, once per reason, of lights drawn unrefined though `--refine` asked for rays
+/// (the device cannot trace the scene or an image this large), and of lights whose
+/// layers were culled on the CPU though `--draw-submission gpu-culled` asked for the
+/// GPU (the same maps, at the CPU's cost).
 pub(crate) fn warn_unrefined(lights: &[gnomon_render::LightStats]) {
-    let mut said: Vec<&gnomon_render::rays::RaysUnavailable> = Vec::new();
-    for why in lights.iter().filter_map(|l| l.refine_fallback.as_ref()) {
-        if !said.contains(&why) {
-            eprintln!("gnomon: warning: --refine: {why}; shadows drawn unrefined");
-            said.push(why);
+    let mut said: Vec<String> = Vec::new();
+    let refine = lights.iter().filter_map(|l| l.refine_fallback.as_ref());
+    let culling = lights.iter().filter_map(|l| l.cull_fallback.as_ref());
+    let warnings = refine
+        .map(|why| format!("--refine: {why}; shadows drawn unrefined"))
+        .chain(culling.map(|why| format!("--draw-submission gpu-culled: {why}; layers culled on the CPU")));
+    for warning in warnings {
+        if !said.contains(&warning) {
+            eprintln!("gnomon: warning: {warning}");
+            said.push(warning);
         }
     }
 }

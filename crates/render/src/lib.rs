@@ -33,7 +33,7 @@ pub use frame::{
     CpuTimings, Creations, DrawStats, Frame, FrameCost, LayerCache, LightShadows, LightStats, LiveFrame,
     OutputRequest, PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
 };
-pub use gpu_scene::GpuScene;
+pub use gpu_scene::{GpuCullUnavailable, GpuScene};
 pub use layout::{ShadowLayout, light_projection};
 pub use passes::blit::HostTarget;
 pub use passes::depth_baseline::DepthBaselineScene;

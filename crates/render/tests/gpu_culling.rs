@@ -9,7 +9,7 @@
 mod support;
 
 use glam::{Mat4, Vec3};
-use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer};
+use gnomon_render::{Frame, Gpu, GpuCullUnavailable, GpuScene, OutputRequest, Renderer};
 use gnomon_scene::{
     Motion, Scene, Settings, builtin,
     settings::{
@@ -109,6 +109,16 @@ fn gpu_culled_maps_equal_the_cpu_fallback_and_the_unculled_maps() {
         println!("{name}: {} commands, {} draws", on_gpu.stats.shadow_commands, on_gpu.stats.shadow_draws);
         assert_eq!(on_gpu.stats.shadow_commands, BUCKETS * layers, "{name}: {:?}", on_gpu.stats);
         assert_eq!(on_gpu.stats.shadow_triangles, on_cpu.stats.shadow_triangles, "{name}");
+        // The fallback says why, and the GPU-culled frame has nothing to say.
+        assert_eq!(on_gpu.lights[0].cull_fallback, None, "{name}");
+        assert_eq!(on_cpu.lights[0].cull_fallback, Some(GpuCullUnavailable::NoIndirectCount), "{name}");
+        let mut indirect = s.clone();
+        indirect.shadow.map.draw_submission = DrawSubmission::Indirect;
+        assert_eq!(
+            map(&fallback, &scene, &indirect).0.lights[0].cull_fallback,
+            None,
+            "{name}: not asked for"
+        );
     }
 }
 

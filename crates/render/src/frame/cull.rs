@@ -9,7 +9,7 @@ use super::{
     plan::{FramePlan, LightPlan},
 };
 use crate::{
-    GpuScene, RenderError,
+    GpuCullUnavailable, GpuScene, RenderError,
     gpu_scene::{CullView, Granularity, LayerFaces, Visible},
 };
 
@@ -18,6 +18,8 @@ pub(super) struct Culled {
     pub camera: Visible,
     /// Per light, per layer.
     pub layers: Vec<Vec<Visible>>,
+    /// Why the lights that were to cull on the GPU culled on the CPU, if they did.
+    pub gpu_cull_fallback: Option<GpuCullUnavailable>,
 }
 
 /// Culls for every layer of every light, and for the camera, in parallel.
@@ -49,7 +51,7 @@ fn cull(uploaded: &GpuScene, plan: &FramePlan) -> Culled {
             }
         })
         .collect();
-    Culled { camera, layers }
+    Culled { camera, layers, gpu_cull_fallback: None }
 }
 
 /// What a shadow pass of `light` through `clip_from_world` (a layer, or a part of
@@ -79,10 +81,15 @@ impl Renderer {
     pub(super) fn cull_frame(&self, uploaded: &GpuScene, plan: &FramePlan) -> Result<Culled, RenderError> {
         let wanted =
             plan.lights.iter().any(|l| l.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled);
-        if wanted && self.gpu.indirect_count {
+        let gpu_cull_fallback = match (wanted, self.gpu.indirect_count) {
+            (false, _) => None,
+            (true, false) => Some(GpuCullUnavailable::NoIndirectCount),
             // Ok(Err(why)): this device cannot; the passes then cull on the CPU.
-            let _unavailable = uploaded.shadow_items(&self.gpu)?;
-        }
-        Ok(cull(uploaded, plan))
+            (true, true) => match uploaded.shadow_items(&self.gpu)? {
+                Ok(_) | Err(GpuCullUnavailable::NoCasters) => None,
+                Err(why) => Some(why),
+            },
+        };
+        Ok(Culled { gpu_cull_fallback, ..cull(uploaded, plan) })
     }
 }

@@ -7,7 +7,10 @@ use gnomon_math::{
     LightProjection,
     omni::{cube_texel_world_size, paraboloid_texel_world_size},
 };
-use gnomon_scene::{Camera, Light, settings::Technique};
+use gnomon_scene::{
+    Camera, Light,
+    settings::{DrawSubmission, Technique},
+};
 
 use crate::{
     Gpu, RenderError,
@@ -185,6 +188,9 @@ pub struct LightStats {
     /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
     /// device cannot trace this scene or an image this large.
     pub refine_fallback: Option<crate::rays::RaysUnavailable>,
+    /// Why its layers were culled on the CPU where its settings asked for the GPU
+    /// (`DrawSubmission::GpuCulled`): the same maps, at the CPU's cost.
+    pub cull_fallback: Option<crate::GpuCullUnavailable>,
 }
 
 impl LightStats {
@@ -524,6 +530,10 @@ impl TimedLights {
                 traced_pixels: None,
                 rays_per_pixel: 1,
                 refine_fallback: None,
+                cull_fallback: culled
+                    .gpu_cull_fallback
+                    .clone()
+                    .filter(|_| light.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled),
             })
             .collect();
         TimedLights { lights, passes: Vec::new(), timings: None }

@@ -16,7 +16,8 @@ use wgpu::util::DeviceExt;
 
 pub(crate) use batches::{Batch, CullView, Granularity, LayerFaces, Run, Visible};
 use batches::{MeshRange, batch_instances};
-use shadow_items::{GpuCullUnavailable, ShadowItems};
+pub use shadow_items::GpuCullUnavailable;
+use shadow_items::ShadowItems;
 
 use crate::{
     Gpu, RenderError,

@@ -96,16 +96,38 @@ pub(crate) struct ShadowItems {
     batch_buckets: Vec<u32>,
 }
 
-/// Why a scene's casters cannot be culled on the GPU: its layers are then culled on
-/// the CPU and drawn from uploaded arguments, the same map.
+/// Why a light's layers that were to be culled on the GPU
+/// (`DrawSubmission::GpuCulled`) were culled on the CPU instead and drawn from
+/// uploaded arguments: the same maps, at the CPU's cost (`LightStats::cull_fallback`).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub(crate) enum GpuCullUnavailable {
+pub enum GpuCullUnavailable {
+    /// Nothing casts a shadow: nothing to cull. Not reported as a fallback.
     #[error("no shadow casters")]
     NoCasters,
+    /// The device cannot draw a count it reads from a buffer (wgpu's
+    /// `MULTI_DRAW_INDIRECT_COUNT`), which is how the culler's kept draws are drawn.
+    #[error("the device cannot draw a count read from a buffer (wgpu's MULTI_DRAW_INDIRECT_COUNT)")]
+    NoIndirectCount,
+    /// The items exceed the device's storage binding limit.
     #[error("{items} shadow items need {bytes} bytes, over the device's storage binding limit of {limit}")]
-    TooLarge { items: u32, bytes: u64, limit: u64 },
+    TooLarge {
+        /// Shadow items: instances drawn whole, and clusters of large meshes.
+        items: u32,
+        /// The bytes they need.
+        bytes: u64,
+        /// The device's storage binding limit, or its buffer size limit if smaller.
+        limit: u64,
+    },
+    /// One workgroup per 64 items exceeds the device's dispatch limit.
     #[error("{items} shadow items need {workgroups} workgroups, over the device's limit of {limit}")]
-    TooManyWorkgroups { items: u32, workgroups: u32, limit: u32 },
+    TooManyWorkgroups {
+        /// Shadow items: instances drawn whole, and clusters of large meshes.
+        items: u32,
+        /// The workgroups a layer's dispatch needs.
+        workgroups: u32,
+        /// The device's `max_compute_workgroups_per_dimension`.
+        limit: u32,
+    },
 }
 
 impl ItemList {
