@@ -290,7 +290,7 @@ impl Bench<'_> {
             progress.inc(1);
         }
         let last = last.expect("at least one frame");
-        crate::render_cmd::warn_unrefined(&last.lights);
+        crate::render_cmd::warn_fallbacks(&last.lights);
         Ok(config_report(config, &series, &last))
     }
 

@@ -125,7 +125,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let mut s = settings.clone();
         s.shadow.filter.technique = technique.clone();
         let frame = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
-        crate::render_cmd::warn_unrefined(&frame.lights);
+        crate::render_cmd::warn_fallbacks(&frame.lights);
         let (mut shadow, mut filter, mut lighting) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.timing_frames {
             if let Some(t) = renderer.time_passes(&uploaded, &scene, &s, ClockChoice::Auto)?.timings {
@@ -286,7 +286,7 @@ fn measure_flicker(
             s.shadow.filter.technique = technique.clone();
             let request = OutputRequest { fixed_layout: frozen.clone(), ..Default::default() };
             let frame = renderer.render_uploaded(uploaded, scene, &s, &request)?;
-            crate::render_cmd::warn_unrefined(&frame.lights);
+            crate::render_cmd::warn_fallbacks(&frame.lights);
             if settings.shadow.cascades.freeze && frozen.is_none() {
                 frozen = Some(frame.shadow_layout());
             }

@@ -100,7 +100,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let request = OutputRequest { shadow_map: args.shadow_map_out.is_some(), ..Default::default() };
     let render_started = std::time::Instant::now();
     let frame = renderer.render(&scene, settings, &request)?;
-    warn_unrefined(&frame.lights);
+    warn_fallbacks(&frame.lights);
     if args.verbose {
         let shadows = match frame.lights.as_slice() {
             [one] => format!("technique {}, shadow map {}²", one.technique.name(), one.resolution),
@@ -223,7 +223,7 @@ pub(crate) fn open_casters_line(scene: &Scene, cull: CullMode) -> String {
 /// (the device cannot trace the scene or an image this large), and of lights whose
 /// layers were culled on the CPU though `--draw-submission gpu-culled` asked for the
 /// GPU (the same maps, at the CPU's cost).
-pub(crate) fn warn_unrefined(lights: &[gnomon_render::LightStats]) {
+pub(crate) fn warn_fallbacks(lights: &[gnomon_render::LightStats]) {
     let mut said: Vec<String> = Vec::new();
     let refine = lights.iter().filter_map(|l| l.refine_fallback.as_ref());
     let culling = lights.iter().filter_map(|l| l.cull_fallback.as_ref());

@@ -79,7 +79,7 @@ fn penumbra_rays_estimate_the_reference_under_every_kind_of_area_light() {
 /// meet: 0.02 % of light-facing pixels wrong.
 const HARD_EDGE_MISMATCH: f64 = 0.0002;
 /// The MAE within 2 px of the shadow's edge: 0.0003 measured; the same filter
-/// without its range weight (a plain binomial average) measured 0.081.
+/// without its range weight (then a round binomial average) measured 0.081.
 const HARD_EDGE_MAE: f64 = 0.01;
 
 /// Under a light a millimetre wide, the penumbra is narrower than a pixel: each
@@ -107,17 +107,24 @@ fn the_penumbra_filter_keeps_hard_edges_hard() {
 }
 
 /// The soft configurations of docs/rays.md at 960 × 540, with 1024-ray references:
-/// `contact` under a spot of radius 0.5 (penumbrae that widen away from each
-/// contact), and `grazing` under a sun 2° wide and 8° up (long penumbrae, which PCSS
-/// estimates half as wide as they are).
+/// `spheres` under a spot of radius 0.3 (curved penumbrae under 4 px wide, which a
+/// round filter kernel widens), `contact` under a spot of radius 0.5 (penumbrae that
+/// widen away from each contact), and `grazing` under a sun 2° wide and 8° up (long
+/// penumbrae, which PCSS estimates half as wide as they are).
 fn soft_configurations() -> Vec<(&'static str, Scene, Settings)> {
-    let mut spot = pcss(960, 540, Refine::Off);
-    spot.light.kind = LightKind::Spot;
-    spot.light.spot_radius = Some(0.5);
+    let spot = |radius| {
+        let mut s = pcss(960, 540, Refine::Off);
+        s.light.kind = LightKind::Spot;
+        s.light.spot_radius = Some(radius);
+        s
+    };
     let mut sun = pcss(960, 540, Refine::Off);
     sun.light.sun_angular_diameter = Some(2.0);
-    let mut configurations =
-        vec![("spot r 0.5, contact", builtin::contact(), spot), ("sun 2°, grazing", builtin::grazing(), sun)];
+    let mut configurations = vec![
+        ("spot r 0.3, spheres", builtin::spheres(), spot(0.3)),
+        ("spot r 0.5, contact", builtin::contact(), spot(0.5)),
+        ("sun 2°, grazing", builtin::grazing(), sun),
+    ];
     for (_, _, s) in &mut configurations {
         s.reference.samples = 1024;
     }

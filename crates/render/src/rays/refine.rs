@@ -98,7 +98,7 @@ pub(crate) fn trace_pass_wgsl() -> String {
 pub(crate) enum ListAccess {
     /// The refining mask pass, which appends to the list and counts.
     Append,
-    /// The trace pass, which reads them (writing only each entry's filter radius),
+    /// The trace pass, which reads them (writing only each entry's penumbra width),
     /// and dispatches by the counters: they must be read-only there.
     Read,
 }
@@ -119,7 +119,7 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
     };
     let buffer =
         |ty, has_dynamic_offset| wgpu::BindingType::Buffer { ty, has_dynamic_offset, min_binding_size: None };
-    // The trace pass writes each listed pixel's penumbra filter radius into its entry
+    // The trace pass writes each listed pixel's penumbra width into its entry
     // (refine_list.wgsl); the counters stay read-only there, as the dispatch's
     // arguments.
     let list = wgpu::BufferBindingType::Storage { read_only: false };
@@ -256,7 +256,7 @@ pub(crate) struct TraceGroups<'a> {
     /// The instances and the light's uniform.
     pub scene: &'a wgpu::BindGroup,
     /// The camera, the prepass, the list (whose entries the trace pass completes
-    /// with their filter radius) and the counters, read only ([`RefineLists::group`]
+    /// with their penumbra width) and the counters, read only ([`RefineLists::group`]
     /// with [`ListAccess::Read`]).
     pub screen: &'a wgpu::BindGroup,
     /// The light's layer of the mask, written, and the copy the filter reads

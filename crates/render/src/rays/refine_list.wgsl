@@ -7,7 +7,8 @@ struct UnsurePixel {
     // x | y << 16.
     pixel: u32,
     // Low 16 bits: the shadow-map layer that shaded it, kept in the mask for the
-    // cascade view. High 16 bits: under a light with an area, the penumbra filter's
-    // radius, which the trace pass writes for the filter pass (0 before).
+    // cascade view. High 16 bits: under a light with an area, the penumbra's
+    // width on screen in 1/16 px, which the trace pass writes for the filter pass (0
+    // before).
     layer: u32,
 };

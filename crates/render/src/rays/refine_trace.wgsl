@@ -22,7 +22,7 @@ struct ListedPixels {
     count: u32,
 };
 
-// The list, whose entries the trace pass completes with their filter radius.
+// The list, whose entries the trace pass completes with their penumbra width.
 @group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;
 @group(1) @binding(4) var<storage, read> listed: ListedPixels;
 
@@ -35,30 +35,32 @@ struct ListedPixels {
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
 @group(3) @binding(1) var base_color_sampler: sampler;
 
-// The penumbra filter's radius at a pixel whose blocked rays met casters `blocker`
-// away on average (-1: none), on a surface of normal `geometric_n` seen at
-// `view_depth`: a quarter of the penumbra's width in pixels, from similar triangles
-// (Fernando 2005: w = 2 r_light · d_blocker / (d_light − d_blocker) at the receiver,
-// 2 tan(θ_sun) · d_blocker under a sun), from 1 to MAX_FILTER_RADIUS. A binomial
-// kernel of radius r has a variance of r/2 px²; a penumbra w px wide from 10 % to
-// 90 % has one of about (w / 2.56)², so a radius of w / 4 widens it by
-// √(1 + 0.82 / w): 10 % at w = 4, 3 % at w = 12, while the noise of 16 rays falls
-// with every pixel the kernel takes in.
-fn penumbra_filter_radius(blocker: f32, world: vec3<f32>, geometric_n: vec3<f32>, view_depth: f32) -> u32 {
+// The penumbra's width on screen, in pixels, at a pixel whose blocked rays met
+// casters `blocker` away on average (-1: none), on a surface of normal `geometric_n`
+// seen at `view_depth`, from similar triangles (Fernando 2005: w = 2 r_light ·
+// d_blocker / (d_light − d_blocker) at the receiver, 2 tan(θ_sun) · d_blocker under a
+// sun). The filter pass sizes its kernel by it.
+fn penumbra_width_px(blocker: f32, world: vec3<f32>, geometric_n: vec3<f32>, view_depth: f32) -> f32 {
     if blocker < 0.0 {
-        return 1u;
+        return UNBLOCKED_WIDTH_PX;
     }
     var width = 2.0 * light.light_size * blocker;
     if light.kind != LIGHT_SUN {
         width /= max(length(light.position - world) - blocker, 1e-6);
     }
     // On screen the receiver's plane is foreshortened by |n·v| across its steepest
-    // direction: the penumbra is at least that narrow there, and the kernel is round.
+    // direction: the penumbra is at least that narrow there.
     width *= abs(dot(geometric_n, normalize(camera.eye - world)));
     let pixel_world = 2.0 * view_depth / (camera.scale_y * camera.height);
-    let radius = width / pixel_world / PIXELS_PER_FILTER_RADIUS;
-    return u32(clamp(radius, 1.0, f32(MAX_FILTER_RADIUS)));
+    return width / pixel_world;
 }
+
+// The width taken where none of a pixel's rays was blocked: its neighbours' rays
+// were, or it would not have been listed, so it lies at a penumbra's lit end.
+const UNBLOCKED_WIDTH_PX: f32 = 4.0;
+// The width is stored in the high 16 bits of the pixel's list entry, in 1/16 px.
+const WIDTH_FIXED_POINT: f32 = 16.0;
+const MAX_STORED_WIDTH_PX: f32 = 4095.0;
 
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -76,8 +78,9 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
         if light.penumbra_rays > 0u {
             let traced = area_visibility(origin, world, geometric_n, entry.pixel);
             textureStore(refined_mask, texel, vec4<f32>(layer + traced.x, 0.0, 0.0, 0.0));
-            let radius = penumbra_filter_radius(traced.y, world, geometric_n, view_depth);
-            unsure_pixels[index].layer = map_layer | (radius << 16u);
+            let width = penumbra_width_px(traced.y, world, geometric_n, view_depth);
+            let stored = u32(clamp(width, 0.0, MAX_STORED_WIDTH_PX) * WIDTH_FIXED_POINT);
+            unsure_pixels[index].layer = map_layer | (stored << 16u);
         } else if centre_ray_blocked(origin, world, light_geometry(world).xyz) {
             textureStore(refined_mask, texel, vec4<f32>(layer, 0.0, 0.0, 0.0));
         }
@@ -86,30 +89,42 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 
 // The penumbra's filter, after the trace pass under a light with an area: each
 // listed pixel's visibility becomes a weighted average of its neighbours' within
-// the radius the trace pass chose from the penumbra's width and stored in the
-// pixel's entry (1 to MAX_FILTER_RADIUS pixels),
-// traced or not, read from the copy `traced_mask` (a cross-bilateral filter, after
-// Tomasi & Manduchi 1998 and the joint bilateral upsampling of Kopf et al. 2007):
-// - binomial spatial weights (1 2 1 at radius 1, 1 4 6 4 1 at 2, ...), which leave a
-//   visibility linear across the kernel unchanged;
+// MAX_FILTER_RADIUS pixels, traced or not, read from the copy `traced_mask` (a
+// cross-bilateral filter, after Tomasi & Manduchi 1998 and the joint bilateral
+// upsampling of Kopf et al. 2007):
+// - anisotropic Gaussian spatial weights, narrow across the penumbra and wide along
+//   it (`penumbra_across` finds which way is across). Along the penumbra the
+//   visibility hardly changes, so averaging there cuts the noise of N rays without
+//   widening the penumbra; across it, a kernel of variance s² widens a penumbra
+//   w px wide from 10 % to 90 % (variance about (w / 2.56)²) by
+//   √(1 + s² (2.56 / w)²). With s² = w / ACROSS_VARIANCE_DIVISOR px² that is
+//   √(1 + 0.41 / w): 5 % at w = 4, 2 % at w = 12;
 // - only neighbours on the same surface: within SURFACE_PIXELS pixel widths of the
 //   centre's tangent plane, with normals within SURFACE_COS, so that no caster's
 //   value is carried onto the floor behind it;
 // - only neighbours the light can reach (facing it, inside its cone);
 // - a range weight (`range_weight`) that keeps hard edges hard.
-// With each pixel's own pattern the estimates' noise is independent: where all nine
-// of a radius-1 kernel count, its weights' sum of squares is 36/256 of their squared
-// sum, and the noise's standard deviation falls to 6/16 of one pixel's. A fixed
-// 5 × 5 kernel did worse than 3 × 3 on `contact` (penumbra MAE 0.0192 against
-// 0.0179): most penumbra pixels lie within a few pixels of a contact, where the
-// penumbra is narrow and a wide kernel blurs it. Hence the radius per pixel.
-const MAX_FILTER_RADIUS: u32 = 3u;
-const PIXELS_PER_FILTER_RADIUS: f32 = 4.0;
+// With each pixel's own pattern the estimates' noise is independent. The round
+// binomial kernels this replaced (1 2 1 at radius 1, up to radius 3 by w / 4)
+// widened the 3.8 px penumbrae of `spheres` by 0.26 px, most of its error (penumbra
+// MAE 0.0224 against 0.0177 now, 1024-ray reference), and cost `contact` and
+// `grazing` 0.0107 and 0.0278 against 0.0101 and 0.0251. Along-variances of 3 px²
+// and across-divisors of 32 each helped one scene and cost another.
+const MAX_FILTER_RADIUS: i32 = 3;
+const ACROSS_VARIANCE_DIVISOR: f32 = 16.0;
+// The least variance across the penumbra, px²: below it no neighbour counts.
+const MIN_ACROSS_VARIANCE: f32 = 0.05;
+// The least variance along the penumbra, px², and where no direction shows (a flat
+// neighbourhood) the variance of a round kernel.
+const MIN_ALONG_VARIANCE: f32 = 2.0;
 // The range weight's width, in standard deviations of the estimates (1.5 and 2
-// measured 0.0191 and 0.0182 there, 3 measured 0.0179).
+// measured 0.0191 and 0.0182 on `contact` with the former round kernel, 3 measured
+// 0.0179).
 const RANGE_SIGMAS: f32 = 3.0;
 const SURFACE_PIXELS: f32 = 2.0;
 const SURFACE_COS: f32 = 0.9;
+// Spatial weights below this are skipped, and their neighbours not read.
+const NEGLIGIBLE_WEIGHT: f32 = 1e-3;
 
 // How much a neighbour's visibility `q` counts toward the centre's `p`: a Gaussian in
 // their difference, RANGE_SIGMAS times as wide as the larger of their estimates'
@@ -121,62 +136,121 @@ fn range_weight(p: f32, q: f32) -> f32 {
     return select(exp(-d * d / (2.0 * RANGE_SIGMAS * RANGE_SIGMAS * variance)), select(0.0, 1.0, d == 0.0), variance == 0.0);
 }
 
-// The binomial coefficient C(2r, r + d): the weight of offset d in a kernel of
-// radius r, 1 2 1 at r = 1.
-fn binomial(r: i32, d: i32) -> f32 {
-    let k = r + abs(d);
-    var c = 1.0;
-    for (var i = 1; i <= 2 * r - k; i++) {
-        c *= f32(k + i) / f32(i);
-    }
-    return c;
-}
-
 // The visibility of a mask texel, which stores it plus 2 × the map layer.
 fn mask_visibility(packed: f32) -> f32 {
     return packed - 2.0 * floor(packed * 0.5);
 }
 
+// The centre of the penumbra filter's kernel.
+struct FilterCentre {
+    texel: vec2<i32>,
+    world: vec3<f32>,
+    n: vec3<f32>,
+    // A pixel's width in world units at the centre's depth.
+    pixel_world: f32,
+    visibility: f32,
+};
+
+// The visibility of the centre's neighbour `q`, or -1 where it says nothing of the
+// centre's penumbra: off the screen or the centre's surface, or not reached by the
+// light at all.
+fn neighbour_visibility(c: FilterCentre, q: vec2<i32>) -> f32 {
+    let size = vec2<i32>(textureDimensions(traced_mask));
+    if any(q < vec2<i32>(0)) || any(q >= size) {
+        return -1.0;
+    }
+    let q_depth = textureLoad(prepass_view_depth, q, 0).x;
+    if q_depth <= 0.0 {
+        return -1.0;
+    }
+    let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
+    let q_world = world_at(vec2<f32>(q) + vec2<f32>(0.5), q_depth);
+    let off_plane = abs(dot(c.n, q_world - c.world));
+    if off_plane > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+        return -1.0;
+    }
+    // A neighbour facing away from the light or outside its cone is dark by
+    // definition, not by a caster: it says nothing of this pixel's penumbra.
+    let q_light = light_geometry(q_world);
+    if dot(q_n, q_light.xyz) <= 0.0 || q_light.w <= 0.0 {
+        return -1.0;
+    }
+    return mask_visibility(textureLoad(traced_mask, q, 0).x);
+}
+
+// The unit direction across the penumbra at the centre, on screen (zero where its
+// 3 × 3 neighbourhood shows none): the gradient's direction of the least-squares
+// plane through the visibilities of the centre and its neighbours on its surface.
+// Each neighbour's estimate is noisy, but nine of them find the direction of a
+// penumbra a few pixels wide to within a few degrees.
+fn penumbra_across(c: FilterCentre) -> vec2<f32> {
+    var count = 0.0;
+    var d_sum = vec2<f32>(0.0);
+    var v_sum = 0.0;
+    var dd = vec3<f32>(0.0);
+    var dv = vec2<f32>(0.0);
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let v = select(neighbour_visibility(c, c.texel + vec2<i32>(dx, dy)), c.visibility, dx == 0 && dy == 0);
+            if v < 0.0 {
+                continue;
+            }
+            let d = vec2<f32>(f32(dx), f32(dy));
+            count += 1.0;
+            d_sum += d;
+            v_sum += v;
+            dd += vec3<f32>(d.x * d.x, d.x * d.y, d.y * d.y);
+            dv += d * v;
+        }
+    }
+    // Centred moments: M g = b.
+    let mean = d_sum / count;
+    let m = dd - count * vec3<f32>(mean.x * mean.x, mean.x * mean.y, mean.y * mean.y);
+    let b = dv - count * mean * (v_sum / count);
+    let det = m.x * m.z - m.y * m.y;
+    if det < 1e-3 {
+        return vec2<f32>(0.0);
+    }
+    let g = vec2<f32>(m.z * b.x - m.y * b.y, m.x * b.y - m.y * b.x) / det;
+    let len = length(g);
+    return select(vec2<f32>(0.0), g / len, len > 1e-4);
+}
+
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let count = listed.count;
-    let size = vec2<i32>(textureDimensions(traced_mask));
     for (var index = id.x; index < count; index += groups.x * REFINE_GROUP_SIZE) {
         let entry = unsure_pixels[index];
         let texel = vec2<i32>(i32(entry.pixel & 0xffffu), i32(entry.pixel >> 16u));
         let view_depth = textureLoad(prepass_view_depth, texel, 0).x;
         let n = octahedron_decode(textureLoad(prepass_normals, texel, 0).zw);
         let world = world_at(vec2<f32>(texel) + vec2<f32>(0.5), view_depth);
-        // A pixel's width in world units at this depth.
         let pixel_world = 2.0 * view_depth / (camera.scale_y * camera.height);
         let visibility = mask_visibility(textureLoad(traced_mask, texel, 0).x);
+        let c = FilterCentre(texel, world, n, pixel_world, visibility);
+        let width = f32(entry.layer >> 16u) / WIDTH_FIXED_POINT;
+        let across = penumbra_across(c);
+        let along_variance = max(width / ACROSS_VARIANCE_DIVISOR, MIN_ALONG_VARIANCE);
+        let round = all(across == vec2<f32>(0.0));
+        let across_variance = select(max(width / ACROSS_VARIANCE_DIVISOR, MIN_ACROSS_VARIANCE), along_variance, round);
+        let radius = MAX_FILTER_RADIUS;
         var sum = 0.0;
         var weights = 0.0;
-        let radius = i32(clamp(entry.layer >> 16u, 1u, MAX_FILTER_RADIUS));
         for (var dy = -radius; dy <= radius; dy++) {
             for (var dx = -radius; dx <= radius; dx++) {
-                let q = texel + vec2<i32>(dx, dy);
-                if any(q < vec2<i32>(0)) || any(q >= size) {
+                let d = vec2<f32>(f32(dx), f32(dy));
+                // Offsets across and along the penumbra (any split, for a round kernel).
+                let a = select(dot(d, across), d.x, round);
+                let b = select(d.x * across.y - d.y * across.x, d.y, round);
+                let spatial = exp(-0.5 * (a * a / across_variance + b * b / along_variance));
+                if spatial < NEGLIGIBLE_WEIGHT {
                     continue;
                 }
-                let q_depth = textureLoad(prepass_view_depth, q, 0).x;
-                if q_depth <= 0.0 {
+                let q_visibility = select(neighbour_visibility(c, texel + vec2<i32>(dx, dy)), visibility, dx == 0 && dy == 0);
+                if q_visibility < 0.0 {
                     continue;
                 }
-                let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
-                let q_world = world_at(vec2<f32>(q) + vec2<f32>(0.5), q_depth);
-                let off_plane = abs(dot(n, q_world - world));
-                if off_plane > SURFACE_PIXELS * pixel_world || dot(n, q_n) < SURFACE_COS {
-                    continue;
-                }
-                // A neighbour facing away from the light or outside its cone is dark by
-                // definition, not by a caster: it says nothing of this pixel's penumbra.
-                let q_light = light_geometry(q_world);
-                if dot(q_n, q_light.xyz) <= 0.0 || q_light.w <= 0.0 {
-                    continue;
-                }
-                let q_visibility = mask_visibility(textureLoad(traced_mask, q, 0).x);
-                let w = binomial(radius, dx) * binomial(radius, dy) * range_weight(visibility, q_visibility);
+                let w = spatial * range_weight(visibility, q_visibility);
                 sum += w * q_visibility;
                 weights += w;
             }
