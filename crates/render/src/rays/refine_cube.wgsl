@@ -92,5 +92,11 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let margin = UNSURE_DEPTH_TEXELS * texel_world / light.range + (light.slope_bias + 1.0) * slope;
     let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), distance / light.range);
     cube_plane = CubePlane(geometric_n, dot(offset, geometric_n), face_directions(clip_from_world));
-    return footprint_unsure(uv, FootprintBounds(0.5 * slope, margin, own_bias), layer);
+    // The surface itself lies behind the lookup's plane along the light's ray through
+    // the lookup, by the normal offset's push over the ray's cosine with the plane
+    // (which faces the light; an edge-on plane was refused above).
+    let cosine = max(-dot(offset / distance, geometric_n), 1e-6);
+    let surface = (cube_plane.reach - dot(to_world, geometric_n)) / cosine / light.range;
+    let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
+    return footprint_unsure(uv, FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing), layer);
 }

@@ -17,6 +17,15 @@ fn map_step(clip_from_world: mat4x4<f32>, ndc: vec3<f32>, w: f32, t: vec3<f32>) 
     return (d.xyz - ndc * d.w) / w * vec3<f32>(0.5, -0.5, 1.0);
 }
 
+// A receiver closer than this to edge-on to the light (N·L below it: within 5.7°) is
+// `FootprintBounds::grazing`. Its depth in the map changes by tan θ ≥ 10 texels of
+// depth per texel, so the default slope bias (1.5) stores it 15 texels or more
+// behind its plane along the ray, a surface curving away from the light around it
+// is biased as much or more, and the normal offset's push toward the light moves
+// the lookup's plane in front of it by the push over N·L (docs/rays.md, "A steep
+// caster's bias").
+const UNSURE_GRAZING_COS: f32 = 0.1;
+
 // How far from the receiver's plane a stored depth may lie, in the map's depth
 // units, and what it then says (`footprint_unsure`).
 struct FootprintBounds {
@@ -27,8 +36,23 @@ struct FootprintBounds {
     // More than this in front: a caster.
     margin: f32,
     // The bias the map was drawn with where the receiver itself is stored
-    // (`receiver_bias`): its own surface lies at least this far behind the plane.
+    // (`receiver_bias`): its own surface lies at least this far behind its plane.
     own_bias: f32,
+    // How far behind the receiver's plane its surface lies: the plane passes through
+    // the lookup's point, which the normal offset moved off the surface toward the
+    // light, by the offset over N·L along the light's ray, many texels of depth on a
+    // surface nearly edge-on to it.
+    surface: f32,
+    // Whether the receiver is nearly edge-on to the light (N·L < UNSURE_GRAZING_COS).
+    // Such a receiver may lie where a surface curves away from the light, and the
+    // crest of the fold beyond it, edge-on from the light, may shadow it: the crest's
+    // bias, larger still, stores it farther behind the receiver's plane than the
+    // receiver's own bias. So in the bilinear 2×2, a texel is evidence of light only
+    // behind the receiver's surface (not the lookup's plane) and its own bias, and a
+    // texel farther behind than that makes the pixel unsure. A flat receiver's own
+    // texels never are, and a flat ground edge-on to the sun traces only its shadows'
+    // edges.
+    grazing: bool,
 };
 
 // The bias the map's rasterizer added to a surface of depth slope `slope` (its
@@ -59,7 +83,11 @@ fn receiver_bias(slope: f32, depth: f32) -> f32 {
 // bias the block's own slopes allow instead, the largest difference between its
 // texels, caught more of them, but it also traced the lit sides of coarsely
 // tessellated columns whole: there adjacent facets' biases differ, and a facet's
-// edge against the ground beyond is a jump.)
+// edge against the ground beyond is a jump.) A receiver nearly edge-on to the light
+// is judged against its surface, and is unsure where a texel there lies farther
+// behind it than its own bias (`FootprintBounds::grazing`). (Judging every receiver
+// against its surface traced a quarter more of `columns`, whose coarse facets'
+// biases differ, for fewer errors past folds than this: docs/rays.md.)
 fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool {
     let size = light.resolution;
     // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels.
@@ -82,6 +110,15 @@ fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool 
             var lit_from = receiver - vec4<f32>(bounds.tolerance);
             if all(vec2<i32>(x, y) == base) {
                 lit_from += vec4<f32>(bounds.own_bias);
+                if bounds.grazing {
+                    // The receiver's own surface, as the map stored it.
+                    let own = receiver + vec4<f32>(bounds.surface + bounds.own_bias);
+                    lit_from = own - vec4<f32>(bounds.tolerance);
+                    let behind_own = stored > own + vec4<f32>(bounds.tolerance);
+                    if any(behind_own & (stored < vec4<f32>(1.0))) {
+                        return true;
+                    }
+                }
             }
             let is_lit = stored >= lit_from;
             let is_shadowed = stored <= receiver - vec4<f32>(bounds.margin);

@@ -75,8 +75,16 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.slope_bias + 1.0) * slope;
     let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), c.z);
 
+    // The surface itself, where the lookup's point came from: its plane is parallel
+    // to the lookup's, as far behind it as the normal offset moved the point.
+    let surface_clip = clip_from_world * vec4<f32>(world, 1.0);
+    let surface_ndc = surface_clip.xyz / surface_clip.w;
+    let surface_uv = surface_ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5);
+    let surface = surface_ndc.z + dot(gradient, (c.xy - surface_uv) * size) - c.z;
+
     map_plane = MapPlane(c.xy * size - vec2<f32>(0.5), c.z, gradient);
-    if footprint_unsure(c.xy, FootprintBounds(0.5 * slope, margin, own_bias), layer) {
+    let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
+    if footprint_unsure(c.xy, FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing), layer) {
         return true;
     }
     return light.penumbra_rays > 0u && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);

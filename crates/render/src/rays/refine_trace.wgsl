@@ -178,30 +178,43 @@ fn neighbour_visibility(c: FilterCentre, q: vec2<i32>) -> f32 {
     return mask_visibility(textureLoad(traced_mask, q, 0).x);
 }
 
+// The visibilities of the centre's 3 × 3 neighbourhood, row by row (the centre's own
+// at 4; -1 where a neighbour says nothing of its penumbra): what both the direction
+// across the penumbra and the kernel's inner ring read, taken once.
+fn neighbourhood(c: FilterCentre) -> array<f32, 9> {
+    var near: array<f32, 9>;
+    for (var k = 0; k < 9; k++) {
+        if k == 4 {
+            near[k] = c.visibility;
+        } else {
+            near[k] = neighbour_visibility(c, c.texel + vec2<i32>(k % 3 - 1, k / 3 - 1));
+        }
+    }
+    return near;
+}
+
 // The unit direction across the penumbra at the centre, on screen (zero where its
-// 3 × 3 neighbourhood shows none): the gradient's direction of the least-squares
-// plane through the visibilities of the centre and its neighbours on its surface.
-// Each neighbour's estimate is noisy, but nine of them find the direction of a
-// penumbra a few pixels wide to within a few degrees.
-fn penumbra_across(c: FilterCentre) -> vec2<f32> {
+// 3 × 3 neighbourhood `near` shows none): the gradient's direction of the
+// least-squares plane through the visibilities of the centre and its neighbours on
+// its surface. Each neighbour's estimate is noisy, but nine of them find the
+// direction of a penumbra a few pixels wide to within a few degrees.
+fn penumbra_across(near: ptr<function, array<f32, 9>>) -> vec2<f32> {
     var count = 0.0;
     var d_sum = vec2<f32>(0.0);
     var v_sum = 0.0;
     var dd = vec3<f32>(0.0);
     var dv = vec2<f32>(0.0);
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let v = select(neighbour_visibility(c, c.texel + vec2<i32>(dx, dy)), c.visibility, dx == 0 && dy == 0);
-            if v < 0.0 {
-                continue;
-            }
-            let d = vec2<f32>(f32(dx), f32(dy));
-            count += 1.0;
-            d_sum += d;
-            v_sum += v;
-            dd += vec3<f32>(d.x * d.x, d.x * d.y, d.y * d.y);
-            dv += d * v;
+    for (var k = 0; k < 9; k++) {
+        let v = (*near)[k];
+        if v < 0.0 {
+            continue;
         }
+        let d = vec2<f32>(f32(k % 3 - 1), f32(k / 3 - 1));
+        count += 1.0;
+        d_sum += d;
+        v_sum += v;
+        dd += vec3<f32>(d.x * d.x, d.x * d.y, d.y * d.y);
+        dv += d * v;
     }
     // Centred moments: M g = b.
     let mean = d_sum / count;
@@ -229,15 +242,15 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         let visibility = mask_visibility(textureLoad(traced_mask, texel, 0).x);
         let c = FilterCentre(texel, world, n, pixel_world, visibility);
         let width = f32(entry.layer >> 16u) / WIDTH_FIXED_POINT;
-        let across = penumbra_across(c);
+        var near = neighbourhood(c);
+        let across = penumbra_across(&near);
         let along_variance = max(width / ACROSS_VARIANCE_DIVISOR, MIN_ALONG_VARIANCE);
         let round = all(across == vec2<f32>(0.0));
         let across_variance = select(max(width / ACROSS_VARIANCE_DIVISOR, MIN_ACROSS_VARIANCE), along_variance, round);
-        let radius = MAX_FILTER_RADIUS;
         var sum = 0.0;
         var weights = 0.0;
-        for (var dy = -radius; dy <= radius; dy++) {
-            for (var dx = -radius; dx <= radius; dx++) {
+        for (var dy = -MAX_FILTER_RADIUS; dy <= MAX_FILTER_RADIUS; dy++) {
+            for (var dx = -MAX_FILTER_RADIUS; dx <= MAX_FILTER_RADIUS; dx++) {
                 let d = vec2<f32>(f32(dx), f32(dy));
                 // Offsets across and along the penumbra (any split, for a round kernel).
                 let a = select(dot(d, across), d.x, round);
@@ -246,7 +259,12 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
                 if spatial < NEGLIGIBLE_WEIGHT {
                     continue;
                 }
-                let q_visibility = select(neighbour_visibility(c, texel + vec2<i32>(dx, dy)), visibility, dx == 0 && dy == 0);
+                var q_visibility: f32;
+                if abs(dx) <= 1 && abs(dy) <= 1 {
+                    q_visibility = near[(dy + 1) * 3 + dx + 1];
+                } else {
+                    q_visibility = neighbour_visibility(c, texel + vec2<i32>(dx, dy));
+                }
                 if q_visibility < 0.0 {
                     continue;
                 }
