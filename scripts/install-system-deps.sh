@@ -4,7 +4,9 @@
 #   (mesa-vulkan-drivers);
 # - a C++ compiler, for meshoptimizer (the `meshopt` crate builds its C++ source);
 # - with --tests, an X server for the viewer's window test when there is no display
-#   (xvfb, whose xvfb-run the test starts itself).
+#   (xvfb, whose xvfb-run the test starts itself), and a lavapipe with ray queries in
+#   a folder of its own for the ray-query tests (fetch-lavapipe-ray-query.sh: the
+#   system's Mesa is left as it is).
 # Does nothing when everything is already there.
 set -eu
 
@@ -33,7 +35,14 @@ if [ "$want_tests" = yes ] && ! command -v xvfb-run >/dev/null 2>&1; then
     echo "install-system-deps: no xvfb-run; installing xvfb for the viewer's window test" >&2
     packages="$packages xvfb xauth"
 fi
-[ -z "$packages" ] && exit 0
+fetch_ray_query() {
+    [ "$want_tests" = yes ] && sh "$(dirname "$0")/fetch-lavapipe-ray-query.sh"
+    return 0
+}
+if [ -z "$packages" ]; then
+    fetch_ray_query
+    exit 0
+fi
 
 if ! command -v apt-get >/dev/null 2>&1; then
     echo "install-system-deps: missing $packages and no apt-get; install your platform's Vulkan driver (on Mesa systems: lavapipe), a C++ compiler and, for the tests, an X server such as Xvfb" >&2
@@ -47,3 +56,4 @@ fi
 $SUDO apt-get update -qq
 # shellcheck disable=SC2086 # the package list is meant to split
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $packages >/dev/null
+fetch_ray_query

@@ -130,6 +130,7 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         RenderError::ShadowMapTooLarge { requested, .. } => Some(format!("--shadow-res = {requested}: ")),
         RenderError::MomentFormatUnsupported { .. } => Some("--moment-format rgba32float: ".into()),
         RenderError::RaysUnavailable(_) => Some("--refine: ".into()),
+        RenderError::RayQueriesUnavailable(_) => Some("--tracer ray-query: ".into()),
         RenderError::NoAdapter { .. }
         | RenderError::DeviceRequest { .. }
         | RenderError::ImageTooLarge { .. }

@@ -220,15 +220,18 @@ pub(crate) fn open_casters_line(scene: &Scene, cull: CullMode) -> String {
 }
 
 /// Warns, once per reason, of lights drawn unrefined though `--refine` asked for rays
-/// (the device cannot trace the scene or an image this large), and of lights whose
-/// layers were culled on the CPU though `--draw-submission gpu-culled` asked for the
-/// GPU (the same maps, at the CPU's cost).
+/// (the device cannot trace the scene or an image this large), of rays traced by the
+/// shader though `--tracer` asked for ray queries, and of lights whose layers were
+/// culled on the CPU though `--draw-submission gpu-culled` asked for the GPU (the same
+/// maps, at the CPU's cost).
 pub(crate) fn warn_fallbacks(lights: &[gnomon_render::LightStats]) {
     let mut said: Vec<String> = Vec::new();
     let refine = lights.iter().filter_map(|l| l.refine_fallback.as_ref());
+    let tracer = lights.iter().filter_map(|l| l.tracer_fallback.as_ref());
     let culling = lights.iter().filter_map(|l| l.cull_fallback.as_ref());
     let warnings = refine
         .map(|why| format!("--refine: {why}; shadows drawn unrefined"))
+        .chain(tracer.map(|why| format!("--tracer ray-query: {why}; rays traced by the shader's BVH")))
         .chain(culling.map(|why| format!("--draw-submission gpu-culled: {why}; layers culled on the CPU")));
     for warning in warnings {
         if !said.contains(&warning) {
@@ -247,8 +250,12 @@ pub(crate) fn traced_line(index: usize, light: &gnomon_render::LightStats, pixel
         1 => String::new(),
         n => format!(", {n} per pixel over the light's area"),
     };
+    let tracer = match light.traversal {
+        Some(gnomon_render::rays::Traversal::RayQuery) => ", ray queries",
+        Some(gnomon_render::rays::Traversal::Shader) | None => ", the shader's BVH",
+    };
     format!(
-        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({rays} rays{per_pixel})",
+        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({rays} rays{per_pixel}{tracer})",
         100.0 * f64::from(traced) / pixels.max(1) as f64
     )
 }

@@ -65,6 +65,9 @@ pub struct Gpu {
     /// (`MULTI_DRAW_INDIRECT_COUNT`): what lets a compute pass cull a layer's casters
     /// and the layer draw what it kept (`DrawSubmission::GpuCulled`).
     pub indirect_count: bool,
+    /// Whether shaders can trace rays through the adapter's own acceleration
+    /// structures (`EXPERIMENTAL_RAY_QUERY`): what `Tracer::RayQuery` needs.
+    pub ray_queries: bool,
 }
 
 impl Gpu {
@@ -97,6 +100,7 @@ impl Gpu {
         let adapter_info = adapter.get_info();
         let mut limits = adapter.limits();
         adjust(&mut limits);
+        let ray_queries = adapter.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gnomon"),
             // Timestamps time each pass where the adapter has them (lavapipe does);
@@ -104,14 +108,26 @@ impl Gpu {
             // depth lets a sun's map clamp casters in front of its near plane onto it
             // ("pancaking"), so the depth range need only span the receivers; a first
             // instance in indirect draws lets a layer's draws be one multi-draw, and
-            // indirect count lets the backend issue it as one command.
+            // indirect count lets the backend issue it as one command; ray queries
+            // let the shadow rays use the adapter's own acceleration structures.
             required_features: adapter.features()
                 & (wgpu::Features::TIMESTAMP_QUERY
                     | wgpu::Features::FLOAT32_FILTERABLE
                     | wgpu::Features::DEPTH_CLIP_CONTROL
                     | wgpu::Features::INDIRECT_FIRST_INSTANCE
-                    | wgpu::Features::MULTI_DRAW_INDIRECT_COUNT),
+                    | wgpu::Features::MULTI_DRAW_INDIRECT_COUNT
+                    | wgpu::Features::EXPERIMENTAL_RAY_QUERY),
             required_limits: limits.clone(),
+            // wgpu names its ray queries experimental and asks for this token before it
+            // enables them. Gnomon holds them to the shader tracer's answers
+            // (reference/tests/ray_queries.rs) wherever a device has them.
+            experimental_features: if ray_queries {
+                // SAFETY: the token only unlocks the EXPERIMENTAL_RAY_QUERY feature
+                // requested above; no other experimental API is used.
+                unsafe { wgpu::ExperimentalFeatures::enabled() }
+            } else {
+                wgpu::ExperimentalFeatures::disabled()
+            },
             ..Default::default()
         }))
         .map_err(|e| RenderError::DeviceRequest {
@@ -122,6 +138,7 @@ impl Gpu {
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, &device);
         Ok(Self {
+            ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
             device,
             queue,
             info: GpuInfo::of(adapter_info),
@@ -134,8 +151,8 @@ impl Gpu {
 
     /// Wraps a device the host application already has, sharing it: Gnomon draws
     /// with whatever features and limits the host asked for, and uses timestamp
-    /// queries, 32-bit float filtering and unclipped depth only where the device has
-    /// them enabled.
+    /// queries, 32-bit float filtering, unclipped depth and ray queries only where
+    /// the device has them enabled.
     pub fn from_host(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         let adapter_info = adapter.get_info();
         let timestamp_period_ns =
@@ -149,6 +166,7 @@ impl Gpu {
             timestamp_period_ns,
             indirect_draws,
             indirect_count,
+            ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
         }
     }
 

@@ -216,6 +216,12 @@ pub enum RenderError {
     /// ([`LightStats::refine_fallback`]); [`crate::rays::ShadowRays`] does.
     #[error(transparent)]
     RaysUnavailable(#[from] rays::RaysUnavailable),
+    /// Ray queries were asked for by name where the device cannot run them
+    /// ([`crate::rays::RayQueriesUnavailable`]). A frame does not fail for it: the
+    /// shader traces instead, and the frame says why ([`LightStats::tracer_fallback`]);
+    /// [`crate::rays::ShadowRays::with_tracer`] does.
+    #[error(transparent)]
+    RayQueriesUnavailable(#[from] rays::RayQueriesUnavailable),
     /// wgpu reported a validation, out-of-memory or internal error, or a wait or readback failed.
     #[error("the GPU reported an error while {during}: {message}")]
     Gpu {

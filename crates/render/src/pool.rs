@@ -92,6 +92,8 @@ pub(crate) enum Binding {
     },
     View(wgpu::TextureView),
     Sampler(wgpu::Sampler),
+    /// A top-level acceleration structure, for the ray-query tracer.
+    Tlas(wgpu::Tlas),
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -352,6 +354,7 @@ impl Pool {
                     }
                     Binding::View(view) => wgpu::BindingResource::TextureView(view),
                     Binding::Sampler(sampler) => wgpu::BindingResource::Sampler(sampler),
+                    Binding::Tlas(tlas) => tlas.as_binding(),
                 },
             })
             .collect();
@@ -382,8 +385,8 @@ impl Pool {
 mod tests {
     /// The zero-creation test counts what the pool creates; it proves that a steady
     /// frame creates nothing only if every per-frame creation goes through the pool.
-    /// Outside it, only the one-time uploads (the scene, the casters' BVH, the GPU
-    /// culler's shadow items), the
+    /// Outside it, only the one-time uploads (the scene, the casters' BVH and
+    /// acceleration structures, the GPU culler's shadow items), the
     /// renderer's fixed bindings, the kept depth and moment maps (counted in
     /// `Renderer::creations`), and `ShadowRays`' batch queries (no frame: buffers
     /// sized to each batch) may create GPU resources.
@@ -398,6 +401,7 @@ mod tests {
             "gpu_scene/materials.rs",
             "gpu_scene/shadow_items.rs",
             "passes/depth_baseline.rs",
+            "rays/accel.rs",
             "rays/mod.rs",
             "rays/query.rs",
         ];

@@ -267,6 +267,7 @@ impl Renderer {
             },
             // Only a forward frame with the BVH built has a group to trace with.
             refine: if tracing_group.is_some() { light.refine } else { Refine::Off },
+            traversal: plan.traversal,
         };
         pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));
         pass.set_bind_group(0, &bindings.scene, &[]);

@@ -191,6 +191,12 @@ pub struct LightStats {
     /// Why its layers were culled on the CPU where its settings asked for the GPU
     /// (`DrawSubmission::GpuCulled`): the same maps, at the CPU's cost.
     pub cull_fallback: Option<crate::GpuCullUnavailable>,
+    /// How its rays traversed the casters, where it traced any (`screen.tracer`
+    /// resolved on the device).
+    pub traversal: Option<crate::rays::Traversal>,
+    /// Why its rays traversed the shader's BVH where `screen.tracer` asked for ray
+    /// queries: the device has none, or cannot take the scene in its structures.
+    pub tracer_fallback: Option<crate::rays::RayQueriesUnavailable>,
 }
 
 impl LightStats {
@@ -534,6 +540,8 @@ impl TimedLights {
                     .gpu_cull_fallback
                     .clone()
                     .filter(|_| light.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled),
+                traversal: None,
+                tracer_fallback: None,
             })
             .collect();
         TimedLights { lights, passes: Vec::new(), timings: None }

@@ -38,6 +38,8 @@ pub(super) struct FramePlan {
     /// The reported light's index.
     pub shown: usize,
     pub lights: Vec<LightPlan>,
+    /// How the frame's shadow rays traverse the casters (`prepare_rays` resolves it).
+    pub traversal: crate::rays::Traversal,
 }
 
 /// One light of a frame, as decided before recording.
@@ -162,7 +164,9 @@ impl Renderer {
         // One light's own pass is its list: the list's walk would only add to it.
         let lighting =
             if mask_path && lights.len() > 1 { settings.screen.lighting } else { Lighting::PerLight };
-        Ok(FramePlan { camera, aspect, mask_path, lighting, shown, lights })
+        // The shader's BVH until `prepare_rays` knows what the frame traces with.
+        let traversal = crate::rays::Traversal::Shader;
+        Ok(FramePlan { camera, aspect, mask_path, lighting, shown, lights, traversal })
     }
 
     /// A light's layout fitted to the camera (and for a sun's SDSM cascades, to the

@@ -147,7 +147,7 @@ impl Renderer {
         settings.validate()?;
         self.check_limits(settings)?;
         let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
-        let fallback = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
+        let fallbacks = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();
         let culled = self.cull_frame(uploaded, &plan)?;
         let cull_done = Instant::now();
@@ -174,7 +174,7 @@ impl Renderer {
             TimesWanted::Now => counters,
             TimesWanted::Late => None,
         };
-        super::refine::report(&gpu, &plan, &mut timed, fallback, traced)?;
+        super::refine::report(&gpu, &plan, &mut timed, fallbacks, traced)?;
         Ok(Submitted::new(plan, recorded, timed, cpu))
     }
 
@@ -281,10 +281,15 @@ impl Renderer {
         // On the forward path, the lights that refine trace in their lighting pass
         // (uncounted: rays/refine_forward.wgsl says why).
         let refines = plan.lights.iter().any(|l| l.refine != Refine::Off);
-        let tracing = uploaded
-            .rays()
-            .filter(|_| !plan.mask_path && refines)
-            .map(|bvh| rays::forward_group(&mut self.pool, &self.layouts.forward_rays, &camera_buffer, bvh));
+        let tracing = uploaded.rays().filter(|_| !plan.mask_path && refines).map(|bvh| {
+            rays::forward_group(
+                &mut self.pool,
+                &self.layouts.forward_rays,
+                &camera_buffer,
+                bvh,
+                plan.traversal,
+            )
+        });
         let shared = SharedLighting {
             plan,
             camera_group: &camera_group,

@@ -161,7 +161,8 @@ impl Renderer {
                     scene: &bindings.scene,
                     screen: read,
                     mask: &mask,
-                    bvh: &bvh.group,
+                    bvh: bvh.group(plan.traversal),
+                    traversal: plan.traversal,
                     counters: &lists.counters,
                 };
                 self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
@@ -231,7 +232,10 @@ impl Renderer {
             label: Some(stage.label()),
             timestamp_writes: rec.clock.compute_writes(slot),
         });
-        self.passes.trace.record(&mut pass, stage, groups, index);
+        self.passes
+            .trace
+            .get(&gpu.device, &self.layouts, groups.traversal)
+            .record(&mut pass, stage, groups, index);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 4;
         drop(pass);

@@ -15,6 +15,7 @@ use super::{
     map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
 use crate::{
+    rays::Traversal,
     techniques::{TechniqueRef, TechniqueRegistry},
     uniforms::{self, LightKindGpu, StructLayout},
 };
@@ -53,14 +54,23 @@ fn every_variant() -> Vec<(String, String)> {
                 LightingRole::Added { visibility: true },
                 LightingRole::Added { visibility: false },
             ] {
-                let key = LightingKey { technique, lookup, role, refine: Refine::Off };
+                let key = LightingKey {
+                    technique,
+                    lookup,
+                    role,
+                    refine: Refine::Off,
+                    traversal: Traversal::Shader,
+                };
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
             }
             // The forward path's lighting pass that traces rays where the map is unsure.
             if let Lookup::Own(_) = lookup {
                 for refine in [Refine::Rays, Refine::EveryPixel] {
-                    let key = LightingKey { technique, lookup, role: LightingRole::First, refine };
-                    out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+                    for traversal in [Traversal::Shader, Traversal::RayQuery] {
+                        let key =
+                            LightingKey { technique, lookup, role: LightingRole::First, refine, traversal };
+                        out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+                    }
                 }
             }
             if let Lookup::Own(map) = lookup {
@@ -95,7 +105,9 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("map scroll".into(), map_scroll::scroll_wgsl()));
     out.push(("blit".into(), blit::blit_wgsl()));
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
-    out.push(("ray trace".into(), crate::rays::trace_pass_wgsl()));
+    for traversal in [Traversal::Shader, Traversal::RayQuery] {
+        out.push((format!("ray trace {traversal:?}"), crate::rays::trace_pass_wgsl(traversal)));
+    }
     out
 }
 

@@ -12,7 +12,7 @@ use gnomon_scene::settings::Refine;
 
 use crate::{
     gpu_types::VertexStream,
-    rays,
+    rays::{self, Traversal},
     techniques::{self, TechniqueRef},
 };
 
@@ -52,6 +52,8 @@ pub(crate) struct LightingKey {
     /// light's refinement says; always off on the mask path, whose mask holds the
     /// rays' answers.
     pub refine: Refine,
+    /// How its rays traverse the casters (`Shader` where it traces none).
+    pub traversal: Traversal,
 }
 
 /// How the lighting pass finds a receiver's visibility.
@@ -194,8 +196,8 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     let mut parts = camera_shading_wgsl();
     parts.extend(visibility_wgsl(key.technique, key.lookup));
     parts.extend(match key.lookup {
-        Lookup::Own(map) => rays::forward_refine_wgsl(key.refine, map),
-        Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map),
+        Lookup::Own(map) => rays::forward_refine_wgsl(key.refine, map, key.traversal),
+        Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map, key.traversal),
     });
     parts.push(SURFACE_WGSL.to_owned());
     parts.push(LIGHTING_COMMON_WGSL.to_owned());
@@ -208,9 +210,9 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
 /// first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
-    /// The layout of the pipelines that trace rays: the camera's group holds the
-    /// casters' BVH and the light's counters too.
-    tracing_layout: wgpu::PipelineLayout,
+    /// The layouts of the pipelines that trace rays, by traversal (ray queries' where
+    /// the device has them): the camera's group holds the tracer's resources too.
+    tracing_layouts: HashMap<Traversal, wgpu::PipelineLayout>,
     pipelines: HashMap<LightingKey, wgpu::RenderPipeline>,
 }
 
@@ -228,9 +230,15 @@ impl LightingPass {
                 immediate_size: 0,
             })
         };
+        let ray_queries = device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY);
+        let traversals = [Some(Traversal::Shader), ray_queries.then_some(Traversal::RayQuery)];
         Self {
             layout: layout("lighting", &layouts.camera),
-            tracing_layout: layout("lighting, tracing shadow rays", &layouts.forward_rays),
+            tracing_layouts: traversals
+                .into_iter()
+                .flatten()
+                .map(|t| (t, layout("lighting, tracing shadow rays", layouts.forward_rays.get(t))))
+                .collect(),
             pipelines: HashMap::new(),
         }
     }
@@ -242,14 +250,20 @@ impl LightingPass {
         // Reading the mask is the same shader whatever technique filled it: one
         // pipeline serves them all, and it traces nothing.
         let key = match key.lookup {
-            Lookup::Mask => {
-                LightingKey { technique: TechniqueRef::any_builtin(), refine: Refine::Off, ..key }
+            Lookup::Mask => LightingKey {
+                technique: TechniqueRef::any_builtin(),
+                refine: Refine::Off,
+                traversal: Traversal::Shader,
+                ..key
+            },
+            Lookup::Own(_) if key.refine == Refine::Off => {
+                LightingKey { traversal: Traversal::Shader, ..key }
             }
             Lookup::Own(_) => key,
         };
         let layout = match key.refine {
             Refine::Off => &self.layout,
-            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.tracing_layout,
+            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.tracing_layouts[&key.traversal],
         };
         self.pipelines.entry(key).or_insert_with(|| {
             let source = lighting_wgsl(key);

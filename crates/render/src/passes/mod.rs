@@ -75,9 +75,22 @@ pub(crate) fn draw_fullscreen(
 /// Concatenates WGSL sources into one module, after the constants generated from
 /// Rust ([`crate::uniforms::wgsl_constants`]). WGSL allows module-scope declarations
 /// in any order, so the shared declarations, the technique and the pass compose freely.
+/// Directives (`enable wgpu_ray_query;`, which the ray-query tracer needs) must come
+/// before every declaration: a part's are lifted to the top, each once.
 pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
-    let mut all = vec![crate::uniforms::wgsl_constants()];
-    all.extend(parts.iter().map(|p| (*p).to_owned()));
+    let mut directives: Vec<&str> = Vec::new();
+    for line in parts.iter().flat_map(|p| p.lines()).map(str::trim) {
+        if line.starts_with("enable ") && !directives.contains(&line) {
+            directives.push(line);
+        }
+    }
+    let mut all: Vec<String> = directives.iter().map(|d| (*d).to_owned()).collect();
+    all.push(crate::uniforms::wgsl_constants());
+    all.extend(
+        parts
+            .iter()
+            .map(|p| p.lines().filter(|l| !l.trim().starts_with("enable ")).collect::<Vec<_>>().join("\n")),
+    );
     all.join("\n")
 }
 
@@ -117,9 +130,9 @@ pub(crate) struct Layouts {
     pub scene: wgpu::BindGroupLayout,
     /// Group 1 of the lighting pass and the prepass: the camera.
     pub camera: wgpu::BindGroupLayout,
-    /// Group 1 of a forward lighting pass that refines by rays: the camera, the
-    /// casters' BVH and the light's counters ([`crate::rays::forward_layout`]).
-    pub forward_rays: wgpu::BindGroupLayout,
+    /// Group 1 of a forward lighting pass that refines by rays: the camera and the
+    /// tracer's resources, for each traversal ([`crate::rays::forward_layouts`]).
+    pub forward_rays: crate::rays::TracerLayouts,
     /// Group 1 of the shadow-mask pass: the camera and the prepass's view depth and
     /// normals.
     pub screen: wgpu::BindGroupLayout,
@@ -134,8 +147,9 @@ pub(crate) struct Layouts {
     /// A material's base-colour texture and sampler: group 3 of the lighting pass,
     /// group 1 of the alpha-masked shadow pass.
     pub material: wgpu::BindGroupLayout,
-    /// The casters' BVH ([`crate::rays`]): group 3 of the trace pass.
-    pub rays: wgpu::BindGroupLayout,
+    /// The tracer's resources ([`crate::rays`]), for each traversal: group 3 of the
+    /// trace pass.
+    pub rays: crate::rays::TracerLayouts,
     /// Group 1 of a shadow-mask pass that refines with rays: `screen`'s bindings,
     /// the list of unsure pixels and the light's counters, written.
     pub refine_screen: wgpu::BindGroupLayout,
@@ -170,7 +184,7 @@ impl Layouts {
                 ],
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
-            forward_rays: crate::rays::forward_layout(device),
+            forward_rays: crate::rays::forward_layouts(device),
             shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(7)]].concat()),
             receiver: layout(
                 "shadow receiver",
@@ -181,7 +195,7 @@ impl Layouts {
                 &[uniform_entry(0, fragment), unfilterable_texture_entry(1), unfilterable_texture_entry(2)],
             ),
             material: layout("material", &[fragment_entry(0, filterable), fragment_entry(1, filtering)]),
-            rays: crate::rays::layout(device),
+            rays: crate::rays::layouts(device),
             refine_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Append),
             trace_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Read),
             refined_mask: crate::rays::refined_mask_layout(device),

@@ -159,7 +159,13 @@ fn no_geometry_vertex_stage_reads_a_storage_buffer() {
     for technique in [Technique::HARD, Technique::PCSS, Technique::VSM] {
         let technique = registry.get(&technique).expect("built in");
         for lookup in [Lookup::Own(MapLookup::Map), Lookup::Mask] {
-            let key = LightingKey { technique, lookup, role: LightingRole::First, refine: Refine::Off };
+            let key = LightingKey {
+                technique,
+                lookup,
+                role: LightingRole::First,
+                refine: Refine::Off,
+                traversal: crate::rays::Traversal::Shader,
+            };
             modules.push(("lighting", Reflected::new(&lighting::lighting_wgsl(key))));
         }
     }

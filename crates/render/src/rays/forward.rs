@@ -7,8 +7,9 @@
 use gnomon_scene::settings::Refine;
 
 use super::{
-    GpuBvh, buffer_entries,
+    GpuBvh, TracerLayouts, Traversal,
     refine::{classify_wgsl, surface_rays_wgsl},
+    traversal,
 };
 use crate::{
     passes::lighting::MapLookup,
@@ -22,19 +23,19 @@ const GROUP: u32 = 1;
 /// The WGSL of `refine_forward`, which the lighting pass calls with each fragment's
 /// map answer: the answer itself when `refine` is off (and on the mask path, whose
 /// mask holds the rays' answers already); otherwise the classification, the tracer
-/// and the fragment's rays.
-pub(crate) fn forward_refine_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
+/// (`traversal`'s) and the fragment's rays.
+pub(crate) fn forward_refine_wgsl(refine: Refine, lookup: MapLookup, traversal: Traversal) -> Vec<String> {
     let Some(mut parts) = classify_wgsl(refine, lookup) else {
         return vec![include_str!("refine_forward_off.wgsl").to_owned()];
     };
-    parts.extend(surface_rays_wgsl(GROUP));
+    parts.extend(surface_rays_wgsl(GROUP, traversal));
     parts.push(include_str!("refine_forward.wgsl").to_owned());
     parts
 }
 
-/// Group 1 of a lighting pass that traces: the camera (0) and the tracer's buffers
-/// (2–6).
-pub(crate) fn forward_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+/// Group 1 of a lighting pass that traces: the camera (0) and the tracer's
+/// resources (2–6), for each traversal the device runs.
+pub(crate) fn forward_layouts(device: &wgpu::Device) -> TracerLayouts {
     let fragment = wgpu::ShaderStages::FRAGMENT;
     let camera = wgpu::BindGroupLayoutEntry {
         binding: 0,
@@ -46,21 +47,25 @@ pub(crate) fn forward_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         },
         count: None,
     };
-    let entries = [vec![camera], buffer_entries(fragment)].concat();
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("camera, tracing shadow rays"),
-        entries: &entries,
+    TracerLayouts::new(device, |t| {
+        let entries = [vec![camera], traversal::entries(fragment, t)].concat();
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("camera, tracing shadow rays"),
+            entries: &entries,
+        })
     })
 }
 
-/// Group 1 of the lighting pass that traces: `camera` and `bvh`'s buffers.
+/// Group 1 of the lighting pass that traces by `traversal`: `camera` and `bvh`'s
+/// resources.
 pub(crate) fn forward_group(
     pool: &mut Pool,
-    layout: &wgpu::BindGroupLayout,
+    layouts: &TracerLayouts,
     camera: &wgpu::Buffer,
     bvh: &GpuBvh,
+    traversal: Traversal,
 ) -> wgpu::BindGroup {
     let mut bindings = vec![(0, Binding::Buffer(camera.clone()))];
-    bindings.extend(bvh.bindings());
-    pool.bind_group_numbered("camera, tracing shadow rays", layout, bindings)
+    bindings.extend(bvh.bindings(traversal));
+    pool.bind_group_numbered("camera, tracing shadow rays", layouts.get(traversal), bindings)
 }

@@ -1,44 +1,40 @@
-//! Shadow rays on the GPU, on any adapter (no ray-tracing hardware needed): the
-//! scene's casters in a BVH built on the CPU and flattened into storage buffers
-//! (`bvh.rs`), walked by a WGSL shader (`trace.wgsl`) that gives the CPU reference's
-//! answers. [`ShadowRays`] answers batches of rays, for a host or a test; the
-//! renderer's trace pass (`refine.rs`) binds the same buffers where it refines a
-//! shadow.
+//! Shadow rays on the GPU, on any adapter: the scene's casters in a BVH built on
+//! the CPU and flattened into storage buffers (`bvh.rs`), walked by a WGSL shader
+//! (`trace_bvh.wgsl`) that gives the CPU reference's answers; and, where the device
+//! has ray queries, the same casters in the adapter's own acceleration structures
+//! (`accel.rs`, `trace_query.wgsl`). [`Traversal`] says which traces a frame.
+//! [`ShadowRays`] answers batches of rays, for a host or a test; the renderer's trace
+//! pass (`refine.rs`) binds the same resources where it refines a shadow.
 
+mod accel;
 mod bvh;
 mod forward;
 mod query;
 mod refine;
+mod traversal;
 
-pub(crate) use forward::{forward_group, forward_layout, forward_refine_wgsl};
+pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    ListAccess, RefineLists, TraceGroups, TracePass, TraceStage, mask_refine_wgsl, refined_mask_layout,
+    ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, mask_refine_wgsl, refined_mask_layout,
     screen_layout as refine_screen_layout,
 };
+pub use traversal::{RayQueriesUnavailable, Traversal};
+pub(crate) use traversal::{TracerLayouts, trace_wgsl};
 
 use gnomon_scene::{Light, settings::Refine};
+use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
 use crate::{Gpu, RenderError};
+use accel::CasterAccel;
 use bvh::CasterBvh;
+use traversal::FIRST_BINDING;
 
 /// The bind group slot the tracer's buffers take in every pipeline that traces.
 pub(crate) const GROUP: u32 = 3;
-
-/// `trace.wgsl` with the constants it shares with [`bvh`], its buffers bound in
-/// `group` (bindings 2–6).
-pub(crate) fn trace_wgsl(group: u32) -> String {
-    format!(
-        "const TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}",
-        bvh::MAX_DEPTH,
-        bvh::NO_ALPHA,
-        bvh::NO_TEXTURE,
-        include_str!("trace.wgsl").replace("TRACE_GROUP", &group.to_string())
-    )
-}
 
 /// The refinement a light gets on the mask path: `refine`, with `auto` resolved to
 /// `rays` for a hard light and to `off` for a light with an area, whose refined
@@ -62,31 +58,19 @@ pub(crate) fn forward_light_refine(refine: Refine) -> Refine {
     }
 }
 
-/// The layout of the tracer's group: bindings 2–6, read-only storage (0 and 1 stay
-/// free for the material texture that passes sharing `scene_common.wgsl` declare).
-pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let entries = buffer_entries(wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE);
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("shadow rays"),
-        entries: &entries,
-    })
-}
-
-/// The entries of the tracer's five read-only buffers, at bindings 2–6, seen by
-/// `stages`.
-fn buffer_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
-    (FIRST_BINDING..FIRST_BINDING + 5)
-        .map(|binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: stages,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
+/// The layouts of the tracer's group, for each traversal the device runs: bindings
+/// 2–6 (0 and 1 stay free for the material texture that passes sharing
+/// `scene_common.wgsl` declare).
+pub(crate) fn layouts(device: &wgpu::Device) -> TracerLayouts {
+    TracerLayouts::new(device, |traversal| {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow rays"),
+            entries: &traversal::entries(
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                traversal,
+            ),
         })
-        .collect()
+    })
 }
 
 /// Why the GPU ray tracer cannot take a scene or a frame on a device: each names the
@@ -172,9 +156,11 @@ fn check_limits(bvh: &CasterBvh, scene: &str, limit: u64) -> Result<(), RaysUnav
 }
 
 /// A scene's casters on the GPU, bound for tracing, with the CPU copy of its tree
-/// that a refit updates.
+/// that a refit updates; and, once a frame has asked for ray queries, the adapter's
+/// acceleration structures over the same triangles.
 pub(crate) struct GpuBvh {
-    pub group: wgpu::BindGroup,
+    /// The shader tracer's group ([`Traversal::Shader`]).
+    group: wgpu::BindGroup,
     /// Triangles in the tree: every casting instance's (0 when none casts).
     pub triangles: usize,
     /// The tree's nodes and triangles as uploaded (its alpha tests and textures,
@@ -182,14 +168,18 @@ pub(crate) struct GpuBvh {
     tree: CasterBvh,
     /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6.
     buffers: Vec<wgpu::Buffer>,
+    /// The acceleration structures and the ray-query tracer's group, built on first
+    /// use; or why this device's structures cannot take the scene.
+    accel: OnceLock<Result<(CasterAccel, wgpu::BindGroup), RayQueriesUnavailable>>,
+    /// The scene's name, for the errors of a later build.
+    scene: String,
 }
-
-/// The first binding of the tracer's buffers in whichever group holds them.
-const FIRST_BINDING: u32 = 2;
 
 /// Which of [`GpuBvh`]'s buffers holds what.
 const NODE_BUFFER: usize = 0;
 const TRIANGLE_BUFFER: usize = 1;
+/// The alpha tests, textures and texels: bindings 4–6 for either traversal.
+const ALPHA_BUFFERS: std::ops::Range<usize> = 2..5;
 
 impl GpuBvh {
     /// Builds the casters' BVH of `scene` and uploads it. The scene must be valid.
@@ -205,6 +195,12 @@ impl GpuBvh {
         // wgpu refuses a binding smaller than one element: an unused buffer holds one
         // zeroed element of the largest kind.
         let contents = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 64] } else { bytes.to_vec() };
+        // A refit rewrites the nodes and triangles in place; the acceleration
+        // structures read their vertices from the triangle buffer.
+        let mut usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        if gpu.ray_queries {
+            usage |= wgpu::BufferUsages::BLAS_INPUT;
+        }
         let device = &gpu.device;
         gpu.checked("uploading the shadow casters' BVH", || {
             let buffers: Vec<wgpu::Buffer> = [
@@ -220,8 +216,7 @@ impl GpuBvh {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(name),
                     contents: &contents(bytes),
-                    // A refit rewrites the nodes and triangles in place.
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    usage,
                 })
             })
             .collect();
@@ -239,14 +234,94 @@ impl GpuBvh {
                 entries: &entries,
             });
             (bvh.alpha, bvh.textures, bvh.texels) = Default::default();
-            Self { group, triangles: bvh.casters, tree: bvh, buffers }
+            Self {
+                group,
+                triangles: bvh.casters,
+                tree: bvh,
+                buffers,
+                accel: OnceLock::new(),
+                scene: scene.name.clone(),
+            }
         })
     }
 
-    /// The tracer's buffers at their bindings (2–6), for a group that holds them
-    /// beside others.
-    pub(crate) fn bindings(&self) -> Vec<(u32, crate::pool::Binding)> {
-        (FIRST_BINDING..).zip(self.buffers.iter().map(|b| crate::pool::Binding::Buffer(b.clone()))).collect()
+    /// Builds the acceleration structures once, for the ray-query tracer: `layout` is
+    /// its group's ([`TracerLayouts::get`]), and the device must have ray queries.
+    /// Ok(Err) says why its structures cannot take the scene (the same answer every
+    /// time); Err is a failure of the device.
+    pub fn build_accel(
+        &self,
+        gpu: &Gpu,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Result<Result<(), RayQueriesUnavailable>, RenderError> {
+        if self.accel.get().is_none() {
+            let built = match CasterAccel::check_limits(gpu, &self.tree, &self.scene) {
+                Ok(()) => {
+                    let accel = CasterAccel::build(gpu, &self.tree, &self.buffers[TRIANGLE_BUFFER])?;
+                    let entries: Vec<wgpu::BindGroupEntry> = std::iter::once(wgpu::BindGroupEntry {
+                        binding: FIRST_BINDING,
+                        resource: accel.binding(),
+                    })
+                    .chain(self.alpha_buffers().map(|(binding, buffer)| wgpu::BindGroupEntry {
+                        binding,
+                        resource: buffer.as_entire_binding(),
+                    }))
+                    .collect();
+                    let group = gpu.checked("binding the casters' acceleration structures", || {
+                        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("shadow rays, ray queries"),
+                            layout,
+                            entries: &entries,
+                        })
+                    })?;
+                    Ok((accel, group))
+                }
+                Err(why) => Err(why),
+            };
+            // Another thread may have built them meanwhile: either is the same.
+            let _ = self.accel.set(built);
+        }
+        Ok(self.accel.get().expect("set above").as_ref().map(|_| ()).map_err(Clone::clone))
+    }
+
+    /// The alpha buffers at their bindings (4–6).
+    fn alpha_buffers(&self) -> impl Iterator<Item = (u32, &wgpu::Buffer)> {
+        (FIRST_BINDING + ALPHA_BUFFERS.start as u32..).zip(&self.buffers[ALPHA_BUFFERS])
+    }
+
+    /// The tracer's group for `traversal`: for ray queries, once
+    /// [`GpuBvh::build_accel`] has built the structures.
+    pub(crate) fn group(&self, traversal: Traversal) -> &wgpu::BindGroup {
+        match traversal {
+            Traversal::Shader => &self.group,
+            Traversal::RayQuery => &self.built_accel().1,
+        }
+    }
+
+    fn built_accel(&self) -> &(CasterAccel, wgpu::BindGroup) {
+        self.accel
+            .get()
+            .and_then(|built| built.as_ref().ok())
+            .expect("the acceleration structures, built when the frame was planned")
+    }
+
+    /// The tracer's resources for `traversal` at their bindings (2–6), for a group
+    /// that holds them beside others.
+    pub(crate) fn bindings(&self, traversal: Traversal) -> Vec<(u32, crate::pool::Binding)> {
+        use crate::pool::Binding;
+        match traversal {
+            Traversal::Shader => {
+                (FIRST_BINDING..).zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone()))).collect()
+            }
+            Traversal::RayQuery => {
+                std::iter::once((FIRST_BINDING, Binding::Tlas(self.built_accel().0.tlas().clone())))
+                    .chain(
+                        self.alpha_buffers()
+                            .map(|(binding, buffer)| (binding, Binding::Buffer(buffer.clone()))),
+                    )
+                    .collect()
+            }
+        }
     }
 
     /// How many instances the scene the tree was built from had.
@@ -256,8 +331,9 @@ impl GpuBvh {
 
     /// Moves the triangles of the `moved` instances to where `scene` now places them
     /// and refits the tree's boxes ([`CasterBvh::refit`]), uploading what changed:
-    /// the node buffer and the changed runs of triangles. `scene` must be the one
-    /// the tree was built from, with new transforms only, and `moved` valid indices.
+    /// the node buffer and the changed runs of triangles. Acceleration structures, if
+    /// built, are built again over the moved triangles. `scene` must be the one the
+    /// tree was built from, with new transforms only, and `moved` valid indices.
     pub fn refit(
         &mut self,
         gpu: &Gpu,
@@ -268,7 +344,13 @@ impl GpuBvh {
         gpu.checked("refitting the shadow casters' BVH", || {
             write_runs(&gpu.queue, &self.buffers[NODE_BUFFER], &self.tree.nodes, &changed.nodes);
             write_runs(&gpu.queue, &self.buffers[TRIANGLE_BUFFER], &self.tree.triangles, &changed.triangles);
-        })
+        })?;
+        match self.accel.get() {
+            Some(Ok((accel, _))) if !changed.triangles.is_empty() => {
+                accel.rebuild(gpu, &self.buffers[TRIANGLE_BUFFER])
+            }
+            Some(_) | None => Ok(()),
+        }
     }
 }
 

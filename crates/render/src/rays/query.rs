@@ -6,8 +6,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use super::{GROUP, GpuBvh};
+use super::{GROUP, GpuBvh, Traversal};
 use crate::{Gpu, RenderError, readback};
+use gnomon_scene::settings::Tracer;
 
 /// A segment to test: from `origin` along the unit `direction`, up to `length`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,17 +37,40 @@ const WORKGROUP: u32 = 64;
 pub struct ShadowRays {
     gpu: Gpu,
     bvh: GpuBvh,
+    traversal: Traversal,
     pipeline: wgpu::ComputePipeline,
     io_layout: wgpu::BindGroupLayout,
 }
 
 impl ShadowRays {
-    /// Builds and uploads the BVH of `scene`'s shadow casters.
+    /// Builds and uploads the BVH of `scene`'s shadow casters, and where the device
+    /// has ray queries, its acceleration structures (`Tracer::Auto`).
     pub fn new(gpu: &Gpu, scene: &gnomon_scene::Scene) -> Result<Self, RenderError> {
+        Self::with_tracer(gpu, scene, Tracer::Auto)
+    }
+
+    /// As [`ShadowRays::new`], tracing as `tracer` asks. Ray queries asked for by
+    /// name on a device that has none, or that cannot take the scene, are refused
+    /// ([`RenderError::RayQueriesUnavailable`]): a batch has no frame to report a
+    /// fallback in.
+    pub fn with_tracer(gpu: &Gpu, scene: &gnomon_scene::Scene, tracer: Tracer) -> Result<Self, RenderError> {
         scene.validate()?;
         let device = &gpu.device;
-        let rays_layout = super::layout(device);
-        let bvh = GpuBvh::upload(gpu, scene, &rays_layout)?;
+        let (traversal, unavailable) = Traversal::resolve(tracer, gpu);
+        if let Some(why) = unavailable {
+            return Err(why.into());
+        }
+        let layouts = super::layouts(device);
+        let bvh = GpuBvh::upload(gpu, scene, layouts.get(Traversal::Shader))?;
+        let traversal = match (traversal, tracer) {
+            (Traversal::Shader, _) => Traversal::Shader,
+            (Traversal::RayQuery, _) => match bvh.build_accel(gpu, layouts.get(Traversal::RayQuery))? {
+                Ok(()) => Traversal::RayQuery,
+                Err(why) if tracer == Tracer::RayQuery => return Err(why.into()),
+                Err(_) => Traversal::Shader,
+            },
+        };
+        let rays_layout = layouts.get(traversal);
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow ray query"),
             entries: &[
@@ -57,14 +81,14 @@ impl ShadowRays {
         let pipeline = gpu.checked("building the shadow ray query", || {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("shadow ray query"),
-                bind_group_layouts: &[Some(&io_layout), None, None, Some(&rays_layout)],
+                bind_group_layouts: &[Some(&io_layout), None, None, Some(rays_layout)],
                 immediate_size: 0,
             });
-            let source = format!(
-                "const QUERY_WORKGROUP: u32 = {WORKGROUP}u;\n{}\n{}",
-                super::trace_wgsl(GROUP),
-                include_str!("query.wgsl")
-            );
+            let source = crate::passes::compose_wgsl(&[
+                &format!("const QUERY_WORKGROUP: u32 = {WORKGROUP}u;"),
+                &super::trace_wgsl(GROUP, traversal),
+                include_str!("query.wgsl"),
+            ]);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("shadow ray query"),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -78,7 +102,12 @@ impl ShadowRays {
                 cache: None,
             })
         })?;
-        Ok(Self { gpu: Gpu::clone(gpu), bvh, pipeline, io_layout })
+        Ok(Self { gpu: Gpu::clone(gpu), bvh, traversal, pipeline, io_layout })
+    }
+
+    /// How the rays traverse the casters.
+    pub fn traversal(&self) -> Traversal {
+        self.traversal
     }
 
     /// Follows instances that moved: `scene`, the one these rays were made for, holds
@@ -139,7 +168,7 @@ impl ShadowRays {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &io, &[]);
-                pass.set_bind_group(GROUP, &self.bvh.group, &[]);
+                pass.set_bind_group(GROUP, self.bvh.group(self.traversal), &[]);
                 let groups = (rays.len() as u32).div_ceil(WORKGROUP);
                 // Workgroups in two dimensions: one dimension alone stops at 65,535.
                 let per_row = groups.min(device.limits().max_compute_workgroups_per_dimension);

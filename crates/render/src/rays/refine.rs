@@ -7,6 +7,7 @@
 
 use gnomon_scene::settings::Refine;
 
+use super::Traversal;
 use crate::{
     passes::{self, Layouts, compose_wgsl, lighting::MapLookup},
     pool::{Binding, Pool},
@@ -72,22 +73,22 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Option<Vec<Str
 }
 
 /// The shadow rays from surface points (surface_rays.wgsl) with what they need: the
-/// tracer, its buffers in `group`, and the light's samples.
-pub(crate) fn surface_rays_wgsl(group: u32) -> Vec<String> {
+/// tracer of `traversal`, its bindings in `group`, and the light's samples.
+pub(crate) fn surface_rays_wgsl(group: u32, traversal: Traversal) -> Vec<String> {
     vec![
-        super::trace_wgsl(group),
+        super::trace_wgsl(group, traversal),
         include_str!("light_sample.wgsl").to_owned(),
         include_str!("surface_rays.wgsl").to_owned(),
     ]
 }
 
-/// The trace pass's WGSL, composed.
-pub(crate) fn trace_pass_wgsl() -> String {
+/// The trace pass's WGSL for `traversal`, composed.
+pub(crate) fn trace_pass_wgsl(traversal: Traversal) -> String {
     let mut parts = passes::lighting::camera_shading_wgsl();
     parts.push(passes::OCTAHEDRON_WGSL.to_owned());
     parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
     parts.push(list_wgsl());
-    parts.extend(surface_rays_wgsl(super::GROUP));
+    parts.extend(surface_rays_wgsl(super::GROUP, traversal));
     parts.push(include_str!("refine_trace.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -168,6 +169,29 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
     })
 }
 
+/// The trace passes of each traversal, the shader's built with the renderer, the ray
+/// queries' on first use.
+pub(crate) struct TracePasses {
+    shader: TracePass,
+    ray_query: Option<TracePass>,
+}
+
+impl TracePasses {
+    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        Self { shader: TracePass::new(device, layouts, Traversal::Shader), ray_query: None }
+    }
+
+    /// The passes of `traversal`, which the device must run.
+    pub fn get(&mut self, device: &wgpu::Device, layouts: &Layouts, traversal: Traversal) -> &TracePass {
+        match traversal {
+            Traversal::Shader => &self.shader,
+            Traversal::RayQuery => {
+                self.ray_query.get_or_insert_with(|| TracePass::new(device, layouts, Traversal::RayQuery))
+            }
+        }
+    }
+}
+
 /// The trace pass's pipeline, and the penumbra filter's that follows it under a
 /// light with an area (`cs_filter_penumbra` in refine_trace.wgsl).
 pub(crate) struct TracePass {
@@ -176,20 +200,20 @@ pub(crate) struct TracePass {
 }
 
 impl TracePass {
-    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+    fn new(device: &wgpu::Device, layouts: &Layouts, traversal: Traversal) -> Self {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow mask ray trace"),
             bind_group_layouts: &[
                 Some(&layouts.scene),
                 Some(&layouts.trace_screen),
                 Some(&layouts.refined_mask),
-                Some(&layouts.rays),
+                Some(layouts.rays.get(traversal)),
             ],
             immediate_size: 0,
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow mask ray trace"),
-            source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl().into()),
+            source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl(traversal).into()),
         });
         let pipeline = |entry_point: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -262,8 +286,10 @@ pub(crate) struct TraceGroups<'a> {
     /// The light's layer of the mask, written, and the copy the filter reads
     /// ([`RefineLists::mask_group`]).
     pub mask: &'a wgpu::BindGroup,
-    /// The casters' BVH.
+    /// The tracer's resources, for `traversal`.
     pub bvh: &'a wgpu::BindGroup,
+    /// How the rays traverse the casters: which trace pipeline runs.
+    pub traversal: Traversal,
     /// The counters, whose first three words at the light's offset are the dispatch.
     pub counters: &'a wgpu::Buffer,
 }

@@ -1,13 +1,10 @@
-// Shadow rays against the casters' BVH (bvh.rs): is the segment from a surface point
-// toward the light blocked? The same answers as the CPU reference (reference/tracer.rs):
-// the watertight ray/triangle test of Woop, Benthin & Wald (JCGT 2(1), 2013) with
-// PBRT's bound on the error of t, cut-out casters tested against their texture's
-// alpha at mip 0, and the ray's origin moved off its surface by Wächter & Binder's
-// offset (Ray Tracing Gems, ch. 6).
+// Shadow rays against Gnomon's own BVH of the casters (bvh.rs), walked by the shader
+// on any adapter: is the segment from a surface point toward the light blocked? The
+// same answers as the CPU reference (reference/tracer.rs): the watertight
+// ray/triangle test of Woop, Benthin & Wald (JCGT 2(1), 2013) with PBRT's bound on
+// the error of t, and cut-out casters alpha-tested (trace_common.wgsl).
 //
-// Bindings 2–6 of group TRACE_GROUP, which `trace_wgsl` sets: 3 in the compute
-// passes, where 0 and 1 are left to the material texture that passes sharing
-// scene_common.wgsl declare, and 1 in the forward lighting pass, beside the camera.
+// Bindings 2 and 3 of group TRACE_GROUP: the nodes and the triangles.
 
 struct BvhNode {
     min: vec3<f32>,
@@ -28,72 +25,8 @@ struct BvhTriangle {
     _pad2: u32,
 };
 
-struct AlphaTest {
-    uv0: vec2<f32>,
-    uv1: vec2<f32>,
-    uv2: vec2<f32>,
-    // Index into bvh_alpha_textures, or NO_TEXTURE.
-    texture: u32,
-    base_alpha: f32,
-    cutoff: f32,
-    _pad: u32,
-};
-
-struct AlphaTexture {
-    first_word: u32,
-    width: u32,
-    height: u32,
-    // 0 repeat, 1 mirrored repeat, 2 clamp to edge.
-    wrap_u: u32,
-    wrap_v: u32,
-    nearest: u32,
-    _pad0: u32,
-    _pad1: u32,
-};
-
 @group(TRACE_GROUP) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(TRACE_GROUP) @binding(3) var<storage, read> bvh_triangles: array<BvhTriangle>;
-@group(TRACE_GROUP) @binding(4) var<storage, read> bvh_alpha: array<AlphaTest>;
-@group(TRACE_GROUP) @binding(5) var<storage, read> bvh_alpha_textures: array<AlphaTexture>;
-@group(TRACE_GROUP) @binding(6) var<storage, read> bvh_alpha_texels: array<u32>;
-
-// A texel index along an axis of `n` texels, wrapped as `mode` says.
-fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
-    if mode == 2u {
-        return clamp(i, 0, n - 1);
-    }
-    if mode == 1u {
-        let m = ((i % (2 * n)) + 2 * n) % (2 * n);
-        return select(m, 2 * n - 1 - m, m >= n);
-    }
-    return ((i % n) + n) % n;
-}
-
-fn alpha_texel(t: AlphaTexture, x: i32, y: i32) -> f32 {
-    let w = i32(t.width);
-    let h = i32(t.height);
-    let index = u32(wrap_texel(y, h, t.wrap_v) * w + wrap_texel(x, w, t.wrap_u));
-    let word = bvh_alpha_texels[t.first_word + index / 4u];
-    return f32((word >> (8u * (index % 4u))) & 0xffu) / 255.0;
-}
-
-// The texture's alpha at `uv`, nearest or bilinear as its sampler asks, at mip 0
-// (texel centres at half-integers), as reference/texture.rs samples it.
-fn sample_alpha(t: AlphaTexture, uv: vec2<f32>) -> f32 {
-    let size = vec2<f32>(f32(t.width), f32(t.height));
-    if t.nearest == 1u {
-        let p = floor(uv * size);
-        return alpha_texel(t, i32(p.x), i32(p.y));
-    }
-    let p = uv * size - vec2<f32>(0.5);
-    let base = floor(p);
-    let f = p - base;
-    let x = i32(base.x);
-    let y = i32(base.y);
-    let top = mix(alpha_texel(t, x, y), alpha_texel(t, x + 1, y), f.x);
-    let bottom = mix(alpha_texel(t, x, y + 1), alpha_texel(t, x + 1, y + 1), f.x);
-    return mix(top, bottom, f.y);
-}
 
 // A ray made the +z axis by a permutation and a shear (Woop et al. §2).
 struct ShearedRay {
@@ -175,14 +108,8 @@ fn triangle_hit(ray: ShearedRay, index: u32, t_max: f32) -> f32 {
     if tri.alpha == NO_ALPHA {
         return t;
     }
-    let test = bvh_alpha[tri.alpha];
     // U weighs the vertex opposite edge BC (A), V the one opposite CA (B), W C.
-    let uv = (test.uv0 * u + test.uv1 * v + test.uv2 * w) / det;
-    var alpha = test.base_alpha;
-    if test.texture != NO_TEXTURE {
-        alpha *= sample_alpha(bvh_alpha_textures[test.texture], uv);
-    }
-    return select(-1.0, t, alpha >= test.cutoff);
+    return select(-1.0, t, alpha_blocks(tri.alpha, vec3<f32>(u, v, w), det));
 }
 
 // Entry distance of the ray into a node's box, or a negative value on a miss. The far
@@ -194,12 +121,6 @@ fn enter_box(node: BvhNode, origin: vec3<f32>, inv_direction: vec3<f32>, t_max: 
     let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
     let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_max)) * (1.0 + 2.0 * gamma(3.0));
     return select(-1.0, near, near <= far);
-}
-
-// Whether a shadow caster blocks the segment from `origin` along the unit
-// `direction` before `t_max`.
-fn ray_blocked(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
-    return ray_first_hit(origin, direction, t_max) >= 0.0;
 }
 
 // The distance along the segment from `origin` along the unit `direction` to the
@@ -262,12 +183,3 @@ fn ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
     return -1.0;
 }
 
-// Moves a surface point off its surface along the geometric normal `n` (facing the
-// side the ray leaves from) by a few units in the last place of its coordinates
-// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray
-// Tracing Gems, ch. 6, 2019), as reference/tracer.rs does.
-fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let of_i = vec3<i32>(n * 256.0);
-    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
-    return select(p_i, p + n / 65536.0, abs(p) < vec3<f32>(1.0 / 32.0));
-}

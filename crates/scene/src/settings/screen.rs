@@ -78,6 +78,26 @@ pub enum Refine {
     EveryPixel,
 }
 
+/// Which tracer answers the shadow rays that `refine` and the `raytraced` technique
+/// cast. Both trace the same casters and give the CPU reference's answers
+/// (docs/rays.md, "Two tracers").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Tracer {
+    /// `ray-query` where the device has ray queries, `shader` elsewhere.
+    #[default]
+    Auto,
+    /// Gnomon's own BVH, built on the CPU and walked by a WGSL shader: any adapter,
+    /// no ray-tracing hardware needed.
+    Shader,
+    /// The adapter's own acceleration structures, through ray queries (wgpu's
+    /// `EXPERIMENTAL_RAY_QUERY`, Vulkan's `VK_KHR_ray_query`): ray-tracing hardware
+    /// where the GPU has it. Where the device has no ray queries, or a scene exceeds
+    /// what its structures take, the shader traces instead and the frame says why.
+    RayQuery,
+}
+
 /// How a light's technique uses shadow rays: a fact of the technique, which the
 /// renderer's technique registry states (`ShadowTechnique::rays`) and lays into each
 /// [`ResolvedLight`]. Most techniques answer from their map and leave rays to
@@ -113,6 +133,13 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub refine: Refine,
+    /// Which tracer casts the rays: auto (ray queries where the device has them),
+    /// shader (Gnomon's BVH walked by a shader, on any adapter) or ray-query.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
+    )]
+    pub tracer: Tracer,
     /// How several lights are lit on the mask path: light-list (one pass over a tiled
     /// list of the lights) or per-light (one pass each).
     #[cfg_attr(
@@ -139,6 +166,7 @@ impl Default for ScreenSpaceSettings {
         Self {
             shadow_path: ShadowPath::Auto,
             refine: Refine::Auto,
+            tracer: Tracer::Auto,
             lighting: Lighting::LightList,
             penumbra_rays: 16,
         }

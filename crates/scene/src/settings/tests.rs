@@ -50,6 +50,8 @@ fn flags_and_toml_agree() {
         "mask",
         "--penumbra-rays",
         "32",
+        "--tracer",
+        "shader",
         "--contact-shadows",
         "--contact-length",
         "0.5",
@@ -91,6 +93,7 @@ fn flags_and_toml_agree() {
         [screen]
         shadow_path = "mask"
         penumbra_rays = 32
+        tracer = "shader"
     "#;
     let from_file: Settings = toml::from_str(text).unwrap();
     assert_eq!(parsed, from_file);

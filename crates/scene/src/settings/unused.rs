@@ -54,15 +54,7 @@ const RULES: &[(&str, Uses, &str)] = &[
     ("shadow.cascades.sdsm", uses_cascades, CASCADES),
     (
         "image.debug_view",
-        |s, lights| {
-            s.image.debug_view != DebugView::Traced
-                || lights.iter().any(|l| match s.light_refine(l) {
-                    Refine::Off => false,
-                    // `auto` traces on the mask path only.
-                    Refine::Auto => s.uses_shadow_mask(lights).unwrap_or(false),
-                    Refine::Rays | Refine::EveryPixel => true,
-                })
-        },
+        |s, lights| s.image.debug_view != DebugView::Traced || traces_rays(s, lights),
         "`screen.refine` rays or every-pixel, or auto on the mask path, or the raytraced technique (for the traced view)",
     ),
     (
@@ -74,7 +66,22 @@ const RULES: &[(&str, Uses, &str)] = &[
         },
         "`screen.refine` rays or every-pixel, or the raytraced technique, and a light with an area",
     ),
+    (
+        "screen.tracer",
+        traces_rays,
+        "`screen.refine` rays or every-pixel, or auto on the mask path, or the raytraced technique",
+    ),
 ];
+
+/// Whether any light of the render traces shadow rays.
+fn traces_rays(s: &Settings, lights: &[ResolvedLight]) -> bool {
+    lights.iter().any(|l| match s.light_refine(l) {
+        Refine::Off => false,
+        // `auto` traces on the mask path only.
+        Refine::Auto => s.uses_shadow_mask(lights).unwrap_or(false),
+        Refine::Rays | Refine::EveryPixel => true,
+    })
+}
 
 const CASCADES: &str = "`shadow.partition` cascades and a sun";
 
@@ -140,6 +147,22 @@ mod tests {
         assert_eq!(unused(&s), ["screen.penumbra_rays"], "auto leaves an area light's penumbrae to the map");
         s.screen.refine = Refine::Rays;
         assert!(unused(&s).is_empty(), "refined penumbrae");
+    }
+
+    #[test]
+    fn a_tracer_needs_rays() {
+        let scene = builtin::build("contact").unwrap();
+        let mut s = Settings::default();
+        s.screen.tracer = Tracer::Shader;
+        let unused = |s: &Settings| -> Vec<&str> {
+            s.unused(&s.resolve_lights(&scene).unwrap()).iter().map(|u| u.setting).collect()
+        };
+        assert!(unused(&s).is_empty(), "the default refines a hard sun on the mask path");
+        s.screen.refine = Refine::Off;
+        assert_eq!(unused(&s), ["screen.tracer"]);
+        s.screen.refine = Refine::Rays;
+        s.screen.shadow_path = ShadowPath::Forward;
+        assert!(unused(&s).is_empty(), "rays asked for by name trace on the forward path");
     }
 
     #[test]
