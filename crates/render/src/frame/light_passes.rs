@@ -20,6 +20,7 @@ use crate::{
         lighting::{self, LightingKey, LightingRole, Lookup},
     },
     pool::{Binding, ViewKey},
+    rays::LightSize,
     timing::PassKind,
 };
 
@@ -267,6 +268,7 @@ impl Renderer {
             },
             // Only a forward frame with the BVH built has a group to trace with.
             refine: if tracing_group.is_some() { light.refine } else { Refine::Off },
+            size: LightSize::of(&light.light),
             traversal: plan.traversal,
         };
         pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));

@@ -99,7 +99,7 @@ impl Renderer {
                 lighting: LightingPass::new(device, &layouts),
                 light_list: LightListPass::new(device, &layouts),
                 screen_space: ScreenSpacePass::new(device, &layouts),
-                trace: TracePasses::new(device, &layouts),
+                trace: TracePasses::default(),
                 moments: MomentPass::new(device, &gpu.queue),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),

@@ -13,7 +13,7 @@ use crate::{
     GpuScene,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
-    rays::{ListAccess, RefineLists, TraceGroups, TraceStage},
+    rays::{LightSize, ListAccess, RefineLists, TraceGroups, TraceStage},
     timing::PassKind,
 };
 use gnomon_math::screen_bounds::PixelRect;
@@ -163,6 +163,7 @@ impl Renderer {
                     mask: &mask,
                     bvh: bvh.group(plan.traversal),
                     traversal: plan.traversal,
+                    size: LightSize::of(&light.light),
                     counters: &lists.counters,
                 };
                 self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
@@ -208,7 +209,12 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let key = MaskKey { technique: light.technique, lookup: bindings.lookup, refine: light.refine };
+        let key = MaskKey {
+            technique: light.technique,
+            lookup: bindings.lookup,
+            refine: light.refine,
+            size: LightSize::of(&light.light),
+        };
         pass.set_pipeline(self.passes.screen_space.mask(&gpu.device, key));
         pass.set_bind_group(0, &bindings.scene, &[]);
         pass.set_bind_group(1, screen.group, screen.counter_offset.as_slice());
@@ -234,7 +240,7 @@ impl Renderer {
         });
         self.passes
             .trace
-            .get(&gpu.device, &self.layouts, groups.traversal)
+            .get(&gpu.device, &self.layouts, groups.traversal, groups.size)
             .record(&mut pass, stage, groups, index);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 4;

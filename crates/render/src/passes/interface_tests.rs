@@ -15,7 +15,7 @@ use super::{
     map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
 use crate::{
-    rays::Traversal,
+    rays::{LightSize, Traversal},
     techniques::{TechniqueRef, TechniqueRegistry},
     uniforms::{self, LightKindGpu, StructLayout},
 };
@@ -59,6 +59,7 @@ fn every_variant() -> Vec<(String, String)> {
                     lookup,
                     role,
                     refine: Refine::Off,
+                    size: LightSize::Hard,
                     traversal: Traversal::Shader,
                 };
                 out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
@@ -67,16 +68,20 @@ fn every_variant() -> Vec<(String, String)> {
             if let Lookup::Own(_) = lookup {
                 for refine in [Refine::Rays, Refine::EveryPixel] {
                     for traversal in [Traversal::Shader, Traversal::RayQuery] {
-                        let key =
-                            LightingKey { technique, lookup, role: LightingRole::First, refine, traversal };
-                        out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+                        for size in [LightSize::Hard, LightSize::Area] {
+                            let role = LightingRole::First;
+                            let key = LightingKey { technique, lookup, role, refine, size, traversal };
+                            out.push((format!("lighting {key:?}"), lighting::lighting_wgsl(key)));
+                        }
                     }
                 }
             }
             if let Lookup::Own(map) = lookup {
                 for refine in [Refine::Off, Refine::Rays, Refine::EveryPixel] {
-                    let key = screen_space::MaskKey { technique, lookup: map, refine };
-                    out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+                    for size in [LightSize::Hard, LightSize::Area] {
+                        let key = screen_space::MaskKey { technique, lookup: map, refine, size };
+                        out.push((format!("mask {key:?}"), screen_space::mask_wgsl(key)));
+                    }
                 }
                 // The receiver with a host's fragment shader calling it, in the group
                 // a host might pick.
@@ -106,7 +111,10 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("blit".into(), blit::blit_wgsl()));
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
-        out.push((format!("ray trace {traversal:?}"), crate::rays::trace_pass_wgsl(traversal)));
+        for size in [LightSize::Hard, LightSize::Area] {
+            let source = crate::rays::trace_pass_wgsl(traversal, size);
+            out.push((format!("ray trace {traversal:?} {size:?}"), source));
+        }
     }
     out
 }

@@ -12,7 +12,7 @@ use gnomon_scene::settings::Refine;
 
 use crate::{
     gpu_types::VertexStream,
-    rays::{self, Traversal},
+    rays::{self, LightSize, Traversal},
     techniques::{self, TechniqueRef},
 };
 
@@ -52,6 +52,8 @@ pub(crate) struct LightingKey {
     /// light's refinement says; always off on the mask path, whose mask holds the
     /// rays' answers.
     pub refine: Refine,
+    /// Whether its traced fragments look for penumbrae (`Hard` where it traces none).
+    pub size: LightSize,
     /// How its rays traverse the casters (`Shader` where it traces none).
     pub traversal: Traversal,
 }
@@ -196,8 +198,8 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     let mut parts = camera_shading_wgsl();
     parts.extend(visibility_wgsl(key.technique, key.lookup));
     parts.extend(match key.lookup {
-        Lookup::Own(map) => rays::forward_refine_wgsl(key.refine, map, key.traversal),
-        Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map, key.traversal),
+        Lookup::Own(map) => rays::forward_refine_wgsl(key.refine, map, key.size, key.traversal),
+        Lookup::Mask => rays::forward_refine_wgsl(Refine::Off, MapLookup::Map, key.size, key.traversal),
     });
     parts.push(SURFACE_WGSL.to_owned());
     parts.push(LIGHTING_COMMON_WGSL.to_owned());
@@ -253,11 +255,12 @@ impl LightingPass {
             Lookup::Mask => LightingKey {
                 technique: TechniqueRef::any_builtin(),
                 refine: Refine::Off,
+                size: LightSize::Hard,
                 traversal: Traversal::Shader,
                 ..key
             },
             Lookup::Own(_) if key.refine == Refine::Off => {
-                LightingKey { traversal: Traversal::Shader, ..key }
+                LightingKey { size: LightSize::Hard, traversal: Traversal::Shader, ..key }
             }
             Lookup::Own(_) => key,
         };

@@ -27,7 +27,8 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let looked_up = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
     // Where the forward path refines and the map is unsure, the fragment's rays
     // decide (rays/refine_forward.wgsl).
-    let shadow = refine_forward(looked_up, in.world, n, geometric_n, geometry, view_depth, in.clip.xy);
+    let facing = facing_error(in.world, world_dx, world_dy);
+    let shadow = refine_forward(looked_up, in.world, n, geometric_n, geometry, view_depth, in.clip.xy, facing);
     let visibility = shadow.x;
     // Under the traced view, a layer past TRACED_LAYER_FLAG marks a pixel whose
     // shadow rays decided (shadow_mask.wgsl, refine_forward.wgsl).

@@ -34,3 +34,4 @@ fn pixel_visibility(
     }
     return shadow;
 }
+

@@ -30,6 +30,8 @@ pub(crate) struct MaskKey {
     pub lookup: MapLookup,
     /// Which of its pixels trace a shadow ray.
     pub refine: Refine,
+    /// Whether its refined pixels look for penumbrae too.
+    pub size: crate::rays::LightSize,
 }
 
 /// The prepass's WGSL, composed: the lighting pass's vertex stage (`vs_surface`) and
@@ -50,7 +52,7 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());
-    parts.extend(crate::rays::mask_refine_wgsl(key.refine, key.lookup));
+    parts.extend(crate::rays::mask_refine_wgsl(key.refine, key.lookup, key.size));
     parts.push(include_str!("shadow_mask.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)

@@ -56,7 +56,7 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     // Where the map is unsure and refinement is on, a ray decides: the pixel is
     // stored lit (with its contact shadow) and the trace pass darkens it if the ray
     // is blocked.
-    let traced = ray_decides(shadow, world, n, geometric_n, l, geometry.w);
+    let traced = ray_decides(shadow, world, n, geometric_n, l, geometry.w, facing_error(world, world_dx, world_dy));
     if traced {
         shadow.x = 1.0;
     }

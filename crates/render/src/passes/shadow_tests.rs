@@ -164,6 +164,7 @@ fn no_geometry_vertex_stage_reads_a_storage_buffer() {
                 lookup,
                 role: LightingRole::First,
                 refine: Refine::Off,
+                size: crate::rays::LightSize::Hard,
                 traversal: crate::rays::Traversal::Shader,
             };
             modules.push(("lighting", Reflected::new(&lighting::lighting_wgsl(key))));

@@ -8,7 +8,7 @@ use gnomon_scene::settings::Refine;
 
 use super::{
     GpuBvh, TracerLayouts, Traversal,
-    refine::{classify_wgsl, surface_rays_wgsl},
+    refine::{LightSize, classify_wgsl, surface_rays_wgsl},
     traversal,
 };
 use crate::{
@@ -24,8 +24,13 @@ const GROUP: u32 = 1;
 /// map answer: the answer itself when `refine` is off (and on the mask path, whose
 /// mask holds the rays' answers already); otherwise the classification, the tracer
 /// (`traversal`'s) and the fragment's rays.
-pub(crate) fn forward_refine_wgsl(refine: Refine, lookup: MapLookup, traversal: Traversal) -> Vec<String> {
-    let Some(mut parts) = classify_wgsl(refine, lookup) else {
+pub(crate) fn forward_refine_wgsl(
+    refine: Refine,
+    lookup: MapLookup,
+    size: LightSize,
+    traversal: Traversal,
+) -> Vec<String> {
+    let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
         return vec![include_str!("refine_forward_off.wgsl").to_owned()];
     };
     parts.extend(surface_rays_wgsl(GROUP, traversal));

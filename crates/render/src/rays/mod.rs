@@ -18,8 +18,8 @@ pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, mask_refine_wgsl, refined_mask_layout,
-    screen_layout as refine_screen_layout,
+    LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, mask_refine_wgsl,
+    refined_mask_layout, screen_layout as refine_screen_layout,
 };
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};

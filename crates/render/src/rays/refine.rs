@@ -7,6 +7,8 @@
 
 use gnomon_scene::settings::Refine;
 
+use std::collections::HashMap;
+
 use super::Traversal;
 use crate::{
     passes::{self, Layouts, compose_wgsl, lighting::MapLookup},
@@ -40,8 +42,8 @@ fn list_wgsl() -> String {
 /// The WGSL of `ray_decides` and `defer_to_ray`, which the shadow-mask pass calls
 /// with each pixel's map answer: never, when `refine` is off; otherwise the
 /// classification ([`classify_wgsl`]) and the list it appends to.
-pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String> {
-    let Some(mut parts) = classify_wgsl(refine, lookup) else {
+pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) -> Vec<String> {
+    let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
         return vec![include_str!("refine_off.wgsl").to_owned()];
     };
     parts.push(list_wgsl());
@@ -49,10 +51,28 @@ pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup) -> Vec<String>
     parts
 }
 
+/// Whether a light has an area whose penumbrae its rays trace: what its
+/// classification looks for, built into its shaders. (A uniform can say it too, but
+/// on lavapipe a branch on a uniform still runs both sides: the area's 6 × 6 search,
+/// left in the mask pass of a hard sun, cost Florence's frame 15–35 ms.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum LightSize {
+    /// A sun without angular diameter, a spot or point light without radius.
+    Hard,
+    /// A light with an area: its refined pixels trace its penumbrae.
+    Area,
+}
+
+impl LightSize {
+    pub fn of(light: &gnomon_scene::Light) -> Self {
+        if light.is_hard() { LightSize::Hard } else { LightSize::Area }
+    }
+}
+
 /// The WGSL of `ray_decides`, which says whether a ray decides a pixel: the
 /// classification (refine_classify.wgsl) with the footprint test of the light's kind
-/// of map. `None` when `refine` is off.
-pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Option<Vec<String>> {
+/// of map, and for a light with an area its penumbrae's. `None` when `refine` is off.
+pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) -> Option<Vec<String>> {
     let every_pixel = match refine {
         Refine::Off => return None,
         // The frame's plan resolves `auto` to `rays` (`super::light_refine`).
@@ -64,8 +84,11 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup) -> Option<Vec<Str
         MapLookup::Cube => &[include_str!("refine_footprint.wgsl"), include_str!("refine_cube.wgsl")],
         MapLookup::Paraboloid => &[include_str!("refine_omni.wgsl")],
     };
+    let penumbrae = size == LightSize::Area;
     let mut parts = vec![
-        format!("const REFINE_EVERY_PIXEL: bool = {every_pixel};\n"),
+        format!(
+            "const REFINE_EVERY_PIXEL: bool = {every_pixel};\nconst REFINE_PENUMBRAE: bool = {penumbrae};\n"
+        ),
         include_str!("refine_classify.wgsl").to_owned(),
     ];
     parts.extend(footprint.iter().map(|s| s.to_string()));
@@ -82,9 +105,11 @@ pub(crate) fn surface_rays_wgsl(group: u32, traversal: Traversal) -> Vec<String>
     ]
 }
 
-/// The trace pass's WGSL for `traversal`, composed.
-pub(crate) fn trace_pass_wgsl(traversal: Traversal) -> String {
+/// The trace pass's WGSL for `traversal` and a light of `size`, composed.
+pub(crate) fn trace_pass_wgsl(traversal: Traversal, size: LightSize) -> String {
+    let penumbrae = size == LightSize::Area;
     let mut parts = passes::lighting::camera_shading_wgsl();
+    parts.push(format!("const REFINE_PENUMBRAE: bool = {penumbrae};"));
     parts.push(passes::OCTAHEDRON_WGSL.to_owned());
     parts.push(passes::SCREEN_COMMON_WGSL.to_owned());
     parts.push(list_wgsl());
@@ -169,26 +194,24 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
     })
 }
 
-/// The trace passes of each traversal, the shader's built with the renderer, the ray
-/// queries' on first use.
+/// The trace passes of each traversal and light size, built on first use.
+#[derive(Default)]
 pub(crate) struct TracePasses {
-    shader: TracePass,
-    ray_query: Option<TracePass>,
+    passes: HashMap<(Traversal, LightSize), TracePass>,
 }
 
 impl TracePasses {
-    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        Self { shader: TracePass::new(device, layouts, Traversal::Shader), ray_query: None }
-    }
-
-    /// The passes of `traversal`, which the device must run.
-    pub fn get(&mut self, device: &wgpu::Device, layouts: &Layouts, traversal: Traversal) -> &TracePass {
-        match traversal {
-            Traversal::Shader => &self.shader,
-            Traversal::RayQuery => {
-                self.ray_query.get_or_insert_with(|| TracePass::new(device, layouts, Traversal::RayQuery))
-            }
-        }
+    /// The passes of `traversal` (which the device must run) for a light of `size`.
+    pub fn get(
+        &mut self,
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        traversal: Traversal,
+        size: LightSize,
+    ) -> &TracePass {
+        self.passes
+            .entry((traversal, size))
+            .or_insert_with(|| TracePass::new(device, layouts, traversal, size))
     }
 }
 
@@ -200,7 +223,7 @@ pub(crate) struct TracePass {
 }
 
 impl TracePass {
-    fn new(device: &wgpu::Device, layouts: &Layouts, traversal: Traversal) -> Self {
+    fn new(device: &wgpu::Device, layouts: &Layouts, traversal: Traversal, size: LightSize) -> Self {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow mask ray trace"),
             bind_group_layouts: &[
@@ -213,7 +236,7 @@ impl TracePass {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow mask ray trace"),
-            source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl(traversal).into()),
+            source: wgpu::ShaderSource::Wgsl(trace_pass_wgsl(traversal, size).into()),
         });
         let pipeline = |entry_point: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -288,8 +311,10 @@ pub(crate) struct TraceGroups<'a> {
     pub mask: &'a wgpu::BindGroup,
     /// The tracer's resources, for `traversal`.
     pub bvh: &'a wgpu::BindGroup,
-    /// How the rays traverse the casters: which trace pipeline runs.
+    /// How the rays traverse the casters, and whether they trace penumbrae: which
+    /// trace pipeline runs.
     pub traversal: Traversal,
+    pub size: LightSize,
     /// The counters, whose first three words at the light's offset are the dispatch.
     pub counters: &'a wgpu::Buffer,
 }

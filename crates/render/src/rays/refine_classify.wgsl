@@ -14,7 +14,11 @@
 
 // Whether a ray decides the pixel: it faces the light, lies inside its cone and range,
 // and the map is unsure of it (or every pixel traces). `shadow` is the lookup's
-// (visibility, layer).
+// (visibility, layer). Within `facing_error` of edge-on to the light
+// (resolve_visibility.wgsl), the geometric normal cannot say whether the surface
+// faces the light, and a ray decides that too: it leaves from the camera's side of
+// the surface, so it leaves the surface's plane where that side faces the light and
+// meets the surface itself where it does not.
 fn ray_decides(
     shadow: vec2<f32>,
     world: vec3<f32>,
@@ -22,13 +26,15 @@ fn ray_decides(
     geometric_n: vec3<f32>,
     l: vec3<f32>,
     cone: f32,
+    facing_error: f32,
 ) -> bool {
-    // Facing away from the light, or outside its cone or range: dark by definition,
-    // which the map's answer already says.
-    if dot(geometric_n, l) <= 0.0 || (light.kind != LIGHT_SUN && cone <= 0.0) {
+    // Outside the light's cone or range, or facing away from it: dark by
+    // definition, which the map's answer already says.
+    let facing = dot(geometric_n, l);
+    if facing <= -facing_error || (light.kind != LIGHT_SUN && cone <= 0.0) {
         return false;
     }
-    return REFINE_EVERY_PIXEL || (shadow.x > 0.0 && shadow.x < 1.0)
+    return REFINE_EVERY_PIXEL || facing < facing_error || (shadow.x > 0.0 && shadow.x < 1.0)
         || map_unsure(world, facing_side(n, geometric_n), geometric_n, l, u32(shadow.y));
 }
 

@@ -25,16 +25,17 @@ fn refine_forward(
     geometry: vec4<f32>,
     view_depth: f32,
     frag: vec2<f32>,
+    facing_error: f32,
 ) -> vec2<f32> {
     let l = geometry.xyz;
-    if !ray_decides(shadow, world, n, geometric_n, l, geometry.w) {
+    if !ray_decides(shadow, world, n, geometric_n, l, geometry.w, facing_error) {
         return shadow;
     }
     // The interpolated point is exact up to the rasterizer's rounding, which the
     // origin's offset for a point rebuilt from depth covers.
     let origin = surface_ray_origin(world, geometric_n, view_depth);
     var visibility = 1.0;
-    if light.penumbra_rays > 0u {
+    if REFINE_PENUMBRAE {
         // The pixel's own pattern, as the trace pass seeds it.
         let pixel = vec2<u32>(frag);
         visibility = area_visibility(origin, world, geometric_n, pixel.x | (pixel.y << 16u)).x;

@@ -7,6 +7,7 @@ fn refine_forward(
     geometry: vec4<f32>,
     view_depth: f32,
     frag: vec2<f32>,
+    facing_error: f32,
 ) -> vec2<f32> {
     return shadow;
 }

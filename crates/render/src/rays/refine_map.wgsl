@@ -87,7 +87,7 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     if footprint_unsure(c.xy, FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing), layer) {
         return true;
     }
-    return light.penumbra_rays > 0u && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
+    return REFINE_PENUMBRAE && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
 }
 
 // Taps a side of `area_unsure`'s grid over the light's footprint.

@@ -6,6 +6,7 @@ fn ray_decides(
     geometric_n: vec3<f32>,
     l: vec3<f32>,
     cone: f32,
+    facing_error: f32,
 ) -> bool {
     return false;
 }

@@ -75,7 +75,7 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
         let origin = surface_ray_origin(world, geometric_n, view_depth);
         let map_layer = entry.layer & 0xffffu;
         let layer = 2.0 * f32(map_layer);
-        if light.penumbra_rays > 0u {
+        if REFINE_PENUMBRAE {
             let traced = area_visibility(origin, world, geometric_n, entry.pixel);
             textureStore(refined_mask, texel, vec4<f32>(layer + traced.x, 0.0, 0.0, 0.0));
             let width = penumbra_width_px(traced.y, world, geometric_n, view_depth);

@@ -136,49 +136,62 @@ fn ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
     let inv_direction = 1.0 / select(direction, tiny, abs(direction) < vec3<f32>(1e-30));
     var stack: array<u32, TRACE_STACK_SIZE>;
     var top = 0u;
-    var node_index = 0u;
-    if enter_box(bvh_nodes[0], origin, inv_direction, t_max) < 0.0 {
+    // The node being visited, as read when its box was tested: a child's record is
+    // loaded once, for its box, and kept for its visit (only a node taken from the
+    // stack is read again).
+    var node = bvh_nodes[0];
+    if enter_box(node, origin, inv_direction, t_max) < 0.0 {
         return -1.0;
     }
     // A walk visits each node at most once; more steps than nodes means a broken tree,
     // and a shader that never ends would hang the device.
     let max_steps = arrayLength(&bvh_nodes);
-    for (var step = 0u; step <= max_steps; step++) {
-        let node = bvh_nodes[node_index];
-        if node.count > 0u {
-            for (var i = node.first; i < node.first + node.count; i++) {
-                let t = triangle_hit(ray, i, t_max);
-                if t >= 0.0 {
-                    return t;
-                }
-            }
-        } else {
-            let left = node.first;
-            let right = node.first + 1u;
-            let t_left = enter_box(bvh_nodes[left], origin, inv_direction, t_max);
-            let t_right = enter_box(bvh_nodes[right], origin, inv_direction, t_max);
+    var steps = 0u;
+    loop {
+        // Down the inner nodes to a leaf (Aila & Laine's while-while: lanes in
+        // lockstep test boxes together, then triangles together).
+        while node.count == 0u && steps <= max_steps {
+            steps++;
+            let left = bvh_nodes[node.first];
+            let right = bvh_nodes[node.first + 1u];
+            let t_left = enter_box(left, origin, inv_direction, t_max);
+            let t_right = enter_box(right, origin, inv_direction, t_max);
             if t_left >= 0.0 && t_right >= 0.0 {
-                // Nearer first; the farther waits on the stack.
                 let near_first = t_left <= t_right;
-                node_index = select(right, left, near_first);
-                stack[top] = select(left, right, near_first);
+                stack[top] = select(node.first, node.first + 1u, near_first);
                 top++;
-                continue;
+                if near_first {
+                    node = left;
+                } else {
+                    node = right;
+                }
+            } else if t_left >= 0.0 {
+                node = left;
+            } else if t_right >= 0.0 {
+                node = right;
+            } else {
+                if top == 0u {
+                    return -1.0;
+                }
+                top--;
+                node = bvh_nodes[stack[top]];
             }
-            if t_left >= 0.0 {
-                node_index = left;
-                continue;
-            }
-            if t_right >= 0.0 {
-                node_index = right;
-                continue;
+        }
+        if steps > max_steps {
+            return -1.0;
+        }
+        steps++;
+        for (var i = node.first; i < node.first + node.count; i++) {
+            let t = triangle_hit(ray, i, t_max);
+            if t >= 0.0 {
+                return t;
             }
         }
         if top == 0u {
             return -1.0;
         }
         top--;
-        node_index = stack[top];
+        node = bvh_nodes[stack[top]];
     }
     return -1.0;
 }
