@@ -68,6 +68,10 @@ pub struct Gpu {
     /// Whether shaders can trace rays through the adapter's own acceleration
     /// structures (`EXPERIMENTAL_RAY_QUERY`): what `Tracer::RayQuery` needs.
     pub ray_queries: bool,
+    /// What kind of device it is: a CPU rasterizer such as lavapipe (`Cpu`) runs
+    /// ray queries in software, slower than the shader's own BVH, so `Tracer::Auto`
+    /// takes them on a GPU only.
+    pub device_type: wgpu::DeviceType,
 }
 
 impl Gpu {
@@ -139,6 +143,7 @@ impl Gpu {
         let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, &device);
         Ok(Self {
             ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+            device_type: adapter_info.device_type,
             device,
             queue,
             info: GpuInfo::of(adapter_info),
@@ -155,6 +160,7 @@ impl Gpu {
     /// the device has them enabled.
     pub fn from_host(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         let adapter_info = adapter.get_info();
+        let device_type = adapter_info.device_type;
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, device);
@@ -167,6 +173,7 @@ impl Gpu {
             indirect_draws,
             indirect_count,
             ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+            device_type,
         }
     }
 

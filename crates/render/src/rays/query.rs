@@ -43,8 +43,8 @@ pub struct ShadowRays {
 }
 
 impl ShadowRays {
-    /// Builds and uploads the BVH of `scene`'s shadow casters, and where the device
-    /// has ray queries, its acceleration structures (`Tracer::Auto`).
+    /// Builds and uploads the BVH of `scene`'s shadow casters, and on a GPU with ray
+    /// queries, its acceleration structures (`Tracer::Auto`).
     pub fn new(gpu: &Gpu, scene: &gnomon_scene::Scene) -> Result<Self, RenderError> {
         Self::with_tracer(gpu, scene, Tracer::Auto)
     }

@@ -22,13 +22,17 @@ pub enum Traversal {
 }
 
 impl Traversal {
-    /// What `tracer` resolves to on `gpu`: ray queries where asked (by `auto` or by
-    /// name) and the device has them, the shader otherwise, with why it was not ray
-    /// queries where they were asked for by name.
+    /// What `tracer` resolves to on `gpu`: ray queries where asked by name and the
+    /// device has them, or by `auto` on a GPU that has them; the shader otherwise,
+    /// with why it was not ray queries where they were asked for by name. (On
+    /// lavapipe, which runs ray queries in software, the shader's BVH traced
+    /// Florence's unsure pixels 5–6× faster: docs/rays.md.)
     pub(crate) fn resolve(tracer: Tracer, gpu: &Gpu) -> (Self, Option<RayQueriesUnavailable>) {
         match tracer {
             Tracer::Shader => (Traversal::Shader, None),
-            Tracer::Auto if gpu.ray_queries => (Traversal::RayQuery, None),
+            Tracer::Auto if gpu.ray_queries && gpu.device_type != wgpu::DeviceType::Cpu => {
+                (Traversal::RayQuery, None)
+            }
             Tracer::Auto => (Traversal::Shader, None),
             Tracer::RayQuery if gpu.ray_queries => (Traversal::RayQuery, None),
             Tracer::RayQuery => (

@@ -85,7 +85,8 @@ pub enum Refine {
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Tracer {
-    /// `ray-query` where the device has ray queries, `shader` elsewhere.
+    /// `ray-query` on a GPU that has ray queries, `shader` elsewhere (lavapipe's
+    /// ray queries, in software, are slower than the shader's BVH).
     #[default]
     Auto,
     /// Gnomon's own BVH, built on the CPU and walked by a WGSL shader: any adapter,
@@ -133,7 +134,7 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub refine: Refine,
-    /// Which tracer casts the rays: auto (ray queries where the device has them),
+    /// Which tracer casts the rays: auto (ray queries on a GPU that has them),
     /// shader (Gnomon's BVH walked by a shader, on any adapter) or ray-query.
     #[cfg_attr(
         feature = "cli",
