@@ -106,11 +106,15 @@ fn raytraced_estimates_the_reference_penumbra_under_a_sun_disk() {
     assert!(traced.penumbra.error.mae < map.penumbra.error.mae, "{traced:?} against PCSS's {map:?}");
 }
 
-/// Sponza under a 70° sun is the one glTF case where `raytraced` and the reference
-/// disagree on more than 0.01 % of light-facing pixels. Wherever they disagree, the
-/// reference's own shadow ray (from its hit point, offset as it offsets it) is traced
-/// on the GPU too: the two tracers must answer it alike, so what differs is the
-/// surface each image shades there (docs/rays.md#measured), not the tracing.
+/// Sponza under a 70° sun was the one glTF case where `raytraced` and the reference
+/// disagreed on more than 0.01 % of light-facing pixels (0.024 %): most of it one face
+/// of the arcade at N·L = 3.5 × 10⁻⁵, which the screen-derivative normal said faced
+/// away from the sun. Within that normal's error of edge-on a ray now decides
+/// (`facing_error`), and the two agree within issue 25's 0.01 %. Wherever they still
+/// disagree, the reference's own shadow ray (from its hit point, offset as it offsets
+/// it) is traced on the GPU too: the two tracers must answer it alike, so what
+/// differs is the surface each image shades there (docs/rays.md#measured), not the
+/// tracing.
 #[test]
 fn where_raytraced_and_the_reference_disagree_on_sponza_the_tracers_agree() {
     let Some(path) = common::shared_scene("sponza/sponza_geometry.glb") else { return };
@@ -123,6 +127,13 @@ fn where_raytraced_and_the_reference_disagree_on_sponza_the_tracers_agree() {
     let raster =
         RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
     let classes = metrics::classify(raster, &truth);
+    let agreement = compare(&frame, &truth);
+    figure(
+        "Sponza, sun 70°, raytraced: mismatch",
+        percent(agreement.mismatch_rate),
+        percent(TRACED_MISMATCH),
+    );
+    assert!(agreement.mismatch_rate <= TRACED_MISMATCH, "{agreement:?}");
     let Light::Directional(sun) = frame.light else { panic!("a sun") };
     let to_light = -sun.direction.normalize();
     let traced = TracedScene::build(&scene);
