@@ -4,36 +4,15 @@
 
 mod common;
 
-use common::{figures::figure, gpu};
+use common::{
+    figures::figure,
+    gpu,
+    rays::{Rng, add_cutout_card, card_alpha, random_rays},
+};
 use glam::{Mat4, Vec3};
 use gnomon_reference::TracedScene;
 use gnomon_render::rays::{ShadowRay, ShadowRays};
-use gnomon_scene::{AlphaMode, Instance, Material, Scene, Texture, Wrap, builtin, geometry};
-
-/// A small xorshift generator: the same rays on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn in_box(&mut self, min: Vec3, max: Vec3) -> Vec3 {
-        min + (max - min) * Vec3::new(self.next(), self.next(), self.next())
-    }
-
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let v = self.in_box(Vec3::splat(-1.0), Vec3::ONE);
-            if (0.01..=1.0).contains(&v.length_squared()) {
-                return v.normalize();
-            }
-        }
-    }
-}
+use gnomon_scene::{Scene, Wrap, builtin, geometry};
 
 /// How many of `rays` the two tracers answer differently.
 fn disagreements(scene: &Scene, rays: &[ShadowRay]) -> usize {
@@ -48,20 +27,6 @@ fn disagreements(scene: &Scene, rays: &[ShadowRay]) -> usize {
         rays.len()
     );
     rays.iter().zip(&answers).filter(|(r, g)| cpu.occluded(r.origin, r.direction, r.length) != **g).count()
-}
-
-/// Random segments through the scene's bounds, of random lengths.
-fn random_rays(scene: &Scene, count: usize, seed: u64) -> Vec<ShadowRay> {
-    let bounds = scene.bounds();
-    let mut rng = Rng(seed);
-    let reach = bounds.extent().max_element();
-    (0..count)
-        .map(|_| ShadowRay {
-            origin: rng.in_box(bounds.min, bounds.max),
-            direction: rng.direction(),
-            length: reach * (0.05 + rng.next()),
-        })
-        .collect()
 }
 
 #[test]
@@ -82,42 +47,10 @@ fn gpu_and_cpu_tracers_agree_on_random_rays_through_solid_casters() {
 fn cutout_scene(nearest: bool, wrap: Wrap) -> Scene {
     let mut scene = builtin::spheres();
     scene.name = format!("cut-out card, nearest {nearest}");
-    let size = 16u32;
-    let rgba8 = (0..size * size)
-        .flat_map(|k| {
-            let (i, j) = ((k % size) as f32, (k / size) as f32);
-            let a = 127.5 + 127.5 * (0.9 * i).sin() * (0.7 * j + 0.3).cos();
-            [255, 255, 255, a as u8]
-        })
-        .collect();
-    scene.textures = vec![Texture {
-        name: "alpha".into(),
-        width: size,
-        height: size,
-        rgba8,
-        wrap_u: wrap,
-        wrap_v: wrap,
-        nearest,
-    }];
-    let mut card = Material::new("card", Vec3::ONE);
-    card.base_color_texture = Some(0);
-    card.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
-    card.double_sided = true;
-    scene.materials = vec![card];
-    // A plane whose texture repeats: its UVs run past 1, so the wrap modes matter.
-    let mut mesh = geometry::plane(4.0, 4.0);
-    for uv in &mut mesh.uvs {
-        *uv = *uv * 2.5 - 0.7;
-    }
-    scene.meshes = vec![mesh];
-    scene.instances = vec![Instance {
-        name: "card".into(),
-        mesh: 0,
-        material: 0,
-        world_from_object: Mat4::from_rotation_x(0.3),
-        casts_shadow: true,
-        motion: gnomon_scene::Motion::Static,
-    }];
+    (scene.textures, scene.materials, scene.meshes, scene.instances) = Default::default();
+    let mut alpha = card_alpha(wrap);
+    alpha.nearest = nearest;
+    add_cutout_card(&mut scene, alpha, 4.0, Mat4::from_rotation_x(0.3));
     scene
 }
 

@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use common::{
     compare,
     figures::{figure, percent, skipped},
+    rays::{Rng, add_cutout_card, card_alpha, random_rays},
     reference,
 };
 use glam::{Mat4, Vec3};
@@ -25,7 +26,7 @@ use gnomon_render::{
     rays::{RayQueriesUnavailable, ShadowRay, ShadowRays, Traversal},
 };
 use gnomon_scene::{
-    AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry,
+    Scene, Settings, Wrap, builtin,
     settings::{LightKind, Refine, ShadowPath, Technique, Tracer},
 };
 
@@ -80,45 +81,6 @@ fn ray_query_gpu(test: &str) -> Option<&'static Gpu> {
         String::from_utf8_lossy(&output.stdout)
     );
     None
-}
-
-/// A small xorshift generator: the same rays on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn in_box(&mut self, min: Vec3, max: Vec3) -> Vec3 {
-        min + (max - min) * Vec3::new(self.next(), self.next(), self.next())
-    }
-
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let v = self.in_box(Vec3::splat(-1.0), Vec3::ONE);
-            if (0.01..=1.0).contains(&v.length_squared()) {
-                return v.normalize();
-            }
-        }
-    }
-}
-
-/// Random segments through the scene's bounds, of random lengths.
-fn random_rays(scene: &Scene, count: usize, seed: u64) -> Vec<ShadowRay> {
-    let bounds = scene.bounds();
-    let mut rng = Rng(seed);
-    let reach = bounds.extent().max_element();
-    (0..count)
-        .map(|_| ShadowRay {
-            origin: rng.in_box(bounds.min, bounds.max),
-            direction: rng.direction(),
-            length: reach * (0.05 + rng.next()),
-        })
-        .collect()
 }
 
 /// How many of `rays` the ray queries answer differently from the shader and from the
@@ -227,41 +189,8 @@ fn ray_queries_alpha_test_cut_out_casters_as_the_reference_does() {
 fn cut_out_card_over_spheres() -> Scene {
     let mut scene = builtin::spheres();
     scene.name = "cut-out card over spheres".into();
-    let size = 16u32;
-    let rgba8 = (0..size * size)
-        .flat_map(|k| {
-            let (i, j) = ((k % size) as f32, (k / size) as f32);
-            let a = 127.5 + 127.5 * (0.9 * i).sin() * (0.7 * j + 0.3).cos();
-            [255, 255, 255, a as u8]
-        })
-        .collect();
-    scene.textures.push(Texture {
-        name: "alpha".into(),
-        width: size,
-        height: size,
-        rgba8,
-        wrap_u: Wrap::Repeat,
-        wrap_v: Wrap::Repeat,
-        nearest: false,
-    });
-    let mut card = Material::new("card", Vec3::ONE);
-    card.base_color_texture = Some(scene.textures.len() - 1);
-    card.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
-    card.double_sided = true;
-    scene.materials.push(card);
-    let mut mesh = geometry::plane(6.0, 6.0);
-    for uv in &mut mesh.uvs {
-        *uv = *uv * 2.5 - 0.7;
-    }
-    scene.meshes.push(mesh);
-    scene.instances.push(Instance {
-        name: "card".into(),
-        mesh: scene.meshes.len() - 1,
-        material: scene.materials.len() - 1,
-        world_from_object: Mat4::from_translation(Vec3::new(0.0, 2.5, 0.0)) * Mat4::from_rotation_x(0.3),
-        casts_shadow: true,
-        motion: gnomon_scene::Motion::Static,
-    });
+    let over = Mat4::from_translation(Vec3::new(0.0, 2.5, 0.0)) * Mat4::from_rotation_x(0.3);
+    add_cutout_card(&mut scene, card_alpha(Wrap::Repeat), 6.0, over);
     scene
 }
 

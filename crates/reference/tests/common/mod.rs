@@ -4,6 +4,7 @@
 
 #[path = "../../../render/tests/support/figures.rs"]
 pub mod figures;
+pub mod rays;
 
 use std::sync::OnceLock;
 
