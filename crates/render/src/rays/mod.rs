@@ -170,9 +170,16 @@ pub(crate) struct GpuBvh {
     buffers: Vec<wgpu::Buffer>,
     /// The acceleration structures and the ray-query tracer's group, built on first
     /// use; or why this device's structures cannot take the scene.
-    accel: OnceLock<Result<(CasterAccel, wgpu::BindGroup), RayQueriesUnavailable>>,
+    accel: OnceLock<Result<QueryTracer, RayQueriesUnavailable>>,
     /// The scene's name, for the errors of a later build.
     scene: String,
+}
+
+/// The casters' acceleration structures, and the ray-query tracer's group that binds
+/// them beside the alpha buffers.
+struct QueryTracer {
+    accel: CasterAccel,
+    group: wgpu::BindGroup,
 }
 
 /// Which of [`GpuBvh`]'s buffers holds what.
@@ -274,7 +281,7 @@ impl GpuBvh {
                             entries: &entries,
                         })
                     })?;
-                    Ok((accel, group))
+                    Ok(QueryTracer { accel, group })
                 }
                 Err(why) => Err(why),
             };
@@ -294,11 +301,11 @@ impl GpuBvh {
     pub(crate) fn group(&self, traversal: Traversal) -> &wgpu::BindGroup {
         match traversal {
             Traversal::Shader => &self.group,
-            Traversal::RayQuery => &self.built_accel().1,
+            Traversal::RayQuery => &self.query_tracer().group,
         }
     }
 
-    fn built_accel(&self) -> &(CasterAccel, wgpu::BindGroup) {
+    fn query_tracer(&self) -> &QueryTracer {
         self.accel
             .get()
             .and_then(|built| built.as_ref().ok())
@@ -314,7 +321,7 @@ impl GpuBvh {
                 (FIRST_BINDING..).zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone()))).collect()
             }
             Traversal::RayQuery => {
-                std::iter::once((FIRST_BINDING, Binding::Tlas(self.built_accel().0.tlas().clone())))
+                std::iter::once((FIRST_BINDING, Binding::Tlas(self.query_tracer().accel.tlas().clone())))
                     .chain(
                         self.alpha_buffers()
                             .map(|(binding, buffer)| (binding, Binding::Buffer(buffer.clone()))),
@@ -346,8 +353,8 @@ impl GpuBvh {
             write_runs(&gpu.queue, &self.buffers[TRIANGLE_BUFFER], &self.tree.triangles, &changed.triangles);
         })?;
         match self.accel.get() {
-            Some(Ok((accel, _))) if !changed.triangles.is_empty() => {
-                accel.rebuild(gpu, &self.buffers[TRIANGLE_BUFFER])
+            Some(Ok(query)) if !changed.triangles.is_empty() => {
+                query.accel.rebuild(gpu, &self.buffers[TRIANGLE_BUFFER])
             }
             Some(_) | None => Ok(()),
         }
