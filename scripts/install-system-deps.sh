@@ -35,9 +35,12 @@ if [ "$want_tests" = yes ] && ! command -v xvfb-run >/dev/null 2>&1; then
     echo "install-system-deps: no xvfb-run; installing xvfb for the viewer's window test" >&2
     packages="$packages xvfb xauth"
 fi
+# The ray-query tests skip, saying so, without it: a failed fetch is no failure here.
 fetch_ray_query() {
-    [ "$want_tests" = yes ] && sh "$(dirname "$0")/fetch-lavapipe-ray-query.sh"
-    return 0
+    if [ "$want_tests" = yes ]; then
+        sh "$(dirname "$0")/fetch-lavapipe-ray-query.sh" ||
+            echo "install-system-deps: no lavapipe with ray queries fetched; the ray-query tests will skip" >&2
+    fi
 }
 if [ -z "$packages" ]; then
     fetch_ray_query
