@@ -251,11 +251,11 @@ pub(crate) fn traced_line(index: usize, light: &gnomon_render::LightStats, pixel
         n => format!(", {n} per pixel over the light's area"),
     };
     let tracer = match light.traversal {
-        Some(gnomon_render::rays::Traversal::RayQuery) => ", ray queries",
-        Some(gnomon_render::rays::Traversal::Shader) | None => ", the shader's BVH",
+        Some(gnomon_render::rays::Traversal::RayQuery) => "ray queries",
+        Some(gnomon_render::rays::Traversal::Shader) | None => "the shader's BVH",
     };
     format!(
-        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({rays} rays{per_pixel}{tracer})",
+        "light {index}: refined by rays at {traced} pixels, {:.2} % of the screen ({rays} rays{per_pixel}), traced by {tracer}",
         100.0 * f64::from(traced) / pixels.max(1) as f64
     )
 }

@@ -417,6 +417,8 @@ fn penumbrae_refined_by_rays_report_their_rays_and_refuse_an_impossible_count() 
         pixels > 0 && line.contains(&format!("({} rays, 8 per pixel over the light's area)", 8 * pixels)),
         "{line}"
     );
+    // Lavapipe traces with the shader's BVH, whatever ray queries it has (`--tracer auto`).
+    assert!(line.ends_with(", traced by the shader's BVH"), "{line}");
     let out = gnomon(dir, &[&args[..], &small, &["--penumbra-rays", "0", "-o", "none.png"]].concat());
     let err = stderr(&out);
     assert!(!out.status.success() && err.contains("--penumbra-rays") && err.contains("1 to 256"), "{err}");
