@@ -7,7 +7,7 @@ mod common;
 use common::{
     figures::figure,
     gpu,
-    rays::{Rng, add_cutout_card, card_alpha, random_rays},
+    rays::{AfterMove, Rng, add_cutout_card, card_alpha, move_every_sphere, random_rays},
 };
 use glam::{Mat4, Vec3};
 use gnomon_reference::TracedScene;
@@ -119,20 +119,7 @@ fn a_refitted_tree_answers_as_the_reference_of_the_moved_scene() {
     // scene, while the tree before the move disagrees with it on many rays.
     let mut scene = builtin::spheres();
     let mut tracer = ShadowRays::new(gpu(), &scene).unwrap();
-    let moved: Vec<usize> = (1..scene.instances.len()).collect();
-    for (k, &i) in moved.iter().enumerate() {
-        let lift = Mat4::from_translation(Vec3::new(0.4 * k as f32, 0.7, -0.3 * k as f32));
-        scene.instances[i].world_from_object =
-            lift * Mat4::from_rotation_y(0.5) * scene.instances[i].world_from_object;
-    }
-    scene.instances[moved[0]].world_from_object *= Mat4::from_translation(Vec3::new(12.0, 0.0, 0.0));
-    let rays = random_rays(&scene, 20_000, 0x2545_f491_4f6c_dd1d);
-    let cpu = TracedScene::build(&scene);
-    let truth: Vec<bool> = rays.iter().map(|r| cpu.occluded(r.origin, r.direction, r.length)).collect();
-    let differ = |answers: &[bool]| answers.iter().zip(&truth).filter(|(a, b)| a != b).count();
-    let stale = differ(&tracer.occluded(&rays).unwrap());
-    tracer.move_instances(&scene, &moved).unwrap();
-    let wrong = differ(&tracer.occluded(&rays).unwrap());
+    let AfterMove { stale, moved: wrong, rays } = move_every_sphere(&mut scene, &mut tracer);
     figure(
         &format!(
             "gpu rays after a refit vs cpu on the moved scene: disagreements of 20,000 (before the refit: {stale})"
@@ -141,7 +128,7 @@ fn a_refitted_tree_answers_as_the_reference_of_the_moved_scene() {
         2,
     );
     assert!(stale > 500, "the move should change many answers: {stale}");
-    assert!(wrong <= 2, "{wrong} of {} rays answered differently after the refit", rays.len());
+    assert!(wrong <= 2, "{wrong} of {rays} rays answered differently after the refit");
     let e = tracer.move_instances(&scene, &[99]).unwrap_err().to_string();
     assert!(e.contains("no instance 99"), "{e}");
     scene.instances.pop();

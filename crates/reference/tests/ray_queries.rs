@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use common::{
     compare,
     figures::{figure, percent, skipped},
-    rays::{Rng, add_cutout_card, card_alpha, random_rays},
+    rays::{AfterMove, Rng, add_cutout_card, card_alpha, move_every_sphere, random_rays},
     reference,
 };
 use glam::{Mat4, Vec3};
@@ -199,20 +199,7 @@ fn ray_queries_follow_moved_instances() {
     let Some(gpu) = ray_query_gpu("ray_queries_follow_moved_instances") else { return };
     let mut scene = builtin::spheres();
     let mut tracer = ShadowRays::with_tracer(gpu, &scene, Tracer::RayQuery).unwrap();
-    let moved: Vec<usize> = (1..scene.instances.len()).collect();
-    for (k, &i) in moved.iter().enumerate() {
-        let lift = Mat4::from_translation(Vec3::new(0.4 * k as f32, 0.7, -0.3 * k as f32));
-        scene.instances[i].world_from_object =
-            lift * Mat4::from_rotation_y(0.5) * scene.instances[i].world_from_object;
-    }
-    scene.instances[moved[0]].world_from_object *= Mat4::from_translation(Vec3::new(12.0, 0.0, 0.0));
-    let rays = random_rays(&scene, 20_000, 0x2545_f491_4f6c_dd1d);
-    let cpu = TracedScene::build(&scene);
-    let truth: Vec<bool> = rays.iter().map(|r| cpu.occluded(r.origin, r.direction, r.length)).collect();
-    let differ = |answers: &[bool]| answers.iter().zip(&truth).filter(|(a, b)| a != b).count();
-    let stale = differ(&tracer.occluded(&rays).unwrap());
-    tracer.move_instances(&scene, &moved).unwrap();
-    let moved_wrong = differ(&tracer.occluded(&rays).unwrap());
+    let AfterMove { stale, moved: moved_wrong, .. } = move_every_sphere(&mut scene, &mut tracer);
     figure(
         &format!("ray queries after a move, spheres: disagreements of 20,000 (before the move: {stale})"),
         moved_wrong,

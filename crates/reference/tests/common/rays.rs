@@ -2,7 +2,8 @@
 //! every run, and a cut-out card to test alpha against.
 
 use glam::{Mat4, Vec3};
-use gnomon_render::rays::ShadowRay;
+use gnomon_reference::TracedScene;
+use gnomon_render::rays::{ShadowRay, ShadowRays};
 use gnomon_scene::{AlphaMode, Instance, Material, Scene, Texture, Wrap, geometry};
 
 /// A small xorshift generator: the same rays on every run.
@@ -89,4 +90,36 @@ pub fn add_cutout_card(scene: &mut Scene, alpha: Texture, size: f32, world_from_
         casts_shadow: true,
         motion: gnomon_scene::Motion::Static,
     });
+}
+
+/// How a tracer answered random rays against the CPU reference of a moved scene,
+/// before and after it followed the move.
+pub struct AfterMove {
+    /// Rays answered differently before the move was followed.
+    pub stale: usize,
+    /// Rays answered differently after.
+    pub moved: usize,
+    /// Rays asked.
+    pub rays: usize,
+}
+
+/// Moves every instance of `scene` (the built-in `spheres`) but the first, the ground:
+/// turned, lifted, one far past the old bounds; then asks `tracer`, built on the scene
+/// before the move, 20,000 random rays before and after `ShadowRays::move_instances`,
+/// against the CPU reference built afresh on the moved scene.
+pub fn move_every_sphere(scene: &mut Scene, tracer: &mut ShadowRays) -> AfterMove {
+    let moved: Vec<usize> = (1..scene.instances.len()).collect();
+    for (k, &i) in moved.iter().enumerate() {
+        let lift = Mat4::from_translation(Vec3::new(0.4 * k as f32, 0.7, -0.3 * k as f32));
+        scene.instances[i].world_from_object =
+            lift * Mat4::from_rotation_y(0.5) * scene.instances[i].world_from_object;
+    }
+    scene.instances[moved[0]].world_from_object *= Mat4::from_translation(Vec3::new(12.0, 0.0, 0.0));
+    let rays = random_rays(scene, 20_000, 0x2545_f491_4f6c_dd1d);
+    let cpu = TracedScene::build(scene);
+    let truth: Vec<bool> = rays.iter().map(|r| cpu.occluded(r.origin, r.direction, r.length)).collect();
+    let differ = |answers: &[bool]| answers.iter().zip(&truth).filter(|(a, b)| a != b).count();
+    let stale = differ(&tracer.occluded(&rays).unwrap());
+    tracer.move_instances(scene, &moved).unwrap();
+    AfterMove { stale, moved: differ(&tracer.occluded(&rays).unwrap()), rays: rays.len() }
 }
