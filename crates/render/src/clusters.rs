@@ -12,7 +12,7 @@
 //!
 //! Nothing a layer draws changes: a skipped cluster has no triangle the rasterizer
 //! would have kept, and a depth test with `Less` keeps the nearest depth whatever
-//! order the triangles come in. `render/tests/clusters.rs` holds the maps to that.
+//! order the triangles come in. `reference/tests/truth/clusters.rs` holds the maps to that.
 
 use std::ops::Range;
 

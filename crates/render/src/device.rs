@@ -124,7 +124,7 @@ impl Gpu {
             required_limits: limits.clone(),
             // wgpu names its ray queries experimental and asks for this token before it
             // enables them. Gnomon holds them to the shader tracer's answers
-            // (reference/tests/ray_queries.rs) wherever a device has them.
+            // (reference/tests/truth/ray_queries.rs) wherever a device has them.
             experimental_features: if ray_queries {
                 // SAFETY: the token only unlocks the EXPERIMENTAL_RAY_QUERY feature
                 // requested above; no other experimental API is used.

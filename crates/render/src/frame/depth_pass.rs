@@ -289,7 +289,7 @@ impl Renderer {
             }
             None => self.record_cpu_culled(encoder, uploaded, depth, &group, timestamp_writes),
         };
-        // What the CPU culled, which the GPU culler keeps too (`render/tests/gpu_culling.rs`
+        // What the CPU culled, which the GPU culler keeps too (`render/tests/gpu/gpu_culling.rs`
         // holds their maps equal): the counts of a layer culled on the GPU stay on it.
         stats.shadow_draws = depth.visible.runs.len() as u32 * depth.area.rects().len() as u32;
         stats.shadow_instances = depth.visible.instances();

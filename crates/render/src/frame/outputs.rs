@@ -144,7 +144,7 @@ pub struct LightStats {
     /// Draws into each layer of its map (one per cascade, six for a cube): the
     /// casters that survived the CPU's culling against that layer's frustum. A layer
     /// culled on the GPU (`DrawSubmission::GpuCulled`) reports the CPU's count, whose
-    /// casters are the ones the GPU keeps (`render/tests/gpu_culling.rs` holds their
+    /// casters are the ones the GPU keeps (`render/tests/gpu/gpu_culling.rs` holds their
     /// maps equal); the GPU issues one draw per kept cluster where the CPU merges
     /// neighbouring ones.
     pub layer_draws: Vec<u32>,

@@ -105,16 +105,15 @@ impl Renderer {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let normals = self.pool.texture("prepass normals", size, screen_space::NORMALS_FORMAT, usage);
         let normals = self.pool.view(&normals, ViewKey::default());
-        let view_depth =
-            self.pool.texture("prepass view depth", size, screen_space::VIEW_DEPTH_FORMAT, usage);
-        let view_depth = self.pool.view(&view_depth, ViewKey::default());
-        self.record_prepass(rec, uploaded, &lit[0].scene, inputs, [&normals, &view_depth]);
+        let surface = self.pool.texture("prepass surface", size, screen_space::SURFACE_FORMAT, usage);
+        let surface = self.pool.view(&surface, ViewKey::default());
+        self.record_prepass(rec, uploaded, &lit[0].scene, inputs, [&normals, &surface]);
         let screen_group = self.pool.bind_group(
             "screen",
             &self.layouts.screen,
             &[
                 Binding::Buffer(inputs.camera_buffer.clone()),
-                Binding::View(view_depth.clone()),
+                Binding::View(surface.clone()),
                 Binding::View(normals.clone()),
             ],
         );
@@ -123,7 +122,7 @@ impl Renderer {
         let refining = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
             let lists = RefineLists::new(&mut self.pool, width, height, plan.lights.len());
             rec.encoder.clear_buffer(&lists.counters, 0, None);
-            let prepass = [&view_depth, &normals];
+            let prepass = [&surface, &normals];
             let camera = inputs.camera_buffer;
             let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
             let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
@@ -272,23 +271,23 @@ impl Renderer {
         self.record_trace(rec, TraceStage::PenumbraFilter, groups, index);
     }
 
-    /// The camera's depth, normals and view depth.
+    /// The camera's depth, normals and surface (world point and view depth).
     fn record_prepass(
         &mut self,
         rec: &mut Recording,
         uploaded: &GpuScene,
         scene_group: &wgpu::BindGroup,
         inputs: &ScreenInputs,
-        [normals, view_depth]: [&wgpu::TextureView; 2],
+        [normals, surface]: [&wgpu::TextureView; 2],
     ) {
         let gpu = &self.gpu;
         let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Prepass, None, None);
-        // View depth 0 marks the background.
+        // View depth 0 (the surface's w) marks the background.
         let mut pass = rec.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("prepass"),
             color_attachments: &[
                 cleared(normals, wgpu::Color::TRANSPARENT),
-                cleared(view_depth, wgpu::Color::TRANSPARENT),
+                cleared(surface, wgpu::Color::TRANSPARENT),
             ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: inputs.depth,

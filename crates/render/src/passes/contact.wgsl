@@ -53,7 +53,7 @@ fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pi
             // The receiver itself.
             continue;
         }
-        let scene_depth = textureLoad(prepass_view_depth, texel, 0).x;
+        let scene_depth = textureLoad(prepass_surface, texel, 0).w;
         let on_plane = plane_point(vec2<f32>(texel) + vec2<f32>(0.5), world, geometric_n);
         let plane_depth = -(camera.view_from_world * vec4<f32>(on_plane, 1.0)).z;
         if abs(scene_depth - plane_depth) <= CONTACT_OWN_PLANE * scene_depth {

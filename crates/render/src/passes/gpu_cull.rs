@@ -216,7 +216,7 @@ pub(crate) fn gpu_cull_wgsl() -> String {
 
 #[cfg(test)]
 mod tests {
-    //! Equal maps (`render/tests/gpu_culling.rs`) would not notice a culler that kept
+    //! Equal maps (`render/tests/gpu/gpu_culling.rs`) would not notice a culler that kept
     //! everything: here the draws it keeps are read back and held to the CPU's.
 
     use glam::Vec3;

@@ -133,7 +133,7 @@ pub(crate) struct Layouts {
     /// Group 1 of a forward lighting pass that refines by rays: the camera and the
     /// tracer's resources, for each traversal ([`crate::rays::forward_layouts`]).
     pub forward_rays: crate::rays::TracerLayouts,
-    /// Group 1 of the shadow-mask pass: the camera and the prepass's view depth and
+    /// Group 1 of the shadow-mask pass: the camera and the prepass's surface and
     /// normals.
     pub screen: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the

@@ -14,8 +14,10 @@ use gnomon_scene::settings::Refine;
 
 /// The prepass's encoded normals: shading normal in xy, geometric normal in zw.
 pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-/// The prepass's linear view depth (0 where no surface is seen).
-pub(crate) const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The prepass's surface: the world point each pixel sees in xyz (interpolated from
+/// the vertices, so on its triangle; prepass.wgsl says why) and its linear view depth
+/// in w (0 where no surface is seen).
+pub(crate) const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// The mask, one array layer per light: visibility + 2 × the shadow-map layer that
 /// shaded it, per pixel (that layer + `uniforms::TRACED_LAYER_FLAG` where rays decided
 /// the pixel, under the traced debug view). A 32-bit float keeps the visibility exact, where half floats
@@ -82,7 +84,7 @@ impl ScreenSpacePass {
             layout: &prepass_layout,
             module: &module,
             fragment_entry: "fs_prepass",
-            targets: &[Some(NORMALS_FORMAT.into()), Some(VIEW_DEPTH_FORMAT.into())],
+            targets: &[Some(NORMALS_FORMAT.into()), Some(SURFACE_FORMAT.into())],
             depth: lighting::SurfaceDepth::Nearest,
         }
         .create(device);

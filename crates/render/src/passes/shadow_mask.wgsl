@@ -1,6 +1,6 @@
 // Screen-space shadow mask (as in Unity URP's screen-space shadows): one full-screen
-// pass per light over the prepass. It rebuilds each pixel's world position from its
-// linear view depth, resolves the light's shadow lookup there once, with the light's
+// pass per light over the prepass. It reads each pixel's world point from the
+// prepass, resolves the light's shadow lookup there once, with the light's
 // own technique (`pixel_visibility`, resolve_visibility.wgsl), lists the pixels whose
 // map answer is unsure for the trace pass when refinement is on (`ray_decides`,
 // rays/refine_classify.wgsl), marches contact shadows when the light has them
@@ -32,7 +32,8 @@ fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     let texel = vec2<i32>(frag.xy);
-    let view_depth = textureLoad(prepass_view_depth, texel, 0).x;
+    let surface = textureLoad(prepass_surface, texel, 0);
+    let view_depth = surface.w;
     if view_depth <= 0.0 {
         // Background: no surface, nothing to shade.
         return 1.0;
@@ -40,7 +41,7 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     let normals = textureLoad(prepass_normals, texel, 0);
     let n = octahedron_decode(normals.xy);
     let geometric_n = octahedron_decode(normals.zw);
-    let world = world_at(frag.xy, view_depth);
+    let world = surface.xyz;
     // The screen derivatives the forward pass's dpdx/dpdy give, rebuilt on the
     // receiver's plane: differences across the pixel's 2×2 quad, as fine derivatives
     // take them.

@@ -359,14 +359,14 @@ impl RefineLists {
     }
 
     /// Group 1 of the refining mask pass (`Append`) or the trace pass (`Read`), with
-    /// the camera and the prepass's `view_depth` and `normals`.
+    /// the camera and the prepass's `surface` and `normals`.
     pub fn group(
         &self,
         pool: &mut Pool,
         layouts: &Layouts,
         access: ListAccess,
         camera: &wgpu::Buffer,
-        [view_depth, normals]: [&wgpu::TextureView; 2],
+        [surface, normals]: [&wgpu::TextureView; 2],
     ) -> wgpu::BindGroup {
         let layout = match access {
             ListAccess::Append => &layouts.refine_screen,
@@ -377,7 +377,7 @@ impl RefineLists {
             layout,
             &[
                 Binding::Buffer(camera.clone()),
-                Binding::View(view_depth.clone()),
+                Binding::View(surface.clone()),
                 Binding::View(normals.clone()),
                 Binding::Buffer(self.pixels.clone()),
                 Binding::BufferWindow { buffer: self.counters.clone(), size: COUNTER_BYTES },

@@ -69,9 +69,10 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
     for (var index = id.x; index < count; index += groups.x * REFINE_GROUP_SIZE) {
         let entry = unsure_pixels[index];
         let texel = vec2<u32>(entry.pixel & 0xffffu, entry.pixel >> 16u);
-        let view_depth = textureLoad(prepass_view_depth, texel, 0).x;
+        let surface = textureLoad(prepass_surface, texel, 0);
+        let view_depth = surface.w;
         let geometric_n = octahedron_decode(textureLoad(prepass_normals, texel, 0).zw);
-        let world = world_at(vec2<f32>(texel) + vec2<f32>(0.5), view_depth);
+        let world = surface.xyz;
         let origin = surface_ray_origin(world, geometric_n, view_depth);
         let map_layer = entry.layer & 0xffffu;
         let layer = 2.0 * f32(map_layer);
@@ -159,12 +160,12 @@ fn neighbour_visibility(c: FilterCentre, q: vec2<i32>) -> f32 {
     if any(q < vec2<i32>(0)) || any(q >= size) {
         return -1.0;
     }
-    let q_depth = textureLoad(prepass_view_depth, q, 0).x;
-    if q_depth <= 0.0 {
+    let q_surface = textureLoad(prepass_surface, q, 0);
+    if q_surface.w <= 0.0 {
         return -1.0;
     }
     let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
-    let q_world = world_at(vec2<f32>(q) + vec2<f32>(0.5), q_depth);
+    let q_world = q_surface.xyz;
     let off_plane = abs(dot(c.n, q_world - c.world));
     if off_plane > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
         return -1.0;
@@ -235,9 +236,10 @@ fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
     for (var index = id.x; index < count; index += groups.x * REFINE_GROUP_SIZE) {
         let entry = unsure_pixels[index];
         let texel = vec2<i32>(i32(entry.pixel & 0xffffu), i32(entry.pixel >> 16u));
-        let view_depth = textureLoad(prepass_view_depth, texel, 0).x;
+        let surface = textureLoad(prepass_surface, texel, 0);
+        let view_depth = surface.w;
         let n = octahedron_decode(textureLoad(prepass_normals, texel, 0).zw);
-        let world = world_at(vec2<f32>(texel) + vec2<f32>(0.5), view_depth);
+        let world = surface.xyz;
         let pixel_world = 2.0 * view_depth / (camera.scale_y * camera.height);
         let visibility = mask_visibility(textureLoad(traced_mask, texel, 0).x);
         let c = FilterCentre(texel, world, n, pixel_world, visibility);

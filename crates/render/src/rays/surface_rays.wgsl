@@ -4,13 +4,14 @@
 // share of rays over a light's area that arrive. Needs trace.wgsl, light_sample.wgsl
 // and the light's uniform.
 
-// A bound on the error of a point rebuilt from the prepass's view depth
-// (screen_common.wgsl's `world_at`): four roundings (pixel to NDC, times the depth,
-// over the projection's scale, the camera's matrix), each within an ulp of the
-// magnitudes involved, so 4ε times its largest coordinate plus its view depth. Less
-// lets a ray start under a large, distant ground and hit it (Florence's open ground
-// seen from 400 units shadowed a third of itself with none); more lifts rays off
-// finely tessellated curved surfaces and lets light leak past their folds.
+// A bound on how far the surface point off its triangle may lie: the point is the
+// rasterizer's interpolation of the vertices' world positions (the prepass's, or the
+// lighting pass's own), a weighted sum whose weights add up to 1 to within a few
+// roundings, each within an ulp of the magnitudes involved, so 4ε times its largest
+// coordinate plus its view depth. Less lets a ray start under a large, distant ground
+// and hit it (Florence's open ground seen from 400 units shadowed a third of itself
+// with none); more lifts rays off finely tessellated curved surfaces and lets light
+// leak past their folds.
 const RECONSTRUCTION_ERROR: f32 = 4.0 * 1.1920929e-7;
 
 // The origin of shadow rays from the surface point `world` (geometric normal
