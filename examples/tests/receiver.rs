@@ -3,7 +3,7 @@
 //! sees the shadows Gnomon's own lighting pass draws, for every technique and every
 //! light kind (a sun, a spot, a point light through a cube or dual paraboloids).
 
-#[path = "../../crates/render/tests/support/figures.rs"]
+#[path = "../../crates/render/tests/gpu/support/figures.rs"]
 #[allow(dead_code)]
 mod figures;
 

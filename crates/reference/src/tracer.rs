@@ -13,6 +13,10 @@ use obvhs::{
 
 use crate::texture::sample_alpha;
 
+#[path = "tracer_cone.rs"]
+mod cone;
+pub(crate) use cone::{RayCone, Receiver, ball_cone};
+
 /// The closest surface along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use crate::{
     TracedScene,
     sampling::{cmj, concentric_disk, cone_direction, hash},
-    tracer::offset_ray_origin,
+    tracer::{RayCone, Receiver, ball_cone, offset_ray_origin},
 };
 
 /// How the reference is computed.
@@ -129,6 +129,29 @@ impl Emitter {
         receives && hit.normal.dot(centre) > 0.0
     }
 
+    /// The cone that holds every shadow ray [`Emitter::sample`] can give from `p`:
+    /// (unit axis, half-angle, longest ray), each widened by a hair for rounding.
+    /// None for a point light, and where `p` is so near the light that the cone
+    /// would be too wide to be of use.
+    fn bounding_cone(&self, p: Vec3) -> Option<(Vec3, f32, f32)> {
+        match *self {
+            Emitter::Sun { to_light, half_angle } => {
+                (half_angle > 0.0).then_some((to_light, half_angle * (1.0 + 1e-4) + 1e-6, f32::INFINITY))
+            }
+            // A disk lies within the ball of its radius about its centre, whose
+            // farthest point is the centre's distance plus the radius away.
+            Emitter::Disk { center, radius, .. } => (radius > 0.0)
+                .then(|| ball_cone(p, center, radius))
+                .flatten()
+                .map(|(axis, half_angle, distance)| (axis, half_angle, (distance + radius) * (1.0 + 1e-4))),
+            // Rays end where they enter the sphere, nearer than its centre.
+            Emitter::Sphere { center, radius, .. } => (radius > 0.0)
+                .then(|| ball_cone(p, center, radius))
+                .flatten()
+                .map(|(axis, half_angle, distance)| (axis, half_angle, distance * (1.0 + 1e-4))),
+        }
+    }
+
     /// A shadow ray toward the light sample `u` from `p`: (direction, length).
     fn sample(&self, p: Vec3, u: Vec2) -> (Vec3, f32) {
         match *self {
@@ -167,6 +190,18 @@ impl Emitter {
     }
 }
 
+/// How an area light's samples are traced at a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LightSampling {
+    /// Every sample's ray, at every pixel: the definition, kept for the test that the
+    /// shortcut changes nothing.
+    #[cfg_attr(not(test), expect(dead_code, reason = "only the test that compares the two samples this way"))]
+    EveryRay,
+    /// None where the whole light is provably in sight (`wholly_in_sight`), every
+    /// sample's ray elsewhere.
+    SkipWhollyInSight,
+}
+
 /// Computes the reference visibility of `light` for `camera`, in parallel over rows.
 /// `progress` is called with the number of rows finished so far (from any thread).
 /// The result depends only on the inputs, not on the thread count or scheduling.
@@ -176,6 +211,17 @@ pub fn reference_visibility(
     light: &Light,
     options: &ReferenceOptions,
     progress: &(dyn Fn(u64) + Sync),
+) -> ReferenceImage {
+    trace_reference(traced, camera, light, options, progress, LightSampling::SkipWhollyInSight)
+}
+
+fn trace_reference(
+    traced: &TracedScene,
+    camera: &Camera,
+    light: &Light,
+    options: &ReferenceOptions,
+    progress: &(dyn Fn(u64) + Sync),
+    sampling: LightSampling,
 ) -> ReferenceImage {
     let (w, h) = (options.width, options.height);
     let aspect = w as f32 / h as f32;
@@ -211,7 +257,7 @@ pub fn reference_visibility(
                     let pixel_seed = hash(y * w + x);
                     let faces_light = emitter.faces(&hit);
                     let (visibility, std_error, shadow_rays) = if faces_light {
-                        shade(traced, &emitter, &hit, samples, pixel_seed)
+                        shade(traced, &emitter, &hit, samples, pixel_seed, sampling)
                     } else {
                         // Outside a spot's cone, or on a surface turned away from the
                         // light, nothing arrives.
@@ -288,7 +334,14 @@ impl PixelResult {
 
 /// Visibility of the light at `hit` (which [faces](Emitter::faces) it), the standard
 /// error of the estimate, and the number of shadow rays traced.
-fn shade(traced: &TracedScene, emitter: &Emitter, hit: &Hit, samples: u32, seed: u32) -> (f32, f32, u64) {
+fn shade(
+    traced: &TracedScene,
+    emitter: &Emitter,
+    hit: &Hit,
+    samples: u32,
+    seed: u32,
+    sampling: LightSampling,
+) -> (f32, f32, u64) {
     let origin = offset_ray_origin(hit.position, hit.normal);
     let rays = std::cell::Cell::new(0u64);
     let visible = |u: Vec2| {
@@ -303,6 +356,9 @@ fn shade(traced: &TracedScene, emitter: &Emitter, hit: &Hit, samples: u32, seed:
     if samples == 1 {
         let v = if visible(Vec2::splat(0.5)) { 1.0 } else { 0.0 };
         return (v, 0.0, rays.get());
+    }
+    if sampling == LightSampling::SkipWhollyInSight && wholly_in_sight(traced, emitter, hit, origin) {
+        return (1.0, 0.0, 0);
     }
     // Split the samples into independent stratified batches; the spread of the batch
     // means estimates the standard error of their average.
@@ -319,3 +375,87 @@ fn shade(traced: &TracedScene, emitter: &Emitter, hit: &Hit, samples: u32, seed:
 }
 
 use crate::Hit;
+
+/// Whether every shadow ray the sampler could send from `hit` (leaving from `origin`)
+/// arrives: the whole light lies above the surface's horizon, and nothing that could
+/// block a ray lies in the cone that holds them all (`TracedScene::cone_is_clear`).
+/// Then the estimate is exactly 1 with no spread, as tracing each sample would have
+/// found, and no ray is traced: most of a soft-shadow reference's pixels are wholly
+/// lit, and each cost `samples` rays before.
+fn wholly_in_sight(traced: &TracedScene, emitter: &Emitter, hit: &Hit, origin: Vec3) -> bool {
+    let Some((axis, half_angle, length)) = emitter.bounding_cone(hit.position) else {
+        return false;
+    };
+    // Every direction within `half_angle` of `axis` climbs away from the surface.
+    if axis.dot(hit.normal) <= half_angle.sin() + 1e-4 {
+        return false;
+    }
+    let cone = RayCone { apex: origin, axis, half_angle, length };
+    traced.cone_is_clear(&cone, &Receiver { point: hit.position, normal: hit.normal })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gnomon_scene::{Settings, builtin, settings::LightKind};
+
+    /// The shortcut for pixels that see the whole light changes no pixel of the
+    /// reference, bit for bit, under each kind of area light (a sun's disk, a spot's
+    /// disk, a point's sphere), over grounds, walls and curved casters; and it does
+    /// skip: most rays of these wholly lit grounds are not traced.
+    #[test]
+    fn skipping_wholly_lit_pixels_changes_no_pixel() {
+        let mut sun = Settings::default();
+        sun.light.sun_angular_diameter = Some(2.0);
+        let mut spot = Settings::default();
+        spot.light.kind = LightKind::Spot;
+        spot.light.spot_radius = Some(0.5);
+        let mut point = Settings::default();
+        point.light.kind = LightKind::Point;
+        point.light.point_radius = Some(0.25);
+        let cases = [
+            ("sun 2°, grazing", builtin::grazing(), sun),
+            ("spot r 0.5, contact", builtin::contact(), spot.clone()),
+            ("spot r 0.5, spheres", builtin::spheres(), spot),
+            ("point r 0.25, spheres", builtin::spheres(), point),
+        ];
+        for (name, scene, s) in cases {
+            let traced = TracedScene::build(&scene);
+            let camera = s.resolve_camera(&scene).unwrap();
+            let light = s.resolve_light(&scene).unwrap();
+            let options = ReferenceOptions { width: 160, height: 90, samples: 64 };
+            let every = trace_reference(&traced, &camera, &light, &options, &|_| {}, LightSampling::EveryRay);
+            let skipping = trace_reference(
+                &traced,
+                &camera,
+                &light,
+                &options,
+                &|_| {},
+                LightSampling::SkipWhollyInSight,
+            );
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&every.visibility), bits(&skipping.visibility), "{name}: visibility");
+            assert_eq!(bits(&every.std_error), bits(&skipping.std_error), "{name}: standard error");
+            let (soft, lit) =
+                every.visibility.iter().zip(&every.faces_light).filter(|(_, faces)| **faces).fold(
+                    (0, 0),
+                    |(soft, lit), (v, _)| {
+                        (soft + (*v > 0.0 && *v < 1.0) as usize, lit + (*v == 1.0) as usize)
+                    },
+                );
+            assert!(soft > 50 && lit > 1000, "{name}: a case with penumbrae and lit ground ({soft}, {lit})");
+            // The rays of wholly lit pixels, which the shortcut is for: it must save
+            // most of them (it cannot save all: a lit pixel near a caster fails the
+            // conservative test and is sampled).
+            let saved = every.rays - skipping.rays;
+            let lit_rays = lit as u64 * u64::from(every.samples);
+            eprintln!(
+                "{name}: {soft} soft and {lit} wholly lit pixels; {saved} of their {lit_rays} rays skipped"
+            );
+            assert!(
+                2 * saved > lit_rays,
+                "{name}: the shortcut skipped {saved} of the wholly lit pixels' {lit_rays} rays"
+            );
+        }
+    }
+}

@@ -1,0 +1,9 @@
+//! The `gnomon` binary's tests, as one test binary: each module runs the command
+//! line on one topic; `support` holds what they share.
+
+mod support;
+
+mod calibrate;
+mod commands;
+mod hardening;
+mod rays;

@@ -1,0 +1,8 @@
+//! Loading scenes (glTF files and TOML scene files), as one test binary; `common`
+//! holds what the modules share.
+
+mod common;
+
+mod gltf;
+mod gltf_coverage;
+mod scene_file;
