@@ -1,9 +1,14 @@
-//! What the lab commands share: scene lookup and the cached, progress-reporting
-//! reference computation.
+//! What the lab commands share: scene lookup, the cached, progress-reporting
+//! reference computation, and the truth at the surfaces a frame drew.
 
 use std::time::Instant;
 
-use gnomon_reference::{ReferenceImage, ReferenceOptions, TracedScene, reference_visibility};
+use gnomon_reference::{
+    ReferenceImage, ReferenceOptions, TracedScene,
+    drawn::{DrawnMetrics, DrawnOptions, DrawnSurfaces, DrawnTruth, drawn_truth, measure_drawn},
+    reference_visibility,
+};
+use gnomon_render::Frame;
 use gnomon_scene::{Camera, Light, Scene, Settings, builtin};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -148,4 +153,50 @@ pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow:
         eprintln!("gnomon: warning: could not cache the reference at {}: {e}", path.display());
     }
     Ok(Reference { image, timing: Some(ReferenceTiming { build_seconds, trace_seconds }) })
+}
+
+/// Each frame's metrics against the truth at the surfaces it drew
+/// (`gnomon_reference::drawn`): every light-facing pixel counted, traced from the
+/// frame's own points and normals. The truth is traced once per distinct set of
+/// surfaces: techniques drawn on one path show the same ones.
+pub fn drawn_metrics(
+    scene: &Scene,
+    settings: &Settings,
+    frames: &[&Frame],
+) -> anyhow::Result<Vec<DrawnMetrics>> {
+    let light: Light = settings.resolve_light(scene)?;
+    let traced = TracedScene::build(scene);
+    // The lift that tells an ambiguous pixel: 10⁻⁵ of the scene's extent.
+    let lift = 1e-5 * scene.bounds().extent().length();
+    let options = DrawnOptions { samples: settings.reference.samples, lift };
+    let bits =
+        |v: &[glam::Vec3]| -> Vec<u32> { v.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect() };
+    let mut truths: Vec<(Vec<u32>, DrawnTruth)> = Vec::new();
+    let mut metrics = Vec::with_capacity(frames.len());
+    for frame in frames {
+        let key = [bits(&frame.position), bits(&frame.geometric_normal)].concat();
+        let known = truths.iter().position(|(k, _)| *k == key);
+        let index = match known {
+            Some(index) => index,
+            None => {
+                let bar = ProgressBar::new(frame.height as u64).with_style(
+                    ProgressStyle::with_template(
+                        "truth at the drawn surfaces {bar:40} {pos}/{len} rows, {eta} left",
+                    )
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+                let surfaces = DrawnSurfaces {
+                    width: frame.width,
+                    position: &frame.position,
+                    geometric_normal: &frame.geometric_normal,
+                };
+                let truth = drawn_truth(&traced, &light, surfaces, &options, &|rows| bar.set_position(rows));
+                bar.finish_and_clear();
+                truths.push((key, truth));
+                truths.len() - 1
+            }
+        };
+        metrics.push(measure_drawn(&frame.visibility, &truths[index].1));
+    }
+    Ok(metrics)
 }

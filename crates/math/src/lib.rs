@@ -24,6 +24,7 @@ pub mod facing;
 pub mod fitting;
 pub mod kernels;
 mod light;
+pub mod octahedron;
 pub mod omni;
 mod projection;
 pub mod screen_bounds;

@@ -6,12 +6,15 @@
 #![warn(missing_docs)]
 
 pub mod aliasing;
+pub mod drawn;
+mod emitter;
 pub mod flicker;
 pub mod heatmap;
 pub mod metrics;
 pub mod penumbra;
 pub mod profile;
 pub mod sampling;
+mod shade;
 pub mod texture;
 mod tracer;
 mod visibility;

@@ -2,14 +2,15 @@
 //! rasterizer's camera, then shadow rays to the light: one exact ray for a point or
 //! directional light, or N stratified samples of an area light.
 
-use glam::{DVec2, DVec4, Vec2, Vec3};
+use glam::{DVec2, DVec4, Vec3};
 use gnomon_scene::{Camera, Light};
 use rayon::prelude::*;
 
 use crate::{
     TracedScene,
-    sampling::{cmj, concentric_disk, cone_direction, hash},
-    tracer::{RayCone, Receiver, ball_cone, offset_ray_origin},
+    emitter::Emitter,
+    sampling::hash,
+    shade::{BATCHES, LightSampling, shade},
 };
 
 /// How the reference is computed.
@@ -59,147 +60,6 @@ impl ReferenceImage {
     pub fn pixel_count(&self) -> usize {
         (self.width * self.height) as usize
     }
-}
-
-/// Batches of independent stratified patterns a pixel's samples are split into, so
-/// that the spread of the batch means gives an honest standard error.
-const BATCHES: u32 = 8;
-
-/// The area of a light as the sampler sees it.
-enum Emitter {
-    /// Parallel rays toward `to_light`; with `half_angle` > 0, a cone of directions.
-    Sun { to_light: Vec3, half_angle: f32 },
-    /// A disk at `center` of `radius` facing along `axis`; 0 is a point.
-    Disk { center: Vec3, axis: Vec3, radius: f32, cos_outer: f32, range: f32 },
-    /// A sphere at `center` of `radius` emitting in every direction; 0 is a point.
-    Sphere { center: Vec3, radius: f32, range: f32 },
-}
-
-impl Emitter {
-    fn new(light: &Light) -> Self {
-        match light {
-            Light::Directional(sun) => Emitter::Sun {
-                to_light: -sun.direction.normalize(),
-                half_angle: 0.5 * sun.angular_diameter_degrees.to_radians(),
-            },
-            Light::Spot(spot) => Emitter::Disk {
-                center: spot.position,
-                axis: spot.direction.normalize(),
-                radius: spot.radius,
-                cos_outer: spot.outer_angle_degrees.to_radians().cos(),
-                range: spot.range,
-            },
-            Light::Point(point) => {
-                Emitter::Sphere { center: point.position, radius: point.radius, range: point.range }
-            }
-        }
-    }
-
-    fn is_point(&self) -> bool {
-        match self {
-            Emitter::Sun { half_angle, .. } => *half_angle <= 0.0,
-            Emitter::Disk { radius, .. } | Emitter::Sphere { radius, .. } => *radius <= 0.0,
-        }
-    }
-
-    /// Direction to the light's centre, and whether the point receives any light at
-    /// all (inside a spot's cone and range).
-    fn centre(&self, p: Vec3) -> (Vec3, bool) {
-        match *self {
-            Emitter::Sun { to_light, .. } => (to_light, true),
-            Emitter::Disk { center, axis, cos_outer, range, .. } => {
-                let to = center - p;
-                let dist = to.length();
-                let l = to / dist;
-                (l, (-l).dot(axis) >= cos_outer && dist <= range)
-            }
-            Emitter::Sphere { center, range, .. } => {
-                let to = center - p;
-                let dist = to.length();
-                (to / dist, dist <= range)
-            }
-        }
-    }
-
-    /// Whether light can reach `hit` at all: inside the light's cone and range, on the
-    /// side of the surface (the camera-facing geometric normal) that faces the
-    /// light's centre, as the rasterizer tests it.
-    fn faces(&self, hit: &Hit) -> bool {
-        let (centre, receives) = self.centre(hit.position);
-        receives && hit.normal.dot(centre) > 0.0
-    }
-
-    /// The cone that holds every shadow ray [`Emitter::sample`] can give from `p`:
-    /// (unit axis, half-angle, longest ray), each widened by a hair for rounding.
-    /// None for a point light, and where `p` is so near the light that the cone
-    /// would be too wide to be of use.
-    fn bounding_cone(&self, p: Vec3) -> Option<(Vec3, f32, f32)> {
-        match *self {
-            Emitter::Sun { to_light, half_angle } => {
-                (half_angle > 0.0).then_some((to_light, half_angle * (1.0 + 1e-4) + 1e-6, f32::INFINITY))
-            }
-            // A disk lies within the ball of its radius about its centre, whose
-            // farthest point is the centre's distance plus the radius away.
-            Emitter::Disk { center, radius, .. } => (radius > 0.0)
-                .then(|| ball_cone(p, center, radius))
-                .flatten()
-                .map(|(axis, half_angle, distance)| (axis, half_angle, (distance + radius) * (1.0 + 1e-4))),
-            // Rays end where they enter the sphere, nearer than its centre.
-            Emitter::Sphere { center, radius, .. } => (radius > 0.0)
-                .then(|| ball_cone(p, center, radius))
-                .flatten()
-                .map(|(axis, half_angle, distance)| (axis, half_angle, distance * (1.0 + 1e-4))),
-        }
-    }
-
-    /// A shadow ray toward the light sample `u` from `p`: (direction, length).
-    fn sample(&self, p: Vec3, u: Vec2) -> (Vec3, f32) {
-        match *self {
-            Emitter::Sun { to_light, half_angle } => {
-                let d = if half_angle > 0.0 { cone_direction(u, to_light, half_angle) } else { to_light };
-                (d, f32::INFINITY)
-            }
-            Emitter::Disk { center, axis, radius, .. } => {
-                let target = if radius > 0.0 {
-                    let (a, b) = axis.any_orthonormal_pair();
-                    let q = concentric_disk(u) * radius;
-                    center + a * q.x + b * q.y
-                } else {
-                    center
-                };
-                let to = target - p;
-                let len = to.length();
-                (to / len, len)
-            }
-            Emitter::Sphere { center, radius, .. } => {
-                let to = center - p;
-                let dist = to.length();
-                let axis = to / dist;
-                if radius <= 0.0 || radius >= dist {
-                    return (axis, dist);
-                }
-                // Uniform over the cone the sphere subtends, which is uniform over its
-                // visible area as the receiver sees it (a sphere of uniform radiance);
-                // the ray ends where it enters the sphere.
-                let d = cone_direction(u, axis, (radius / dist).asin());
-                let along = d.dot(to);
-                let entry = along - (radius * radius - (dist * dist - along * along)).max(0.0).sqrt();
-                (d, entry.max(0.0))
-            }
-        }
-    }
-}
-
-/// How an area light's samples are traced at a pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum LightSampling {
-    /// Every sample's ray, at every pixel: the definition, kept for the test that the
-    /// shortcut changes nothing.
-    #[cfg_attr(not(test), expect(dead_code, reason = "only the test that compares the two samples this way"))]
-    EveryRay,
-    /// None where the whole light is provably in sight (`wholly_in_sight`), every
-    /// sample's ray elsewhere.
-    SkipWhollyInSight,
 }
 
 /// Computes the reference visibility of `light` for `camera`, in parallel over rows.
@@ -330,68 +190,6 @@ impl PixelResult {
         depth: f32::NAN,
         position: Vec3::NAN,
     };
-}
-
-/// Visibility of the light at `hit` (which [faces](Emitter::faces) it), the standard
-/// error of the estimate, and the number of shadow rays traced.
-fn shade(
-    traced: &TracedScene,
-    emitter: &Emitter,
-    hit: &Hit,
-    samples: u32,
-    seed: u32,
-    sampling: LightSampling,
-) -> (f32, f32, u64) {
-    let origin = offset_ray_origin(hit.position, hit.normal);
-    let rays = std::cell::Cell::new(0u64);
-    let visible = |u: Vec2| {
-        let (d, len) = emitter.sample(hit.position, u);
-        // Light samples below the surface's horizon are blocked by the surface itself.
-        if d.dot(hit.normal) <= 0.0 {
-            return false;
-        }
-        rays.set(rays.get() + 1);
-        !traced.occluded(origin, d, len)
-    };
-    if samples == 1 {
-        let v = if visible(Vec2::splat(0.5)) { 1.0 } else { 0.0 };
-        return (v, 0.0, rays.get());
-    }
-    if sampling == LightSampling::SkipWhollyInSight && wholly_in_sight(traced, emitter, hit, origin) {
-        return (1.0, 0.0, 0);
-    }
-    // Split the samples into independent stratified batches; the spread of the batch
-    // means estimates the standard error of their average.
-    let per_batch = samples / BATCHES;
-    let means: Vec<f32> = (0..BATCHES)
-        .map(|b| {
-            let pattern = hash(seed ^ hash(b + 1));
-            (0..per_batch).filter(|&s| visible(cmj(s, per_batch, pattern))).count() as f32 / per_batch as f32
-        })
-        .collect();
-    let mean = means.iter().sum::<f32>() / BATCHES as f32;
-    let variance = means.iter().map(|m| (m - mean).powi(2)).sum::<f32>() / (BATCHES - 1) as f32;
-    (mean, (variance / BATCHES as f32).sqrt(), rays.get())
-}
-
-use crate::Hit;
-
-/// Whether every shadow ray the sampler could send from `hit` (leaving from `origin`)
-/// arrives: the whole light lies above the surface's horizon, and nothing that could
-/// block a ray lies in the cone that holds them all (`TracedScene::cone_is_clear`).
-/// Then the estimate is exactly 1 with no spread, as tracing each sample would have
-/// found, and no ray is traced: most of a soft-shadow reference's pixels are wholly
-/// lit, and each cost `samples` rays before.
-fn wholly_in_sight(traced: &TracedScene, emitter: &Emitter, hit: &Hit, origin: Vec3) -> bool {
-    let Some((axis, half_angle, length)) = emitter.bounding_cone(hit.position) else {
-        return false;
-    };
-    // Every direction within `half_angle` of `axis` climbs away from the surface.
-    if axis.dot(hit.normal) <= half_angle.sin() + 1e-4 {
-        return false;
-    }
-    let cone = RayCone { apex: origin, axis, half_angle, length };
-    traced.cone_is_clear(&cone, &Receiver { point: hit.position, normal: hit.normal })
 }
 
 #[cfg(test)]

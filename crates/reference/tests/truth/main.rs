@@ -12,6 +12,7 @@ mod analytic;
 mod clusters;
 mod gpu_rays;
 mod many_lights;
+mod one_surface;
 mod penumbra;
 mod point_lights;
 mod ray_queries;

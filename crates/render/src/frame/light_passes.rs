@@ -52,6 +52,8 @@ pub(super) struct MaskInputs<'a> {
     /// The whole mask, a layer per light.
     pub mask: &'a wgpu::TextureView,
     pub tiles: &'a LightTiles,
+    /// Group 1 of the lighting passes here: the camera and the prepass's outputs.
+    pub surface_group: &'a wgpu::BindGroup,
 }
 
 /// Background colour of the image, linear RGB.
@@ -190,7 +192,7 @@ impl Renderer {
         });
         pass.set_pipeline(self.passes.light_list.pipeline(&gpu.device));
         pass.set_bind_group(0, &first.scene, &[]);
-        pass.set_bind_group(1, shared.camera_group, &[]);
+        pass.set_bind_group(1, masks.surface_group, &[]);
         pass.set_bind_group(2, &group, &[]);
         rec.stats.pipeline_changes += 1;
         rec.stats.bind_group_changes += 3;
@@ -230,7 +232,7 @@ impl Renderer {
         index: usize,
         bindings: &LightBindings,
     ) {
-        let SharedLighting { plan, camera_group, tracing_group, targets, camera, .. } = *shared;
+        let SharedLighting { plan, camera_group, tracing_group, targets, camera, masks } = *shared;
         let light = &plan.lights[index];
         let first = index == 0;
         let last = index + 1 == plan.lights.len();
@@ -273,7 +275,15 @@ impl Renderer {
         };
         pass.set_pipeline(self.passes.lighting.pipeline(&gpu.device, key));
         pass.set_bind_group(0, &bindings.scene, &[]);
-        let camera_group = tracing_group.filter(|_| key.refine != Refine::Off).unwrap_or(camera_group);
+        // Group 1: the camera, with the prepass's outputs on the mask path or the
+        // casters' BVH where the forward pass traces.
+        let camera_group = match (key.lookup, masks) {
+            (Lookup::Mask, Some(masks)) => masks.surface_group,
+            (Lookup::Mask, None) => unreachable!("the mask path records its screen-space passes first"),
+            (Lookup::Own(_), _) => {
+                tracing_group.filter(|_| key.refine != Refine::Off).unwrap_or(camera_group)
+            }
+        };
         pass.set_bind_group(1, camera_group, &[]);
         pass.set_bind_group(2, &bindings.lighting, &[]);
         rec.stats.pipeline_changes += 1;

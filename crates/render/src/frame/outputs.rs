@@ -67,6 +67,10 @@ pub struct Frame {
     pub position: Vec<Vec3>,
     /// World-space unit normal of the visible surface, facing the camera; NaN for background.
     pub normal: Vec<Vec3>,
+    /// World-space unit normal of the visible triangle's plane, facing the camera;
+    /// NaN for background. With `position`, the surface a shadow ray from the pixel
+    /// leaves (`gnomon compare` traces its reference from them).
+    pub geometric_normal: Vec<Vec3>,
     /// View-space depth (distance along the camera's axis); NaN for background.
     pub depth: Vec<f32>,
     /// Instance index + 1 of the visible surface; 0 for background.
@@ -456,11 +460,16 @@ impl Submitted {
                 depth.push(p.w);
             }
         }
-        let normal = normal_w
-            .iter()
-            .zip(&object_id)
-            .map(|(n, &id)| if id == 0 { nan3 } else { n.truncate() })
-            .collect();
+        // Both normals come octahedron-encoded (lighting_common.wgsl).
+        let decoded = |pick: fn(Vec4) -> glam::Vec2| -> Vec<Vec3> {
+            normal_w
+                .iter()
+                .zip(&object_id)
+                .map(|(n, &id)| if id == 0 { nan3 } else { gnomon_math::octahedron::decode(pick(*n)) })
+                .collect()
+        };
+        let normal = decoded(|n| n.truncate().truncate());
+        let geometric_normal = decoded(|n| glam::Vec2::new(n.z, n.w));
         let layout = self.layout;
         Ok(Frame {
             width,
@@ -469,6 +478,7 @@ impl Submitted {
             visibility,
             position,
             normal,
+            geometric_normal,
             depth,
             object_id,
             camera: self.camera,

@@ -259,6 +259,7 @@ impl Renderer {
             visible: &culled.camera,
             arguments: camera_arguments(&mut self.pool, &gpu, uploaded, &culled.camera, submission),
         };
+        let mut surface_group = None;
         if let Some(tiles) = &tiles {
             let mask_rects = (0..plan.lights.len()).map(|i| plan.mask_rect(tiles, i, viewport)).collect();
             let screen = super::screen::ScreenInputs {
@@ -273,10 +274,12 @@ impl Renderer {
                     Lighting::PerLight => MaskStart::Clear,
                 },
             };
-            let lists = self.record_screen_space(rec, uploaded, plan, &lit, &screen);
+            let outputs = self.record_screen_space(rec, uploaded, plan, &lit, &screen);
             // Each light's count of the pixels its rays decided.
-            readbacks.refine_counters =
-                lists.map(|lists| RefineLists::copy_counters(&lists.counters, &mut self.pool, rec.encoder));
+            readbacks.refine_counters = outputs
+                .lists
+                .map(|lists| RefineLists::copy_counters(&lists.counters, &mut self.pool, rec.encoder));
+            surface_group = Some(outputs.surface_group);
         }
         // On the forward path, the lights that refine trace in their lighting pass
         // (uncounted: rays/refine_forward.wgsl says why).
@@ -296,7 +299,11 @@ impl Renderer {
             tracing_group: tracing.as_ref(),
             targets: &targets,
             camera: &camera,
-            masks: mask.as_ref().zip(tiles.as_ref()).map(|(mask, tiles)| MaskInputs { mask, tiles }),
+            masks: mask
+                .as_ref()
+                .zip(tiles.as_ref())
+                .zip(surface_group.as_ref())
+                .map(|((mask, tiles), surface_group)| MaskInputs { mask, tiles, surface_group }),
         };
         self.record_lights(rec, uploaded, &shared, &lit);
         if readback.images {

@@ -20,6 +20,15 @@ use gnomon_math::screen_bounds::PixelRect;
 use gnomon_scene::settings::Refine;
 
 /// What the screen-space passes draw into and read.
+/// What the mask path's passes leave for the lighting passes and the frame.
+pub(super) struct ScreenOutputs {
+    /// The refinement's lists, whose counters say how many pixels each light traced.
+    pub lists: Option<RefineLists>,
+    /// Group 1 of the lighting passes on the mask path: the camera and the prepass's
+    /// surface, normals and object, the surface each pixel shades (seen_prepass.wgsl).
+    pub surface_group: wgpu::BindGroup,
+}
+
 pub(super) struct ScreenInputs<'a> {
     /// What the camera sees, and how its draws go out.
     pub camera: &'a CameraDraws<'a>,
@@ -91,7 +100,8 @@ impl Renderer {
     /// The depth-and-normal prepass into `inputs.depth`, then each light's mask pass
     /// into its layer of the mask, followed, where the light refines its shadow by
     /// rays, by its trace pass. Returns the refinement's lists, whose counters say
-    /// how many pixels each light traced.
+    /// how many pixels each light traced, and the group of the prepass's outputs,
+    /// which the lighting passes shade from.
     pub(super) fn record_screen_space(
         &mut self,
         rec: &mut Recording,
@@ -99,7 +109,7 @@ impl Renderer {
         plan: &FramePlan,
         lit: &[LightBindings],
         inputs: &ScreenInputs,
-    ) -> Option<RefineLists> {
+    ) -> ScreenOutputs {
         let (width, height) = (inputs.depth.texture().width(), inputs.depth.texture().height());
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
@@ -107,7 +117,9 @@ impl Renderer {
         let normals = self.pool.view(&normals, ViewKey::default());
         let surface = self.pool.texture("prepass surface", size, screen_space::SURFACE_FORMAT, usage);
         let surface = self.pool.view(&surface, ViewKey::default());
-        self.record_prepass(rec, uploaded, &lit[0].scene, inputs, [&normals, &surface]);
+        let object = self.pool.texture("prepass object", size, screen_space::OBJECT_FORMAT, usage);
+        let object = self.pool.view(&object, ViewKey::default());
+        self.record_prepass(rec, uploaded, &lit[0].scene, inputs, [&normals, &surface, &object]);
         let screen_group = self.pool.bind_group(
             "screen",
             &self.layouts.screen,
@@ -115,6 +127,7 @@ impl Renderer {
                 Binding::Buffer(inputs.camera_buffer.clone()),
                 Binding::View(surface.clone()),
                 Binding::View(normals.clone()),
+                Binding::View(object.clone()),
             ],
         );
         // The list of unsure pixels and each light's counters, cleared: zero
@@ -171,7 +184,7 @@ impl Renderer {
                 }
             }
         }
-        refining.map(|refining| refining.lists)
+        ScreenOutputs { lists: refining.map(|refining| refining.lists), surface_group: screen_group }
     }
 
     /// Light `index`'s mask pass into its `target` layer of the mask, with group 1
@@ -271,14 +284,14 @@ impl Renderer {
         self.record_trace(rec, TraceStage::PenumbraFilter, groups, index);
     }
 
-    /// The camera's depth, normals and surface (world point and view depth).
+    /// The camera's depth, normals, surface (world point and view depth) and object.
     fn record_prepass(
         &mut self,
         rec: &mut Recording,
         uploaded: &GpuScene,
         scene_group: &wgpu::BindGroup,
         inputs: &ScreenInputs,
-        [normals, surface]: [&wgpu::TextureView; 2],
+        [normals, surface, object]: [&wgpu::TextureView; 3],
     ) {
         let gpu = &self.gpu;
         let slot = rec.clock.begin(gpu, rec.encoder, PassKind::Prepass, None, None);
@@ -288,6 +301,7 @@ impl Renderer {
             color_attachments: &[
                 cleared(normals, wgpu::Color::TRANSPARENT),
                 cleared(surface, wgpu::Color::TRANSPARENT),
+                cleared(object, wgpu::Color::TRANSPARENT),
             ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: inputs.depth,
@@ -301,7 +315,7 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(self.passes.screen_space.prepass());
+        pass.set_pipeline(self.passes.screen_space.prepass(&gpu.device));
         // The light plays no part in the prepass; any light's group carries the
         // instances.
         pass.set_bind_group(0, scene_group, &[]);

@@ -168,6 +168,7 @@ pub(crate) fn light_list_wgsl() -> String {
     let mut parts = lighting::camera_shading_wgsl();
     parts.push(lighting::SURFACE_WGSL.to_owned());
     parts.push(lighting::LIGHTING_COMMON_WGSL.to_owned());
+    parts.extend(lighting::seen_surface_wgsl(lighting::Lookup::Mask));
     parts.push(include_str!("light_list.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -207,7 +208,7 @@ impl LightListPass {
             label: Some("light list"),
             bind_group_layouts: &[
                 Some(&layouts.scene),
-                Some(&layouts.camera),
+                Some(&layouts.screen),
                 Some(&group_layout),
                 Some(&layouts.material),
             ],
@@ -216,8 +217,8 @@ impl LightListPass {
         Self { group_layout, layout, pipeline: None }
     }
 
-    /// The pipeline: groups 0 (the scene and the first light), 1 (the camera), 2
-    /// (`group_layout`) and 3 (each draw's material).
+    /// The pipeline: groups 0 (the scene and the first light), 1 (the camera and the
+    /// prepass's outputs), 2 (`group_layout`) and 3 (each draw's material).
     pub fn pipeline(&mut self, device: &wgpu::Device) -> &wgpu::RenderPipeline {
         let layout = &self.layout;
         self.pipeline.get_or_insert_with(|| {

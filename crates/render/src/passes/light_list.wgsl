@@ -38,11 +38,17 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     if alpha_cut(inst, in.uv) {
         discard;
     }
-    let n = surface_normals(in).shading;
+    // The prepass's surface at this pixel, which every light's mask was resolved
+    // for; a fragment of another instance on the same depth is not it
+    // (seen_prepass.wgsl).
+    if !is_seen_surface(in) {
+        discard;
+    }
+    let seen = seen_surface(in);
+    let n = seen.shading_n;
     let albedo = base_color_of(inst, in.uv).rgb;
-    let v = normalize(camera.eye - in.world);
+    let v = normalize(camera.eye - seen.world);
     let texel = vec2<u32>(in.clip.xy);
-    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
 
     // The reported light's layer covers every pixel; the others only the tiles that
     // list them.
@@ -56,7 +62,7 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
             let i = word * 32u + firstTrailingBit(bits);
             bits &= bits - 1u;
             let e = emitters[i];
-            let geometry = emitter_geometry(e, in.world);
+            let geometry = emitter_geometry(e, seen.world);
             if geometry.w <= 0.0 {
                 continue;
             }
@@ -77,8 +83,8 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     var out: FragmentOut;
     out.color = vec4<f32>(color, 1.0);
     out.visibility = shown.x;
-    out.position = vec4<f32>(in.world, view_depth);
-    out.normal = vec4<f32>(n, 0.0);
+    out.position = vec4<f32>(seen.world, seen.view_depth);
+    out.normal = seen.encoded_normals;
     out.object_id = inst.object_id;
     return out;
 }

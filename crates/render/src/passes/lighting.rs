@@ -193,6 +193,16 @@ impl SurfacePipeline<'_> {
     }
 }
 
+/// The WGSL that defines `seen_surface`, the surface a lighting pass shades at a
+/// pixel: the fragment's own on the forward path, the prepass's on the mask path.
+pub(crate) fn seen_surface_wgsl(lookup: Lookup) -> Vec<String> {
+    let seen = match lookup {
+        Lookup::Own(_) => vec![include_str!("seen_own.wgsl")],
+        Lookup::Mask => vec![super::SCREEN_COMMON_WGSL, include_str!("seen_prepass.wgsl")],
+    };
+    [super::OCTAHEDRON_WGSL].into_iter().chain(seen).map(str::to_owned).collect()
+}
+
 /// The lighting pass's WGSL for `key`, composed.
 pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     let mut parts = camera_shading_wgsl();
@@ -203,6 +213,7 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
     });
     parts.push(SURFACE_WGSL.to_owned());
     parts.push(LIGHTING_COMMON_WGSL.to_owned());
+    parts.extend(seen_surface_wgsl(key.lookup));
     parts.push(include_str!("lighting.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
@@ -212,6 +223,8 @@ pub(crate) fn lighting_wgsl(key: LightingKey) -> String {
 /// first use.
 pub(crate) struct LightingPass {
     layout: wgpu::PipelineLayout,
+    /// On the mask path group 1 holds the prepass's outputs beside the camera.
+    mask_layout: wgpu::PipelineLayout,
     /// The layouts of the pipelines that trace rays, by traversal (ray queries' where
     /// the device has them): the camera's group holds the tracer's resources too.
     tracing_layouts: HashMap<Traversal, wgpu::PipelineLayout>,
@@ -236,6 +249,7 @@ impl LightingPass {
         let traversals = [Some(Traversal::Shader), ray_queries.then_some(Traversal::RayQuery)];
         Self {
             layout: layout("lighting", &layouts.camera),
+            mask_layout: layout("lighting on the mask path", &layouts.screen),
             tracing_layouts: traversals
                 .into_iter()
                 .flatten()
@@ -246,8 +260,9 @@ impl LightingPass {
     }
 
     /// The pipeline of `key`: groups 0 (scene and light), 1 (the camera; with the
-    /// casters' BVH and the light's counters where the key refines), 2 (the light's
-    /// shadow resources) and 3 (each draw's material).
+    /// casters' BVH and the light's counters where the key refines; with the
+    /// prepass's outputs on the mask path), 2 (the light's shadow resources) and 3
+    /// (each draw's material).
     pub fn pipeline(&mut self, device: &wgpu::Device, key: LightingKey) -> &wgpu::RenderPipeline {
         // Reading the mask is the same shader whatever technique filled it: one
         // pipeline serves them all, and it traces nothing.
@@ -264,9 +279,12 @@ impl LightingPass {
             }
             Lookup::Own(_) => key,
         };
-        let layout = match key.refine {
-            Refine::Off => &self.layout,
-            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.tracing_layouts[&key.traversal],
+        let layout = match (key.lookup, key.refine) {
+            (Lookup::Mask, _) => &self.mask_layout,
+            (Lookup::Own(_), Refine::Off) => &self.layout,
+            (Lookup::Own(_), Refine::Auto | Refine::Rays | Refine::EveryPixel) => {
+                &self.tracing_layouts[&key.traversal]
+            }
         };
         self.pipelines.entry(key).or_insert_with(|| {
             let source = lighting_wgsl(key);

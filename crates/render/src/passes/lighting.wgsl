@@ -1,6 +1,7 @@
 // Lighting pass: Lambert diffuse + Blinn-Phong specular + ambient, with the shadow
 // factor of the selected technique multiplying only the direct term. Also writes the
-// per-pixel visibility, world position, normal, view depth and object id.
+// per-pixel visibility, world position, normals, view depth and object id, all of
+// one surface (`seen_surface`).
 //
 // `pixel_visibility` comes from resolve_visibility.wgsl on the forward path (the
 // technique's lookup, per fragment, which `refine_forward` refines by rays where
@@ -12,10 +13,12 @@
 @fragment
 fn fs_main(in: SurfaceVertex) -> FragmentOut {
     let inst = instances[in.instance];
-    let normals = surface_normals(in);
-    let n = normals.shading;
-    let geometric_n = normals.geometric;
-    let geometry = light_geometry(in.world);
+    // The surface this pixel shows: the fragment's own, or on the mask path the
+    // prepass's (seen_own.wgsl, seen_prepass.wgsl).
+    let seen = seen_surface(in);
+    let n = seen.shading_n;
+    let geometric_n = seen.geometric_n;
+    let geometry = light_geometry(seen.world);
     let l = geometry.xyz;
     let cone = geometry.w;
 
@@ -23,23 +26,23 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     // each lookup carries them into its own cascade's texture space.
     let world_dx = dpdx(in.world);
     let world_dy = dpdy(in.world);
-    let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
-    let looked_up = pixel_visibility(in.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
+    let view_depth = seen.view_depth;
+    let looked_up = pixel_visibility(seen.world, n, geometric_n, l, cone, world_dx, world_dy, in.clip.xy, view_depth);
     // Where the forward path refines and the map is unsure, the fragment's rays
     // decide (rays/refine_forward.wgsl).
-    let facing = facing_error(in.world, world_dx, world_dy);
-    let shadow = refine_forward(looked_up, in.world, n, geometric_n, geometry, view_depth, in.clip.xy, facing);
+    let facing = facing_error(seen.world, world_dx, world_dy);
+    let shadow = refine_forward(looked_up, seen.world, n, geometric_n, geometry, view_depth, in.clip.xy, facing);
     let visibility = shadow.x;
     // Under the traced view, a layer past TRACED_LAYER_FLAG marks a pixel whose
     // shadow rays decided (shadow_mask.wgsl, refine_forward.wgsl).
     let traced = u32(shadow.y) >= TRACED_LAYER_FLAG;
     let layer = u32(shadow.y) % TRACED_LAYER_FLAG;
 
-    if alpha_cut(inst, in.uv) {
+    if alpha_cut(inst, in.uv) || !is_seen_surface(in) {
         discard;
     }
     let albedo = base_color_of(inst, in.uv).rgb;
-    let v = normalize(camera.eye - in.world);
+    let v = normalize(camera.eye - seen.world);
     let direct = light.radiance * cone * blinn_phong(albedo, inst.specular, inst.shininess, n, l, v);
     var color = light.ambient * albedo + visibility * direct;
     if camera.debug_view == DEBUG_VIEW_CASCADES {
@@ -52,8 +55,8 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     var out: FragmentOut;
     out.color = vec4<f32>(color, 1.0);
     out.visibility = visibility;
-    out.position = vec4<f32>(in.world, view_depth);
-    out.normal = vec4<f32>(n, 0.0);
+    out.position = vec4<f32>(seen.world, view_depth);
+    out.normal = seen.encoded_normals;
     out.object_id = inst.object_id;
     return out;
 }

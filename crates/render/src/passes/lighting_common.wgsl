@@ -1,12 +1,28 @@
-// What the lighting passes share: their outputs, in `lighting::TARGETS` order, and
-// the cascade debug view's tint of each shadow-map layer.
+// What the lighting passes share: their outputs, in `lighting::TARGETS` order, the
+// surface each pixel shades, and the cascade debug view's tint of each shadow-map
+// layer.
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
     @location(1) visibility: f32,
     @location(2) position: vec4<f32>,
+    // xy: the shading normal, zw: the geometric normal, both octahedron-encoded
+    // (octahedron.wgsl) and facing the camera, as the prepass stores them.
     @location(3) normal: vec4<f32>,
     @location(4) object_id: u32,
+};
+
+// The surface a pixel shows, which its colour, its visibility and its outputs all
+// describe: on the forward path the fragment's own (seen_own.wgsl), on the mask path
+// the one the prepass kept and the shadow mask was resolved for (seen_prepass.wgsl).
+struct SeenSurface {
+    world: vec3<f32>,
+    view_depth: f32,
+    // The interpolated normal and the triangle's plane, both facing the camera.
+    shading_n: vec3<f32>,
+    geometric_n: vec3<f32>,
+    // Both normals, octahedron-encoded, for the normal output.
+    encoded_normals: vec4<f32>,
 };
 
 // The tints are indexed only under their view: a dynamically indexed constant array costs a

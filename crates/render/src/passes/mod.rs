@@ -133,8 +133,8 @@ pub(crate) struct Layouts {
     /// Group 1 of a forward lighting pass that refines by rays: the camera and the
     /// tracer's resources, for each traversal ([`crate::rays::forward_layouts`]).
     pub forward_rays: crate::rays::TracerLayouts,
-    /// Group 1 of the shadow-mask pass: the camera and the prepass's surface and
-    /// normals.
+    /// Group 1 of the shadow-mask pass and of the lighting passes on the mask path:
+    /// the camera and the prepass's surface, normals and object.
     pub screen: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the
     /// filterable techniques' moment map and its sampler, a point light's cube with
@@ -192,7 +192,12 @@ impl Layouts {
             ),
             screen: layout(
                 "screen",
-                &[uniform_entry(0, fragment), unfilterable_texture_entry(1), unfilterable_texture_entry(2)],
+                &[
+                    uniform_entry(0, vf),
+                    unfilterable_texture_entry(1),
+                    unfilterable_texture_entry(2),
+                    fragment_entry(3, texture(wgpu::TextureSampleType::Uint, wgpu::TextureViewDimension::D2)),
+                ],
             ),
             material: layout("material", &[fragment_entry(0, filterable), fragment_entry(1, filtering)]),
             rays: crate::rays::layouts(device),

@@ -17,6 +17,9 @@ struct PrepassTargets {
     @location(0) normals: vec4<f32>,
     // xyz: the world point, w: its view depth (0 where no surface is seen).
     @location(1) surface: vec4<f32>,
+    // The instance drawn (its index in the instance buffer) + 1; 0 where no surface
+    // is seen. The lighting pass shades only this instance's fragments (seen_prepass.wgsl).
+    @location(2) object: u32,
 };
 
 // The vertex stage is surface.wgsl's vs_surface, the lighting pass's own.
@@ -29,5 +32,6 @@ fn fs_prepass(in: SurfaceVertex) -> PrepassTargets {
     var out: PrepassTargets;
     out.normals = vec4<f32>(octahedron_encode(normals.shading), octahedron_encode(normals.geometric));
     out.surface = vec4<f32>(in.world, -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z);
+    out.object = in.instance + 1u;
     return out;
 }

@@ -18,6 +18,9 @@ pub(crate) const NORMALS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba
 /// the vertices, so on its triangle; prepass.wgsl says why) and its linear view depth
 /// in w (0 where no surface is seen).
 pub(crate) const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The prepass's object: the instance it kept at each pixel, + 1 (0 where no surface
+/// is seen), which the lighting passes shade alone (seen_prepass.wgsl).
+pub(crate) const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// The mask, one array layer per light: visibility + 2 × the shadow-map layer that
 /// shaded it, per pixel (that layer + `uniforms::TRACED_LAYER_FLAG` where rays decided
 /// the pixel, under the traced debug view). A 32-bit float keeps the visibility exact, where half floats
@@ -61,7 +64,11 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
 }
 
 pub(crate) struct ScreenSpacePass {
-    prepass: wgpu::RenderPipeline,
+    prepass_layout: wgpu::PipelineLayout,
+    /// Built on first use: its targets take more colour-attachment bytes than a
+    /// device opened with wgpu's default limits allows (36 of 32), and a host on such
+    /// a device never draws the mask path.
+    prepass: Option<wgpu::RenderPipeline>,
     mask_layout: wgpu::PipelineLayout,
     /// The mask pipelines that list pixels for rays bind the list in group 1.
     refine_layout: wgpu::PipelineLayout,
@@ -75,19 +82,6 @@ impl ScreenSpacePass {
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.camera), None, Some(&layouts.material)],
             immediate_size: 0,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("prepass"),
-            source: wgpu::ShaderSource::Wgsl(prepass_wgsl().into()),
-        });
-        let prepass = lighting::SurfacePipeline {
-            label: "prepass",
-            layout: &prepass_layout,
-            module: &module,
-            fragment_entry: "fs_prepass",
-            targets: &[Some(NORMALS_FORMAT.into()), Some(SURFACE_FORMAT.into())],
-            depth: lighting::SurfaceDepth::Nearest,
-        }
-        .create(device);
         let mask_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow mask"),
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.screen), Some(&layouts.shadow)],
@@ -98,12 +92,31 @@ impl ScreenSpacePass {
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.refine_screen), Some(&layouts.shadow)],
             immediate_size: 0,
         });
-        Self { prepass, mask_layout, refine_layout, masks: HashMap::new() }
+        Self { prepass_layout, prepass: None, mask_layout, refine_layout, masks: HashMap::new() }
     }
 
     /// The prepass pipeline: groups 0 (scene), 1 (camera) and 3 (material).
-    pub fn prepass(&self) -> &wgpu::RenderPipeline {
-        &self.prepass
+    pub fn prepass(&mut self, device: &wgpu::Device) -> &wgpu::RenderPipeline {
+        let layout = &self.prepass_layout;
+        self.prepass.get_or_insert_with(|| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("prepass"),
+                source: wgpu::ShaderSource::Wgsl(prepass_wgsl().into()),
+            });
+            lighting::SurfacePipeline {
+                label: "prepass",
+                layout,
+                module: &module,
+                fragment_entry: "fs_prepass",
+                targets: &[
+                    Some(NORMALS_FORMAT.into()),
+                    Some(SURFACE_FORMAT.into()),
+                    Some(OBJECT_FORMAT.into()),
+                ],
+                depth: lighting::SurfaceDepth::Nearest,
+            }
+            .create(device)
+        })
     }
 
     /// The mask pipeline of a technique, lookup and refinement: groups 0 (scene and

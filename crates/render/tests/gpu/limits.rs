@@ -105,8 +105,8 @@ fn refinement_falls_back_and_raytraced_is_refused_where_rays_cannot_run() {
 }
 
 /// A host's device opened with wgpu's default limits takes a renderer: what needs
-/// more (the lighting passes' colour attachments, the light list's) is built only when
-/// first drawn. The window example opens its device so.
+/// more (the colour attachments of the lighting passes, the prepass and the light
+/// list) is built only when first drawn. The window example opens its device so.
 #[test]
 fn a_renderer_opens_on_a_device_with_default_limits() {
     let gpu = Gpu::new_headless_with(|l| *l = wgpu::Limits::default()).expect("adapter");
