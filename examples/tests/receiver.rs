@@ -14,6 +14,12 @@ use gnomon_scene::{
     settings::{LightKind, OmniMap, RayUse, Refine, ShadowPath, Technique},
 };
 
+/// The device shared by this binary's tests.
+fn gpu() -> &'static Gpu {
+    static GPU: std::sync::OnceLock<Gpu> = std::sync::OnceLock::new();
+    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
+}
+
 // Wide enough that the sky shows beside the ground: background pixels are compared too.
 const WIDTH: u32 = 224;
 const HEIGHT: u32 = 112;
@@ -69,8 +75,8 @@ fn settings(technique: Technique, light: LightKind, omni: OmniMap) -> Settings {
 
 #[test]
 fn a_hosts_shader_sees_gnomons_shadows_for_every_technique_and_light() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let (mut worst, mut cases) = (0.0f64, 0);
     // A technique that is rays leaves no map for a host to read (refused below).
@@ -88,7 +94,7 @@ fn a_hosts_shader_sees_gnomons_shadows_for_every_technique_and_light() {
             let case = format!("{technique:?}, {light:?} light, {omni:?}");
             let settings = settings(technique.technique(), light, omni);
             let frame = renderer.render(&scene, &settings, &OutputRequest::default()).unwrap();
-            let hosted = host_visibility(&gpu, &mut renderer, &scene, &settings);
+            let hosted = host_visibility(gpu, &mut renderer, &scene, &settings);
             assert_eq!(hosted.len(), frame.visibility.len());
             // Where Gnomon drew nothing (object id 0), the host must not have either (−1).
             let expected =
@@ -117,8 +123,8 @@ fn a_hosts_shader_sees_gnomons_shadows_for_every_technique_and_light() {
 
 #[test]
 fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut settings = settings(Technique::PCF, LightKind::Sun, OmniMap::Cube);
@@ -143,8 +149,8 @@ fn the_mask_path_is_refused_with_the_settings_that_chose_it() {
 
 #[test]
 fn a_technique_that_is_rays_is_refused_by_name() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -24,6 +24,19 @@ pub struct SceneArgs {
     /// Camera view of a scene file (.toml) to use [default: its first view].
     #[arg(long, value_name = "NAME")]
     pub view: Option<String>,
+    /// Let a glTF model read buffer and image files outside its own folder (by
+    /// default a model may only name files beside or below it).
+    #[arg(long)]
+    pub allow_outside_uris: bool,
+}
+
+impl SceneArgs {
+    /// How the models of this scene are loaded.
+    pub fn load_options(&self) -> gnomon_scene::gltf_loader::LoadOptions {
+        use gnomon_scene::gltf_loader::{LoadOptions, UriScope};
+        let uri_scope = if self.allow_outside_uris { UriScope::Anywhere } else { UriScope::ModelFolder };
+        LoadOptions { uri_scope }
+    }
 }
 
 /// The scene `args` names (a scene file, a glTF file or a built-in scene) and the
@@ -33,9 +46,9 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
     let (name, view) = (args.scene.as_str(), args.view.as_deref());
     let path = std::path::Path::new(name);
     let is_toml = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let options = args.load_options();
     let (mut scene, settings) = if is_toml {
-        anyhow::ensure!(path.is_file(), "{name}: no such file");
-        let loaded = gnomon_scene::scene_file::load(path, view)?;
+        let loaded = gnomon_scene::scene_file::load_with(path, view, &options)?;
         for warning in &loaded.warnings {
             eprintln!("gnomon: warning: {name}: {warning}");
         }
@@ -57,7 +70,7 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
             anyhow::bail!("--view {v}: views come from scene files (.toml), and `{name}` is not one");
         }
         command_line.validate()?;
-        (load_scene_file(name)?, command_line.clone())
+        (load_scene_file(name, &options)?, command_line.clone())
     };
     if settings.scene.ground {
         scene.add_ground_plane();
@@ -75,15 +88,17 @@ pub fn load(args: &SceneArgs, command_line: &Settings) -> anyhow::Result<(Scene,
 
 /// The scene `name`: a glTF file (`.gltf` or `.glb`) or a built-in scene, or an error
 /// that names the valid choices.
-pub fn load_scene_file(name: &str) -> anyhow::Result<Scene> {
+pub fn load_scene_file(
+    name: &str,
+    options: &gnomon_scene::gltf_loader::LoadOptions,
+) -> anyhow::Result<Scene> {
     let path = std::path::Path::new(name);
     let is_gltf = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
     if is_gltf {
-        anyhow::ensure!(path.is_file(), "{name}: no such file");
-        let (scene, extras) = gnomon_scene::gltf_loader::load(path)?;
+        let (scene, extras) = gnomon_scene::gltf_loader::load_with(path, options)?;
         for warning in &extras.warnings {
             eprintln!("gnomon: warning: {name}: {warning}");
         }

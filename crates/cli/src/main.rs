@@ -131,9 +131,12 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         RenderError::MomentFormatUnsupported { .. } => Some("--moment-format rgba32float: ".into()),
         RenderError::RaysUnavailable(_) => Some("--refine: ".into()),
         RenderError::RayQueriesUnavailable(_) => Some("--tracer ray-query: ".into()),
+        RenderError::ImageTooLarge { width, height, .. }
+        | RenderError::ImageTooManyBytes { width, height, .. } => {
+            Some(format!("--width {width} --height {height}: "))
+        }
         RenderError::NoAdapter { .. }
         | RenderError::DeviceRequest { .. }
-        | RenderError::ImageTooLarge { .. }
         | RenderError::AttachmentsTooLarge { .. }
         | RenderError::ReceiverNeedsMapPath
         | RenderError::ReceiverCannotTrace { .. }

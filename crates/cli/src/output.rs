@@ -30,7 +30,17 @@ pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Resul
     if path.is_dir() {
         bail!("{flag} {}: is a directory, expected a file name", path.display());
     }
+    if let Some(kind) = not_a_regular_file(path) {
+        bail!("{flag} {}: exists and is {kind}; outputs replace regular files only", path.display());
+    }
     Ok(())
+}
+
+/// What is at `path` when it is neither absent nor a regular file (a device, a FIFO,
+/// a directory, a socket): a rename over it would replace a device node with a file.
+fn not_a_regular_file(path: &Path) -> Option<&'static str> {
+    let metadata = std::fs::metadata(path).ok()?;
+    (!metadata.is_file()).then(|| gnomon_scene::gltf_loader::sources::file_kind(&metadata))
 }
 
 /// Fails unless `dir` is a directory or could be created (its parent exists).
@@ -138,6 +148,9 @@ impl Drop for Staged {
 
 impl Staged {
     fn temp_for(&mut self, path: &Path) -> anyhow::Result<PathBuf> {
+        if let Some(kind) = not_a_regular_file(path) {
+            bail!("cannot write {}: it is {kind}; outputs replace regular files only", path.display());
+        }
         if let Some((_, earlier)) = self.files.iter().find(|(_, dest)| identity(dest) == identity(path)) {
             bail!(
                 "two outputs would write {} (and {}): give each its own path",
@@ -372,5 +385,21 @@ mod tests {
         let e = check_file(Path::new("/no/such/dir/out.png"), &["png"], "--out").unwrap_err().to_string();
         assert!(e.contains("does not exist"), "{e}");
         assert!(check_file(Path::new("out.png"), &["png"], "--out").is_ok());
+    }
+
+    /// A device node (here a link to /dev/null named like a PNG) is not replaced by
+    /// the output: refused before anything is written, by the flag and in staging.
+    #[cfg(unix)]
+    #[test]
+    fn a_device_is_not_an_output() {
+        let dir = tempfile::tempdir().unwrap();
+        let device = dir.path().join("x.png");
+        std::os::unix::fs::symlink("/dev/null", &device).unwrap();
+        let e = check_file(&device, &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("--out") && e.contains("a character device"), "{e}");
+        let mut staged = Staged::default();
+        let e = staged.text(&device, "text").unwrap_err().to_string();
+        assert!(e.contains("a character device"), "{e}");
+        assert!(std::fs::symlink_metadata(&device).unwrap().file_type().is_symlink(), "left as it was");
     }
 }

@@ -93,6 +93,27 @@ pub enum RenderError {
         /// Name of the adapter, as wgpu reports it.
         adapter: String,
     },
+    /// An image whose largest target holds more bytes than the device's largest
+    /// buffer, through which it is read back (16 bytes a pixel: the position and
+    /// normal outputs, and the prepass's surface).
+    #[error(
+        "an image of {width}×{height} takes {bytes} bytes in each of its largest targets, more than adapter \
+         `{adapter}` allows in one buffer ({max_buffer} bytes): at most {max_pixels} pixels in all"
+    )]
+    ImageTooManyBytes {
+        /// The requested image width, in pixels.
+        width: u32,
+        /// The requested image height, in pixels.
+        height: u32,
+        /// Bytes of its largest target.
+        bytes: u64,
+        /// The device's largest buffer (`max_buffer_size`), in bytes.
+        max_buffer: u64,
+        /// The most pixels an image may have on this device.
+        max_pixels: u64,
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
     /// The device cannot hold the lighting pass's colour targets: too few attachment bytes per pixel.
     #[error(
         "adapter `{adapter}` allows {available} bytes of colour attachments per pixel; the lighting \

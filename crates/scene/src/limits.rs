@@ -16,6 +16,18 @@ use crate::{Camera, DirectionalLight, Light, PointLight, SpotLight};
 /// The largest coordinate or distance, in world units: `f32`'s spacing is 1 there.
 pub const MAX_COORDINATE: f32 = 1.0e7;
 
+/// The most bytes a model file may make the loader hold: its buffers, its decoded
+/// images and the vertex data it expands, together, each charged before it is
+/// allocated (`gltf_loader::sources::Budget`). A file of a few kilobytes can declare
+/// gigabytes; with this and the process's own use, loading any file stays under 2 GB.
+/// Sponza, the largest scene tested, takes 9 MB of it.
+pub const MAX_MODEL_BYTES: u64 = 1 << 30;
+
+/// The largest scene file (TOML): a scene file describes models, lights and views in
+/// a few kilobytes; a larger one is not a scene file (and a line of it would be
+/// echoed whole into a parse error).
+pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
+
 /// A range of valid values for one quantity, and the words that describe it.
 #[derive(Clone, Copy, Debug)]
 pub struct Limit {

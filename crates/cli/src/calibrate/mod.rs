@@ -118,6 +118,9 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     output::check_dir(&args.out, "--out")?;
     if let Some(path) = &args.write {
         output::check_file(path, &["toml"], "--write")?;
+        // A file the run could not edit at its end is refused before the sweep.
+        settings_file_text(path, &settings.shadow.bias, None)
+            .with_context(|| format!("--write {}", path.display()))?;
     }
     let requested = plan::Requested {
         depth_bias: args.sweep_depth_bias,
@@ -160,7 +163,14 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let refine = settings.screen.refine;
     let mut points = Vec::with_capacity(grid.len());
     for tuned in &grid {
-        points.push(measuring.measure(&calibration, tuned, refine)?.rates(tuned.clone()));
+        let pooled = measuring.measure(&calibration, tuned, refine)?;
+        // A bias chosen from no pixel is no measurement (an empty or flattened view).
+        anyhow::ensure!(
+            pooled.compared > 0,
+            "{}: no light-facing pixel to measure in the calibration views: nothing to choose a bias from",
+            scene.name
+        );
+        points.push(pooled.rates(tuned.clone()));
     }
     let front = sweep::pareto_front(&points);
     let chosen = sweep::least_mismatch(&points).context("an empty sweep")?;
@@ -238,12 +248,16 @@ fn write_outputs(
     staged.text(&args.out.join("calibration.md"), &report)?;
     let json = serde_json::to_string_pretty(&report_json(scene, technique, r))?;
     staged.text(&args.out.join("calibration.json"), &json)?;
-    staged.commit()?;
-    print!("{report}");
+    // The scene file's new text, staged with the rest: all of them are written, or
+    // none (a scene file that cannot be edited leaves the report unwritten too).
     if let Some(path) = &args.write {
         let tuned = &r.points[r.chosen].setting;
-        write_settings(path, &tuned.bias, swept_kernel.then_some(tuned.pcf_kernel))?;
+        let text = settings_file_text(path, &tuned.bias, swept_kernel.then_some(tuned.pcf_kernel))
+            .with_context(|| format!("--write {}", path.display()))?;
+        staged.text(path, &text)?;
     }
+    staged.commit()?;
+    print!("{report}");
     Ok(())
 }
 
@@ -368,24 +382,37 @@ fn report_json(scene: &Scene, technique: &str, r: &Results) -> serde_json::Value
     })
 }
 
-/// Stores `bias` in `path`'s `[settings.shadow.bias]`, and `kernel` (when it was
-/// swept) as its `settings.shadow.filter.pcf_kernel`, keeping the rest of the file.
-fn write_settings(path: &std::path::Path, bias: &BiasSettings, kernel: Option<f32>) -> anyhow::Result<()> {
-    let text = if path.is_file() { std::fs::read_to_string(path)? } else { String::new() };
-    let mut doc: toml::Table =
-        toml::from_str(&text).with_context(|| format!("--write {}: not TOML", path.display()))?;
-    let settings = doc.entry("settings").or_insert_with(|| toml::Table::new().into());
-    let table = settings.as_table_mut().context("--write: `settings` is not a table")?;
-    let shadow = table.entry("shadow").or_insert_with(|| toml::Table::new().into());
-    let shadow = shadow.as_table_mut().context("--write: `settings.shadow` is not a table")?;
-    shadow.insert("bias".into(), toml::Value::try_from(bias)?);
+/// `path`'s text with `bias` as its `[settings.shadow.bias]` and `kernel` (when it was
+/// swept) as its `settings.shadow.filter.pcf_kernel`: edited in place (`toml_edit`),
+/// so that the file's comments, the order of its keys and its layout stay as its
+/// author wrote them. A file that does not exist yet is created.
+fn settings_file_text(
+    path: &std::path::Path,
+    bias: &BiasSettings,
+    kernel: Option<f32>,
+) -> anyhow::Result<String> {
+    let text = match std::fs::metadata(path) {
+        Ok(metadata) if metadata.is_file() => std::fs::read_to_string(path).context("cannot read it")?,
+        Ok(_) => anyhow::bail!("is not a regular file"),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(anyhow::Error::new(e).context("cannot read it")),
+    };
+    let mut doc: toml_edit::DocumentMut = text.parse().context("is not TOML")?;
+    let table = |item: &mut toml_edit::Item, key: &str| -> anyhow::Result<()> {
+        if item.is_none() {
+            *item = toml_edit::table();
+        }
+        anyhow::ensure!(item.is_table_like(), "`{key}` is not a table");
+        Ok(())
+    };
+    table(&mut doc["settings"], "settings")?;
+    table(&mut doc["settings"]["shadow"], "settings.shadow")?;
+    // The bias as the settings' own serializer writes it, then as an editable table.
+    let bias_doc: toml_edit::DocumentMut = toml::to_string(bias)?.parse().context("the bias")?;
+    doc["settings"]["shadow"]["bias"] = toml_edit::Item::Table(bias_doc.as_table().clone());
     if let Some(kernel) = kernel {
-        let filter = shadow.entry("filter").or_insert_with(|| toml::Table::new().into());
-        let filter = filter.as_table_mut().context("--write: `settings.shadow.filter` is not a table")?;
-        filter.insert("pcf_kernel".into(), toml::Value::Float(kernel.into()));
+        table(&mut doc["settings"]["shadow"]["filter"], "settings.shadow.filter")?;
+        doc["settings"]["shadow"]["filter"]["pcf_kernel"] = toml_edit::value(f64::from(kernel));
     }
-    let temp = path.with_extension("toml.tmp");
-    std::fs::write(&temp, toml::to_string_pretty(&doc)?)?;
-    std::fs::rename(&temp, path)?;
-    Ok(())
+    Ok(doc.to_string())
 }

@@ -19,7 +19,8 @@ fn calibrate(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
 fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
     let temp = temp_dir("calibrate");
     let dir = temp.path();
-    std::fs::write(dir.join("scene.toml"), "builtin = \"contact\"\n").unwrap();
+    let authored = "# The courtyard, as its author wrote it.\nbuiltin = \"contact\"  # keep\n";
+    std::fs::write(dir.join("scene.toml"), authored).unwrap();
     let out = calibrate(
         dir,
         &[
@@ -63,6 +64,7 @@ fn calibrate_plots_the_front_picks_a_setting_and_writes_it() {
     assert!(colours.len() > 20, "{} colours", colours.len());
     // The chosen bias is in the scene file, which still loads and keeps its content.
     let written = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
+    assert!(written.starts_with(authored), "the author's comments and layout kept: {written}");
     let table: toml::Table = toml::from_str(&written).unwrap();
     assert_eq!(table["builtin"].as_str(), Some("contact"));
     let bias = &table["settings"]["shadow"]["bias"];
@@ -97,4 +99,34 @@ fn calibrate_refuses_empty_inverted_and_pointless_sweeps_before_any_work() {
         assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
         assert!(!dir.join("cal").exists(), "{args:?} wrote output");
     }
+}
+
+/// All or nothing (issue 49): a `--write` file that cannot be edited (not TOML) fails
+/// the run before any output is written (before the sweep, in fact), naming the file.
+#[test]
+fn calibrate_writes_nothing_when_its_scene_file_cannot_be_edited() {
+    let temp = temp_dir("calibrate-write");
+    let dir = temp.path();
+    std::fs::write(dir.join("scene.toml"), "builtin = \"contact\"\n").unwrap();
+    std::fs::write(dir.join("broken.toml"), "settings = [unclosed\n").unwrap();
+    let out = calibrate(
+        dir,
+        &[
+            "--technique",
+            "hard",
+            "--sweep-slope-bias",
+            "0..1:2",
+            "--views",
+            "2",
+            "--out",
+            "cal",
+            "--write",
+            "broken.toml",
+        ],
+    );
+    assert!(!out.status.success());
+    let said = stderr(&out);
+    assert!(said.contains("--write") && said.contains("broken.toml") && said.contains("not TOML"), "{said}");
+    assert!(!dir.join("cal").exists(), "wrote {:?}", files_in(&dir.join("cal")));
+    assert_eq!(std::fs::read_to_string(dir.join("broken.toml")).unwrap(), "settings = [unclosed\n");
 }

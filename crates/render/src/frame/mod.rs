@@ -211,6 +211,21 @@ impl Renderer {
         if width > max || height > max {
             return Err(RenderError::ImageTooLarge { width, height, max, adapter });
         }
+        // Every camera-sized target is read back through one buffer: the largest (16
+        // bytes a pixel) must fit the device's largest buffer.
+        let bytes = u64::from(width) * u64::from(height) * lighting::LARGEST_TARGET_BYTES;
+        if bytes > limits.max_buffer_size {
+            let max_buffer = limits.max_buffer_size;
+            let max_pixels = max_buffer / lighting::LARGEST_TARGET_BYTES;
+            return Err(RenderError::ImageTooManyBytes {
+                width,
+                height,
+                bytes,
+                max_buffer,
+                max_pixels,
+                adapter,
+            });
+        }
         self.moment_format(settings)?;
         Ok(())
     }

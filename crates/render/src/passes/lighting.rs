@@ -27,6 +27,10 @@ pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth3
 pub(crate) const TARGETS: [wgpu::TextureFormat; 5] =
     [COLOR_FORMAT, VISIBILITY_FORMAT, POSITION_FORMAT, NORMAL_FORMAT, ID_FORMAT];
 
+/// Bytes a pixel of the largest camera-sized target: the position and normal outputs'
+/// 32-bit RGBA, as the prepass's surface and normals.
+pub(crate) const LARGEST_TARGET_BYTES: u64 = 16;
+
 /// Bytes per pixel of all colour attachments together (checked against the device).
 pub(crate) fn target_bytes_per_pixel() -> u32 {
     TARGETS.iter().map(|f| f.block_copy_size(None).unwrap_or(16)).sum()

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use glam::Mat4;
 use gnomon_math::linearize_perspective_depth;
-use gnomon_render::{Gpu, OutputRequest, Renderer, timing::ClockChoice};
+use gnomon_render::{OutputRequest, Renderer, timing::ClockChoice};
 use gnomon_scene::{
     Light, Scene, Settings, builtin,
     settings::{BiasSettings, LightKind, Partition},
@@ -66,8 +66,8 @@ fn both_maps(renderer: &mut Renderer, scene: &Scene, settings: &Settings) -> (Ve
 /// same depth in every texel of every layer.
 #[test]
 fn the_baseline_draws_every_projected_layer_exactly_as_the_shadow_pass() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let mut cascaded = small();
     cascaded.shadow.partition = Partition::Cascades;
     let mut spot = small();
@@ -103,8 +103,8 @@ fn the_baseline_draws_every_projected_layer_exactly_as_the_shadow_pass() {
 /// pass's, in every texel of all six faces, and both cover the same texels.
 #[test]
 fn the_baseline_draws_the_cube_faces_the_shadow_pass_draws() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = baked(builtin::spheres());
     let mut s = small();
     s.light.kind = LightKind::Point;
@@ -155,8 +155,8 @@ fn the_baseline_draws_the_cube_faces_the_shadow_pass_draws() {
 /// alone.
 #[test]
 fn instanced_casters_differ_from_the_baseline_by_rounding_alone() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     assert!(scene.instances.iter().any(|i| i.world_from_object != Mat4::IDENTITY));
     let (ours, theirs, _) = both_maps(&mut renderer, &scene, &small());
@@ -186,8 +186,8 @@ fn instanced_casters_differ_from_the_baseline_by_rounding_alone() {
 /// against an independent one.
 #[test]
 fn the_baseline_times_fit_in_the_wall_clock_time_of_the_call() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::lamps();
     let mut s = small();
     s.light.kind = LightKind::All;

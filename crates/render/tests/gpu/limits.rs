@@ -28,8 +28,8 @@ fn a_shadow_map_larger_than_the_device_allows_is_refused_by_name() {
 
 #[test]
 fn settings_outside_their_ranges_are_refused_before_rendering() {
-    let gpu = Gpu::new_headless().expect("adapter");
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let mut s = Settings::default();
     s.shadow.map.resolution = 16384;
     let err = renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap_err();
@@ -43,8 +43,8 @@ fn settings_outside_their_ranges_are_refused_before_rendering() {
 
 #[test]
 fn an_empty_scene_is_refused() {
-    let gpu = Gpu::new_headless().expect("adapter");
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let mut scene = builtin::spheres();
     scene.instances.clear();
     let err = renderer.render(&scene, &Settings::default(), &OutputRequest::default()).unwrap_err();
@@ -111,4 +111,21 @@ fn refinement_falls_back_and_raytraced_is_refused_where_rays_cannot_run() {
 fn a_renderer_opens_on_a_device_with_default_limits() {
     let gpu = Gpu::new_headless_with(|l| *l = wgpu::Limits::default()).expect("adapter");
     Renderer::new(&gpu).expect("a renderer on default limits");
+}
+
+/// Issue 49: an image whose side the device takes but whose targets it cannot hold
+/// (16384² × 16 bytes is 4 GiB a target; lavapipe's largest buffer is 2 GiB) is
+/// refused before anything is created, naming the limit, not with a validation error
+/// about an invalid texture.
+#[test]
+fn an_image_larger_than_the_devices_largest_buffer_is_refused_by_name() {
+    let gpu = Gpu::new_headless_with(|l| l.max_buffer_size = 1 << 20).expect("adapter");
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (512, 512);
+    let err = renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap_err();
+    let RenderError::ImageTooManyBytes { bytes, max_buffer, max_pixels, .. } = err else { panic!("{err:?}") };
+    assert_eq!((bytes, max_buffer, max_pixels), (512 * 512 * 16, 1 << 20, (1 << 20) / 16));
+    (s.image.width, s.image.height) = (256, 256);
+    renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).expect("2¹⁶ pixels of 16 bytes fit");
 }

@@ -3,7 +3,7 @@
 
 use crate::support;
 
-use gnomon_render::{Gpu, OutputRequest, Renderer, read_texture};
+use gnomon_render::{OutputRequest, Renderer, read_texture};
 use gnomon_scene::{Settings, builtin, settings::Partition};
 
 fn small() -> Settings {
@@ -16,8 +16,8 @@ fn small() -> Settings {
 
 #[test]
 fn a_live_frame_is_the_frame_that_is_read_back() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut settings = small();
@@ -27,7 +27,7 @@ fn a_live_frame_is_the_frame_that_is_read_back() {
     let frame = renderer.render_uploaded(&uploaded, &scene, &settings, &OutputRequest::default()).unwrap();
     let live = renderer.render_live(&uploaded, &scene, &settings).unwrap();
     assert_eq!((live.color.width(), live.color.height()), (160, 96));
-    let color: Vec<u8> = read_texture(&gpu, &live.color).unwrap();
+    let color: Vec<u8> = read_texture(gpu, &live.color).unwrap();
     let differing = color.iter().zip(&frame.color).filter(|(a, b)| a.abs_diff(**b) > 2).count();
     assert_eq!(differing, 0, "the live image differs from the read-back one in {differing} channels");
     assert_eq!(live.layout.projections.len(), frame.cascades.len());
@@ -36,8 +36,8 @@ fn a_live_frame_is_the_frame_that_is_read_back() {
 
 #[test]
 fn the_map_preview_shows_every_cascade_in_gray_side_by_side() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::columns();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut settings = small();
@@ -47,7 +47,7 @@ fn the_map_preview_shows_every_cascade_in_gray_side_by_side() {
     let tile = 64;
     let preview = renderer.preview_shadow_map(&live, tile).unwrap();
     assert_eq!((preview.width(), preview.height()), (3 * tile, tile), "three cascades side by side");
-    let texels: Vec<u8> = read_texture(&gpu, &preview).unwrap();
+    let texels: Vec<u8> = read_texture(gpu, &preview).unwrap();
     // Every cascade sees the ground and some columns: a spread of grays, with the
     // columns' tops (nearest the sun) darker than the ground around them.
     for layer in 0..3 {
@@ -69,12 +69,12 @@ fn the_map_preview_shows_every_cascade_in_gray_side_by_side() {
 /// frame's pass times, and the first reports none.
 #[test]
 fn live_frames_report_the_previous_frames_times() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     if gpu.timestamp_period_ns.is_none() {
         support::figures::skipped("live frame timings", "the adapter has no timestamp queries");
         return;
     }
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut settings = small();

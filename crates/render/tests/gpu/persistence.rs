@@ -8,7 +8,7 @@
 use crate::support;
 
 use gnomon_render::{
-    Creations, Gpu, HostTarget, OutputRequest, Renderer,
+    Creations, HostTarget, OutputRequest, Renderer,
     techniques::{TechniqueRef, TechniqueRegistry},
     timing::ClockChoice,
     wgpu,
@@ -144,14 +144,14 @@ fn light_cases(technique: TechniqueRef) -> Vec<(&'static str, Settings)> {
 
 #[test]
 fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     let scene = builtin::spheres();
     let mut failures = Vec::new();
     let (mut checked, mut total) = (0, 0);
     for technique in TechniqueRegistry::builtin().iter() {
         for (name, settings) in light_cases(technique) {
             // A fresh renderer per case, so that each case warms up alone.
-            let mut renderer = Renderer::new(&gpu).unwrap();
+            let mut renderer = Renderer::new(gpu).unwrap();
             let created = created_in_steady_state(&mut renderer, &scene, &settings);
             checked += 1;
             total += created.total();
@@ -174,14 +174,14 @@ fn a_steady_frame_creates_nothing_for_every_technique_and_light_kind() {
 
 #[test]
 fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     let scene = builtin::lamps();
     // Auto: the light list on the mask path for Gnomon's frames; per-light maps for a
     // host's shader.
     for path in [ShadowPath::Forward, ShadowPath::Mask, ShadowPath::Auto] {
         let mut settings = small(Technique::PCF, LightKind::All);
         settings.screen.shadow_path = path;
-        let mut renderer = Renderer::new(&gpu).unwrap();
+        let mut renderer = Renderer::new(gpu).unwrap();
         let created = created_in_steady_state(&mut renderer, &scene, &settings);
         assert_eq!(created.total(), 0, "{path:?}: {created:?}");
     }
@@ -192,7 +192,7 @@ fn every_light_of_lamps_at_once_creates_nothing_in_steady_state() {
 /// for a sun with a disk (whose penumbra filter copies the mask into a pooled texture).
 #[test]
 fn refined_frames_create_nothing_in_steady_state() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     let cases = [
         (builtin::spheres(), LightKind::Sun, None),
         (builtin::lamps(), LightKind::All, None),
@@ -204,7 +204,7 @@ fn refined_frames_create_nothing_in_steady_state() {
             settings.light.sun_angular_diameter = sun_disk;
             settings.screen.refine = refine;
             settings.screen.shadow_path = ShadowPath::Mask;
-            let mut renderer = Renderer::new(&gpu).unwrap();
+            let mut renderer = Renderer::new(gpu).unwrap();
             let created = created_in_steady_state(&mut renderer, &scene, &settings);
             assert_eq!(created.total(), 0, "{} {refine:?}: {created:?}", scene.name);
         }
@@ -216,9 +216,9 @@ fn refined_frames_create_nothing_in_steady_state() {
 /// and nothing else; going back finds the first resources again.
 #[test]
 fn a_changed_setting_creates_only_what_depends_on_it() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     let scene = builtin::spheres();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let uploaded = renderer.upload(&scene).unwrap();
     let mut small_map = small(Technique::PCF, LightKind::Sun);
     // The pool's keying: a kept map (`map_cache.rs`) is its own texture, made again

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use glam::{Mat4, Vec3, Vec4};
 use gnomon_render::{
-    Gpu, OutputRequest, Renderer,
+    OutputRequest, Renderer,
     timing::{ClockChoice, PassKind, PassTime, TimingSource},
 };
 use gnomon_scene::{
@@ -23,8 +23,8 @@ fn small() -> Settings {
 
 #[test]
 fn identical_columns_are_one_instanced_draw() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::columns();
     assert_eq!(scene.instances.len(), 97, "a ground and 96 columns");
     let frame = renderer.render(&scene, &small(), &OutputRequest::default()).unwrap();
@@ -54,7 +54,7 @@ fn reaches_into_view(clip_from_world: Mat4, mesh: &gnomon_scene::Mesh, world_fro
 
 #[test]
 fn thousands_of_distinct_meshes_add_no_state_changes() {
-    let gpu = Gpu::new_headless().unwrap();
+    let gpu = crate::support::gpu();
     let stats_for = |count: usize| {
         let mut scene = builtin::contact();
         scene.instances.truncate(1);
@@ -72,7 +72,7 @@ fn thousands_of_distinct_meshes_add_no_state_changes() {
                 motion: gnomon_scene::Motion::Static,
             });
         }
-        let mut renderer = Renderer::new(&gpu).unwrap();
+        let mut renderer = Renderer::new(gpu).unwrap();
         let stats = renderer.render(&scene, &small(), &OutputRequest::default()).unwrap().stats;
         // The instances whose bounds reach into the camera's view, counted here by
         // brute force in clip space, independently of the renderer's culling.
@@ -102,8 +102,8 @@ fn thousands_of_distinct_meshes_add_no_state_changes() {
 
 #[test]
 fn timing_alone_submits_the_same_frame_as_a_full_render() {
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::spheres();
     let uploaded = renderer.upload(&scene).unwrap();
     // Both frames draw their maps: the second would keep the first's otherwise.
@@ -140,8 +140,8 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
     // one shadow time per layer, one lighting time per light (or one for them all,
     // from the light list), on GPU timestamps and on the CPU wall clock, with the
     // layer times summing to the light's shadow time.
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let mut cascaded = small();
     cascaded.shadow.partition = Partition::Cascades;
     cascaded.shadow.cascades.count = 3;
@@ -216,8 +216,8 @@ fn every_cascade_and_every_light_is_timed_on_either_clock() {
 fn culling_draws_only_what_the_light_and_camera_see_in_few_draws() {
     // 20 000 objects, nine tenths of them far away: each pass draws about a tenth of
     // them, in a number of draws far below the number of objects drawn.
-    let gpu = Gpu::new_headless().unwrap();
-    let mut renderer = Renderer::new(&gpu).unwrap();
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
     let scene = builtin::build("instances:20000").unwrap();
     let uploaded = renderer.upload(&scene).unwrap();
     assert_eq!(uploaded.instance_count(), 20_001);

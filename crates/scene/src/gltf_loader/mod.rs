@@ -21,6 +21,17 @@ use crate::{
 mod images;
 mod node_extras;
 mod primitives;
+pub mod sources;
+mod structure;
+
+pub use sources::UriScope;
+
+/// How a model is loaded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Where the buffer and image files it names may be: by default in its folder.
+    pub uri_scope: UriScope,
+}
 
 /// A glTF file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -51,12 +62,18 @@ pub struct FileExtras {
     pub warnings: Vec<String>,
 }
 
-/// Loads `path` into a scene. The camera and the lights come from the file when it
-/// has them; otherwise the camera is fitted to the bounds and a default sun (45° up)
-/// and spot light are placed.
+/// Loads `path` into a scene, with the default [`LoadOptions`] (the files it names
+/// must lie in its folder). The camera and the lights come from the file when it has
+/// them; otherwise the camera is fitted to the bounds and a default sun (45° up) and
+/// spot light are placed.
 pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Loads `path` into a scene as [`load`] does, with `options`.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtras), LoadError> {
     let fail = |problem: String| LoadError { path: path.to_path_buf(), problem };
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let bytes = read_model(path).map_err(fail)?;
     glb_header_fits(&bytes).map_err(fail)?;
     // A first look without validation, for the problems validation would misname.
     if let Ok(raw) = gltf::Gltf::from_slice_without_validation(&bytes) {
@@ -72,44 +89,61 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
         // unwrap indices that may be out of range (found by fuzzing).
         let json = raw.document.as_json();
         indices_the_crate_trusts(json).map_err(fail)?;
-        let buffers = json.buffers.iter().filter_map(|b| b.uri.as_deref().map(|u| ("buffer", u)));
-        let images = json.images.iter().filter_map(|i| i.uri.as_deref().map(|u| ("image", u)));
-        for (kind, uri) in buffers.chain(images) {
-            if !uri.starts_with("data:") && !base.join(uri).is_file() {
-                return Err(fail(format!(
-                    "its {kind} file `{uri}` is missing (looked in {})",
-                    base.display()
-                )));
+        // Every file the model names, checked before anything is read: missing,
+        // outside the model's folder, or not a regular file.
+        let buffers = json
+            .buffers
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| b.uri.as_deref().map(|u| (format!("buffer {i}"), u)));
+        let images = json
+            .images
+            .iter()
+            .enumerate()
+            .filter_map(|(i, m)| m.uri.as_deref().map(|u| (format!("image {i}"), u)));
+        for (what, uri) in buffers.chain(images) {
+            if !uri.starts_with("data:") {
+                sources::resolve(base, uri, options.uri_scope, &what).map_err(fail)?;
             }
         }
+        check_version(json).map_err(fail)?;
+        structure::check(json).map_err(fail)?;
     }
     // The gltf crate validates the JSON and the buffer and accessor ranges; guard
     // against a panic on data it does not check all the same.
     let base = path.parent().unwrap_or(Path::new("."));
-    let imported = std::panic::catch_unwind(|| {
-        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes)?;
-        let buffers = gltf::import_buffers(&document, Some(base), blob)?;
-        Ok::<_, gltf::Error>((document, buffers))
-    })
+    let mut budget = sources::Budget::default();
+    let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(|e| describe(&e))?;
+        let buffers = sources::buffers(&document, base, blob, options.uri_scope, &mut budget)?;
+        Ok::<_, String>((document, buffers))
+    }))
     .map_err(|_| fail("the glTF importer failed on malformed data".into()))?;
     let (document, buffers) = match imported {
         Ok(i) => i,
-        Err(e) => {
+        Err(problem) => {
             // Validation insists on min/max for positions, which files with NaN or
             // infinite positions often lack; say what is really wrong when we can.
             // Only then: any other fault may make the unvalidated read panic.
-            let only_bounds_missing = matches!(&e, gltf::Error::Validation(errors)
-                if errors.iter().all(|(path, _)| path.as_str().ends_with(".min") || path.as_str().ends_with(".max")));
-            if only_bounds_missing && let Some(problem) = non_finite_positions(path, &bytes) {
+            let only_bounds_missing = gltf::Gltf::from_slice(&bytes).err().is_some_and(|e| {
+                matches!(&e, gltf::Error::Validation(errors)
+                    if errors.iter().all(|(path, _)| path.as_str().ends_with(".min") || path.as_str().ends_with(".max")))
+            });
+            if only_bounds_missing
+                && let Some(problem) = non_finite_positions(path, &bytes, options.uri_scope)
+            {
                 return Err(fail(problem));
             }
-            return Err(fail(describe(&e)));
+            return Err(fail(problem));
         }
     };
+    accessors_fit(&document, &mut budget).map_err(fail)?;
     let extension_warnings = extensions(&document).map_err(fail)?;
-    let images = std::panic::catch_unwind(|| images::import(&document, base, &buffers))
-        .map_err(|_| fail("the glTF image reader failed on malformed data".into()))?
-        .map_err(fail)?;
+    let images = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        images::import(&document, base, &buffers, options.uri_scope, &mut budget)
+    }))
+    .map_err(|_| fail("the glTF image reader failed on malformed data".into()))?
+    .map_err(fail)?;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| build(path, &document, &buffers, &images)))
         .map(|built| {
             built.map(|(scene, mut extras)| {
@@ -119,6 +153,85 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
         })
         .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
         .map_err(fail)
+}
+
+/// The model file's bytes: a regular file (not a directory, FIFO or device, each of
+/// which is named as what it is), no larger than a model may be.
+fn read_model(path: &Path) -> Result<Vec<u8>, String> {
+    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => "cannot read: no such file".to_string(),
+        _ => format!("cannot read: {e}"),
+    })?;
+    if !metadata.is_file() {
+        return Err(format!("cannot read: it is {}, not a regular file", sources::file_kind(&metadata)));
+    }
+    let limit = crate::limits::MAX_MODEL_BYTES;
+    if metadata.len() > limit {
+        return Err(format!(
+            "the file is {}; a model may be at most {}",
+            sources::size(metadata.len()),
+            sources::size(limit)
+        ));
+    }
+    std::fs::read(path).map_err(|e| format!("cannot read: {e}"))
+}
+
+/// glTF 2.x only: `asset.version` is "2.0" (a `minVersion` above it is refused too).
+fn check_version(json: &gltf::json::Root) -> Result<(), String> {
+    let major = |v: &str| v.split('.').next().and_then(|m| m.parse::<u32>().ok());
+    let version = &json.asset.version;
+    if major(version) != Some(2) {
+        return Err(format!("`asset.version` is \"{version}\"; Gnomon reads glTF 2.x"));
+    }
+    if let Some(min) = &json.asset.min_version
+        && (major(min) != Some(2) || min.as_str() > "2.0")
+    {
+        return Err(format!("`asset.minVersion` is \"{min}\"; Gnomon reads glTF 2.0"));
+    }
+    Ok(())
+}
+
+/// Checks every accessor against what reading it would take, before anything is read:
+/// its byte stride against its element (the gltf crate asserts on a stride smaller
+/// than an element, and the spec asks for a multiple of 4 from 4 to 252), and its
+/// element count against the budget, which a sparse accessor with no buffer view
+/// leaves to its count alone (999,999,999 asked for 12 GB).
+fn accessors_fit(document: &gltf::Document, budget: &mut sources::Budget) -> Result<(), String> {
+    for accessor in document.accessors() {
+        let what = format!("accessor {}{}", accessor.index(), sources::named(accessor.name()));
+        let element = accessor.size() as u64;
+        if let Some(view) = accessor.view()
+            && let Some(stride) = view.stride()
+            && ((stride as u64) < element || stride % 4 != 0 || !(4..=252).contains(&stride))
+        {
+            return Err(format!(
+                "{what}: its buffer view {} has a byte stride of {stride}, for elements of {element} bytes; a stride is \
+                 a multiple of 4 from 4 to 252, at least an element's size",
+                view.index()
+            ));
+        }
+        // What the reader expands it to: at most 16 bytes an element of any type
+        // Gnomon reads (positions and normals as 3 × f32, UVs 2 × f32, indices u32),
+        // and the element itself as stored.
+        let expanded = (accessor.count() as u64).saturating_mul(element.max(16));
+        budget.take(expanded, &format!("{what}, {} elements,", accessor.count()))?;
+    }
+    Ok(())
+}
+
+/// Whether any instance has a triangle of non-zero area once placed: a file of
+/// degenerate triangles only (or of meshes flattened by their nodes) draws an empty
+/// sky, which a calibration would then measure as "0 pixels".
+fn draws_anything(meshes: &[crate::Mesh], instances: &[Instance]) -> bool {
+    instances.iter().any(|instance| {
+        let mesh = &meshes[instance.mesh];
+        let world: Vec<Vec3> =
+            mesh.positions.iter().map(|p| instance.world_from_object.transform_point3(*p)).collect();
+        mesh.indices.chunks_exact(3).any(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| world[i as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        })
+    })
 }
 
 /// Checks the indices that the gltf crate uses unchecked: its validation looks up
@@ -220,7 +333,7 @@ fn extensions(document: &gltf::Document) -> Result<Vec<String>, String> {
 }
 
 /// Reads the positions of an unvalidated file and reports the first NaN or infinity.
-fn non_finite_positions(path: &Path, bytes: &[u8]) -> Option<String> {
+fn non_finite_positions(path: &Path, bytes: &[u8], scope: UriScope) -> Option<String> {
     std::panic::catch_unwind(|| {
         let raw = gltf::Gltf::from_slice_without_validation(bytes).ok()?;
         // The reader unwraps the accessors' and views' indices: read only a file whose
@@ -239,7 +352,9 @@ fn non_finite_positions(path: &Path, bytes: &[u8]) -> Option<String> {
         if !(views_in_range && accessors_in_range && positions_in_range && positions_readable(json)) {
             return None;
         }
-        let buffers = gltf::import_buffers(&raw.document, path.parent(), raw.blob.clone()).ok()?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut budget = sources::Budget::default();
+        let buffers = sources::buffers(&raw.document, base, raw.blob.clone(), scope, &mut budget).ok()?;
         for mesh in raw.document.meshes() {
             for (k, prim) in mesh.primitives().enumerate() {
                 let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
@@ -364,12 +479,10 @@ fn build(
     let mut singular_nodes = 0usize;
     while let Some((node, parent, depth, parent_motion)) = stack.pop() {
         visits += 1;
-        // A node graph with a cycle would expand forever; glTF requires a forest.
-        if depth > 256 || visits > 4 * document.nodes().len() + 16 {
-            return Err(format!(
-                "node {} is part of a cycle in the node hierarchy (nodes must form trees)",
-                node.index()
-            ));
+        // A node graph with a cycle would expand forever; `structure::check` refused
+        // one already, and this bounds the walk whatever comes.
+        if depth > structure::MAX_NODE_DEPTH || visits > 4 * document.nodes().len() + 16 {
+            return Err(format!("node {} lies in a cycle or too deep in the node hierarchy", node.index()));
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         if !local.is_finite() {
@@ -432,6 +545,13 @@ fn build(
                 {
                     // glTF allows cones up to 90°; a spot's perspective map covers 89°.
                     let outer = outer_cone_angle.to_degrees().clamp(1.0, 89.0);
+                    if outer != outer_cone_angle.to_degrees() {
+                        extras.warnings.push(format!(
+                            "light {}: its outer cone of {:.2}° is drawn as {outer}° (a spot's map covers 1° to 89°)",
+                            light.index(),
+                            outer_cone_angle.to_degrees()
+                        ));
+                    }
                     Some(Light::Spot(SpotLight {
                         position,
                         direction,
@@ -477,6 +597,13 @@ fn build(
             Some(skipped) => format!("has no triangles to draw in its scene, only {skipped}"),
             None => "has no triangle meshes in its scene".into(),
         });
+    }
+    if !draws_anything(&meshes, &instances) {
+        return Err(format!(
+            "every triangle of its scene has zero area ({} instance(s) of {} mesh(es)): nothing would be drawn",
+            instances.len(),
+            meshes.len()
+        ));
     }
     // The light list in the file's order; the first of each type is the default.
     found.sort_by_key(|(index, _)| *index);

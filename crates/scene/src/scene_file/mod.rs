@@ -149,18 +149,71 @@ struct Source {
 impl Source {
     /// An error about the file as a whole.
     fn fail(&self, problem: impl Into<String>) -> SceneFileError {
-        SceneFileError { path: self.path.clone(), location: None, problem: problem.into() }
+        SceneFileError { path: self.path.clone(), location: None, problem: clipped(problem.into()) }
     }
 
     /// An error about the value at `key` (or the nearest table on its way).
     fn fail_at(&self, key: &KeyPath, problem: impl Into<String>) -> SceneFileError {
-        SceneFileError { path: self.path.clone(), location: locate(&self.text, key), problem: problem.into() }
+        SceneFileError {
+            path: self.path.clone(),
+            location: locate(&self.text, key),
+            problem: clipped(problem.into()),
+        }
     }
 }
 
-/// Loads the scene file at `path`, using the view called `view` (or the first).
+/// `problem` with every line longer than a screen's width cut short: toml's errors
+/// quote the offending line, which in a malformed file may be megabytes long.
+fn clipped(problem: String) -> String {
+    const KEEP: usize = 160;
+    if problem.lines().all(|l| l.chars().count() <= 2 * KEEP) {
+        return problem;
+    }
+    problem
+        .lines()
+        .map(|line| {
+            let n = line.chars().count();
+            if n <= 2 * KEEP {
+                line.to_owned()
+            } else {
+                format!("{}… ({} more characters)", line.chars().take(KEEP).collect::<String>(), n - KEEP)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Loads the scene file at `path`, using the view called `view` (or the first), its
+/// models with the default [`gltf_loader::LoadOptions`].
 pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFileError> {
+    load_with(path, view, &gltf_loader::LoadOptions::default())
+}
+
+/// Loads the scene file at `path` as [`load`] does, its models with `options`.
+pub fn load_with(
+    path: &Path,
+    view: Option<&str>,
+    options: &gltf_loader::LoadOptions,
+) -> Result<LoadedSceneFile, SceneFileError> {
     let unreadable = |problem: String| SceneFileError { path: path.to_path_buf(), location: None, problem };
+    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => unreadable("cannot read: no such file".into()),
+        _ => unreadable(format!("cannot read: {e}")),
+    })?;
+    if !metadata.is_file() {
+        return Err(unreadable(format!(
+            "cannot read: it is {}, not a regular file",
+            gltf_loader::sources::file_kind(&metadata)
+        )));
+    }
+    let limit = crate::limits::MAX_SCENE_FILE_BYTES;
+    if metadata.len() > limit {
+        return Err(unreadable(format!(
+            "the file is {}; a scene file may be at most {}",
+            gltf_loader::sources::size(metadata.len()),
+            gltf_loader::sources::size(limit)
+        )));
+    }
     let text = std::fs::read_to_string(path).map_err(|e| unreadable(format!("cannot read: {e}")))?;
     let source = Source { path: path.to_path_buf(), text };
     // toml's own errors carry the line, the column and the offending text.
@@ -180,7 +233,7 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
         }
         toml::from_str::<SettingsOnly>(&source.text).map_err(|e| source.fail(format!("[settings]: {e}")))?;
     }
-    let (mut scene, warnings) = start_scene(&file, &source)?;
+    let (mut scene, warnings) = start_scene(&file, &source, options)?;
     scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let bounds = scene.bounds();
     if file.builtin.is_none() {
@@ -192,6 +245,19 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
     }
     apply_lights(&file, &source, &mut scene)?;
     let view_names: Vec<String> = file.view.iter().map(|v| v.name.clone()).collect();
+    // `--view NAME` would pick the first of two views of one name, silently.
+    for (i, name) in view_names.iter().enumerate() {
+        if let Some(first) = view_names[..i].iter().position(|n| n == name) {
+            return Err(source.fail_at(
+                &[Step::Key("view"), Step::Index(i), Step::Key("name")],
+                format!(
+                    "[[view]] {} has the name `{name}` of [[view]] {}: each view needs a name of its own",
+                    i + 1,
+                    first + 1
+                ),
+            ));
+        }
+    }
     let chosen = match view {
         Some(name) => Some(file.view.iter().position(|v| v.name == name).ok_or_else(|| {
             source.fail(if view_names.is_empty() {
@@ -227,7 +293,11 @@ pub fn load(path: &Path, view: Option<&str>) -> Result<LoadedSceneFile, SceneFil
 
 /// The built-in scene the file starts from, with its models placed, and what their
 /// loading warned of.
-fn start_scene(file: &SceneFile, source: &Source) -> Result<(Scene, Vec<String>), SceneFileError> {
+fn start_scene(
+    file: &SceneFile,
+    source: &Source,
+    options: &gltf_loader::LoadOptions,
+) -> Result<(Scene, Vec<String>), SceneFileError> {
     let mut warnings = Vec::new();
     let mut scene: Option<Scene> = match &file.builtin {
         Some(name) => Some(crate::builtin::build(name).map_err(|e| {
@@ -245,8 +315,8 @@ fn start_scene(file: &SceneFile, source: &Source) -> Result<(Scene, Vec<String>)
     for (i, model) in file.model.iter().enumerate() {
         let at = |key: &'static str| [Step::Key("model"), Step::Index(i), Step::Key(key)];
         let model_path = base.join(&model.file);
-        let (loaded, extras) =
-            gltf_loader::load(&model_path).map_err(|e| source.fail_at(&at("file"), format!("model: {e}")))?;
+        let (loaded, extras) = gltf_loader::load_with(&model_path, options)
+            .map_err(|e| source.fail_at(&at("file"), format!("model: {e}")))?;
         warnings.extend(extras.warnings.iter().map(|w| format!("model `{}`: {w}", model.file.display())));
         let [rx, ry, rz] = model.rotation_degrees.map(f32::to_radians);
         let world_from_model = Mat4::from_scale_rotation_translation(

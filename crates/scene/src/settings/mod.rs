@@ -110,10 +110,13 @@ pub enum DebugView {
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ImageSettings {
-    /// Image width in pixels (1 to 16384).
+    /// Image width in pixels: 1 to 16384, and as the device allows (its largest
+    /// texture, and its largest buffer for 16 bytes a pixel), checked before
+    /// rendering.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image"))]
     pub width: u32,
-    /// Image height in pixels (1 to 16384).
+    /// Image height in pixels: 1 to 16384, and as the device allows (see
+    /// `--width`).
     #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image"))]
     pub height: u32,
     /// A diagnostic view over the image.
@@ -163,6 +166,10 @@ impl CameraSettings {
     }
 }
 
+/// The largest image side Gnomon allows, whatever the device (the renderer also
+/// holds an image to what the device can hold).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
 /// The largest shadow map Gnomon allows, whatever the device.
 pub const MAX_SHADOW_RESOLUTION: u32 = 8192;
 
@@ -179,8 +186,9 @@ impl Settings {
     /// largest texture) are checked by the renderer, which knows the device.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let i = &self.image;
-        check((1..=16384).contains(&i.width), "image.width", i.width, "1 to 16384 pixels")?;
-        check((1..=16384).contains(&i.height), "image.height", i.height, "1 to 16384 pixels")?;
+        let valid = format!("1 to {MAX_IMAGE_SIDE} pixels");
+        check((1..=MAX_IMAGE_SIDE).contains(&i.width), "image.width", i.width, &valid)?;
+        check((1..=MAX_IMAGE_SIDE).contains(&i.height), "image.height", i.height, &valid)?;
         let c = &self.camera;
         check_vec(c.eye, "camera.eye")?;
         check_vec(c.target, "camera.target")?;

@@ -44,6 +44,11 @@ const RULES: &[(&str, Uses, &str)] = &[
         |_, lights| lights.iter().any(|l| matches!(l.light, Light::Point(_))),
         "a point light",
     ),
+    (
+        "shadow.map.resolution",
+        |s, lights| lights.iter().any(|l| l.shadow.map.resolution == s.shadow.map.resolution),
+        "a light that does not set its own (each light here sets its own `shadow.map.resolution` in the scene)",
+    ),
     ("shadow.cascades.count", uses_cascades, CASCADES),
     ("shadow.cascades.split", uses_cascades, CASCADES),
     ("shadow.cascades.split_lambda", uses_cascades, CASCADES),
@@ -132,6 +137,22 @@ mod tests {
         let lights = s.resolve_lights(&scene).unwrap();
         let unused: Vec<&str> = s.unused(&lights).iter().map(|u| u.setting).collect();
         assert_eq!(unused, ["light.light_index", "light.spot_range"], "a point light uses the paraboloid");
+    }
+
+    /// Issue 49: `lamps:64 --light all --shadow-res 8192` drew every lamp's cube at
+    /// its own 256² without a word.
+    #[test]
+    fn a_resolution_every_light_overrides_is_reported() {
+        let scene = builtin::build("lamps:4").unwrap();
+        let mut s = Settings::default();
+        s.light.kind = LightKind::All;
+        s.shadow.map.resolution = 8192;
+        let lights = s.resolve_lights(&scene).unwrap();
+        let unused: Vec<&str> = s.unused(&lights).iter().map(|u| u.setting).collect();
+        assert_eq!(unused, ["shadow.map.resolution"]);
+        s.light.kind = LightKind::Sun;
+        let lights = s.resolve_lights(&scene).unwrap();
+        assert!(s.unused(&lights).is_empty(), "the sun alone takes the render's resolution");
     }
 
     #[test]

@@ -71,7 +71,7 @@ fn every_broken_file_gives_a_clear_error() {
     let e = broken("IndexOutOfRange.gltf");
     assert!(e.contains("index 255 is out of range for its 24 vertices"), "{e}");
     let e = broken("MissingBin.gltf");
-    assert!(e.contains("buffer file `BoxTextured0.bin` is missing"), "{e}");
+    assert!(e.contains("buffer 0: its file `BoxTextured0.bin` is missing"), "{e}");
     let e = broken("RecursiveNodes.gltf");
     assert!(e.contains("cycle"), "{e}");
     let e = broken("BoxWithInfinites.glb");

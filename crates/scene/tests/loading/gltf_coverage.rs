@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{glb, temp_dir};
+use common::{glb, png_declaring, temp_dir};
 use gnomon_scene::gltf_loader;
 
 /// A unit quad's four corners (48 bytes) then the indices 0, 1, 2, 3 as u16 (8 bytes).
@@ -26,11 +26,13 @@ struct Quad<'a> {
     matrix: Option<&'a str>,
     /// Extra top-level JSON members (`"extensionsUsed": [...]`), each followed by a comma.
     extra: &'a str,
+    /// More nodes drawing the mesh untransformed, beside the first.
+    copies: usize,
 }
 
 impl Default for Quad<'_> {
     fn default() -> Self {
-        Quad { modes: &[5], index_count: 4, matrix: None, extra: "" }
+        Quad { modes: &[5], index_count: 4, matrix: None, extra: "", copies: 0 }
     }
 }
 
@@ -45,8 +47,8 @@ fn quad_json(q: &Quad, bin_length: usize, image: &str) -> String {
         r#"{{
   "asset": {{"version": "2.0"}}, {extra}
   "scene": 0,
-  "scenes": [{{"nodes": [0]}}],
-  "nodes": [{{"mesh": 0{matrix}}}],
+  "scenes": [{{"nodes": [{roots}]}}],
+  "nodes": [{{"mesh": 0{matrix}}}{copies}],
   "meshes": [{{"primitives": [{primitives}]}}],
   "buffers": [{{"byteLength": {bin_length}}}],
   "bufferViews": [{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 8}}{image_view}],
@@ -54,6 +56,8 @@ fn quad_json(q: &Quad, bin_length: usize, image: &str) -> String {
                 {{"bufferView": 1, "componentType": 5123, "count": {count}, "type": "SCALAR"}}]{images}
 }}"#,
         extra = q.extra,
+        roots = (0..=q.copies).map(|i| i.to_string()).collect::<Vec<_>>().join(", "),
+        copies = r#", {"mesh": 0}"#.repeat(q.copies),
         primitives = primitives.join(", "),
         count = q.index_count,
         image_view = if image.is_empty() {
@@ -102,10 +106,14 @@ fn an_index_accessor_past_its_buffer_is_an_error_that_names_it() {
 }
 
 #[test]
-fn a_singular_node_matrix_warns() {
+fn a_singular_node_matrix_warns_and_a_scene_of_nothing_else_is_refused() {
     let zero = "[0,0,0,0, 0,0,0,0, 0,0,0,0, 0,0,0,0]";
-    let (_, extras) = load("singular", &Quad { matrix: Some(zero), ..Default::default() }).unwrap();
+    let (_, extras) =
+        load("singular", &Quad { matrix: Some(zero), copies: 1, ..Default::default() }).unwrap();
     assert!(extras.warnings.iter().any(|w| w.contains("singular transform")), "{:?}", extras.warnings);
+    // Alone, the flattened mesh would draw an empty sky.
+    let e = load("flattened", &Quad { matrix: Some(zero), ..Default::default() }).unwrap_err();
+    assert!(e.contains("zero area"), "{e}");
 }
 
 #[test]
@@ -117,34 +125,6 @@ fn ignored_extensions_warn_and_unreadable_required_ones_fail() {
         r#""extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"],"#;
     let e = load("required", &Quad { extra: required, ..Default::default() }).unwrap_err();
     assert!(e.contains("KHR_mesh_quantization"), "{e}");
-}
-
-/// CRC-32 (ISO 3309, as PNG uses): for the hand-made PNG header below.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = if crc & 1 == 1 { (crc >> 1) ^ 0xEDB8_8320 } else { crc >> 1 };
-        }
-    }
-    !crc
-}
-
-/// A PNG whose header declares `side`² pixels, with no pixel data behind it (an
-/// empty IDAT chunk, then IEND).
-fn png_declaring(side: u32) -> Vec<u8> {
-    let mut ihdr = b"IHDR".to_vec();
-    ihdr.extend(side.to_be_bytes());
-    ihdr.extend(side.to_be_bytes());
-    ihdr.extend([8, 6, 0, 0, 0]); // 8-bit RGBA, deflate, adaptive filter, no interlace
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    for chunk in [&ihdr[..], b"IDAT", b"IEND"] {
-        png.extend((chunk.len() as u32 - 4).to_be_bytes());
-        png.extend(chunk);
-        png.extend(crc32(chunk).to_be_bytes());
-    }
-    png
 }
 
 #[test]

@@ -5,4 +5,5 @@ mod common;
 
 mod gltf;
 mod gltf_coverage;
+mod hostile;
 mod scene_file;

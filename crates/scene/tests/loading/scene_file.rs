@@ -334,3 +334,31 @@ file = "moving.glb"
     let message = error.to_string();
     assert!(message.contains("fast") && message.contains("dynamic"), "{message}");
 }
+
+/// Issue 49: two views of one name (`--view` would pick the first, silently), a file
+/// too large to be a scene file, a directory, and a long malformed line, which toml
+/// quotes in its error, cut short.
+#[test]
+fn duplicate_views_oversized_files_and_directories_are_refused_by_name() {
+    let temp = temp_dir("scene-file-hostile");
+    let dir = temp.path();
+    let view = "[[view]]\nname = \"top\"\neye = [0.0, 9.0, 0.0]\ntarget = [0.0, 0.0, 0.1]\n";
+    let path = write_scene(dir, &format!("[[model]]\nfile = \"tri.glb\"\n{view}{view}"));
+    let e = scene_file::load(&path, None).err().unwrap().to_string();
+    assert!(e.contains("[[view]] 2 has the name `top` of [[view]] 1"), "{e}");
+    let big = dir.join("big.toml");
+    std::fs::write(&big, vec![b'#'; 2 << 20]).unwrap();
+    let e = scene_file::load(&big, None).err().unwrap().to_string();
+    assert!(e.contains("2.0 MiB") && e.contains("at most 1.0 MiB"), "{e}");
+    let e = scene_file::load(dir, None).err().unwrap().to_string();
+    assert!(e.contains("is a directory"), "{e}");
+    let long = dir.join("long.toml");
+    std::fs::write(&long, format!("builtin = \"spheres\"\nx = [{}", "1,".repeat(200_000))).unwrap();
+    let e = scene_file::load(&long, None).err().unwrap().to_string();
+    assert!(
+        e.len() < 2_000 && e.contains("more characters"),
+        "{} bytes: {}",
+        e.len(),
+        &e[..e.len().min(400)]
+    );
+}

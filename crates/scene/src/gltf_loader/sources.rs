@@ -1,0 +1,283 @@
+//! Where a glTF file's bytes come from, each source checked before it is read: the
+//! GLB's binary chunk, data URIs, and files the model names. A model is untrusted
+//! input: a few kilobytes of JSON may name an 8 GB file, a device, a FIFO, or a path
+//! outside its folder (`../../etc/passwd`), and declare buffers, accessors and images
+//! far larger than the file. So:
+//!
+//! - a URI resolves inside the model's folder (after symbolic links), unless the
+//!   caller allows more ([`UriScope::Anywhere`]); data URIs and the GLB chunk are
+//!   always fine;
+//! - a file must be a regular file, and is read up to the length the model declares;
+//! - every size is charged to one [`Budget`] before anything of that size is
+//!   allocated: buffers, decoded images and the accessors the loader expands.
+
+use std::{
+    io::Read,
+    path::{Path, PathBuf},
+};
+
+use crate::limits::MAX_MODEL_BYTES;
+
+/// Where the files a model names may be.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UriScope {
+    /// In the model's folder or below it: what an embedding that loads models from
+    /// others should allow.
+    #[default]
+    ModelFolder,
+    /// Anywhere the process may read.
+    Anywhere,
+}
+
+/// The bytes a model may make the loader hold: its buffers, its decoded images and
+/// the vertex data it expands, together ([`MAX_MODEL_BYTES`]).
+#[derive(Debug)]
+pub struct Budget {
+    left: u64,
+}
+
+impl Default for Budget {
+    fn default() -> Self {
+        Budget { left: MAX_MODEL_BYTES }
+    }
+}
+
+impl Budget {
+    /// Charges `bytes` for `what` (`buffer 2 (`body`)`), or says why it cannot.
+    pub fn take(&mut self, bytes: u64, what: &str) -> Result<(), String> {
+        if bytes > self.left {
+            return Err(format!(
+                "{what} takes {} but the model may take at most {} in all (buffers, decoded images \
+                 and vertex data; {} left)",
+                size(bytes),
+                size(MAX_MODEL_BYTES),
+                size(self.left)
+            ));
+        }
+        self.left -= bytes;
+        Ok(())
+    }
+}
+
+/// `bytes` in words: `8.0 GB`, `294 KB`.
+pub fn size(bytes: u64) -> String {
+    match bytes {
+        b if b >= 1 << 30 => format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30)),
+        b if b >= 1 << 20 => format!("{:.1} MiB", b as f64 / f64::from(1u32 << 20)),
+        b if b >= 1 << 10 => format!("{:.1} KiB", b as f64 / 1024.0),
+        b => format!("{b} bytes"),
+    }
+}
+
+/// The file a URI names, resolved against the model's folder `base` and checked:
+/// inside the folder unless `scope` allows more, and a regular file.
+pub fn resolve(base: &Path, uri: &str, scope: UriScope, what: &str) -> Result<PathBuf, String> {
+    let decoded = percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
+        .map_err(|_| format!("{what}: its URI `{uri}` is not UTF-8 once decoded"))?;
+    if decoded.contains("://") || decoded.starts_with("file:") {
+        return Err(format!(
+            "{what}: its URI `{uri}` names a scheme; only relative paths and data URIs are read"
+        ));
+    }
+    let path = base.join(decoded.as_ref());
+    let metadata = std::fs::metadata(&path).map_err(|e| {
+        let base_shown = if base.as_os_str().is_empty() { Path::new(".") } else { base };
+        match e.kind() {
+            std::io::ErrorKind::NotFound => {
+                format!("{what}: its file `{uri}` is missing (looked in {})", base_shown.display())
+            }
+            _ => format!("{what}: cannot read its file `{uri}`: {e}"),
+        }
+    })?;
+    if !metadata.is_file() {
+        return Err(format!("{what}: `{uri}` is {}, not a regular file", file_kind(&metadata)));
+    }
+    if scope == UriScope::ModelFolder {
+        let folder =
+            std::fs::canonicalize(if base.as_os_str().is_empty() { Path::new(".") } else { base })
+                .map_err(|e| format!("{what}: cannot resolve the model's folder {}: {e}", base.display()))?;
+        let target =
+            std::fs::canonicalize(&path).map_err(|e| format!("{what}: cannot resolve `{uri}`: {e}"))?;
+        if !target.starts_with(&folder) {
+            return Err(format!(
+                "{what}: `{uri}` lies outside the model's folder ({}); a model may only name files beside \
+                 or below it (a caller may allow more: `UriScope::Anywhere`)",
+                folder.display()
+            ));
+        }
+    }
+    Ok(path)
+}
+
+/// What kind of file system entry `metadata` describes, for a message.
+pub fn file_kind(metadata: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = metadata.file_type();
+        if kind.is_fifo() {
+            return "a FIFO";
+        }
+        if kind.is_char_device() {
+            return "a character device";
+        }
+        if kind.is_block_device() {
+            return "a block device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if metadata.is_dir() { "a directory" } else { "not a regular file" }
+}
+
+/// The first `length` bytes of the regular file at `path` (checked by [`resolve`]),
+/// which must hold at least that many.
+pub fn read_prefix(path: &Path, length: u64, what: &str, uri: &str) -> Result<Vec<u8>, String> {
+    let file = std::fs::File::open(path).map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?;
+    let on_disk = file.metadata().map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?.len();
+    if on_disk < length {
+        return Err(format!(
+            "{what}: its file `{uri}` holds {} but the model declares {}",
+            size(on_disk),
+            size(length)
+        ));
+    }
+    let mut bytes = Vec::with_capacity(length as usize);
+    file.take(length)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?;
+    Ok(bytes)
+}
+
+/// The bytes of a data URI (`data:[<type>][;base64],<data>`).
+pub fn data_uri(uri: &str, what: &str) -> Result<Vec<u8>, String> {
+    let (header, payload) = uri
+        .strip_prefix("data:")
+        .and_then(|rest| rest.split_once(','))
+        .ok_or_else(|| format!("{what}: its data URI has no `,` after its header"))?;
+    if !header.ends_with(";base64") {
+        return Ok(percent_encoding::percent_decode_str(payload).collect());
+    }
+    base64::decode(payload.trim())
+        .map_err(|e| format!("{what}: its data URI is not valid base64: {}", base64_error(&e)))
+}
+
+fn base64_error(e: &base64::DecodeError) -> String {
+    match e {
+        base64::DecodeError::InvalidByte(offset, byte) => {
+            format!("byte {byte} (`{}`) at offset {offset} of its data", char::from(*byte).escape_default())
+        }
+        base64::DecodeError::InvalidLength => "its length is not that of base64 data".into(),
+        base64::DecodeError::InvalidLastSymbol(offset, byte) => {
+            format!("its last symbol {byte} at offset {offset} has bits past the data's end")
+        }
+    }
+}
+
+/// Reads every buffer of `document`, each checked and charged to `budget` first: the
+/// GLB's binary chunk `blob`, a data URI, or a file beside the model.
+pub fn buffers(
+    document: &gltf::Document,
+    base: &Path,
+    mut blob: Option<Vec<u8>>,
+    scope: UriScope,
+    budget: &mut Budget,
+) -> Result<Vec<gltf::buffer::Data>, String> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let what = format!("buffer {}{}", buffer.index(), named(buffer.name()));
+        let length = buffer.length() as u64;
+        budget.take(length, &what)?;
+        let mut bytes = match buffer.source() {
+            gltf::buffer::Source::Bin => blob
+                .take()
+                .ok_or_else(|| format!("{what} is the GLB's binary chunk, which the file lacks"))?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => data_uri(uri, &what)?,
+            gltf::buffer::Source::Uri(uri) => {
+                read_prefix(&resolve(base, uri, scope, &what)?, length, &what, uri)?
+            }
+        };
+        if (bytes.len() as u64) < length {
+            return Err(format!("{what} holds {} but declares {}", size(bytes.len() as u64), size(length)));
+        }
+        // The glTF crate pads each buffer to a multiple of four, as its reader expects.
+        bytes.truncate(length as usize);
+        while bytes.len() % 4 != 0 {
+            bytes.push(0);
+        }
+        buffers.push(gltf::buffer::Data(bytes));
+    }
+    Ok(buffers)
+}
+
+/// ` (`name`)`, or nothing for an unnamed element.
+pub fn named(name: Option<&str>) -> String {
+    name.map(|n| format!(" (`{n}`)")).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_uri_outside_the_models_folder_is_refused_unless_allowed() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        std::fs::write(dir.path().join("secret.bin"), b"1234").unwrap();
+        std::fs::write(model.join("mine.bin"), b"5678").unwrap();
+        let e = resolve(&model, "../secret.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+        assert!(e.contains("outside the model's folder"), "{e}");
+        assert!(resolve(&model, "../secret.bin", UriScope::Anywhere, "buffer 0").is_ok());
+        assert!(resolve(&model, "mine.bin", UriScope::ModelFolder, "buffer 0").is_ok());
+        let absolute = dir.path().join("secret.bin");
+        let e = resolve(&model, absolute.to_str().unwrap(), UriScope::ModelFolder, "buffer 0").unwrap_err();
+        assert!(e.contains("outside the model's folder"), "{e}");
+        let e = resolve(&model, "file:///etc/passwd", UriScope::Anywhere, "buffer 0").unwrap_err();
+        assert!(e.contains("scheme"), "{e}");
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(dir.path().join("secret.bin"), model.join("link.bin")).unwrap();
+            let e = resolve(&model, "link.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+            assert!(e.contains("outside the model's folder"), "a link out of the folder: {e}");
+        }
+    }
+
+    #[test]
+    fn a_directory_or_a_device_is_named_for_what_it_is() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        let e = resolve(dir.path(), "sub", UriScope::ModelFolder, "image 1").unwrap_err();
+        assert!(e.contains("is a directory"), "{e}");
+        #[cfg(unix)]
+        {
+            let e = resolve(Path::new("/dev"), "null", UriScope::Anywhere, "image 1").unwrap_err();
+            assert!(e.contains("a character device"), "{e}");
+        }
+        let e = resolve(dir.path(), "gone.png", UriScope::ModelFolder, "image 1").unwrap_err();
+        assert!(e.contains("is missing"), "{e}");
+    }
+
+    #[test]
+    fn a_file_shorter_than_declared_and_a_bad_data_uri_name_their_buffer() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("short.bin");
+        std::fs::write(&path, b"12").unwrap();
+        let e = read_prefix(&path, 8, "buffer 3", "short.bin").unwrap_err();
+        assert!(e.contains("buffer 3") && e.contains("2 bytes") && e.contains("8 bytes"), "{e}");
+        assert_eq!(read_prefix(&path, 1, "buffer 3", "short.bin").unwrap(), b"1");
+        let e = data_uri("data:application/octet-stream;base64,!AAA", "buffer 0").unwrap_err();
+        assert!(e.contains("buffer 0") && e.contains("base64") && e.contains("offset 0"), "{e}");
+        assert_eq!(data_uri("data:application/octet-stream;base64,AQID", "buffer 0").unwrap(), [1, 2, 3]);
+    }
+
+    #[test]
+    fn the_budget_refuses_what_it_cannot_hold_and_says_how_much() {
+        let mut budget = Budget::default();
+        budget.take(MAX_MODEL_BYTES / 2, "buffer 0").unwrap();
+        let e = budget.take(MAX_MODEL_BYTES, "image 4").unwrap_err();
+        assert!(e.contains("image 4") && e.contains("GiB"), "{e}");
+    }
+}
