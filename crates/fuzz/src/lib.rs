@@ -36,9 +36,36 @@ pub struct Report {
     pub slowest: Duration,
 }
 
+/// Where the input being tried is kept while it runs: a file opened once and
+/// rewritten in place before each execution, so that when the process dies on an
+/// input (an allocation over the memory cap aborts it), the supervisor finds the
+/// input that killed it (`gnomon-fuzz` without `--worker`).
+pub struct CurrentInput(std::fs::File);
+
+impl CurrentInput {
+    /// Opens (creates or truncates) the file at `path`.
+    pub fn create(path: &Path) -> std::io::Result<Self> {
+        std::fs::File::create(path).map(CurrentInput)
+    }
+
+    fn store(&self, input: &[u8]) {
+        use std::os::unix::fs::FileExt;
+        // Best effort: a failed write only loses the name of a later crash.
+        let _ = self.0.set_len(0).and_then(|()| self.0.write_all_at(input, 0));
+    }
+}
+
 /// Runs `target` for `duration` from the seeds in `seeds`, with a fixed `seed` for
-/// the mutator so a run can be repeated. Inputs that panic are written to `crashes`.
-pub fn run(target: Target, seeds: &[PathBuf], duration: Duration, seed: u64, crashes: &Path) -> Report {
+/// the mutator so a run can be repeated. Inputs that panic are written to `crashes`;
+/// each input is kept in `current`, when given, while it runs.
+pub fn run(
+    target: Target,
+    seeds: &[PathBuf],
+    duration: Duration,
+    seed: u64,
+    crashes: &Path,
+    current: Option<&CurrentInput>,
+) -> Report {
     let mut corpus: Vec<Vec<u8>> = seeds.iter().filter_map(|p| std::fs::read(p).ok()).collect();
     if corpus.is_empty() {
         corpus.push(Vec::new());
@@ -65,6 +92,9 @@ pub fn run(target: Target, seeds: &[PathBuf], duration: Duration, seed: u64, cra
             let other = &corpus[rng.below(corpus.len())];
             mutate::mutate(base, other, target.mutation_hints(), &mut rng)
         };
+        if let Some(current) = current {
+            current.store(&input);
+        }
         let one = Instant::now();
         let panics_before = PANICS.load(std::sync::atomic::Ordering::Relaxed);
         let outcome = std::panic::catch_unwind(|| target.run(&input, workdir.path()));

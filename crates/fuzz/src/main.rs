@@ -1,17 +1,63 @@
 //! `gnomon-fuzz`: runs the fuzz targets for a while and reports executions, outcomes
-//! and crashes. Exits with 1 if any input panicked (saved under `--crashes`).
+//! and crashes. Exits with 1 if any input panicked or took more memory than the cap
+//! (each saved under `--crashes`).
 //!
 //! ```sh
 //! cargo run --release -p gnomon-fuzz -- --seconds 60            # every target, 60 s each (CI)
 //! cargo run --release -p gnomon-fuzz -- gltf --seconds 3600     # one target for an hour
 //! ```
+//!
+//! Each target runs in a worker process under a memory cap (`--memory-cap-mb`, 1 GiB
+//! by default): an allocation that would take the process past it fails, which
+//! aborts the worker as a real out-of-memory would abort Gnomon. The supervisor (this
+//! process without `--worker`) finds the input that was running in the file the
+//! worker keeps it in, saves it as a crash, and starts a new worker for the rest of
+//! the target's time. So a small file that makes Gnomon allocate gigabytes is found
+//! as a crash, not lost with the process.
 
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Duration;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use clap::Parser;
-use gnomon_fuzz::{Target, files_under};
+use gnomon_fuzz::{CurrentInput, Report, Target, files_under};
+
+/// The system allocator, refusing what would take the live heap past `CAP` bytes (0:
+/// no cap). Only a worker sets the cap.
+struct Capped;
+
+static CAP: AtomicUsize = AtomicUsize::new(0);
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: every call goes to `System` unchanged, or returns null as a failed
+// allocation may; `LIVE` counts what `System` holds for us.
+unsafe impl GlobalAlloc for Capped {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let cap = CAP.load(Ordering::Relaxed);
+        let live = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+        if cap != 0 && live > cap {
+            LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+            return std::ptr::null_mut();
+        }
+        // SAFETY: the caller's layout, as `GlobalAlloc::alloc` requires.
+        let p = unsafe { System.alloc(layout) };
+        if p.is_null() {
+            LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+        // SAFETY: `ptr` came from `alloc` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Capped = Capped;
 
 /// Fuzz Gnomon's inputs (no GPU needed).
 #[derive(Parser)]
@@ -26,12 +72,21 @@ struct Args {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// More seed files or folders, for every target [default: the examples, the
-    /// broken glTF test files, and ../shared/scenes/assimp-gltf2 when present].
+    /// broken glTF test files, the fuzzer's own seeds, and
+    /// ../shared/scenes/assimp-gltf2 when present].
     #[arg(long = "seeds", value_name = "PATH")]
     seeds: Vec<PathBuf>,
-    /// Where inputs that panic are written.
+    /// Where inputs that panic or exceed the memory cap are written.
     #[arg(long, default_value = "fuzz-crashes")]
     crashes: PathBuf,
+    /// The memory a target's process may hold, in MiB: an allocation past it is a
+    /// crash (Gnomon must refuse such an input before allocating).
+    #[arg(long, default_value_t = 1024)]
+    memory_cap_mb: usize,
+    /// Run one target in this process and write its report to this file (what the
+    /// supervisor starts; not for use by hand).
+    #[arg(long, hide = true, value_name = "REPORT")]
+    worker: Option<PathBuf>,
 }
 
 /// The seed files a target starts from, besides its built-in seeds.
@@ -48,6 +103,7 @@ fn default_seeds(target: Target) -> Vec<PathBuf> {
         Target::Gltf => [
             root.join("examples/data"),
             root.join("crates/scene/tests/data/broken"),
+            root.join("crates/fuzz/seeds/gltf"),
             root.join("../shared/scenes/assimp-gltf2"),
         ]
         .into_iter()
@@ -60,64 +116,178 @@ fn default_seeds(target: Target) -> Vec<PathBuf> {
 
 fn main() -> ExitCode {
     let args = Args::parse();
-    let targets: Vec<Target> = if args.targets.is_empty() {
-        Target::ALL.to_vec()
-    } else {
-        let mut chosen = Vec::new();
-        for name in &args.targets {
-            match Target::named(name) {
-                Some(t) => chosen.push(t),
-                None => {
-                    eprintln!("gnomon-fuzz: error: no target `{name}`: choose scene-file, gltf or flags");
-                    return ExitCode::FAILURE;
-                }
+    let mut targets = Vec::new();
+    for name in &args.targets {
+        match Target::named(name) {
+            Some(t) => targets.push(t),
+            None => {
+                eprintln!("gnomon-fuzz: error: no target `{name}`: choose scene-file, gltf or flags");
+                return ExitCode::FAILURE;
             }
         }
-        chosen
-    };
+    }
+    if targets.is_empty() {
+        targets = Target::ALL.to_vec();
+    }
+    if let Some(report_path) = &args.worker {
+        return worker(&args, targets[0], report_path);
+    }
     println!(
-        "| target | seconds | executions | per second | distinct outcomes | corpus | slowest input | crashes | caught panics |"
+        "| target | seconds | executions | per second | distinct outcomes | corpus | slowest input | crashes (of them out of memory) | caught panics |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut crashed = false;
     for target in targets {
-        let seed_dir = tempfile::tempdir().expect("a temporary directory");
-        let mut seeds: Vec<PathBuf> = default_seeds(target);
-        seeds.extend(
-            args.seeds.iter().flat_map(|p| if p.is_dir() { files_under(p) } else { vec![p.clone()] }),
-        );
-        for (i, seed) in target.builtin_seeds().iter().enumerate() {
-            let path = seed_dir.path().join(format!("builtin-{i}"));
-            if std::fs::write(&path, seed).is_ok() {
-                seeds.push(path);
-            }
-        }
-        let report =
-            gnomon_fuzz::run(target, &seeds, Duration::from_secs(args.seconds), args.seed, &args.crashes);
+        let run = supervise(&args, target);
         println!(
-            "| {} | {} | {} | {:.0} | {} | {} | {:.0} ms | {} | {} |",
+            "| {} | {} | {} | {:.0} | {} | {} | {:.0} ms | {} ({}) | {} |",
             target.name(),
             args.seconds,
-            report.executions,
-            report.executions as f64 / args.seconds.max(1) as f64,
-            report.outcomes,
-            report.corpus,
-            report.slowest.as_secs_f64() * 1e3,
-            report.crashes.len(),
-            report.caught.len()
+            run.report.executions,
+            run.report.executions as f64 / args.seconds.max(1) as f64,
+            run.report.outcomes,
+            run.report.corpus,
+            run.report.slowest.as_secs_f64() * 1e3,
+            run.report.crashes.len(),
+            run.out_of_memory,
+            run.report.caught.len()
         );
-        for crash in &report.crashes {
-            eprintln!("gnomon-fuzz: {} panicked on {}", target.name(), crash.display());
+        for crash in &run.report.crashes {
+            eprintln!("gnomon-fuzz: {} crashed on {}", target.name(), crash.display());
             crashed = true;
         }
-        if let Some(first) = report.caught.first() {
+        if let Some(first) = run.report.caught.first() {
             eprintln!(
                 "gnomon-fuzz: {} caught {} panic(s), e.g. on {}",
                 target.name(),
-                report.caught.len(),
+                run.report.caught.len(),
                 first.display()
             );
         }
     }
     if crashed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+}
+
+/// What the workers of one target found together.
+#[derive(Default)]
+struct Supervised {
+    report: Report,
+    /// Of the crashes, the inputs that took a worker past the memory cap.
+    out_of_memory: usize,
+}
+
+/// Runs `target` in workers for `--seconds` in all, starting a new one (with the next
+/// mutator seed) whenever one dies, and saving the input it died on.
+fn supervise(args: &Args, target: Target) -> Supervised {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let (report_path, current_path) = (dir.path().join("report"), dir.path().join("current"));
+    let started = Instant::now();
+    let mut total = Supervised::default();
+    let mut restarts = 0u64;
+    while started.elapsed().as_secs() < args.seconds {
+        let left = args.seconds - started.elapsed().as_secs();
+        let _ = std::fs::remove_file(&report_path);
+        let mut command = std::process::Command::new(std::env::current_exe().expect("the fuzzer's own path"));
+        command
+            .arg(target.name())
+            .args(["--seconds", &left.max(1).to_string(), "--seed", &(args.seed + restarts).to_string()])
+            .args(["--memory-cap-mb", &args.memory_cap_mb.to_string()])
+            .arg("--crashes")
+            .arg(&args.crashes)
+            .arg("--worker")
+            .arg(&report_path)
+            .env("GNOMON_FUZZ_CURRENT", &current_path);
+        for seed in &args.seeds {
+            command.arg("--seeds").arg(seed);
+        }
+        let status = command.status().expect("starting a fuzzing worker");
+        match read_report(&report_path) {
+            Some(report) if status.success() => add(&mut total.report, report),
+            _ => {
+                // The worker died on its current input: past the memory cap, or any
+                // other abort. Keep the input; go on with a new worker.
+                let _ = std::fs::create_dir_all(&args.crashes);
+                let path = args.crashes.join(format!("{}-died-{}", target.name(), restarts));
+                let _ = std::fs::copy(&current_path, &path);
+                eprintln!(
+                    "gnomon-fuzz: {} worker died ({status}); its input is {}",
+                    target.name(),
+                    path.display()
+                );
+                total.report.crashes.push(path);
+                total.out_of_memory += 1;
+            }
+        }
+        restarts += 1;
+    }
+    total
+}
+
+fn add(total: &mut Report, one: Report) {
+    total.executions += one.executions;
+    total.outcomes = total.outcomes.max(one.outcomes);
+    total.corpus = total.corpus.max(one.corpus);
+    total.slowest = total.slowest.max(one.slowest);
+    total.crashes.extend(one.crashes);
+    total.caught.extend(one.caught);
+}
+
+/// One target in this process, under the memory cap; its report to `report_path`.
+fn worker(args: &Args, target: Target, report_path: &Path) -> ExitCode {
+    let seed_dir = tempfile::tempdir().expect("a temporary directory");
+    let mut seeds: Vec<PathBuf> = default_seeds(target);
+    seeds.extend(args.seeds.iter().flat_map(|p| if p.is_dir() { files_under(p) } else { vec![p.clone()] }));
+    for (i, seed) in target.builtin_seeds().iter().enumerate() {
+        let path = seed_dir.path().join(format!("builtin-{i}"));
+        if std::fs::write(&path, seed).is_ok() {
+            seeds.push(path);
+        }
+    }
+    let current =
+        std::env::var_os("GNOMON_FUZZ_CURRENT").and_then(|p| CurrentInput::create(Path::new(&p)).ok());
+    CAP.store(args.memory_cap_mb.saturating_mul(1 << 20), Ordering::Relaxed);
+    let report = gnomon_fuzz::run(
+        target,
+        &seeds,
+        Duration::from_secs(args.seconds),
+        args.seed,
+        &args.crashes,
+        current.as_ref(),
+    );
+    CAP.store(0, Ordering::Relaxed);
+    let lines = [
+        report.executions.to_string(),
+        report.outcomes.to_string(),
+        report.corpus.to_string(),
+        report.slowest.as_nanos().to_string(),
+        report.crashes.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join("\t"),
+        report.caught.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join("\t"),
+    ];
+    match std::fs::write(report_path, lines.join("\n")) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("gnomon-fuzz: cannot write the worker's report {}: {e}", report_path.display());
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A worker's report, as `worker` writes it.
+fn read_report(path: &Path) -> Option<Report> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.split('\n');
+    let mut number = || lines.next().and_then(|l| l.parse::<u64>().ok());
+    let (executions, outcomes, corpus, slowest) = (number()?, number()?, number()?, number()?);
+    let mut paths = text
+        .split('\n')
+        .skip(4)
+        .map(|l| l.split('\t').filter(|p| !p.is_empty()).map(PathBuf::from).collect());
+    Some(Report {
+        executions,
+        outcomes: outcomes as usize,
+        corpus: corpus as usize,
+        slowest: Duration::from_nanos(slowest),
+        crashes: paths.next().unwrap_or_default(),
+        caught: paths.next().unwrap_or_default(),
+    })
 }

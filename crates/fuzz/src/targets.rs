@@ -255,4 +255,21 @@ mod tests {
         }
         assert!(tried >= 4, "the regressions are where this test looks: {tried} found");
     }
+
+    /// Issue 49's hostile files (the glTF target's seeds): each is refused with an
+    /// error, at once, without a panic, and without allocating what it declares (run
+    /// in this process with no memory cap, a file that did would abort the test).
+    #[test]
+    fn every_hostile_seed_is_refused_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let seeds = crate::files_under(&Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds/gltf"));
+        let files: Vec<_> = seeds.iter().filter(|p| p.extension().is_some_and(|e| e == "gltf")).collect();
+        assert!(files.len() >= 14, "{files:?}");
+        for file in files {
+            let started = std::time::Instant::now();
+            let outcome = Target::Gltf.run(&std::fs::read(file).unwrap(), dir.path());
+            assert_ne!(outcome, "ok", "{} was accepted", file.display());
+            assert!(started.elapsed().as_secs() < 5, "{}: {:?}", file.display(), started.elapsed());
+        }
+    }
 }
