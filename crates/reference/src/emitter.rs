@@ -3,7 +3,7 @@
 //! that holds every ray toward it.
 
 use glam::{Vec2, Vec3};
-use gnomon_scene::Light;
+use gnomon_scene::{Falloff, Light};
 
 use crate::{
     Hit,
@@ -15,8 +15,9 @@ use crate::{
 pub(crate) enum Emitter {
     /// Parallel rays toward `to_light`; with `half_angle` > 0, a cone of directions.
     Sun { to_light: Vec3, half_angle: f32 },
-    /// A disk at `center` of `radius` facing along `axis`; 0 is a point.
-    Disk { center: Vec3, axis: Vec3, radius: f32, cos_outer: f32, range: f32 },
+    /// A disk at `center` of `radius` facing along `axis`; 0 is a point. Each of its
+    /// points falls off with distance as `falloff` says.
+    Disk { center: Vec3, axis: Vec3, radius: f32, cos_outer: f32, range: f32, falloff: Falloff },
     /// A sphere at `center` of `radius` emitting in every direction; 0 is a point.
     Sphere { center: Vec3, radius: f32, range: f32 },
 }
@@ -34,6 +35,7 @@ impl Emitter {
                 radius: spot.radius,
                 cos_outer: spot.outer_angle_degrees.to_radians().cos(),
                 range: spot.range,
+                falloff: spot.falloff,
             },
             Light::Point(point) => {
                 Emitter::Sphere { center: point.position, radius: point.radius, range: point.range }
@@ -95,6 +97,19 @@ impl Emitter {
                 .then(|| ball_cone(p, center, radius))
                 .flatten()
                 .map(|(axis, half_angle, distance)| (axis, half_angle, distance * (1.0 + 1e-4))),
+        }
+    }
+
+    /// The weight in the light's visibility of a shadow ray of length `len` (from
+    /// [`Emitter::sample`]), relative to the others: under an inverse-square falloff
+    /// each point of a disk is a point light of that falloff, so nearer points count
+    /// for more. A sphere's samples are uniform in the solid angle it subtends, which
+    /// already falls off as the inverse square of the distance, so they count alike,
+    /// as do a constant light's and a sun's. `light_sample_weight` on the GPU.
+    pub(crate) fn weight(&self, len: f32) -> f32 {
+        match *self {
+            Emitter::Disk { falloff, .. } => falloff.at(len),
+            Emitter::Sun { .. } | Emitter::Sphere { .. } => 1.0,
         }
     }
 

@@ -29,8 +29,9 @@ pub(crate) enum LightSampling {
     SkipWhollyInSight,
 }
 
-/// Visibility of the light at `hit` (which [faces](Emitter::faces) it), the standard
-/// error of the estimate, and the number of shadow rays traced.
+/// Visibility of the light at `hit` (which [faces](Emitter::faces) it): the share of
+/// its samples that arrive, each weighted by [`Emitter::weight`]; the standard error
+/// of the estimate; and the number of shadow rays traced.
 pub(crate) fn shade(
     traced: &TracedScene,
     emitter: &Emitter,
@@ -41,17 +42,19 @@ pub(crate) fn shade(
 ) -> (f32, f32, u64) {
     let origin = offset_ray_origin(hit.position, hit.normal);
     let rays = std::cell::Cell::new(0u64);
-    let visible = |u: Vec2| {
+    // A sample's weight (`Emitter::weight`) and whether its ray arrives.
+    let sample = |u: Vec2| {
         let (d, len) = emitter.sample(hit.position, u);
+        let weight = emitter.weight(len);
         // Light samples below the surface's horizon are blocked by the surface itself.
         if d.dot(hit.normal) <= 0.0 {
-            return false;
+            return (weight, false);
         }
         rays.set(rays.get() + 1);
-        !traced.occluded(origin, d, len)
+        (weight, !traced.occluded(origin, d, len))
     };
     if samples == 1 {
-        let v = if visible(Vec2::splat(0.5)) { 1.0 } else { 0.0 };
+        let v = if sample(Vec2::splat(0.5)).1 { 1.0 } else { 0.0 };
         return (v, 0.0, rays.get());
     }
     if sampling == LightSampling::SkipWhollyInSight && wholly_in_sight(traced, emitter, hit, origin) {
@@ -63,7 +66,11 @@ pub(crate) fn shade(
     let means: Vec<f32> = (0..BATCHES)
         .map(|b| {
             let pattern = hash(seed ^ hash(b + 1));
-            (0..per_batch).filter(|&s| visible(cmj(s, per_batch, pattern))).count() as f32 / per_batch as f32
+            let (arrived, total) = (0..per_batch).fold((0.0f32, 0.0f32), |(arrived, total), s| {
+                let (weight, visible) = sample(cmj(s, per_batch, pattern));
+                (arrived + if visible { weight } else { 0.0 }, total + weight)
+            });
+            arrived / total.max(1e-30)
         })
         .collect();
     let mean = means.iter().sum::<f32>() / BATCHES as f32;

@@ -12,7 +12,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec4, Vec3, Vec4};
 use gnomon_math::ProjectionKind;
 use gnomon_scene::{
-    Camera, Light, Scene, Settings,
+    Camera, Falloff, Light, Scene, Settings,
     settings::{CascadeSelection, DebugView, KernelUnit, MAX_CASCADES as SETTINGS_MAX_CASCADES, OmniMap},
 };
 
@@ -43,6 +43,38 @@ impl LightKindGpu {
             LightKindGpu::Sun => "LIGHT_SUN",
             LightKindGpu::Spot => "LIGHT_SPOT",
             LightKindGpu::Point => "LIGHT_POINT",
+        }
+    }
+}
+
+/// How a [`LightGpu`]'s light weakens with distance (`FALLOFF_CONSTANT`, … in WGSL):
+/// [`gnomon_scene::Falloff`] on the GPU.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FalloffGpu {
+    /// No falloff inside the range (`FALLOFF_CONSTANT`); also every sun.
+    Constant = 0,
+    /// `KHR_lights_punctual`'s windowed inverse square (`FALLOFF_INVERSE_SQUARE`).
+    InverseSquare = 1,
+}
+
+impl FalloffGpu {
+    /// Every falloff, for generating the WGSL constants.
+    pub const ALL: [FalloffGpu; 2] = [FalloffGpu::Constant, FalloffGpu::InverseSquare];
+
+    /// Its name in WGSL.
+    pub const fn wgsl_name(self) -> &'static str {
+        match self {
+            FalloffGpu::Constant => "FALLOFF_CONSTANT",
+            FalloffGpu::InverseSquare => "FALLOFF_INVERSE_SQUARE",
+        }
+    }
+
+    /// The falloff's code and its window (0 for none), as the uniforms hold them.
+    pub fn of(falloff: Falloff) -> (u32, f32) {
+        match falloff {
+            Falloff::Constant => (FalloffGpu::Constant as u32, 0.0),
+            Falloff::InverseSquare { window } => (FalloffGpu::InverseSquare as u32, window.unwrap_or(0.0)),
         }
     }
 }
@@ -166,12 +198,13 @@ pub struct LightGpu {
     /// (`ScreenSpaceSettings::penumbra_rays`), 0 for a hard light, whose pixel casts
     /// one ray to its centre.
     pub penumbra_rays: u32,
+    /// A spot or point light's [`FalloffGpu`] with distance.
+    pub falloff: u32,
+    /// Where an inverse-square falloff's window reaches 0, in world units; 0 for no
+    /// window.
+    pub falloff_window: f32,
     /// Padding to the 16-byte alignment of `params`.
     pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
     /// The technique's own parameters ([`TechniqueParams`]).
     pub params: TechniqueParams,
     /// Each layer's clip_from_world (a paraboloid's: its hemisphere's frame);
@@ -280,6 +313,9 @@ pub fn wgsl_constants() -> String {
     }
     for kind in LightKindGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind as u32);
+    }
+    for falloff in FalloffGpu::ALL {
+        s += &format!("const {}: u32 = {}u;\n", falloff.wgsl_name(), falloff as u32);
     }
     s += &format!("const CULL_WORKGROUP: u32 = {}u;\n", crate::passes::gpu_cull::CULL_WORKGROUP);
     for code in crate::passes::gpu_cull::WindingCode::ALL {
@@ -390,6 +426,7 @@ impl LightGpu {
                 self.direction = spot.direction.normalize();
                 self.position = spot.position;
                 self.range = spot.range;
+                (self.falloff, self.falloff_window) = FalloffGpu::of(spot.falloff);
                 self.cos_inner = spot.inner_angle_degrees.to_radians().cos();
                 self.cos_outer = spot.outer_angle_degrees.to_radians().cos();
             }
@@ -398,6 +435,7 @@ impl LightGpu {
                 self.radiance = point.color * point.intensity;
                 self.position = point.position;
                 self.range = point.range;
+                (self.falloff, self.falloff_window) = FalloffGpu::of(point.falloff);
             }
         }
     }
@@ -460,12 +498,12 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
             texel_per_distance, normal_offset, resolution, kernel_width, kernel_in_world, poisson_taps,
             receiver_plane_bias, light_size, blocker_taps, max_penumbra_texels, select_by_projection,
             cascade_blend, depth_bias, slope_bias, contact_steps, contact_length, contact_thickness,
-            contact_bias, contact_distance, penumbra_rays, _pad0, _pad1, _pad2, params, cascade_clip_from_world,
+            contact_bias, contact_distance, penumbra_rays, falloff, falloff_window, _pad0, params, cascade_clip_from_world,
             cascades,
         }),
         struct_layout!(TechniqueParams as "TechniqueParams" { reals, integers }),
         struct_layout!(light_list::EmitterGpu as "Emitter" {
-            radiance, kind, direction, range, position, cos_inner, cos_outer, _pad0, _pad1, _pad2,
+            radiance, kind, direction, range, position, cos_inner, cos_outer, falloff, falloff_window, _pad0,
         }),
         struct_layout!(light_list::LightListGpu as "LightList" {
             ambient, shown, tiles_x, _pad0, _pad1, _pad2,

@@ -17,7 +17,7 @@ pub mod settings;
 
 pub use casters::OpenCasters;
 pub use model::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, Motion, PointLight, Scene,
+    AlphaMode, Camera, DirectionalLight, Falloff, Instance, Light, Material, Mesh, Motion, PointLight, Scene,
     SceneLight, SpotLight, Texture, Wrap, sun_direction,
 };
 pub use scene_error::SceneError;

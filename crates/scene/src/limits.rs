@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use crate::{Camera, DirectionalLight, Light, PointLight, SpotLight};
+use crate::{Camera, DirectionalLight, Falloff, Light, PointLight, SpotLight};
 
 /// The largest coordinate or distance, in world units: `f32`'s spacing is 1 there.
 pub const MAX_COORDINATE: f32 = 1.0e7;
@@ -162,7 +162,7 @@ impl SpotLight {
         LIGHT_RADIUS.check("radius", self.radius)?;
         check_vec3(&COLOR_CHANNEL, "color", self.color)?;
         INTENSITY.check("intensity", self.intensity)?;
-        Ok(())
+        check_falloff(self.falloff)
     }
 }
 
@@ -173,7 +173,15 @@ impl PointLight {
         LIGHT_RADIUS.check("radius", self.radius)?;
         check_vec3(&COLOR_CHANNEL, "color", self.color)?;
         INTENSITY.check("intensity", self.intensity)?;
-        Ok(())
+        check_falloff(self.falloff)
+    }
+}
+
+/// A falloff's window is a distance, as a range is.
+fn check_falloff(falloff: Falloff) -> Result<(), LimitError> {
+    match falloff {
+        Falloff::Constant | Falloff::InverseSquare { window: None } => Ok(()),
+        Falloff::InverseSquare { window: Some(window) } => LIGHT_RANGE.check("range", window).map(|_| ()),
     }
 }
 
@@ -243,9 +251,12 @@ mod tests {
             range: 10.0,
             color: Vec3::ONE,
             intensity: 1.0,
+            falloff: Falloff::InverseSquare { window: Some(10.0) },
             radius: 0.0,
         };
         assert!(Light::Spot(spot).validate().is_ok());
+        let bad_window = SpotLight { falloff: Falloff::InverseSquare { window: Some(-1.0) }, ..spot };
+        assert_eq!(Light::Spot(bad_window).validate().unwrap_err().quantity, "range");
         let bad_colour = SpotLight { color: Vec3::new(f32::NAN, -1.0, 1e38), ..spot };
         assert_eq!(Light::Spot(bad_colour).validate().unwrap_err().quantity, "color");
         let inner_past_outer = SpotLight { inner_angle_degrees: 40.0, ..spot };

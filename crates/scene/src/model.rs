@@ -203,6 +203,43 @@ pub struct DirectionalLight {
     pub angular_diameter_degrees: f32,
 }
 
+/// How a spot or point light's irradiance changes with distance `d` inside its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Falloff {
+    /// The same irradiance at every distance, cut to nothing at the range: the
+    /// teaching light of the shadow tutorials, whose pools of light have hard rims.
+    /// `intensity` is then the irradiance itself.
+    Constant,
+    /// Physical falloff as glTF's `KHR_lights_punctual` specifies it: `intensity` is a
+    /// luminous intensity in candela, and a surface facing the light at `d` metres
+    /// receives `intensity / d²` lux, times the extension's window
+    /// `clamp(1 − (d / window)⁴, 0, 1)` that brings it smoothly to 0 at `window`
+    /// (no window when `None`: a file light without a range). One lux shades a white
+    /// surface as a sun of intensity 1 does, the mapping the Khronos sample viewer
+    /// uses (docs/lights.md).
+    InverseSquare {
+        /// The distance at which the window reaches 0; `None` for no window.
+        window: Option<f32>,
+    },
+}
+
+impl Falloff {
+    /// Distances below this count as this, so that a surface touching a light gets a
+    /// large but finite irradiance (1 mm, where glTF's metres are the unit).
+    pub const MIN_DISTANCE: f32 = 1e-3;
+
+    /// The factor on `color · intensity` at `distance` from the light.
+    pub fn at(self, distance: f32) -> f32 {
+        match self {
+            Falloff::Constant => 1.0,
+            Falloff::InverseSquare { window } => {
+                let windowed = window.map_or(1.0, |w| (1.0 - (distance / w).powi(4)).clamp(0.0, 1.0));
+                windowed / distance.max(Self::MIN_DISTANCE).powi(2)
+            }
+        }
+    }
+}
+
 /// A point light restricted to a cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpotLight {
@@ -218,9 +255,11 @@ pub struct SpotLight {
     pub range: f32,
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Brightness scale: lit surfaces receive `color · intensity`, with no falloff with distance
-    /// inside `range` (only the cone's edge fades).
+    /// Brightness: lit surfaces receive `color · intensity` times the [`Falloff`] at
+    /// their distance, and the cone's fade at its edge.
     pub intensity: f32,
+    /// How the light weakens with distance inside `range`.
+    pub falloff: Falloff,
     /// Radius in world units of the light's emitting disk, facing along `direction`;
     /// 0 is a point light (hard shadows). The reference samples this disk for soft shadows.
     pub radius: f32,
@@ -245,9 +284,11 @@ pub struct PointLight {
     pub range: f32,
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Brightness scale: lit surfaces receive `color · intensity`, with no falloff with distance
-    /// inside `range`.
+    /// Brightness: lit surfaces receive `color · intensity` times the [`Falloff`] at
+    /// their distance.
     pub intensity: f32,
+    /// How the light weakens with distance inside `range`.
+    pub falloff: Falloff,
     /// Radius in world units of the emitting sphere; 0 is a point (hard shadows). The
     /// reference samples the sphere's solid angle for soft shadows.
     pub radius: f32,
@@ -369,9 +410,17 @@ impl Scene {
                 range: 30.0,
                 color: white,
                 intensity: 1.0,
+                falloff: Falloff::Constant,
                 radius: 0.0,
             },
-            point: PointLight { position: above, range: 30.0, color: white, intensity: 1.0, radius: 0.0 },
+            point: PointLight {
+                position: above,
+                range: 30.0,
+                color: white,
+                intensity: 1.0,
+                falloff: Falloff::Constant,
+                radius: 0.0,
+            },
             lights: Vec::new(),
             ambient: Vec3::splat(0.12),
             textures: Vec::new(),

@@ -12,7 +12,7 @@ use gnomon_reference::{
     reference_visibility,
 };
 use gnomon_scene::{
-    Camera, DirectionalLight, Instance, Light, Material, Mesh, Scene, SpotLight, builtin, geometry,
+    Camera, DirectionalLight, Falloff, Instance, Light, Material, Mesh, Scene, SpotLight, builtin, geometry,
 };
 
 fn scene_with(meshes: Vec<(Mesh, Mat4)>) -> Scene {
@@ -128,6 +128,7 @@ fn sphere_under_a_spot_is_exact_to_a_pixel_and_dark_outside_the_cone() {
         range: 30.0,
         color: Vec3::ONE,
         intensity: 1.0,
+        falloff: Falloff::Constant,
         radius: 0.0,
     };
     let light = Light::Spot(spot);
@@ -178,6 +179,7 @@ fn penumbra_scene(r: f32) -> (Scene, Light, Camera) {
         range: 30.0,
         color: Vec3::ONE,
         intensity: 1.0,
+        falloff: Falloff::Constant,
         radius: r,
     });
     let cam = camera(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.0, 0.0), 60.0);

@@ -10,6 +10,7 @@ mod aliasing;
 mod alpha;
 mod analytic;
 mod clusters;
+mod falloff;
 mod gpu_rays;
 mod many_lights;
 mod one_surface;

@@ -17,7 +17,7 @@ use super::{
 use crate::{
     rays::{LightSize, Traversal},
     techniques::{TechniqueRef, TechniqueRegistry},
-    uniforms::{self, LightKindGpu, StructLayout},
+    uniforms::{self, FalloffGpu, LightKindGpu, StructLayout},
 };
 
 /// The lookups a technique's map can be read through, from its stated facts.
@@ -183,6 +183,9 @@ fn generated_constants_are_what_rust_says() {
     assert_eq!(value("MAX_CASCADES") as usize, uniforms::MAX_CASCADES);
     for kind in LightKindGpu::ALL {
         assert_eq!(value(kind.wgsl_name()), kind as u32);
+    }
+    for falloff in FalloffGpu::ALL {
+        assert_eq!(value(falloff.wgsl_name()), falloff as u32);
     }
 }
 

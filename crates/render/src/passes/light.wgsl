@@ -56,9 +56,9 @@ struct Light {
     contact_bias: f32,            // start offset along the normal (world)
     contact_distance: f32,        // view depth where contact shadows end
     penumbra_rays: u32,           // refinement: rays per pixel over the light's area (0: hard, one ray)
+    falloff: u32,                 // FALLOFF_CONSTANT or FALLOFF_INVERSE_SQUARE
+    falloff_window: f32,          // where the inverse square's window reaches 0 (0: no window)
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
     params: TechniqueParams,
     // One layer of the shadow map per cascade (one in all for a single map).
     cascade_clip_from_world: array<mat4x4<f32>, MAX_CASCADES>,

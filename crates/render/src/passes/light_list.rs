@@ -40,12 +40,12 @@ pub struct EmitterGpu {
     pub cos_inner: f32,
     /// cos of the spot's outer half-angle (−1 for other lights).
     pub cos_outer: f32,
+    /// A `FalloffGpu`.
+    pub falloff: u32,
+    /// Where an inverse-square falloff's window reaches 0 (0 for no window).
+    pub falloff_window: f32,
     /// Padding to WGSL's 16-byte struct alignment.
     pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
 }
 
 impl EmitterGpu {
@@ -59,6 +59,8 @@ impl EmitterGpu {
             position: light.position,
             cos_inner: light.cos_inner,
             cos_outer: light.cos_outer,
+            falloff: light.falloff,
+            falloff_window: light.falloff_window,
             ..Self::default()
         }
     }

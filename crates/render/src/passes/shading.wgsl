@@ -16,23 +16,44 @@ struct Emitter {
     position: vec3<f32>,
     cos_inner: f32,
     cos_outer: f32,
+    falloff: u32,
+    falloff_window: f32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 };
 
 // The light uniform's emitter.
 fn light_emitter() -> Emitter {
     return Emitter(
         light.radiance, light.kind, light.direction, light.range,
-        light.position, light.cos_inner, light.cos_outer, 0u, 0u, 0u,
+        light.position, light.cos_inner, light.cos_outer, light.falloff, light.falloff_window, 0u,
     );
 }
 
-// Fraction of emitter `e`'s light arriving at `world` before shadowing: 1 for the sun,
-// the cone and range test for a spot (0 outside the outer cone or beyond the range),
-// the range test for a point light.
-// Returns (unit direction to the light, cone factor in [0, 1]).
+// Distances below this count as this, so that a surface touching a light gets a
+// large but finite irradiance (`Falloff::MIN_DISTANCE`).
+const MIN_FALLOFF_DISTANCE: f32 = 1e-3;
+
+// The factor on a light's colour × intensity at `distance` from it: 1 for a constant
+// falloff; for KHR_lights_punctual's, the inverse square times the window
+// clamp(1 − (d / window)⁴, 0, 1) that reaches 0 at `window` (none when 0).
+// `gnomon_scene::Falloff::at` on the CPU.
+fn distance_falloff(falloff: u32, window: f32, distance: f32) -> f32 {
+    if falloff != FALLOFF_INVERSE_SQUARE {
+        return 1.0;
+    }
+    var windowed = 1.0;
+    if window > 0.0 {
+        let r = distance / window;
+        windowed = clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    }
+    let d = max(distance, MIN_FALLOFF_DISTANCE);
+    return windowed / (d * d);
+}
+
+// What of emitter `e`'s colour × intensity arrives at `world` before shadowing: 1
+// for the sun; for a spot, its cone's fade (0 outside the outer cone) times its
+// distance falloff, 0 beyond its range; for a point light, the falloff within its range.
+// Returns (unit direction to the light, that factor: > 0 exactly where light arrives).
 fn emitter_geometry(e: Emitter, world: vec3<f32>) -> vec4<f32> {
     if e.kind == LIGHT_SUN {
         return vec4<f32>(-e.direction, 1.0);
@@ -40,13 +61,14 @@ fn emitter_geometry(e: Emitter, world: vec3<f32>) -> vec4<f32> {
     let to_light = e.position - world;
     let dist = length(to_light);
     let l = to_light / dist;
+    let falloff = distance_falloff(e.falloff, e.falloff_window, dist);
     if e.kind == LIGHT_POINT {
-        return vec4<f32>(l, select(0.0, 1.0, dist <= e.range));
+        return vec4<f32>(l, select(0.0, falloff, dist <= e.range));
     }
     let cos_angle = dot(-l, e.direction);
     let inside = cos_angle >= e.cos_outer && dist <= e.range;
-    let falloff = smoothstep(e.cos_outer, e.cos_inner, cos_angle);
-    return vec4<f32>(l, select(0.0, falloff, inside));
+    let cone = smoothstep(e.cos_outer, e.cos_inner, cos_angle);
+    return vec4<f32>(l, select(0.0, cone * falloff, inside));
 }
 
 // `emitter_geometry` of the light uniform's light.

@@ -133,6 +133,19 @@ fn cone_direction(u: vec2<f32>, axis: vec3<f32>, half_angle: f32) -> vec3<f32> {
     return normalize(axis * cos_theta + (basis[0] * cos(phi) + basis[1] * sin(phi)) * sin_theta);
 }
 
+// The weight of a penumbra ray of length `len` in the light's visibility, relative to
+// its other rays: under an inverse-square falloff, each point of a spot's disk is a
+// point light of that falloff, so nearer points count for more (the reference's
+// `Emitter::weight`). A sphere's rays are uniform in the solid angle it subtends,
+// which already makes its light fall off as the inverse square of the distance, so
+// they count alike, as do every ray of a constant light's and a sun's.
+fn light_sample_weight(len: f32) -> f32 {
+    if light.kind != LIGHT_SPOT {
+        return 1.0;
+    }
+    return distance_falloff(light.falloff, light.falloff_window, len);
+}
+
 // A shadow ray from `p` toward the point `u` of the light's area: its direction, and
 // its length (past every caster for a sun). `light.light_size` is the tangent of the
 // sun's angular radius, or the spot's disk or point's sphere radius.

@@ -35,7 +35,8 @@ fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool
 }
 
 // The share of `light.penumbra_rays` rays from `origin` to points stratified over the
-// light's area that arrive, and the mean distance to the caster that each blocked
+// light's area that arrive, each weighted by its point's falloff
+// (`light_sample_weight`), and the mean distance to the caster that each blocked
 // ray met (-1 when none was blocked). `pixel` seeds the pixel's own pattern, so
 // neighbours' errors are independent and the filter pass averages them down. A
 // sample below the surface's horizon is blocked by the surface itself, as in the
@@ -44,23 +45,25 @@ fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, 
     let count = light.penumbra_rays;
     let grid = cmj_grid(count);
     let pattern = lowbias32(pixel ^ 0x9e3779b9u);
-    var arrived = 0u;
+    var arrived = 0.0;
+    var total = 0.0;
     var blocked = 0u;
     var blocker_distance = 0.0;
     for (var s = 0u; s < count; s++) {
         let ray = light_sample(world, cmj(s, count, grid, pattern));
+        let weight = light_sample_weight(ray.w);
+        total += weight;
         if dot(ray.xyz, geometric_n) <= 0.0 {
             continue;
         }
         let t = ray_first_hit(origin, ray.xyz, ray.w);
         if t < 0.0 {
-            arrived += 1u;
+            arrived += weight;
         } else {
             blocked += 1u;
             blocker_distance += t;
         }
     }
     let mean_blocker = select(-1.0, blocker_distance / f32(max(blocked, 1u)), blocked > 0u);
-    return vec2<f32>(f32(arrived) / f32(count), mean_blocker);
+    return vec2<f32>(arrived / max(total, 1e-30), mean_blocker);
 }
-

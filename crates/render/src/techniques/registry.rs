@@ -234,6 +234,7 @@ mod tests {
             range: 5.0,
             color: glam::Vec3::ONE,
             intensity: 1.0,
+            falloff: gnomon_scene::Falloff::Constant,
             radius: 0.0,
         })
     }

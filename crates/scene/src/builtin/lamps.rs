@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 
 use super::{GROUND, SceneBuilder, at, point, spot, sun};
 use crate::{
-    Camera, Light, PointLight, Scene, SceneLight, geometry,
+    Camera, Falloff, Light, PointLight, Scene, SceneLight, geometry,
     settings::{FilterSettingsPatch, MAX_LIGHTS, MapSettingsPatch, Partition, ShadowOverrides, Technique},
 };
 
@@ -49,11 +49,10 @@ pub fn lamp_grid(count: usize) -> Scene {
         b.place(&format!("post {i}"), post, stone, at(base + Vec3::new(0.0, 0.9, 0.0)));
         let beside = base + Vec3::new(0.3 * LAMP_SPACING, 0.5, 0.2 * LAMP_SPACING);
         b.place(&format!("crate {i}"), crate_mesh, wood, at(beside) * Mat4::from_rotation_y(0.37 * i as f32));
-        lamps.push(PointLight {
-            color: palette[i % palette.len()],
-            intensity: 0.45,
-            ..point(base + Vec3::new(0.0, 2.4, 0.0), LAMP_REACH * LAMP_SPACING)
-        });
+        lamps.push(lamp(
+            point(base + Vec3::new(0.0, 2.4, 0.0), LAMP_REACH * LAMP_SPACING),
+            palette[i % palette.len()],
+        ));
     }
     let size = extent.x.max(extent.z);
     let camera = Camera {
@@ -86,6 +85,17 @@ pub fn lamp_grid(count: usize) -> Scene {
         })
         .collect();
     scene
+}
+
+/// A lamp: a point light of physical falloff (glTF's `KHR_lights_punctual`,
+/// windowed to 0 at its range) of 5 cd: it lights the ground 2.4 m below it at
+/// 5 / 2.4² = 0.87 and the foot of a neighbouring post in `lamps:N`, 6 m along, at
+/// 0.02, where the old constant lamp lit both alike and stopped at a hard rim.
+fn lamp(mut light: PointLight, color: Vec3) -> PointLight {
+    light.color = color;
+    light.intensity = 5.0;
+    light.falloff = Falloff::InverseSquare { window: Some(light.range) };
+    light
 }
 
 /// A 30 × 30 courtyard with a ring of 3 m pillars, crates and spheres, lit by eight
@@ -124,11 +134,6 @@ pub fn lamps() -> Scene {
         near: 0.1,
         far: 80.0,
     };
-    let dim = |mut l: PointLight, color: Vec3| {
-        l.color = color;
-        l.intensity = 0.35;
-        l
-    };
     // Each light's own technique, and map resolution when it has one.
     let own = |technique: Technique, resolution: Option<u32>| ShadowOverrides {
         filter: FilterSettingsPatch { technique: Some(technique), ..Default::default() },
@@ -159,7 +164,9 @@ pub fn lamps() -> Scene {
     for (i, (position, target, color)) in spots.into_iter().enumerate() {
         let mut s = spot(position, target, 38.0, 25.0);
         s.color = color;
-        s.intensity = 0.5;
+        // 50 cd: about the old constant 0.5 at the 10 m from lamp to courtyard.
+        s.intensity = 50.0;
+        s.falloff = Falloff::InverseSquare { window: Some(s.range) };
         let technique = [Technique::PCF, Technique::PCSS, Technique::HARD][i].clone();
         let resolution = if technique == Technique::PCSS {
             s.radius = 0.3;
@@ -176,7 +183,7 @@ pub fn lamps() -> Scene {
     for (i, (position, color)) in points.into_iter().enumerate() {
         let technique =
             [Technique::PCF2X2, Technique::PCF_POISSON, Technique::PCF, Technique::PCSS][i].clone();
-        let mut p = dim(point(position, 22.0), color);
+        let mut p = lamp(point(position, 22.0), color);
         if technique == Technique::PCSS {
             p.radius = 0.15;
         }
@@ -191,7 +198,7 @@ pub fn lamps() -> Scene {
         camera,
         sun_light,
         spot(Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), 38.0, 25.0),
-        dim(point(points[0].0, 22.0), points[0].1),
+        lamp(point(points[0].0, 22.0), points[0].1),
     );
     scene.ambient = Vec3::splat(0.06);
     scene.lights = lights;

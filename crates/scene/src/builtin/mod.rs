@@ -8,7 +8,8 @@ mod lamps;
 pub use lamps::{MAX_LAMPS, lamp_grid, lamps};
 
 use crate::{
-    Camera, DirectionalLight, Instance, Material, Mesh, PointLight, Scene, SpotLight, geometry, sun_direction,
+    Camera, DirectionalLight, Falloff, Instance, Material, Mesh, PointLight, Scene, SpotLight, geometry,
+    sun_direction,
 };
 
 /// A built-in scene: its name, what it shows, and how to build it.
@@ -180,12 +181,20 @@ fn spot(position: Vec3, target: Vec3, outer_degrees: f32, range: f32) -> SpotLig
         range,
         color: Vec3::new(1.0, 0.95, 0.85),
         intensity: 1.0,
+        falloff: Falloff::Constant,
         radius: 0.0,
     }
 }
 
 fn point(position: Vec3, range: f32) -> PointLight {
-    PointLight { position, range, color: Vec3::new(1.0, 0.93, 0.8), intensity: 1.0, radius: 0.0 }
+    PointLight {
+        position,
+        range,
+        color: Vec3::new(1.0, 0.93, 0.8),
+        intensity: 1.0,
+        falloff: Falloff::Constant,
+        radius: 0.0,
+    }
 }
 
 fn at(p: Vec3) -> Mat4 {

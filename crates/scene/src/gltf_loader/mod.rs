@@ -14,11 +14,11 @@ use glam::{Mat4, Vec3};
 use node_extras::node_motion;
 
 use crate::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Motion, PointLight, Scene, SceneLight,
-    SpotLight, Texture, sun_direction,
+    AlphaMode, Camera, Instance, Light, Material, Motion, PointLight, Scene, SceneLight, SpotLight, Texture,
 };
 
 mod images;
+mod lights;
 mod node_extras;
 mod primitives;
 pub mod sources;
@@ -526,52 +526,7 @@ fn build(
             }
         }
         if let Some(light) = node.light() {
-            let color = Vec3::from_array(light.color());
-            let position = world.transform_point3(Vec3::ZERO);
-            let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-            // glTF intensities are photometric (lux, candela); Gnomon's lights are
-            // relative, so every file light gets intensity 1 and its colour.
-            let parsed = match light.kind() {
-                gltf::khr_lights_punctual::Kind::Directional if direction != Vec3::ZERO => {
-                    Some(Light::Directional(DirectionalLight {
-                        direction,
-                        color,
-                        intensity: 1.0,
-                        angular_diameter_degrees: 0.0,
-                    }))
-                }
-                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle }
-                    if direction != Vec3::ZERO =>
-                {
-                    // glTF allows cones up to 90°; a spot's perspective map covers 89°.
-                    let outer = outer_cone_angle.to_degrees().clamp(1.0, 89.0);
-                    if outer != outer_cone_angle.to_degrees() {
-                        extras.warnings.push(format!(
-                            "light {}: its outer cone of {:.2}° is drawn as {outer}° (a spot's map covers 1° to 89°)",
-                            light.index(),
-                            outer_cone_angle.to_degrees()
-                        ));
-                    }
-                    Some(Light::Spot(SpotLight {
-                        position,
-                        direction,
-                        inner_angle_degrees: inner_cone_angle.to_degrees().clamp(0.0, outer),
-                        outer_angle_degrees: outer,
-                        range: light.range().unwrap_or(f32::INFINITY),
-                        color,
-                        intensity: 1.0,
-                        radius: 0.0,
-                    }))
-                }
-                gltf::khr_lights_punctual::Kind::Point => Some(Light::Point(PointLight {
-                    position,
-                    range: light.range().unwrap_or(f32::INFINITY),
-                    color,
-                    intensity: 1.0,
-                    radius: 0.0,
-                })),
-                _ => None,
-            };
+            let parsed = lights::from_file(&light, world, &mut extras.warnings);
             match parsed {
                 Some(l) => {
                     let name = light.name().map_or_else(|| format!("light {}", light.index()), str::to_owned);
@@ -631,29 +586,9 @@ fn build(
             near: 0.1,
             far: 100.0,
         },
-        sun: DirectionalLight {
-            direction: -sun_direction(45.0, 30.0),
-            color: Vec3::new(1.0, 0.97, 0.92),
-            intensity: 1.0,
-            angular_diameter_degrees: 0.0,
-        },
-        spot: SpotLight {
-            position: Vec3::ONE,
-            direction: Vec3::NEG_Y,
-            inner_angle_degrees: 28.0,
-            outer_angle_degrees: 35.0,
-            range: 10.0,
-            color: Vec3::new(1.0, 0.95, 0.85),
-            intensity: 1.0,
-            radius: 0.0,
-        },
-        point: PointLight {
-            position: Vec3::ONE,
-            range: 10.0,
-            color: Vec3::new(1.0, 0.93, 0.8),
-            intensity: 1.0,
-            radius: 0.0,
-        },
+        sun: lights::default_sun(),
+        spot: lights::default_spot(),
+        point: lights::default_point(),
         lights: Vec::new(),
         ambient: Vec3::splat(0.12),
         textures,
@@ -676,9 +611,6 @@ fn build(
         range: 4.0 * radius,
         ..scene.spot
     });
-    if !scene.spot.range.is_finite() {
-        scene.spot.range = 4.0 * radius + scene.spot.position.distance(center);
-    }
     // A point light without a file's: above the centre, reaching past the bounds.
     scene.point = point.unwrap_or(PointLight {
         position: center + Vec3::new(0.2, 0.9, 0.3) * radius,
@@ -686,18 +618,10 @@ fn build(
         ..scene.point
     });
     // A light without a range reaches past everything the file holds.
-    for l in lights.iter_mut().map(|l| &mut l.light) {
-        let (range, position) = match l {
-            Light::Spot(s) => (&mut s.range, s.position),
-            Light::Point(p) => (&mut p.range, p.position),
-            Light::Directional(_) => continue,
-        };
-        if !range.is_finite() {
-            *range = 4.0 * radius + position.distance(center);
-        }
-    }
-    if !scene.point.range.is_finite() {
-        scene.point.range = 4.0 * radius + scene.point.position.distance(center);
+    let reach = |position: Vec3| 4.0 * radius + position.distance(center);
+    lights::give_ranges(&mut scene.spot, &mut scene.point, reach);
+    for l in &mut lights {
+        lights::give_range(&mut l.light, reach);
     }
     scene.lights = lights;
     scene.validate_lights_and_camera().map_err(|e| e.to_string())?;

@@ -6,7 +6,7 @@ use glam::Vec3;
 use serde::Deserialize;
 
 use crate::{
-    DirectionalLight, Light, PointLight, SpotLight, limits, settings::ShadowOverrides, sun_direction,
+    DirectionalLight, Falloff, Light, PointLight, SpotLight, limits, settings::ShadowOverrides, sun_direction,
 };
 
 #[derive(Deserialize)]
@@ -32,6 +32,7 @@ pub(super) struct SpotEntry {
     radius: f32,
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
+    falloff: Option<FalloffEntry>,
 }
 
 #[derive(Deserialize)]
@@ -43,6 +44,7 @@ pub(super) struct PointEntry {
     radius: f32,
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
+    falloff: Option<FalloffEntry>,
 }
 
 /// One `[[light]]`: a sun, spot or point light with the fields of `[sun]`, `[spot]`
@@ -64,7 +66,27 @@ pub(super) struct LightEntry {
     radius: Option<f32>,
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
+    falloff: Option<FalloffEntry>,
     pub shadow: Option<ShadowOverrides>,
+}
+
+/// A spot or point light's `falloff`: `"constant"` (the default: `intensity` is the
+/// irradiance everywhere inside `range`) or `"inverse-square"` (glTF's
+/// `KHR_lights_punctual`: `intensity` in candela, windowed to 0 at `range`).
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum FalloffEntry {
+    Constant,
+    InverseSquare,
+}
+
+impl FalloffEntry {
+    fn falloff(entry: Option<Self>, range: f32) -> Falloff {
+        match entry {
+            None | Some(FalloffEntry::Constant) => Falloff::Constant,
+            Some(FalloffEntry::InverseSquare) => Falloff::InverseSquare { window: Some(range) },
+        }
+    }
 }
 
 /// What is wrong with a light table: the key at fault (`None` for the table as a
@@ -113,6 +135,7 @@ impl From<&SpotEntry> for LightEntry {
             radius: Some(spot.radius),
             color: spot.color,
             intensity: spot.intensity,
+            falloff: spot.falloff,
             ..Default::default()
         }
     }
@@ -127,6 +150,7 @@ impl From<&PointEntry> for LightEntry {
             radius: Some(point.radius),
             color: point.color,
             intensity: point.intensity,
+            falloff: point.falloff,
             ..Default::default()
         }
     }
@@ -192,24 +216,30 @@ impl LightEntry {
                         problem: "`target` equals `position`: a spot must aim somewhere".into(),
                     });
                 }
+                let range = limits::LIGHT_RANGE.check("range", need(self.range, "range", "")?)?;
                 Ok(Light::Spot(SpotLight {
                     position,
                     direction: aim.normalize(),
                     inner_angle_degrees: inner,
                     outer_angle_degrees: outer,
-                    range: limits::LIGHT_RANGE.check("range", need(self.range, "range", "")?)?,
+                    range,
                     color,
                     intensity,
+                    falloff: FalloffEntry::falloff(self.falloff, range),
                     radius,
                 }))
             }
-            "point" => Ok(Light::Point(PointLight {
-                position: checked_position(self.position, "position")?,
-                range: limits::LIGHT_RANGE.check("range", need(self.range, "range", "")?)?,
-                color,
-                intensity,
-                radius,
-            })),
+            "point" => {
+                let range = limits::LIGHT_RANGE.check("range", need(self.range, "range", "")?)?;
+                Ok(Light::Point(PointLight {
+                    position: checked_position(self.position, "position")?,
+                    range,
+                    color,
+                    intensity,
+                    falloff: FalloffEntry::falloff(self.falloff, range),
+                    radius,
+                }))
+            }
             other => Err(EntryError {
                 key: Some("type"),
                 problem: format!("`type` = \"{other}\" is invalid: sun, spot or point"),

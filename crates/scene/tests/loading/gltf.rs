@@ -8,7 +8,7 @@ use std::path::Path;
 use common::{glb, hierarchy_json, temp_dir, triangle_bytes};
 
 use glam::{Mat4, Quat, Vec3};
-use gnomon_scene::{AlphaMode, gltf_loader};
+use gnomon_scene::{AlphaMode, Falloff, gltf_loader};
 
 fn check_hierarchy(path: &Path) {
     let (scene, extras) = gltf_loader::load(path).unwrap();
@@ -123,8 +123,8 @@ fn every_punctual_light_joins_the_light_list() {
         r#""asset": {"version": "2.0"},
   "extensionsUsed": ["KHR_lights_punctual"],
   "extensions": {"KHR_lights_punctual": {"lights": [
-    {"type": "point", "name": "bulb", "color": [1, 0.5, 0.5], "range": 6},
-    {"type": "spot", "spot": {"outerConeAngle": 0.5}},
+    {"type": "point", "name": "bulb", "color": [1, 0.5, 0.5], "range": 6, "intensity": 40},
+    {"type": "spot", "spot": {"outerConeAngle": 0.5}, "intensity": 250},
     {"type": "point"}
   ]}},"#,
         1,
@@ -151,4 +151,41 @@ fn every_punctual_light_joins_the_light_list() {
     // A light without a range reaches past the scene.
     let Light::Point(unranged) = scene.lights[2].light else { panic!() };
     assert!(unranged.range.is_finite() && unranged.range > 2.0);
+    // The extension's units and falloff: candela, the inverse square windowed at the
+    // range, and no window without one (the range Gnomon gives it is only the map's).
+    assert_eq!(bulb.intensity, 40.0);
+    assert_eq!(bulb.falloff, Falloff::InverseSquare { window: Some(6.0) });
+    assert_eq!((unranged.intensity, unranged.falloff), (1.0, Falloff::InverseSquare { window: None }));
+    let Light::Spot(spot) = scene.lights[1].light else { panic!() };
+    assert_eq!((spot.intensity, spot.falloff), (250.0, Falloff::InverseSquare { window: None }));
+}
+
+/// A directional light's intensity is illuminance in lux, which Gnomon shades one to
+/// one (a sun of intensity 1 is 1 lux): it is kept, not replaced by 1.
+#[test]
+fn a_suns_lux_are_its_intensity() {
+    use gnomon_scene::Light;
+    let temp = temp_dir("sun-lux");
+    let dir = temp.path();
+    let json = hierarchy_json(None)
+        .replacen(
+            r#""asset": {"version": "2.0"},"#,
+            r#""asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 3.5}]}},"#,
+            1,
+        )
+        .replacen(r#""scenes": [{"nodes": [0]}],"#, r#""scenes": [{"nodes": [0, 2]}],"#, 1)
+        .replacen(
+            r#"{"name": "child", "translation": [1, 0, 0], "mesh": 0}"#,
+            r#"{"name": "child", "translation": [1, 0, 0], "mesh": 0},
+    {"rotation": [-0.5, 0, 0, 0.8660254], "extensions": {"KHR_lights_punctual": {"light": 0}}}"#,
+            1,
+        );
+    std::fs::write(dir.join("sun.glb"), glb(&json, &triangle_bytes())).unwrap();
+    let (scene, extras) = gltf_loader::load(&dir.join("sun.glb")).unwrap();
+    assert!(extras.has_sun);
+    let Light::Directional(sun) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
+    assert_eq!(sun.intensity, 3.5);
+    assert_eq!(scene.sun, sun, "the file's sun is the default");
 }

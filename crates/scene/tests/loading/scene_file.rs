@@ -126,6 +126,7 @@ type = "point"
 position = [1.0, 2.0, 0.0]
 range = 8.0
 color = [1.0, 0.5, 0.25]
+falloff = "inverse-square"
 [light.shadow]
 filter.technique = "pcss"
 map.resolution = 512
@@ -152,6 +153,9 @@ fn point_lights_and_the_light_list_come_from_the_file() {
     assert_eq!(names, ["key", "lamp", "light 2"]);
     let Light::Point(lamp) = scene.lights[1].light else { panic!("{:?}", scene.lights[1]) };
     assert_eq!((lamp.range, lamp.color), (8.0, Vec3::new(1.0, 0.5, 0.25)));
+    // `falloff` is glTF's, windowed at the range; a light without it keeps Gnomon's constant.
+    assert_eq!(lamp.falloff, gnomon_scene::Falloff::InverseSquare { window: Some(8.0) });
+    assert_eq!(scene.point.falloff, gnomon_scene::Falloff::Constant);
 
     // --light all resolves every light with its own shadow settings over the render's.
     let mut s = Settings::default();
@@ -185,6 +189,16 @@ fn bad_light_entries_name_the_light_and_the_field() {
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\n", "needs `range`");
     check("type = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = -1.0\n", "a distance in (0, 1e7]");
     check("type = \"area\"\n", "sun, spot or point");
+    // A falloff of no known name is a parse error at its line, listing the valid ones.
+    let path = write_scene(
+        dir,
+        "[[model]]\nfile = \"tri.glb\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 1.0, 0.0]\nrange = 5.0\nfalloff = \"quadratic\"\n",
+    );
+    let e = scene_file::load(&path, None).err().unwrap().to_string();
+    assert!(
+        e.contains("scene.toml") && e.contains("line 7") && e.contains("`constant` or `inverse-square`"),
+        "{e}"
+    );
     // The [point] table is checked the same way.
     let path =
         write_scene(dir, "[[model]]\nfile = \"tri.glb\"\n[point]\nposition = [0.0, 1.0, 0.0]\nrange = 0.0\n");
