@@ -9,7 +9,8 @@ use glam::Vec3;
 use gnomon_math::{LightProjection, ProjectionKind, linearize_perspective_depth};
 use gnomon_render::ShadowMapImage;
 
-/// Fails unless `path` has one of `extensions` and its directory exists.
+/// Fails unless `path` has one of `extensions`, its directory exists and takes new
+/// files, and `path` is absent or a regular file.
 pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Result<()> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !ext.as_deref().is_some_and(|e| extensions.contains(&e)) {
@@ -33,7 +34,17 @@ pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Resul
     if let Some(kind) = not_a_regular_file(path) {
         bail!("{flag} {}: exists and is {kind}; outputs replace regular files only", path.display());
     }
-    Ok(())
+    probe_writable(dir)
+        .with_context(|| format!("{flag} {}: cannot write in {}", path.display(), dir.display()))
+}
+
+/// Creates and removes a file in `dir`, as staging will: a directory that exists but
+/// takes no files (read-only, or a pseudo file system such as /proc) is found before
+/// the work, not when the outputs are moved into place at its end.
+fn probe_writable(dir: &Path) -> std::io::Result<()> {
+    let probe = dir.join(format!(".gnomon-probe-{}", std::process::id()));
+    std::fs::OpenOptions::new().write(true).create_new(true).open(&probe)?;
+    std::fs::remove_file(&probe)
 }
 
 /// What is at `path` when it is neither absent nor a regular file (a device, a FIFO,

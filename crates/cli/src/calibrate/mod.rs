@@ -238,8 +238,27 @@ fn write_outputs(
         chosen: r.chosen,
         defaults: (r.defaults.false_shadow, r.defaults.false_lit),
     })?;
+    // A folder this run creates is removed again if its outputs fail: all or nothing.
+    let created = !args.out.exists();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("--out: cannot create {}", args.out.display()))?;
+    let written = stage_and_commit(args, scene, technique, r, &rgb);
+    if written.is_err() && created {
+        let _ = std::fs::remove_dir(&args.out);
+    }
+    written
+}
+
+/// The report, the plot and `--write`'s scene file, staged and moved into place
+/// together.
+fn stage_and_commit(
+    args: &CalibrateArgs,
+    scene: &Scene,
+    technique: &str,
+    r: &Results,
+    rgb: &[u8],
+) -> anyhow::Result<()> {
+    let swept_kernel = r.points.iter().any(|t| t.setting.pcf_kernel != r.defaults.setting.pcf_kernel);
     let mut staged = output::Staged::default();
     let (w, h) = plot::PLOT_SIZE;
     let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();

@@ -130,3 +130,23 @@ fn calibrate_writes_nothing_when_its_scene_file_cannot_be_edited() {
     assert!(!dir.join("cal").exists(), "wrote {:?}", files_in(&dir.join("cal")));
     assert_eq!(std::fs::read_to_string(dir.join("broken.toml")).unwrap(), "settings = [unclosed\n");
 }
+
+/// A `--write` into a folder that takes no files (/proc, where even root cannot
+/// create one) is refused before the sweep, naming the flag and the folder: the
+/// audit's run failed only when its outputs were moved into place, after the work,
+/// and said only "No such file or directory".
+#[test]
+#[cfg(target_os = "linux")]
+fn calibrate_refuses_a_write_into_a_folder_that_takes_no_files_before_any_work() {
+    let temp = temp_dir("calibrate-proc");
+    let dir = temp.path();
+    let out = calibrate(
+        dir,
+        &["--technique", "hard", "--views", "2", "--out", "cal", "--write", "/proc/gnomon-calibration.toml"],
+    );
+    assert!(!out.status.success());
+    let said = stderr(&out);
+    assert!(said.contains("--write /proc/gnomon-calibration.toml: cannot write in /proc"), "{said}");
+    assert!(!said.contains("reference"), "it swept before refusing: {said}");
+    assert!(!dir.join("cal").exists(), "wrote {:?}", files_in(&dir.join("cal")));
+}

@@ -352,8 +352,11 @@ fn non_finite_positions(path: &Path, bytes: &[u8], scope: UriScope) -> Option<St
         if !(views_in_range && accessors_in_range && positions_in_range && positions_readable(json)) {
             return None;
         }
-        let base = path.parent().unwrap_or(Path::new("."));
+        // Strides and sizes as the validated path checks them: the reader asserts on a
+        // stride shorter than its element (found by fuzzing, the hour-long run).
         let mut budget = sources::Budget::default();
+        accessors_fit(&raw.document, &mut budget).ok()?;
+        let base = path.parent().unwrap_or(Path::new("."));
         let buffers = sources::buffers(&raw.document, base, raw.blob.clone(), scope, &mut budget).ok()?;
         for mesh in raw.document.meshes() {
             for (k, prim) in mesh.primitives().enumerate() {
