@@ -187,6 +187,9 @@ fn generated_constants_are_what_rust_says() {
     for falloff in FalloffGpu::ALL {
         assert_eq!(value(falloff.wgsl_name()), falloff as u32);
     }
+    // Array sizes come from the settings' limits, declared once there.
+    assert_eq!(value("POISSON_DISK_SIZE"), *gnomon_scene::settings::POISSON_TAPS.end());
+    assert_eq!(value("MAX_BLUR_TAPS"), 2 * gnomon_scene::settings::MAX_BLUR_RADIUS + 1);
 }
 
 /// A layout check that would pass whatever the offsets were proves nothing: a Rust

@@ -16,8 +16,8 @@ struct FilterParams {
 @group(0) @binding(1) var filter_target: texture_storage_2d_array<MOMENT_FORMAT, write>;
 @group(0) @binding(2) var<uniform> params: FilterParams;
 
-// Weighted average of up to 33 values in log space (channel x only).
-fn log_average(values: ptr<function, array<f32, 33>>, weights: ptr<function, array<f32, 33>>, count: i32) -> f32 {
+// Weighted average of up to MAX_BLUR_TAPS values in log space (channel x only).
+fn log_average(values: ptr<function, array<f32, MAX_BLUR_TAPS>>, weights: ptr<function, array<f32, MAX_BLUR_TAPS>>, count: i32) -> f32 {
     var top = -1e30;
     for (var i = 0; i < count; i++) {
         top = max(top, (*values)[i]);
@@ -37,8 +37,8 @@ fn blur_main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let layer = i32(id.z);
-    var values: array<f32, 33>;
-    var weights: array<f32, 33>;
+    var values: array<f32, MAX_BLUR_TAPS>;
+    var weights: array<f32, MAX_BLUR_TAPS>;
     var sum = vec4<f32>(0.0);
     var total = 0.0;
     for (var i = -params.radius; i <= params.radius; i++) {
@@ -69,8 +69,8 @@ fn downsample_main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let layer = i32(id.z);
     let src_max = vec2<i32>(textureDimensions(filter_source)) - vec2<i32>(1);
-    var values: array<f32, 33>;
-    var weights: array<f32, 33>;
+    var values: array<f32, MAX_BLUR_TAPS>;
+    var weights: array<f32, MAX_BLUR_TAPS>;
     var sum = vec4<f32>(0.0);
     for (var i = 0; i < 4; i++) {
         let q = min(2 * p + vec2<i32>(i % 2, i / 2), src_max);

@@ -169,8 +169,9 @@ pub trait ShadowTechnique: Sync {
 /// The helpers every cube lookup shares, composed before a technique's cube WGSL.
 pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
 
-/// Taps in the shared Poisson disk, the most any technique may ask for.
-pub const POISSON_DISK_SIZE: usize = 64;
+/// Taps in the shared Poisson disk: the most any technique may ask for, the end of
+/// the settings' `POISSON_TAPS` (which `Settings::validate` holds every render to).
+pub const POISSON_DISK_SIZE: usize = *gnomon_scene::settings::POISSON_TAPS.end() as usize;
 
 /// The shadow resources a technique may read, as the lighting, mask and moment passes
 /// bind them (group 2). The shadow receiver declares the same names in the host's

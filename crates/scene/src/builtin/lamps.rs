@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 
 use super::{GROUND, SceneBuilder, at, point, spot, sun};
 use crate::{
-    Camera, Falloff, Light, PointLight, Scene, SceneLight, geometry,
+    Camera, DirectionalLight, Falloff, Light, PointLight, Scene, SceneLight, SpotLight, geometry,
     settings::{FilterSettingsPatch, MAX_LIGHTS, MapSettingsPatch, Partition, ShadowOverrides, Technique},
 };
 
@@ -134,6 +134,26 @@ pub fn lamps() -> Scene {
         near: 0.1,
         far: 80.0,
     };
+    let Courtyard { lights, sun, first_spot, first_lamp } = courtyard_lights();
+    let mut scene = b.finish("lamps", camera, sun, first_spot, first_lamp);
+    scene.ambient = Vec3::splat(0.06);
+    scene.lights = lights;
+    scene
+}
+
+/// The courtyard's light list, and its sun, first spot and first lamp, which are also
+/// the scene's `--light sun`, `spot` and `point`.
+struct Courtyard {
+    lights: Vec<SceneLight>,
+    sun: DirectionalLight,
+    first_spot: SpotLight,
+    first_lamp: PointLight,
+}
+
+/// The courtyard's eight lights, each with its own technique (and map resolution
+/// where it sets one): a low sun with cascades, three coloured spots and four lamps,
+/// the spots and lamps of physical falloff.
+fn courtyard_lights() -> Courtyard {
     // Each light's own technique, and map resolution when it has one.
     let own = |technique: Technique, resolution: Option<u32>| ShadowOverrides {
         filter: FilterSettingsPatch { technique: Some(technique), ..Default::default() },
@@ -153,6 +173,8 @@ pub fn lamps() -> Scene {
         (Vec3::new(0.5, 2.5, -4.0), Vec3::new(1.0, 0.5, 0.8)),
         (Vec3::new(-5.0, 1.8, -0.5), Vec3::new(0.7, 1.0, 0.5)),
     ];
+    let mut spots_made = Vec::new();
+    let mut lamps_made = Vec::new();
     let mut lights = vec![SceneLight {
         name: "sun".into(),
         light: Light::Directional(sun_light),
@@ -174,6 +196,7 @@ pub fn lamps() -> Scene {
         } else {
             Some(1024)
         };
+        spots_made.push(s);
         lights.push(SceneLight {
             name: format!("spot {i}"),
             light: Light::Spot(s),
@@ -187,20 +210,12 @@ pub fn lamps() -> Scene {
         if technique == Technique::PCSS {
             p.radius = 0.15;
         }
+        lamps_made.push(p);
         lights.push(SceneLight {
             name: format!("lamp {i}"),
             light: Light::Point(p),
             shadow: Some(own(technique, Some(512))),
         });
     }
-    let mut scene = b.finish(
-        "lamps",
-        camera,
-        sun_light,
-        spot(Vec3::new(-8.0, 6.0, 8.0), Vec3::new(-2.0, 0.0, 1.0), 38.0, 25.0),
-        lamp(point(points[0].0, 22.0), points[0].1),
-    );
-    scene.ambient = Vec3::splat(0.06);
-    scene.lights = lights;
-    scene
+    Courtyard { lights, sun: sun_light, first_spot: spots_made[0], first_lamp: lamps_made[0] }
 }

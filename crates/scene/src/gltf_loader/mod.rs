@@ -9,14 +9,9 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec3};
+use crate::Scene;
 
-use node_extras::node_motion;
-
-use crate::{
-    AlphaMode, Camera, Instance, Light, Material, Motion, PointLight, Scene, SceneLight, SpotLight, Texture,
-};
-
+mod assemble;
 mod images;
 mod lights;
 mod node_extras;
@@ -144,15 +139,17 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtra
     }))
     .map_err(|_| fail("the glTF image reader failed on malformed data".into()))?
     .map_err(fail)?;
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| build(path, &document, &buffers, &images)))
-        .map(|built| {
-            built.map(|(scene, mut extras)| {
-                extras.warnings.extend(extension_warnings);
-                (scene, extras)
-            })
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        assemble::build(path, &document, &buffers, &images)
+    }))
+    .map(|built| {
+        built.map(|(scene, mut extras)| {
+            extras.warnings.extend(extension_warnings);
+            (scene, extras)
         })
-        .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
-        .map_err(fail)
+    })
+    .map_err(|_| fail("the glTF reader failed on malformed data".into()))?
+    .map_err(fail)
 }
 
 /// The model file's bytes: a regular file (not a directory, FIFO or device, each of
@@ -217,21 +214,6 @@ fn accessors_fit(document: &gltf::Document, budget: &mut sources::Budget) -> Res
         budget.take(expanded, &format!("{what}, {} elements,", accessor.count()))?;
     }
     Ok(())
-}
-
-/// Whether any instance has a triangle of non-zero area once placed: a file of
-/// degenerate triangles only (or of meshes flattened by their nodes) draws an empty
-/// sky, which a calibration would then measure as "0 pixels".
-fn draws_anything(meshes: &[crate::Mesh], instances: &[Instance]) -> bool {
-    instances.iter().any(|instance| {
-        let mesh = &meshes[instance.mesh];
-        let world: Vec<Vec3> =
-            mesh.positions.iter().map(|p| instance.world_from_object.transform_point3(*p)).collect();
-        mesh.indices.chunks_exact(3).any(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| world[i as usize]);
-            (b - a).cross(c - a).length_squared() > 0.0
-        })
-    })
 }
 
 /// Checks the indices that the gltf crate uses unchecked: its validation looks up
@@ -385,248 +367,4 @@ fn describe(e: &gltf::Error) -> String {
         gltf::Error::Io(io) => format!("cannot read a file it refers to: {io}"),
         other => other.to_string(),
     }
-}
-
-fn build(
-    path: &Path,
-    document: &gltf::Document,
-    buffers: &[gltf::buffer::Data],
-    images: &[gltf::image::Data],
-) -> Result<(Scene, FileExtras), String> {
-    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-
-    // Textures: one per glTF texture, with its image and sampler.
-    let mut textures = Vec::new();
-    for t in document.textures() {
-        let image =
-            images.get(t.source().index()).ok_or_else(|| format!("texture {} has no image", t.index()))?;
-        let sampler = t.sampler();
-        textures.push(Texture {
-            name: t.name().unwrap_or("texture").to_string(),
-            width: image.width,
-            height: image.height,
-            rgba8: images::to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
-            wrap_u: images::wrap(sampler.wrap_s()),
-            wrap_v: images::wrap(sampler.wrap_t()),
-            nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
-        });
-    }
-
-    // Materials, plus a default one (last) for primitives without a material.
-    let mut materials = Vec::new();
-    let mut texcoord_sets = Vec::new();
-    for m in document.materials() {
-        let pbr = m.pbr_metallic_roughness();
-        let [r, g, b, a] = pbr.base_color_factor();
-        let texture = pbr.base_color_texture();
-        let mut material = Material::new(m.name().unwrap_or("material"), Vec3::new(r, g, b));
-        material.alpha = a;
-        material.base_color_texture = texture.as_ref().map(|t| t.texture().index());
-        material.alpha_mode = match m.alpha_mode() {
-            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
-            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-        };
-        material.double_sided = m.double_sided();
-        texcoord_sets.push(texture.map(|t| t.tex_coord()).unwrap_or(0));
-        materials.push(material);
-    }
-    let default_material = materials.len();
-    materials.push(Material::new("default", Vec3::splat(0.8)));
-    texcoord_sets.push(0);
-
-    // Meshes: one per primitive, with the texcoord set its material samples.
-    let mut meshes = Vec::new();
-    // For each glTF mesh: its primitives as (mesh index, material index, blend).
-    let mut primitives_of = Vec::new();
-    let mut modes = primitives::ModeCounts::default();
-    for mesh in document.meshes() {
-        let mut list = Vec::new();
-        for (k, prim) in mesh.primitives().enumerate() {
-            let label = format!("mesh {} (`{}`) primitive {k}", mesh.index(), mesh.name().unwrap_or(""));
-            let material = prim.material().index().unwrap_or(default_material);
-            match primitives::read(&prim, buffers, texcoord_sets[material], label)? {
-                Some(m) => {
-                    modes.triangles += 1;
-                    meshes.push(m);
-                    list.push((meshes.len() - 1, material));
-                }
-                None if prim.mode() == gltf::mesh::Mode::Points => modes.points += 1,
-                None => modes.lines += 1,
-            }
-        }
-        primitives_of.push(list);
-    }
-
-    // The node hierarchy, from the default scene's roots (or every root node).
-    let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
-        Some(s) => s.nodes().collect(),
-        None => {
-            let mut is_child = vec![false; document.nodes().len()];
-            for n in document.nodes() {
-                for c in n.children() {
-                    is_child[c.index()] = true;
-                }
-            }
-            document.nodes().filter(|n| !is_child[n.index()]).collect()
-        }
-    };
-    let mut instances = Vec::new();
-    let mut camera = None;
-    // Lights as the nodes place them, with the index of the file's light each is.
-    let mut found: Vec<(usize, SceneLight)> = Vec::new();
-    let mut extras = FileExtras::default();
-    let mut stack: Vec<(gltf::Node, Mat4, usize, Motion)> =
-        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0, Motion::Static)).collect();
-    let mut visits = 0usize;
-    let mut singular_nodes = 0usize;
-    while let Some((node, parent, depth, parent_motion)) = stack.pop() {
-        visits += 1;
-        // A node graph with a cycle would expand forever; `structure::check` refused
-        // one already, and this bounds the walk whatever comes.
-        if depth > structure::MAX_NODE_DEPTH || visits > 4 * document.nodes().len() + 16 {
-            return Err(format!("node {} lies in a cycle or too deep in the node hierarchy", node.index()));
-        }
-        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-        if !local.is_finite() {
-            return Err(format!("node {} has a non-finite transform", node.index()));
-        }
-        let world = parent * local;
-        // A node that moves carries its children along.
-        let motion = parent_motion.max(node_motion(&node)?);
-        if let Some(mesh) = node.mesh() {
-            if world.determinant() == 0.0 {
-                singular_nodes += 1;
-            }
-            for &(mesh_index, material) in &primitives_of[mesh.index()] {
-                instances.push(Instance {
-                    name: format!("node {} `{}`", node.index(), node.name().unwrap_or("")),
-                    mesh: mesh_index,
-                    material,
-                    world_from_object: world,
-                    casts_shadow: materials[material].alpha_mode != AlphaMode::Blend,
-                    motion,
-                });
-            }
-        }
-        let node_camera = node.camera();
-        if camera.is_none()
-            && let Some(gltf::camera::Projection::Perspective(p)) =
-                node_camera.as_ref().map(|c| c.projection())
-        {
-            let eye = world.transform_point3(Vec3::ZERO);
-            let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-            if forward != Vec3::ZERO {
-                camera = Some(Camera {
-                    eye,
-                    target: eye + forward,
-                    up,
-                    fov_y_degrees: p.yfov().to_degrees(),
-                    near: p.znear(),
-                    far: p.zfar().unwrap_or(p.znear() * 1e5),
-                });
-            }
-        }
-        if let Some(light) = node.light() {
-            let parsed = lights::from_file(&light, world, &mut extras.warnings);
-            match parsed {
-                Some(l) => {
-                    let name = light.name().map_or_else(|| format!("light {}", light.index()), str::to_owned);
-                    found.push((light.index(), SceneLight { name, light: l, shadow: None }));
-                }
-                None => extras.ignored_lights += 1,
-            }
-        }
-        for child in node.children() {
-            stack.push((child, world, depth + 1, motion));
-        }
-    }
-    if let Some(skipped) = modes.skipped() {
-        extras.warnings.push(format!("{skipped} skipped: points and lines cast no shadow"));
-    }
-    if singular_nodes > 0 {
-        extras.warnings.push(format!(
-            "{singular_nodes} node(s) with meshes have a singular transform (determinant 0): they flatten to nothing"
-        ));
-    }
-    if instances.is_empty() {
-        return Err(match modes.skipped() {
-            Some(skipped) => format!("has no triangles to draw in its scene, only {skipped}"),
-            None => "has no triangle meshes in its scene".into(),
-        });
-    }
-    if !draws_anything(&meshes, &instances) {
-        return Err(format!(
-            "every triangle of its scene has zero area ({} instance(s) of {} mesh(es)): nothing would be drawn",
-            instances.len(),
-            meshes.len()
-        ));
-    }
-    // The light list in the file's order; the first of each type is the default.
-    found.sort_by_key(|(index, _)| *index);
-    let mut lights: Vec<SceneLight> = found.into_iter().map(|(_, l)| l).collect();
-    let (mut sun, mut spot, mut point) = (None, None, None);
-    for l in &lights {
-        match l.light {
-            Light::Directional(d) if sun.is_none() => sun = Some(d),
-            Light::Spot(s) if spot.is_none() => spot = Some(s),
-            Light::Point(p) if point.is_none() => point = Some(p),
-            _ => {}
-        }
-    }
-
-    let mut scene = Scene {
-        name,
-        meshes,
-        materials,
-        instances,
-        camera: Camera {
-            eye: Vec3::ONE,
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_degrees: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        sun: lights::default_sun(),
-        spot: lights::default_spot(),
-        point: lights::default_point(),
-        lights: Vec::new(),
-        ambient: Vec3::splat(0.12),
-        textures,
-        has_ground: false,
-    };
-    scene.validate().map_err(|e| e.to_string())?;
-    let bounds = scene.bounds();
-    let (center, radius) = (bounds.center(), bounds.bounding_radius().max(1e-3));
-    extras.has_camera = camera.is_some();
-    extras.has_sun = sun.is_some();
-    extras.has_spot = spot.is_some();
-    extras.has_point = point.is_some();
-    scene.camera = camera.unwrap_or_else(|| crate::framing::default_camera(&scene));
-    if let Some(s) = sun {
-        scene.sun = s;
-    }
-    scene.spot = spot.unwrap_or(SpotLight {
-        position: center + Vec3::new(0.3, 1.6, 0.5) * radius,
-        direction: (center - (center + Vec3::new(0.3, 1.6, 0.5) * radius)).normalize(),
-        range: 4.0 * radius,
-        ..scene.spot
-    });
-    // A point light without a file's: above the centre, reaching past the bounds.
-    scene.point = point.unwrap_or(PointLight {
-        position: center + Vec3::new(0.2, 0.9, 0.3) * radius,
-        range: 4.0 * radius,
-        ..scene.point
-    });
-    // A light without a range reaches past everything the file holds.
-    let reach = |position: Vec3| 4.0 * radius + position.distance(center);
-    lights::give_ranges(&mut scene.spot, &mut scene.point, reach);
-    for l in &mut lights {
-        lights::give_range(&mut l.light, reach);
-    }
-    scene.lights = lights;
-    scene.validate_lights_and_camera().map_err(|e| e.to_string())?;
-    Ok((scene, extras))
 }

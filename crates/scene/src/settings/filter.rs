@@ -166,7 +166,7 @@ pub struct FilterSettings {
     /// Unit of --pcf-kernel.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
     pub kernel_unit: KernelUnit,
-    /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64.
+    /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64 ([`POISSON_TAPS`]).
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter"))]
     pub poisson_samples: u32,
     /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
@@ -183,6 +183,15 @@ pub struct FilterSettings {
     #[patch(nesting)]
     pub moments: MomentSettings,
 }
+
+/// The taps a Poisson-disk kernel may take (`poisson_samples`,
+/// `pcss.blocker_samples`): at least enough to cover the disk, at most the disk the
+/// GPU holds (`POISSON_DISK_SIZE` in WGSL is the end of this range).
+pub const POISSON_TAPS: std::ops::RangeInclusive<u32> = 8..=64;
+
+/// The widest blur of a moment map, in texels on each side (`moments.blur_radius`):
+/// the filter pass's arrays hold `2 × MAX_BLUR_RADIUS + 1` taps (`MAX_BLUR_TAPS` in WGSL).
+pub const MAX_BLUR_RADIUS: u32 = 16;
 
 impl Default for FilterSettings {
     fn default() -> Self {
@@ -211,7 +220,7 @@ impl Default for FilterSettings {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct PcssSettings {
-    /// Depth taps of PCSS's blocker search: 8 to 64.
+    /// Depth taps of PCSS's blocker search: 8 to 64 ([`POISSON_TAPS`]).
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS"))]
     pub blocker_samples: u32,
     /// Largest blocker-search and penumbra radius, in texels: 1 to 64. Wider
@@ -255,7 +264,7 @@ pub enum MomentFormat {
 #[serde(default, deny_unknown_fields)]
 pub struct MomentSettings {
     /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):
-    /// 0 (no blur) to 16.
+    /// 0 (no blur) to 16 ([`MAX_BLUR_RADIUS`]).
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps"))]
     pub blur_radius: u32,
     /// Build mipmaps of the moment map and sample them trilinearly (VSM, EVSM, MSM,
@@ -327,10 +336,10 @@ impl MomentSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
         let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
         check(
-            self.blur_radius <= 16,
+            self.blur_radius <= MAX_BLUR_RADIUS,
             "shadow.filter.moments.blur_radius",
             self.blur_radius,
-            "0 to 16 texels",
+            &format!("0 to {MAX_BLUR_RADIUS} texels"),
         )?;
         check(
             in_range(self.min_variance, 0.0, 1.0),

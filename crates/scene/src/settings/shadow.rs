@@ -467,17 +467,18 @@ impl ShadowSettings {
                 "a world width in (0, 1e7]",
             )?,
         }
+        let taps = format!("{} to {}", POISSON_TAPS.start(), POISSON_TAPS.end());
         check(
-            (8..=64).contains(&f.poisson_samples),
+            POISSON_TAPS.contains(&f.poisson_samples),
             "shadow.filter.poisson_samples",
             f.poisson_samples,
-            "8 to 64",
+            &taps,
         )?;
         check(
-            (8..=64).contains(&f.pcss.blocker_samples),
+            POISSON_TAPS.contains(&f.pcss.blocker_samples),
             "shadow.filter.pcss.blocker_samples",
             f.pcss.blocker_samples,
-            "8 to 64",
+            &taps,
         )?;
         check(
             f.pcss.max_radius.is_finite() && (1.0..=64.0).contains(&f.pcss.max_radius),
