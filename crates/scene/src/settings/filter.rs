@@ -339,7 +339,7 @@ impl MomentSettings {
             self.blur_radius <= MAX_BLUR_RADIUS,
             "shadow.filter.moments.blur_radius",
             self.blur_radius,
-            &format!("0 to {MAX_BLUR_RADIUS} texels"),
+            format!("0 to {MAX_BLUR_RADIUS} texels"),
         )?;
         check(
             in_range(self.min_variance, 0.0, 1.0),
