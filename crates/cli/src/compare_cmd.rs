@@ -6,11 +6,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use gnomon_reference::{
-    aliasing,
-    drawn::DrawnMetrics,
     flicker::{Flicker, FlickerCounter, PathFrame},
-    heatmap,
-    metrics::{self, Metrics, PixelClass, RasterView},
+    metrics::{self, RasterView},
 };
 use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, Renderer, timing::ClockChoice};
 use gnomon_scene::settings::LightKind;
@@ -19,11 +16,9 @@ use gnomon_scene::{
     camera_path::{CameraPathKind, camera_on_path},
     settings::{CameraSettings, Technique},
 };
-use image::RgbaImage;
 
 use crate::{
-    compare_report::{AliasingSummary, PathReport, Report, Row, markdown_table},
-    grid::{self, Downscale, Tile},
+    compare_report::{AliasingSummary, PathReport, Report, markdown_table},
     lab, output,
 };
 
@@ -65,15 +60,91 @@ pub struct CompareArgs {
     pub settings: Settings,
 }
 
-/// One technique's frame, and the median GPU milliseconds of its (shadow, lighting)
-/// passes where the adapter has timestamps.
-struct Rendered {
-    technique: Technique,
-    frame: Frame,
-    timing: Option<(f64, Option<f64>, f64)>,
+/// One technique's frame, and the median GPU time of its passes where the adapter
+/// has timestamps.
+pub(crate) struct Rendered {
+    pub technique: Technique,
+    pub frame: Frame,
+    pub timing: Option<PassMedians>,
+}
+
+/// The median GPU milliseconds of a technique's passes over `--timing-frames` frames.
+#[derive(Clone, Copy)]
+pub(crate) struct PassMedians {
+    pub shadow_ms: f64,
+    /// The moment map's filter pass, for the filterable techniques.
+    pub filter_ms: Option<f64>,
+    pub lighting_ms: f64,
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    check_args(args)?;
+    let (mut scene, mut settings) = lab::load(&args.scene, &args.settings)?;
+    if settings.light.kind == LightKind::All {
+        single_out_light(&mut scene, &mut settings)?;
+    }
+    let settings = &settings;
+    output::check_dir(&args.out, "--out")?;
+
+    let gpu = Gpu::new_headless()?;
+    if args.verbose {
+        eprintln!("gnomon: {}", gpu.info);
+        eprintln!("gnomon: {}", crate::render_cmd::open_casters_line(&scene, settings.shadow.bias.cull));
+    }
+    let mut renderer = Renderer::new(&gpu)?;
+    renderer.check_limits(settings)?;
+    let uploaded = renderer.upload(&scene)?;
+    let frames = render_techniques(args, &mut renderer, &uploaded, &scene, settings)?;
+    let flicker = match args.camera_path {
+        Some(kind) => measure_flicker(args, kind, &mut renderer, &uploaded, &scene, settings)?,
+        None => vec![None; args.techniques.len()],
+    };
+    let aliasing = gnomon_viewer::measure_aliasing(&frames[0].frame, settings);
+    let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
+    let drawn = lab::drawn_metrics(&scene, settings, &frames.iter().map(|r| &r.frame).collect::<Vec<_>>())?;
+
+    let mut staged = output::Staged::default();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("--out: cannot create {}", args.out.display()))?;
+    let measured = crate::compare_outputs::Measured {
+        reference: &reference,
+        aliasing: &aliasing,
+        frames: &frames,
+        flicker,
+        drawn,
+    };
+    let rows = crate::compare_outputs::stage(&mut staged, &args.out, measured)?;
+    let report = Report {
+        scene: &scene.name,
+        width: reference.width,
+        height: reference.height,
+        shadow_resolution: settings.shadow.map.resolution,
+        light: format!("{:?}", settings.resolve_light(&scene)?),
+        reference_samples: reference.samples,
+        adapter: gpu.info.adapter.clone(),
+        backend: gpu.info.backend.clone(),
+        aliasing: AliasingSummary { mean: aliasing.mean, max: aliasing.max },
+        camera_path: args.camera_path.map(|kind| PathReport {
+            kind,
+            frames: args.path_frames,
+            travel: args.path_travel,
+            frozen_cascades: settings.shadow.cascades.freeze,
+        }),
+        denominators: metrics::DENOMINATORS.iter().copied().collect(),
+        rows,
+    };
+    let table = markdown_table(&report, reference.samples > 1);
+    staged.text(&args.out.join("metrics.json"), &serde_json::to_string_pretty(&report)?)?;
+    staged.text(&args.out.join("metrics.md"), &table)?;
+    let written = staged.commit()?;
+    print!("{table}");
+    eprintln!("gnomon: wrote {} files to {}", written.len(), args.out.display());
+    Ok(())
+}
+
+/// The flags `Settings` does not check: the timing frames, the techniques (each
+/// named once, since its files are named after it) and the camera path.
+fn check_args(args: &CompareArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
     anyhow::ensure!(
         (1..=100).contains(&args.timing_frames),
@@ -84,7 +155,6 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         !args.techniques.is_empty(),
         "--techniques is empty: name at least one of `gnomon techniques`"
     );
-    // Each technique's files are named after it: a repeated one would overwrite its own.
     if let Some((i, repeated)) =
         args.techniques.iter().enumerate().find(|(i, t)| args.techniques[..*i].contains(t))
     {
@@ -105,160 +175,39 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         "--path-travel = {} is invalid: a fraction in (0, 1]",
         args.path_travel
     );
-    let (mut scene, mut settings) = lab::load(&args.scene, &args.settings)?;
-    if settings.light.kind == LightKind::All {
-        single_out_light(&mut scene, &mut settings)?;
-    }
-    let settings = &settings;
-    output::check_dir(&args.out, "--out")?;
+    Ok(())
+}
 
-    let gpu = Gpu::new_headless()?;
-    if args.verbose {
-        eprintln!("gnomon: {}", gpu.info);
-        eprintln!("gnomon: {}", crate::render_cmd::open_casters_line(&scene, settings.shadow.bias.cull));
-    }
-    let mut renderer = Renderer::new(&gpu)?;
-    renderer.check_limits(settings)?;
-    let uploaded = renderer.upload(&scene)?;
-
-    let mut frames: Vec<Rendered> = Vec::new();
+/// Each technique's frame, and its passes timed over `--timing-frames` frames.
+fn render_techniques(
+    args: &CompareArgs,
+    renderer: &mut Renderer,
+    uploaded: &GpuScene,
+    scene: &Scene,
+    settings: &Settings,
+) -> anyhow::Result<Vec<Rendered>> {
+    let mut frames = Vec::new();
     for technique in &args.techniques {
         let mut s = settings.clone();
         s.shadow.filter.technique = technique.clone();
-        let frame = renderer.render_uploaded(&uploaded, &scene, &s, &OutputRequest::default())?;
+        let frame = renderer.render_uploaded(uploaded, scene, &s, &OutputRequest::default())?;
         crate::render_cmd::warn_fallbacks(&frame.lights);
         let (mut shadow, mut filter, mut lighting) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..args.timing_frames {
-            if let Some(t) = renderer.time_passes(&uploaded, &scene, &s, ClockChoice::Auto)?.timings {
+            if let Some(t) = renderer.time_passes(uploaded, scene, &s, ClockChoice::Auto)?.timings {
                 shadow.push(t.shadow_ms);
                 filter.extend(t.filter_ms);
                 lighting.push(t.lighting_ms);
             }
         }
-        let timing = (!shadow.is_empty()).then(|| {
-            let filter = (!filter.is_empty()).then(|| median(&mut filter));
-            (median(&mut shadow), filter, median(&mut lighting))
+        let timing = (!shadow.is_empty()).then(|| PassMedians {
+            shadow_ms: median(&mut shadow),
+            filter_ms: (!filter.is_empty()).then(|| median(&mut filter)),
+            lighting_ms: median(&mut lighting),
         });
         frames.push(Rendered { technique: technique.clone(), frame, timing });
     }
-
-    let flicker = match args.camera_path {
-        Some(kind) => measure_flicker(args, kind, &mut renderer, &uploaded, &scene, settings)?,
-        None => vec![None; args.techniques.len()],
-    };
-    let aliasing = gnomon_viewer::measure_aliasing(&frames[0].frame, settings);
-
-    let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
-    let drawn = lab::drawn_metrics(&scene, settings, &frames.iter().map(|r| &r.frame).collect::<Vec<_>>())?;
-    let soft = reference.samples > 1;
-    let (w, h) = (reference.width, reference.height);
-
-    let mut rows = Vec::new();
-    let mut tiles = vec![vec![Tile {
-        image: rgba(w, h, output::visibility_rgba(&reference.visibility)),
-        caption: caption_reference(&reference),
-        downscale: Downscale::Smooth,
-    }]];
-    let mut staged = output::Staged::default();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("--out: cannot create {}", args.out.display()))?;
-    staged.png_rgba(
-        &args.out.join("reference.png"),
-        w,
-        h,
-        &output::visibility_rgba(&reference.visibility),
-    )?;
-    staged.png_rgba(&args.out.join("aliasing.png"), w, h, &aliasing::heatmap(&aliasing))?;
-    for ((Rendered { technique, frame, timing }, flicker), drawn) in frames.iter().zip(flicker).zip(drawn) {
-        let raster =
-            RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
-        let classes: Vec<PixelClass> = metrics::classify(raster, &reference);
-        let m = metrics::measure(raster, &reference, &classes);
-        let error = if soft {
-            heatmap::soft(&frame.visibility, &reference, &classes)
-        } else {
-            heatmap::hard(&frame.visibility, &reference, &classes)
-        };
-        let name = technique.name();
-        staged.png_rgba(&args.out.join(format!("{name}.png")), w, h, &frame.color)?;
-        staged.png_rgba(&args.out.join(format!("{name}-error.png")), w, h, &error)?;
-        let summary = edge_caption(&m, &drawn, soft);
-        let mut caption = vec![name.to_string()];
-        if let Some((s, f, l)) = timing {
-            caption.push(format!("shadow pass {s:.2} ms"));
-            if let Some(f) = f {
-                caption.push(format!("moment pass {f:.2} ms"));
-            }
-            caption.push(format!("lighting pass {l:.2} ms"));
-        }
-        tiles.push(vec![
-            Tile { image: rgba(w, h, frame.color.clone()), caption, downscale: Downscale::Smooth },
-            Tile {
-                image: rgba(w, h, error),
-                caption: summary
-                    .into_iter()
-                    .chain([
-                        format!("false shadow {:.3}%", 100.0 * m.false_shadow_rate),
-                        format!("false lit {:.3}%", 100.0 * m.false_lit_rate),
-                        format!("all surfaces: mismatch {:.3}%", 100.0 * m.surface_mismatch_rate),
-                    ])
-                    .collect(),
-                downscale: Downscale::Salient(if soft { soft_priority } else { hard_priority }),
-            },
-        ]);
-        rows.push(Row {
-            technique: name.to_owned(),
-            drawn,
-            metrics: m,
-            shadow_ms: timing.map(|t| t.0),
-            filter_ms: timing.and_then(|t| t.1),
-            lighting_ms: timing.map(|t| t.2),
-            moment_format: frame.moment_format.map(|f| format!("{f:?}").to_lowercase()),
-            flicker,
-        });
-    }
-    let legend: Vec<(String, [u8; 3])> = if soft {
-        [0.0f32, 0.25, 0.5, 0.75, 1.0].iter().map(|&e| (format!("|V-R| {e}"), heatmap::ramp(e))).collect()
-    } else {
-        heatmap::HARD_LEGEND.iter().map(|(l, c)| (l.to_string(), *c)).collect()
-    };
-    // Many techniques go two to a row, so the grid stays a page, not a scroll.
-    if tiles.len() > 5 {
-        let mut techniques = tiles.split_off(1);
-        while !techniques.is_empty() {
-            let n = techniques.len().min(2);
-            tiles.push(techniques.drain(..n).flatten().collect());
-        }
-    }
-    let grid = grid::compose(&tiles, 480, &legend);
-    staged.png_rgba(&args.out.join("grid.png"), grid.width(), grid.height(), grid.as_raw())?;
-
-    let report = Report {
-        scene: &scene.name,
-        width: w,
-        height: h,
-        shadow_resolution: settings.shadow.map.resolution,
-        light: format!("{:?}", settings.resolve_light(&scene)?),
-        reference_samples: reference.samples,
-        adapter: gpu.info.adapter.clone(),
-        backend: gpu.info.backend.clone(),
-        aliasing: AliasingSummary { mean: aliasing.mean, max: aliasing.max },
-        camera_path: args.camera_path.map(|kind| PathReport {
-            kind,
-            frames: args.path_frames,
-            travel: args.path_travel,
-            frozen_cascades: settings.shadow.cascades.freeze,
-        }),
-        denominators: metrics::DENOMINATORS.iter().copied().collect(),
-        rows,
-    };
-    let table = markdown_table(&report, soft);
-    staged.text(&args.out.join("metrics.json"), &serde_json::to_string_pretty(&report)?)?;
-    staged.text(&args.out.join("metrics.md"), &table)?;
-    let written = staged.commit()?;
-    print!("{table}");
-    eprintln!("gnomon: wrote {} files to {}", written.len(), args.out.display());
-    Ok(())
+    Ok(frames)
 }
 
 /// Renders every technique and the reference along the camera path and counts, for
@@ -315,50 +264,6 @@ fn measure_flicker(
     }
     bar.finish_and_clear();
     Ok(counters.iter().map(|c| Some(c.result())).collect())
-}
-
-/// The first lines of an error tile's caption (each under the tile's 30 characters),
-/// each figure named for its denominator: under an area light, the MAE over all
-/// compared pixels, over the penumbra, and the penumbra width error with its bias;
-/// under a point-like light, the mismatch rate over every drawn pixel and the MAE over
-/// the edge band.
-fn edge_caption(m: &Metrics, drawn: &DrawnMetrics, soft: bool) -> Vec<String> {
-    if soft {
-        let width = match (m.penumbra.width.error_px, m.penumbra.width.bias_px) {
-            (Some(e), Some(b)) => format!("width error {e:.1} px ({b:+.1})"),
-            _ => "width error: none resolved".to_string(),
-        };
-        vec![format!("MAE {:.4} all", m.mae), format!("MAE {:.4} penumbra", m.penumbra.error.mae), width]
-    } else {
-        vec![
-            format!("mismatch {:.3}% every pixel", 100.0 * drawn.mismatch_rate),
-            format!("edge MAE {:.3} within 2 px", m.edge.mae),
-        ]
-    }
-}
-
-/// Wrong pixels outrank silhouettes, which outrank correct ones.
-fn hard_priority(p: [u8; 4]) -> u32 {
-    let c = [p[0], p[1], p[2]];
-    if c == heatmap::FALSE_SHADOW || c == heatmap::FALSE_LIT {
-        2
-    } else {
-        u32::from(c == heatmap::SILHOUETTE)
-    }
-}
-
-/// Larger errors are brighter on the ramp.
-fn soft_priority(p: [u8; 4]) -> u32 {
-    3 * p[0] as u32 + 6 * p[1] as u32 + p[2] as u32
-}
-
-fn rgba(w: u32, h: u32, data: Vec<u8>) -> RgbaImage {
-    RgbaImage::from_raw(w, h, data).unwrap_or_else(|| RgbaImage::new(w, h))
-}
-
-fn caption_reference(r: &gnomon_reference::ReferenceImage) -> Vec<String> {
-    let kind = if r.samples > 1 { format!("{} samples/pixel", r.samples) } else { "exact".to_string() };
-    vec!["reference (ray traced)".into(), kind]
 }
 
 fn median(values: &mut [f64]) -> f64 {

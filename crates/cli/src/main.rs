@@ -7,6 +7,7 @@ mod bench_report;
 mod cache;
 mod calibrate;
 mod compare_cmd;
+mod compare_outputs;
 mod compare_report;
 mod grid;
 mod lab;

@@ -36,7 +36,6 @@ impl ShadowTechnique for Hard {
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         // The nearest texel along the direction, compared once.
-        Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    \
-                return textureSampleCompareLevel(shadow_cube, shadow_compare_nearest, q.offset, q.depth);\n}\n"])
+        Some(&[include_str!("hard_cube.wgsl")])
     }
 }

@@ -43,14 +43,11 @@ impl ShadowTechnique for Pcf2x2 {
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
-        &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
-           return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.layer, q.coords.z);\n}\n"]
+        &[include_str!("pcf2x2.wgsl")]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&[
-            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_compare_tap(q, vec2<f32>(0.0));\n}\n",
-        ])
+        Some(&[include_str!("pcf2x2_cube.wgsl")])
     }
 }
 
@@ -78,16 +75,11 @@ impl ShadowTechnique for PcfBox {
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
-        &[
-            PCF_WGSL,
-            "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), false);\n}\n",
-        ]
+        &[PCF_WGSL, include_str!("pcf_box.wgsl")]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&[
-            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_pcf_grid(q, cube_kernel_width_texels(q), false);\n}\n",
-        ])
+        Some(&[include_str!("pcf_box_cube.wgsl")])
     }
 }
 
@@ -115,16 +107,11 @@ impl ShadowTechnique for PcfTent {
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
-        &[
-            PCF_WGSL,
-            "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return pcf_kernel(q, kernel_width_texels(q), true);\n}\n",
-        ]
+        &[PCF_WGSL, include_str!("pcf_tent.wgsl")]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&[
-            "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return cube_pcf_grid(q, cube_kernel_width_texels(q), true);\n}\n",
-        ])
+        Some(&[include_str!("pcf_tent_cube.wgsl")])
     }
 }
 
@@ -152,12 +139,10 @@ impl ShadowTechnique for PcfPoisson {
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
-        &["fn sample_shadow(q: ShadowQuery) -> f32 {\n    \
-           return pcf_poisson(q, 0.5 * kernel_width_texels(q), light.poisson_taps);\n}\n"]
+        &[include_str!("pcf_poisson.wgsl")]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&["fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    \
-                return cube_pcf_poisson(q, 0.5 * cube_kernel_width_texels(q), light.poisson_taps);\n}\n"])
+        Some(&[include_str!("pcf_poisson_cube.wgsl")])
     }
 }

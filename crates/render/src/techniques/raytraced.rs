@@ -10,13 +10,6 @@ use gnomon_scene::settings::{FilterSettings, RayUse, Technique};
 
 use super::{MapSupport, ShadowTechnique, Tunables};
 
-/// The answer of pixels that trace no ray. Every pixel that faces the light and lies
-/// in its cone and range traces (`ray_decides`, `rays/refine_classify.wgsl`); the rest
-/// receive no light, so they are shadowed, and no map is read (the frame draws none,
-/// `frame/record.rs`'s `cull`).
-const UNTRACED: &str = "fn sample_shadow(q: ShadowQuery) -> f32 {\n    return 0.0;\n}\n";
-const UNTRACED_CUBE: &str = "fn sample_shadow_cube(q: CubeQuery) -> f32 {\n    return 0.0;\n}\n";
-
 pub struct Raytraced;
 
 impl ShadowTechnique for Raytraced {
@@ -30,11 +23,11 @@ impl ShadowTechnique for Raytraced {
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
-        &[UNTRACED]
+        &[include_str!("raytraced.wgsl")]
     }
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
-        Some(&[UNTRACED_CUBE])
+        Some(&[include_str!("raytraced_cube.wgsl")])
     }
 
     /// Rays do not care what the map is.

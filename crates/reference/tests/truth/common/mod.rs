@@ -2,11 +2,13 @@
 //! test binary, a render, a reference trace and the comparison of the two.
 #![allow(dead_code)]
 
+#[path = "../../../../render/tests/gpu/support/device.rs"]
+pub mod device;
 #[path = "../../../../render/tests/gpu/support/figures.rs"]
 pub mod figures;
-pub mod rays;
 
-use std::sync::OnceLock;
+pub use device::{gpu, render};
+pub mod rays;
 
 use glam::{Mat4, Vec3};
 use gnomon_reference::{
@@ -14,20 +16,10 @@ use gnomon_reference::{
     metrics::{self, Metrics, RasterView},
     reference_visibility,
 };
-use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
+use gnomon_render::Frame;
 use gnomon_scene::{
     Camera, DirectionalLight, Instance, Material, Scene, Settings, builtin, geometry, sun_direction,
 };
-
-/// The device shared by the tests in one binary (WGPU_BACKEND is honoured; CI sets vulkan).
-pub fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
-
-pub fn render(scene: &Scene, s: &Settings) -> Frame {
-    Renderer::new(gpu()).unwrap().render(scene, s, &OutputRequest::default()).unwrap()
-}
 
 /// The reference for the settings' camera and light, with `s.reference.samples` rays
 /// per pixel for an area light (one for a point or a sun without size).

@@ -2,24 +2,14 @@
 //! rays for ground truth on small procedural scenes, and pixel footprints.
 #![allow(dead_code)]
 
+pub mod device;
 pub mod figures;
 
-use std::sync::OnceLock;
+pub use device::{gpu, render};
 
 use glam::{Mat4, Vec3};
-use gnomon_render::{Frame, Gpu, OutputRequest, Renderer};
+use gnomon_render::Frame;
 use gnomon_scene::{Instance, Light, Material, Scene, Settings, geometry};
-
-/// The device shared by the tests in one binary (WGPU_BACKEND is honoured; CI sets vulkan).
-pub fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
-
-pub fn render(scene: &Scene, settings: &Settings) -> Frame {
-    let mut renderer = Renderer::new(gpu()).expect("renderer");
-    renderer.render(scene, settings, &OutputRequest::default()).expect("render")
-}
 
 /// The default settings at a size and map resolution, unrefined: these tests measure
 /// the shadow maps themselves, which the default's rays would correct where the map

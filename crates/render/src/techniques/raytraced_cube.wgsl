@@ -1,0 +1,5 @@
+// raytraced on a cube map: as raytraced.wgsl.
+
+fn sample_shadow_cube(q: CubeQuery) -> f32 {
+    return 0.0;
+}
