@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use gnomon_render::{Gpu, LayerCache, OutputRequest, Renderer};
+use gnomon_render::{Frame, Gpu, LayerCache, OutputRequest, Renderer};
 use gnomon_scene::{
     Scene, Settings,
     settings::{CullMode, value_name},
@@ -62,7 +62,41 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
     let (scene, settings) = crate::lab::load(&args.scene, &args.settings)?;
     let settings = &settings;
+    check_outputs(args)?;
 
+    let gpu = Gpu::new_headless()?;
+    if args.verbose {
+        eprintln!("gnomon: {}", gpu.info);
+        let b = scene.bounds();
+        let camera = settings.resolve_camera(&scene)?;
+        eprintln!(
+            "gnomon: scene bounds {:.3} to {:.3}; camera at {:.3} looking at {:.3}",
+            b.min, b.max, camera.eye, camera.target
+        );
+        eprintln!("gnomon: {}", open_casters_line(&scene, settings.shadow.bias.cull));
+    }
+    let mut renderer = Renderer::new(&gpu)?;
+    renderer.check_limits(settings)?;
+    let request = OutputRequest { shadow_map: args.shadow_map_out.is_some(), ..Default::default() };
+    let render_started = std::time::Instant::now();
+    let frame = renderer.render(&scene, settings, &request)?;
+    warn_fallbacks(&frame.lights);
+    if args.verbose {
+        report_frame(&gpu, &scene, &frame, render_started.elapsed());
+    }
+    let written = stage_outputs(args, &frame)?.commit()?;
+    for path in &written {
+        println!("{}", path.display());
+    }
+    if args.verbose {
+        eprintln!("gnomon: done in {:.1} ms", started.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(())
+}
+
+/// Every output location checked before any work, so that a typo costs nothing, and
+/// no two outputs aimed at one file.
+fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
     // Check every output location before any work, so that a typo costs nothing.
     output::check_file(&args.out, &["png"], "--out")?;
     if let Some(p) = &args.shadow_map_out {
@@ -84,86 +118,70 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             .collect();
     output::refuse_shared_destinations(&planned)?;
 
-    let gpu = Gpu::new_headless()?;
-    if args.verbose {
-        eprintln!("gnomon: {}", gpu.info);
-        let b = scene.bounds();
-        let camera = settings.resolve_camera(&scene)?;
-        eprintln!(
-            "gnomon: scene bounds {:.3} to {:.3}; camera at {:.3} looking at {:.3}",
-            b.min, b.max, camera.eye, camera.target
-        );
-        eprintln!("gnomon: {}", open_casters_line(&scene, settings.shadow.bias.cull));
-    }
-    let mut renderer = Renderer::new(&gpu)?;
-    renderer.check_limits(settings)?;
-    let request = OutputRequest { shadow_map: args.shadow_map_out.is_some(), ..Default::default() };
-    let render_started = std::time::Instant::now();
-    let frame = renderer.render(&scene, settings, &request)?;
-    warn_fallbacks(&frame.lights);
-    if args.verbose {
-        let shadows = match frame.lights.as_slice() {
-            [one] => format!("technique {}, shadow map {}²", one.technique.name(), one.resolution),
-            many => format!("{} shadowed lights", many.len()),
-        };
-        eprintln!(
-            "gnomon: scene `{}` ({} triangles, {} instances), {}×{}, {shadows}, rendered in {:.1} ms",
-            scene.name,
-            scene.triangle_count(),
-            scene.instances.len(),
-            frame.width,
-            frame.height,
-            render_started.elapsed().as_secs_f64() * 1e3
-        );
-        let st = frame.stats;
-        let prepass = if frame.shadow_mask {
-            format!(", {} in the prepass (shadows resolved in a screen-space mask)", st.prepass_draws)
-        } else {
-            String::new()
-        };
-        eprintln!(
-            "gnomon: draws: {} in the shadow pass ({} draw commands), {} in the lighting pass{prepass}; {} pipeline and {} bind group changes",
-            st.shadow_draws,
-            st.shadow_commands,
-            st.lighting_draws,
-            st.pipeline_changes,
-            st.bind_group_changes
-        );
-        if let Some(format) = frame.moment_format {
-            let why = match format {
-                gnomon_render::wgpu::TextureFormat::Rgba16Float
-                    if !gpu.device.features().contains(gnomon_render::wgpu::Features::FLOAT32_FILTERABLE) =>
-                {
-                    " (this adapter cannot filter 32-bit floats)"
-                }
-                _ => "",
-            };
-            eprintln!("gnomon: moment map {format:?}{why}");
-        }
-        if let Some(t) = frame.timings {
-            let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
-            let prepass = t.prepass_ms.map(|p| format!(", prepass {p:.2} ms")).unwrap_or_default();
-            let mask = t.mask_ms.map(|m| format!(", shadow mask {m:.2} ms")).unwrap_or_default();
-            let trace = t.trace_ms.map(|m| format!(", ray trace {m:.2} ms")).unwrap_or_default();
-            eprintln!(
-                "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}{prepass}{mask}{trace}, lighting pass {:.2} ms",
-                t.frame_ms, t.shadow_ms, t.lighting_ms
-            );
-        }
-        for (i, light) in frame.lights.iter().enumerate() {
-            eprintln!("gnomon: {}", light_line(i, light));
-            if light.traced_pixels.is_some() {
-                eprintln!("gnomon: {}", traced_line(i, light, frame.pixel_count()));
-            } else if light.refine != gnomon_scene::settings::Refine::Off {
-                // The forward path counts nothing (rays/refine_forward.wgsl says why).
-                eprintln!(
-                    "gnomon: light {i}: refined by rays in the lighting pass (forward path: not counted)"
-                );
-            }
-        }
-    }
+    Ok(())
+}
 
-    // Encode everything to temporary files first; rename only when all succeeded.
+/// `--verbose`'s lines on a rendered frame: its scene and size, its draws, its moment
+/// map, its GPU times, and each light's map, draws and rays.
+fn report_frame(gpu: &Gpu, scene: &Scene, frame: &Frame, render_time: std::time::Duration) {
+    let shadows = match frame.lights.as_slice() {
+        [one] => format!("technique {}, shadow map {}²", one.technique.name(), one.resolution),
+        many => format!("{} shadowed lights", many.len()),
+    };
+    eprintln!(
+        "gnomon: scene `{}` ({} triangles, {} instances), {}×{}, {shadows}, rendered in {:.1} ms",
+        scene.name,
+        scene.triangle_count(),
+        scene.instances.len(),
+        frame.width,
+        frame.height,
+        render_time.as_secs_f64() * 1e3
+    );
+    let st = frame.stats;
+    let prepass = if frame.shadow_mask {
+        format!(", {} in the prepass (shadows resolved in a screen-space mask)", st.prepass_draws)
+    } else {
+        String::new()
+    };
+    eprintln!(
+        "gnomon: draws: {} in the shadow pass ({} draw commands), {} in the lighting pass{prepass}; {} pipeline and {} bind group changes",
+        st.shadow_draws, st.shadow_commands, st.lighting_draws, st.pipeline_changes, st.bind_group_changes
+    );
+    if let Some(format) = frame.moment_format {
+        let why = match format {
+            gnomon_render::wgpu::TextureFormat::Rgba16Float
+                if !gpu.device.features().contains(gnomon_render::wgpu::Features::FLOAT32_FILTERABLE) =>
+            {
+                " (this adapter cannot filter 32-bit floats)"
+            }
+            _ => "",
+        };
+        eprintln!("gnomon: moment map {format:?}{why}");
+    }
+    if let Some(t) = frame.timings {
+        let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
+        let prepass = t.prepass_ms.map(|p| format!(", prepass {p:.2} ms")).unwrap_or_default();
+        let mask = t.mask_ms.map(|m| format!(", shadow mask {m:.2} ms")).unwrap_or_default();
+        let trace = t.trace_ms.map(|m| format!(", ray trace {m:.2} ms")).unwrap_or_default();
+        eprintln!(
+            "gnomon: GPU time: frame {:.2} ms: shadow pass {:.2} ms{filter}{prepass}{mask}{trace}, lighting pass {:.2} ms",
+            t.frame_ms, t.shadow_ms, t.lighting_ms
+        );
+    }
+    for (i, light) in frame.lights.iter().enumerate() {
+        eprintln!("gnomon: {}", light_line(i, light));
+        if light.traced_pixels.is_some() {
+            eprintln!("gnomon: {}", traced_line(i, light, frame.pixel_count()));
+        } else if light.refine != gnomon_scene::settings::Refine::Off {
+            // The forward path counts nothing (rays/refine_forward.wgsl says why).
+            eprintln!("gnomon: light {i}: refined by rays in the lighting pass (forward path: not counted)");
+        }
+    }
+}
+
+/// Every output encoded to a temporary file beside its destination, to be moved into
+/// place together.
+fn stage_outputs(args: &RenderArgs, frame: &Frame) -> anyhow::Result<Staged> {
     let mut staged = Staged::default();
     staged.png_rgba(&args.out, frame.width, frame.height, &frame.color)?;
     if let (Some(path), Some(map)) = (&args.shadow_map_out, &frame.shadow_map) {
@@ -189,14 +207,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         staged.float_image(&object_id, w, h, &ids)?;
         staged.float_image(&visibility, w, h, &frame.visibility)?;
     }
-    let written = staged.commit()?;
-    for path in &written {
-        println!("{}", path.display());
-    }
-    if args.verbose {
-        eprintln!("gnomon: done in {:.1} ms", started.elapsed().as_secs_f64() * 1e3);
-    }
-    Ok(())
+    Ok(staged)
 }
 
 /// `--verbose`'s line on open meshes: how many single-sided casters `cull auto` found

@@ -447,10 +447,43 @@ impl ShadowSettings {
         Ok(shadow)
     }
 
-    /// Checks every shadow value against its documented range.
+    /// Checks every shadow value against its documented range, group by group, and
+    /// the combinations that cannot work together.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let s = self;
-        let f = &s.filter;
+        s.filter.validate()?;
+        if s.map.warp != WarpKind::None {
+            let warp = value_name(&s.map.warp);
+            check(
+                s.partition == Partition::Single,
+                "shadow.map.warp",
+                &warp,
+                "a warp of a single map: with `shadow.partition` cascades use `shadow.map.warp` none",
+            )?;
+            check(
+                s.filter.kernel_unit == KernelUnit::Texels,
+                "shadow.map.warp",
+                &warp,
+                "with `shadow.filter.kernel_unit` world: a warped map's kernels are in texels",
+            )?;
+        }
+        s.cascades.validate()?;
+        s.bias.validate()?;
+        let r = s.map.resolution;
+        check(
+            (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
+            "shadow.map.resolution",
+            r,
+            format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
+        )?;
+        s.contact.validate()?;
+        Ok(())
+    }
+}
+
+impl FilterSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let f = self;
         match f.kernel_unit {
             KernelUnit::Texels => check(
                 f.pcf_kernel.is_finite() && (1.0..=MAX_KERNEL_TEXELS).contains(&f.pcf_kernel),
@@ -487,22 +520,13 @@ impl ShadowSettings {
             "1 to 64 texels",
         )?;
         f.moments.validate()?;
-        if s.map.warp != WarpKind::None {
-            let warp = value_name(&s.map.warp);
-            check(
-                s.partition == Partition::Single,
-                "shadow.map.warp",
-                &warp,
-                "a warp of a single map: with `shadow.partition` cascades use `shadow.map.warp` none",
-            )?;
-            check(
-                f.kernel_unit == KernelUnit::Texels,
-                "shadow.map.warp",
-                &warp,
-                "with `shadow.filter.kernel_unit` world: a warped map's kernels are in texels",
-            )?;
-        }
-        let c = &s.cascades;
+        Ok(())
+    }
+}
+
+impl CascadeSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let c = self;
         check(
             (1..=MAX_CASCADES).contains(&c.count),
             "shadow.cascades.count",
@@ -536,7 +560,13 @@ impl ShadowSettings {
                 "only with `shadow.cascades.cascade_fit` tight: bounds that follow every pixel cannot keep a stable cascade still",
             )?;
         }
-        let b = &s.bias;
+        Ok(())
+    }
+}
+
+impl BiasSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let b = self;
         check(
             (-MAX_DEPTH_BIAS..=MAX_DEPTH_BIAS).contains(&b.depth_bias),
             "shadow.bias.depth_bias",
@@ -555,14 +585,6 @@ impl ShadowSettings {
             b.normal_offset,
             format!("in [0, {MAX_NORMAL_OFFSET}] texels"),
         )?;
-        let r = s.map.resolution;
-        check(
-            (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
-            "shadow.map.resolution",
-            r,
-            format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
-        )?;
-        s.contact.validate()?;
         Ok(())
     }
 }
