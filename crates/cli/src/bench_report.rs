@@ -99,8 +99,24 @@ pub(crate) fn summarize(name: &str, values: &[f64]) -> Summary {
 /// The report as markdown: the device, then a table of passes per configuration,
 /// then each layer's time where a light has several.
 pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
-    use std::fmt::Write;
     let mut md = String::new();
+    header(&mut md, report, info);
+    let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));
+    pass_table(&mut md, report, sweep);
+    if report.configs.iter().any(|c| c.layers.len() > 1) {
+        layer_table(&mut md, report, sweep);
+    }
+    md
+}
+
+/// A row's cell: the median and, in brackets, the 95th percentile.
+fn cell(s: Option<&Summary>) -> String {
+    s.map_or("–".to_string(), |s| format!("{:.3} ({:.3})", s.median_ms, s.p95_ms))
+}
+
+/// The title and the device, the scene, the frames timed and the command.
+fn header(md: &mut String, report: &Report, info: &GpuInfo) {
+    use std::fmt::Write;
     let _ = writeln!(md, "# gnomon bench: {}\n", report.scene);
     let _ = writeln!(
         md,
@@ -126,6 +142,11 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         report.frames,
         report.command,
     );
+}
+
+/// One row per configuration: each pass's time, in frame order, and its draws.
+fn pass_table(md: &mut String, report: &Report, sweep: Option<&str>) {
+    use std::fmt::Write;
     let mut columns: Vec<String> = Vec::new();
     for config in &report.configs {
         for pass in &config.passes {
@@ -155,7 +176,6 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         "layers drawn",
     ];
     columns.sort_by_key(|c| ORDER.iter().position(|o| o == c).unwrap_or(ORDER.len()));
-    let sweep = report.sweep.as_deref().and_then(|s| s.split('=').next()).map(|f| f.trim_start_matches('-'));
     let has_baseline = report.configs.iter().any(|c| c.depth_only.is_some());
     let has_rays = report.configs.iter().any(|c| c.rays.is_some());
     let _ = write!(md, "| technique |");
@@ -181,9 +201,6 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
         + 2 * usize::from(has_baseline)
         + usize::from(has_rays);
     let _ = writeln!(md, "|{}", "---|".repeat(cells));
-    let cell = |s: Option<&Summary>| {
-        s.map_or("–".to_string(), |s| format!("{:.3} ({:.3})", s.median_ms, s.p95_ms))
-    };
     for config in &report.configs {
         let _ = write!(md, "| {} |", config.technique);
         if sweep.is_some() {
@@ -214,33 +231,35 @@ pub(crate) fn markdown(report: &Report, info: &GpuInfo) -> String {
             config.lighting_instances
         );
     }
-    if report.configs.iter().any(|c| c.layers.len() > 1) {
-        let _ = writeln!(md, "\nEach shadow-map layer (light L, layer: cascade or cube face):\n");
-        let _ = writeln!(
-            md,
-            "| technique | layer | median (p95) | draws | commands | triangles |\n|---|---|---|---|---|---|"
-        );
-        for config in &report.configs {
-            let label = match &config.sweep_value {
-                Some(v) => format!("{} {}={v}", config.technique, sweep.unwrap_or("")),
-                None => config.technique.clone(),
-            };
-            for (index, layer) in config.layers.iter().enumerate() {
-                let drawn = config.layer_drawn.get(index);
-                let count = |n: Option<u64>| n.map_or("–".to_string(), |n| n.to_string());
-                let _ = writeln!(
-                    md,
-                    "| {label} | {} | {} | {} | {} | {} |",
-                    layer.name.trim_start_matches("shadow "),
-                    cell(Some(layer)),
-                    count(drawn.map(|d| u64::from(d.draws))),
-                    count(drawn.map(|d| u64::from(d.commands))),
-                    count(drawn.map(|d| d.triangles)),
-                );
-            }
+}
+
+/// Each shadow-map layer's time and draws, where a light has several.
+fn layer_table(md: &mut String, report: &Report, sweep: Option<&str>) {
+    use std::fmt::Write;
+    let _ = writeln!(md, "\nEach shadow-map layer (light L, layer: cascade or cube face):\n");
+    let _ = writeln!(
+        md,
+        "| technique | layer | median (p95) | draws | commands | triangles |\n|---|---|---|---|---|---|"
+    );
+    for config in &report.configs {
+        let label = match &config.sweep_value {
+            Some(v) => format!("{} {}={v}", config.technique, sweep.unwrap_or("")),
+            None => config.technique.clone(),
+        };
+        for (index, layer) in config.layers.iter().enumerate() {
+            let drawn = config.layer_drawn.get(index);
+            let count = |n: Option<u64>| n.map_or("–".to_string(), |n| n.to_string());
+            let _ = writeln!(
+                md,
+                "| {label} | {} | {} | {} | {} | {} |",
+                layer.name.trim_start_matches("shadow "),
+                cell(Some(layer)),
+                count(drawn.map(|d| u64::from(d.draws))),
+                count(drawn.map(|d| u64::from(d.commands))),
+                count(drawn.map(|d| d.triangles)),
+            );
         }
     }
-    md
 }
 
 #[cfg(test)]
