@@ -234,20 +234,9 @@ impl Renderer {
             self.pool.bind_group("camera", &self.layouts.camera, &[Binding::Buffer(camera_buffer.clone())]);
         // On the mask path, one layer of the mask per light.
         let mask_layers = if plan.mask_path { self.mask_layers(plan, width, height) } else { vec![] };
-        let mut readbacks = FrameReadbacks::default();
-        let mut lit = Vec::with_capacity(plan.lights.len());
-        let mut shown_map = None;
-        for (index, light) in plan.lights.iter().enumerate() {
-            let map = self.record_shadow_maps(rec, uploaded, light, &culled.layers[index], index as u32);
-            if index == plan.shown {
-                if readback.shadow_map {
-                    let aspect = wgpu::TextureAspect::DepthOnly;
-                    readbacks.shadow_map = Some(readback::record(&mut self.pool, rec.encoder, &map, aspect));
-                }
-                shown_map = Some(map.clone());
-            }
-            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
-        }
+        let LitLights { lit, shown_map, shown_map_readback } =
+            self.record_light_maps(rec, uploaded, plan, culled, &mask_layers, readback);
+        let mut readbacks = FrameReadbacks { shadow_map: shown_map_readback, ..Default::default() };
         let targets = self.lighting_targets(width, height);
         let viewport = Viewport { width, height };
         let tiles = plan.mask_path.then(|| plan.light_tiles(viewport));
@@ -313,11 +302,36 @@ impl Renderer {
                 .map(|t| readback::record(&mut self.pool, rec.encoder, t, wgpu::TextureAspect::All))
                 .collect();
         }
-        Drawn {
-            readbacks,
-            color: targets.textures[0].clone(),
-            shadow_map: shown_map.expect("the reported light is one of the lights"),
+        Drawn { readbacks, color: targets.textures[0].clone(), shadow_map: shown_map }
+    }
+
+    /// The first passes: each light's shadow maps (and moment map), and its bindings
+    /// for the passes from the camera; the reported light's map copied out when asked.
+    fn record_light_maps(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        plan: &FramePlan,
+        culled: &Culled,
+        mask_layers: &[wgpu::TextureView],
+        readback: Readback,
+    ) -> LitLights {
+        let mut lit = Vec::with_capacity(plan.lights.len());
+        let mut shown_map = None;
+        let mut shown_map_readback = None;
+        for (index, light) in plan.lights.iter().enumerate() {
+            let map = self.record_shadow_maps(rec, uploaded, light, &culled.layers[index], index as u32);
+            if index == plan.shown {
+                if readback.shadow_map {
+                    let aspect = wgpu::TextureAspect::DepthOnly;
+                    shown_map_readback = Some(readback::record(&mut self.pool, rec.encoder, &map, aspect));
+                }
+                shown_map = Some(map.clone());
+            }
+            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
         }
+        let shown_map = shown_map.expect("the reported light is one of the lights");
+        LitLights { lit, shown_map, shown_map_readback }
     }
 
     /// A light's uniform and its maps as the passes from the camera read them: the
@@ -395,6 +409,14 @@ impl Renderer {
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
+}
+
+/// Each light's bindings for the passes from the camera, and the reported light's map.
+struct LitLights {
+    lit: Vec<LightBindings>,
+    shown_map: wgpu::Texture,
+    /// The reported light's map being copied out, when the frame asked for it.
+    shown_map_readback: Option<crate::readback::PendingReadback>,
 }
 
 /// What a frame's passes drew.

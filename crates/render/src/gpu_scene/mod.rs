@@ -80,26 +80,58 @@ fn next_generation() -> u64 {
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
+/// Every mesh's vertices and indices in one buffer each, and where each mesh lies.
+struct PackedMeshes {
+    vertices: Vec<VertexGpu>,
+    indices: Vec<u32>,
+    ranges: Vec<MeshRange>,
+}
+
+impl PackedMeshes {
+    fn of(scene: &Scene) -> Self {
+        let mut packed = PackedMeshes {
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            ranges: Vec::with_capacity(scene.meshes.len()),
+        };
+        for mesh in &scene.meshes {
+            packed.ranges.push(MeshRange {
+                first_index: packed.indices.len() as u32,
+                index_count: mesh.indices.len() as u32,
+                base_vertex: packed.vertices.len() as i32,
+            });
+            packed.vertices.extend(mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).map(
+                |((p, n), uv)| VertexGpu { position: p.to_array(), normal: n.to_array(), uv: uv.to_array() },
+            ));
+            packed.indices.extend_from_slice(&mesh.indices);
+        }
+        packed
+    }
+}
+
+/// The instances' records must fit one storage binding and one buffer of the device.
+fn check_instance_bytes(gpu: &Gpu, scene: &Scene, instance_data: &[InstanceGpu]) -> Result<(), RenderError> {
+    let instance_bytes = std::mem::size_of_val(instance_data) as u64;
+    let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+    if instance_bytes > limit {
+        return Err(RenderError::SceneTooLarge {
+            scene: scene.name.clone(),
+            instances: instance_data.len(),
+            bytes: instance_bytes,
+            limit,
+            max_instances: limit / std::mem::size_of::<InstanceGpu>() as u64,
+        });
+    }
+    Ok(())
+}
+
 impl GpuScene {
     pub(crate) fn upload(gpu: &Gpu, scene: &Scene, layouts: &Layouts) -> Result<Self, RenderError> {
         scene.validate()?;
         if scene.instances.is_empty() || scene.triangle_count() == 0 {
             return Err(RenderError::EmptyScene(scene.name.clone()));
         }
-        let mut vertices = Vec::new();
-        let mut indices = Vec::new();
-        let mut ranges = Vec::with_capacity(scene.meshes.len());
-        for mesh in &scene.meshes {
-            ranges.push(MeshRange {
-                first_index: indices.len() as u32,
-                index_count: mesh.indices.len() as u32,
-                base_vertex: vertices.len() as i32,
-            });
-            vertices.extend(mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).map(|((p, n), uv)| {
-                VertexGpu { position: p.to_array(), normal: n.to_array(), uv: uv.to_array() }
-            }));
-            indices.extend_from_slice(&mesh.indices);
-        }
+        let PackedMeshes { vertices, indices, ranges } = PackedMeshes::of(scene);
         let positions: Vec<[f32; 3]> = vertices.iter().map(|v| v.position).collect();
         let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
 
@@ -136,17 +168,7 @@ impl GpuScene {
             slots[index] = Some(slot as u32);
         }
         let instance_data: Vec<InstanceGpu> = order.iter().map(|&i| instance_gpu(scene, i)).collect();
-        let instance_bytes = std::mem::size_of_val(instance_data.as_slice()) as u64;
-        let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
-        if instance_bytes > limit {
-            return Err(RenderError::SceneTooLarge {
-                scene: scene.name.clone(),
-                instances: instance_data.len(),
-                bytes: instance_bytes,
-                limit,
-                max_instances: limit / std::mem::size_of_val(&instance_data[0]) as u64,
-            });
-        }
+        check_instance_bytes(gpu, scene, &instance_data)?;
         let device = &gpu.device;
         let buffer = |label: &str, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -13,6 +13,20 @@ impl Model {
     /// The light, the debug views, the GPU timings and the reproduction buttons.
     pub(super) fn inspect_panel(&mut self, ui: &mut egui::Ui, images: &Images) {
         ui.heading("Light");
+        self.light_section(ui);
+        ui.separator();
+        ui.heading("Debug views");
+        self.debug_views_section(ui, images);
+        ui.separator();
+        ui.heading("GPU time");
+        self.timings_table(ui);
+        ui.separator();
+        ui.heading("Reproduce");
+        self.reproduce_section(ui);
+    }
+
+    /// The light's sliders, and for a sun its time of day, latitude and season.
+    fn light_section(&mut self, ui: &mut egui::Ui) {
         let light = self.settings.resolve_light(&self.scene).ok();
         self.light_sliders(ui, light);
         if matches!(light, Some(Light::Directional(_))) {
@@ -38,9 +52,11 @@ impl Model {
         ui.label(
             "Right-drag in the view to move the light; the Light section of the settings sets it exactly.",
         );
+    }
 
-        ui.separator();
-        ui.heading("Debug views");
+    /// The lit, texel-density and error views, the tints, the shadow maps and the
+    /// comparison with the reference.
+    fn debug_views_section(&mut self, ui: &mut egui::Ui, images: &Images) {
         let mut view = self.view;
         ui.horizontal(|ui| {
             ui.selectable_value(&mut view, View::Lit, "lit")
@@ -107,13 +123,10 @@ impl Model {
                 ui.label(RichText::new("(for an earlier view)").weak());
             }
         }
+    }
 
-        ui.separator();
-        ui.heading("GPU time");
-        self.timings_table(ui);
-
-        ui.separator();
-        ui.heading("Reproduce");
+    /// The buttons that reproduce this view: as a command, or as a scene file.
+    fn reproduce_section(&mut self, ui: &mut egui::Ui) {
         if ui
             .button("Copy as CLI command")
             .on_hover_text("A `gnomon render` command for this view.")
