@@ -8,15 +8,21 @@
 //! groups of four. `naga_layout_tests` (no device needed) parses every composed shader
 //! and checks each struct's size and each field's offset against the Rust type.
 
+mod light;
+
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, UVec4, Vec3, Vec4};
-use gnomon_math::ProjectionKind;
+use glam::{Mat4, Vec3};
 use gnomon_scene::{
-    Camera, Falloff, Light, Scene, Settings,
-    settings::{CascadeSelection, DebugView, KernelUnit, MAX_CASCADES as SETTINGS_MAX_CASCADES, OmniMap},
+    Camera, Falloff,
+    settings::{DebugView, MAX_CASCADES as SETTINGS_MAX_CASCADES},
 };
 
-use crate::{layout::ShadowLayout, techniques};
+pub use light::{
+    BiasGpu, CascadeChoiceGpu, ContactGpu, EmitterGpu, LightGpu, LightInputs, MapGpu, PcfGpu, PcssGpu,
+    RaysGpu,
+};
+
+use crate::techniques;
 
 /// The most cascades (array layers) a light's uniform holds: the settings' limit.
 pub const MAX_CASCADES: usize = SETTINGS_MAX_CASCADES as usize;
@@ -79,17 +85,6 @@ impl FalloffGpu {
     }
 }
 
-/// A technique's own parameters ([`techniques::ShadowTechnique::params`]): reals and
-/// integers, each technique documenting what it puts where (`TechniqueParams` in WGSL).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct TechniqueParams {
-    /// Real-valued parameters (an exponent, a bias, …), laid out by each technique.
-    pub reals: Vec4,
-    /// Counts, variants and switches (0 or 1).
-    pub integers: UVec4,
-}
-
 /// One layer (cascade) of a light's map (`Cascade` in `light.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -112,117 +107,6 @@ pub struct CascadeGpu {
     pub _pad1: u32,
     /// Padding to WGSL's 16-byte layout.
     pub _pad2: u32,
-}
-
-/// The light uniform (`Light` in `light.wgsl`): the light, its map's layers and the
-/// shadow settings its passes read.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct LightGpu {
-    /// The layer being drawn (shadow passes) or layer 0 (everything else).
-    pub clip_from_world: Mat4,
-    /// World space to layer 0's light view space: the light's axes, and distances along its view axis.
-    pub light_from_world: Mat4,
-    /// Colour × intensity.
-    pub radiance: Vec3,
-    /// A [`LightKindGpu`].
-    pub kind: u32,
-    /// The sun's travel direction or the spot's axis (unit).
-    pub direction: Vec3,
-    /// A spot or point light's range in world units.
-    pub range: f32,
-    /// A spot or point light's position.
-    pub position: Vec3,
-    /// Layers of the map: cascades, cube faces or paraboloids.
-    pub layer_count: u32,
-    /// Ambient light, added once by the first light's pass.
-    pub ambient: Vec3,
-    /// Moment-map layers per cascade, for the filterable techniques.
-    pub moment_layers: u32,
-    /// cos of the spot's inner and outer angles.
-    pub cos_inner: f32,
-    /// cos of the spot's outer half-angle: no light outside it (−1, every direction, for other lights).
-    pub cos_outer: f32,
-    /// The map's near and far planes along the light's axis.
-    pub map_near: f32,
-    /// The map's far plane along the light's axis, in world units.
-    pub map_far: f32,
-    /// Texel world size of an orthographic map, and per unit of distance for a
-    /// perspective one.
-    pub texel_ortho: f32,
-    /// Texel world size per unit of distance from the light, for a perspective map (0 for an
-    /// orthographic one; for a paraboloid map, radians per texel on its axis).
-    pub texel_per_distance: f32,
-    /// The normal offset, in texels.
-    pub normal_offset: f32,
-    /// Texels per side of each layer.
-    pub resolution: f32,
-    /// The PCF kernel's width, in texels or world units (`kernel_in_world`).
-    pub kernel_width: f32,
-    /// 1 when `kernel_width` is in world units, 0 when in texels.
-    pub kernel_in_world: u32,
-    /// Taps of the Poisson-disk PCF and of PCSS's filtering step, at most the disk's size.
-    pub poisson_taps: u32,
-    /// 1 to tilt the compared depth along the receiver's plane across the kernel, 0 not.
-    pub receiver_plane_bias: u32,
-    /// PCSS: the light's size (spot or point radius in world units, tan of the sun's
-    /// angular radius), blocker-search taps, the largest radius in texels.
-    pub light_size: f32,
-    /// PCSS: taps of the blocker search, at most the Poisson disk's size.
-    pub blocker_taps: u32,
-    /// PCSS: the largest blocker-search and penumbra radius, in texels.
-    pub max_penumbra_texels: f32,
-    /// 1 to pick cascades by projection, 0 by view depth.
-    pub select_by_projection: u32,
-    /// The blend band as a fraction of a cascade's depth range.
-    pub cascade_blend: f32,
-    /// The rasterizer's depth bias, for the passes that write their own depth (a
-    /// point light's distance cube): constant, in units of the last mantissa bit, and
-    /// slope-scaled.
-    pub depth_bias: f32,
-    /// Slope-scaled depth bias: multiplies the depth a surface spans across one texel.
-    pub slope_bias: f32,
-    /// Contact shadows: ray steps (0 when off), ray length in world units, thickness
-    /// as a fraction of view depth, the ray's start offset along the normal, and the
-    /// view depth where they end.
-    pub contact_steps: u32,
-    /// Contact shadows: length of the ray toward the light, in world units.
-    pub contact_length: f32,
-    /// Contact shadows: assumed thickness of the depth buffer's surfaces, as a fraction of view depth.
-    pub contact_thickness: f32,
-    /// Contact shadows: the ray's start offset along the surface normal, in world units.
-    pub contact_bias: f32,
-    /// Contact shadows: the view depth beyond which they are off (faded over its last quarter).
-    pub contact_distance: f32,
-    /// Refinement by rays: the rays a refined pixel casts over the light's area
-    /// (`ScreenSpaceSettings::penumbra_rays`), 0 for a hard light, whose pixel casts
-    /// one ray to its centre.
-    pub penumbra_rays: u32,
-    /// A spot or point light's [`FalloffGpu`] with distance.
-    pub falloff: u32,
-    /// Where an inverse-square falloff's window reaches 0, in world units; 0 for no
-    /// window.
-    pub falloff_window: f32,
-    /// Padding to the 16-byte alignment of `params`.
-    pub _pad0: u32,
-    /// The technique's own parameters ([`TechniqueParams`]).
-    pub params: TechniqueParams,
-    /// Each layer's clip_from_world (a paraboloid's: its hemisphere's frame);
-    /// layer 0 equals `clip_from_world` outside the shadow passes.
-    pub cascade_clip_from_world: [Mat4; MAX_CASCADES],
-    /// Each layer's texel size, view-depth span and warp flag; unused layers are zero.
-    pub cascades: [CascadeGpu; MAX_CASCADES],
-}
-
-impl Default for LightGpu {
-    fn default() -> Self {
-        Self {
-            clip_from_world: Mat4::IDENTITY,
-            light_from_world: Mat4::IDENTITY,
-            cascade_clip_from_world: [Mat4::IDENTITY; MAX_CASCADES],
-            ..Zeroable::zeroed()
-        }
-    }
 }
 
 /// The camera uniform (`Camera` in `camera.wgsl`).
@@ -325,148 +209,6 @@ pub fn wgsl_constants() -> String {
     s
 }
 
-/// What a light's uniform is made from.
-pub struct LightInputs<'a> {
-    /// The scene, for its ambient light.
-    pub scene: &'a Scene,
-    /// The light the uniform describes.
-    pub light: &'a Light,
-    /// The light's map layers: projections and cascade splits.
-    pub layout: &'a ShadowLayout,
-    /// The render's settings with this light's shadow settings.
-    pub settings: &'a Settings,
-    /// The technique's own parameters ([`techniques::ShadowTechnique::params`]).
-    pub params: TechniqueParams,
-    /// The filterable map the technique samples, if it has one (for its moment layer count).
-    pub filterable_map: Option<techniques::FilterableMap>,
-}
-
-impl LightGpu {
-    /// The uniform of one light of a frame.
-    pub fn new(inputs: &LightInputs) -> Self {
-        let LightInputs { scene, light, layout, settings, params, filterable_map } = *inputs;
-        let projection = &layout.projections[0];
-        let shadow = &settings.shadow;
-        let resolution = shadow.map.resolution;
-        let (texel_ortho, texel_per_distance) = projection.texel_size_coefficients(resolution);
-        let f = &shadow.filter;
-        let contact = &shadow.contact;
-        let mut uniform = LightGpu {
-            clip_from_world: projection.clip_from_world(),
-            light_from_world: projection.light_from_world,
-            ambient: scene.ambient,
-            layer_count: layout.projections.len() as u32,
-            moment_layers: filterable_map.map_or(1, |m| m.layers),
-            cos_inner: 1.0,
-            cos_outer: -1.0,
-            map_near: projection.near,
-            map_far: projection.far,
-            texel_ortho,
-            texel_per_distance,
-            normal_offset: shadow.bias.normal_offset,
-            resolution: resolution as f32,
-            kernel_width: f.pcf_kernel,
-            kernel_in_world: (f.kernel_unit == KernelUnit::World).into(),
-            poisson_taps: f.poisson_samples,
-            receiver_plane_bias: f.receiver_plane_bias.into(),
-            light_size: light_size(light),
-            blocker_taps: f.pcss.blocker_samples,
-            max_penumbra_texels: f.pcss.max_radius,
-            select_by_projection: (shadow.cascades.cascade_selection == CascadeSelection::Projection).into(),
-            cascade_blend: shadow.cascades.cascade_blend,
-            depth_bias: shadow.bias.depth_bias as f32,
-            slope_bias: shadow.bias.slope_bias,
-            contact_distance: contact.contact_distance,
-            penumbra_rays: if light.is_hard() { 0 } else { settings.screen.penumbra_rays },
-            params,
-            ..Default::default()
-        };
-        if contact.contact_shadows {
-            uniform.contact_steps = contact.contact_steps;
-            uniform.contact_length = contact.contact_length;
-            uniform.contact_thickness = contact.contact_thickness;
-            uniform.contact_bias = contact.contact_bias;
-        }
-        uniform.set_layers(layout, resolution);
-        uniform.set_light(light);
-        if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
-            uniform.set_paraboloids(layout, resolution);
-        }
-        uniform
-    }
-
-    /// Each layer's projection, texel size and view-depth span.
-    fn set_layers(&mut self, layout: &ShadowLayout, resolution: u32) {
-        self.cascade_clip_from_world = [self.clip_from_world; MAX_CASCADES];
-        for (i, p) in layout.projections.iter().enumerate() {
-            self.cascade_clip_from_world[i] = p.clip_from_world();
-            let texel = p.texel_size_coefficients(resolution).0;
-            let warped = matches!(p.kind, ProjectionKind::Warped { .. });
-            self.cascades[i] = CascadeGpu {
-                texel_world: texel,
-                warp_step: texel,
-                split_start: layout.splits.get(i).map_or(0.0, |z| z.min(f32::MAX)),
-                split_end: layout.splits.get(i + 1).map_or(0.0, |z| z.min(f32::MAX)),
-                warped: warped.into(),
-                ..Default::default()
-            };
-        }
-    }
-
-    /// The light's kind, colour, position and cone.
-    fn set_light(&mut self, light: &Light) {
-        match light {
-            Light::Directional(sun) => {
-                self.kind = LightKindGpu::Sun as u32;
-                self.radiance = sun.color * sun.intensity;
-                self.direction = sun.direction.normalize();
-            }
-            Light::Spot(spot) => {
-                self.kind = LightKindGpu::Spot as u32;
-                self.radiance = spot.color * spot.intensity;
-                self.direction = spot.direction.normalize();
-                self.position = spot.position;
-                self.range = spot.range;
-                (self.falloff, self.falloff_window) = FalloffGpu::of(spot.falloff);
-                self.cos_inner = spot.inner_angle_degrees.to_radians().cos();
-                self.cos_outer = spot.outer_angle_degrees.to_radians().cos();
-            }
-            Light::Point(point) => {
-                self.kind = LightKindGpu::Point as u32;
-                self.radiance = point.color * point.intensity;
-                self.position = point.position;
-                self.range = point.range;
-                (self.falloff, self.falloff_window) = FalloffGpu::of(point.falloff);
-            }
-        }
-    }
-
-    /// The paraboloid passes read each hemisphere's frame, not a projection; its
-    /// texels are 4 / resolution radians wide on the axis, the largest.
-    fn set_paraboloids(&mut self, layout: &ShadowLayout, resolution: u32) {
-        for (frame, p) in self.cascade_clip_from_world.iter_mut().zip(&layout.projections) {
-            *frame = p.light_from_world;
-        }
-        self.cascades = [CascadeGpu::default(); MAX_CASCADES];
-        self.texel_ortho = 0.0;
-        self.texel_per_distance = 4.0 / resolution as f32;
-    }
-
-    /// This uniform drawing layer `layer` of the map.
-    pub fn for_layer(&self, layer: usize) -> Self {
-        LightGpu { clip_from_world: self.cascade_clip_from_world[layer], ..*self }
-    }
-}
-
-/// PCSS's light size, the same quantity the reference's area light uses.
-fn light_size(light: &Light) -> f32 {
-    match light {
-        Light::Directional(sun) => (0.5 * sun.angular_diameter_degrees.to_radians()).tan(),
-        Light::Spot(spot) => spot.radius,
-        Light::Point(point) => point.radius,
-    }
-}
-
 /// A GPU struct's fields as Rust lays them out, for the layout test to compare with
 /// the WGSL struct of the same name.
 #[cfg(test)]
@@ -494,17 +236,29 @@ pub(crate) fn struct_layouts() -> Vec<StructLayout> {
     use crate::passes::{depth_reduce, gpu_cull, light_list, map_preview, moments};
     vec![
         struct_layout!(LightGpu as "Light" {
-            clip_from_world, light_from_world, radiance, kind, direction, range, position, layer_count,
-            ambient, moment_layers, cos_inner, cos_outer, map_near, map_far, texel_ortho,
-            texel_per_distance, normal_offset, resolution, kernel_width, kernel_in_world, poisson_taps,
-            receiver_plane_bias, light_size, blocker_taps, max_penumbra_texels, select_by_projection,
-            cascade_blend, depth_bias, slope_bias, contact_steps, contact_length, contact_thickness,
-            contact_bias, contact_distance, penumbra_rays, falloff, falloff_window, _pad0, params, cascade_clip_from_world,
-            cascades,
+            clip_from_world, light_from_world, emitter, ambient, _pad0, map, cascade_choice, bias, pcf, pcss,
+            contact, rays, technique, cascade_clip_from_world, cascades,
         }),
-        struct_layout!(TechniqueParams as "TechniqueParams" { reals, integers }),
-        struct_layout!(light_list::EmitterGpu as "Emitter" {
-            radiance, kind, direction, range, position, cos_inner, cos_outer, falloff, falloff_window, _pad0,
+        struct_layout!(EmitterGpu as "Emitter" {
+            radiance, kind, direction, range, position, cos_inner, cos_outer, falloff, falloff_window, size,
+        }),
+        struct_layout!(MapGpu as "ShadowMap" {
+            layer_count, moment_layers, resolution, near, far, texel_ortho, texel_per_distance, _pad0,
+        }),
+        struct_layout!(CascadeChoiceGpu as "CascadeChoice" { by_projection, blend, _pad0, _pad1 }),
+        struct_layout!(BiasGpu as "Bias" { normal_offset, depth, slope, receiver_plane }),
+        struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
+        struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, _pad0, _pad1 }),
+        struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
+        struct_layout!(RaysGpu as "Rays" { penumbra_rays, _pad0, _pad1, _pad2 }),
+        struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),
+        struct_layout!(techniques::variance::VarianceParams as "VarianceParams" {
+            positive_exponent, negative_exponent, min_variance, bleeding_reduction, variant, _pad0, _pad1, _pad2,
+        }),
+        struct_layout!(techniques::esm::EsmParams as "EsmParams" { exponent, _pad0, _pad1, _pad2, _pad3 }),
+        struct_layout!(techniques::msm::MsmParams as "MsmParams" { moment_bias, hausdorff, quantised, _pad0, _pad1 }),
+        struct_layout!(techniques::convolution::ConvolutionParams as "ConvolutionParams" {
+            terms, attenuation, scale, offset, _pad0,
         }),
         struct_layout!(light_list::LightListGpu as "LightList" {
             ambient, shown, tiles_x, _pad0, _pad1, _pad2,

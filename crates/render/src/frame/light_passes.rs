@@ -16,7 +16,7 @@ use super::{
 use crate::{
     GpuScene,
     passes::{
-        light_list::{EmitterGpu, LightListGpu, LightTiles, Reach},
+        light_list::{LightListGpu, LightTiles, Reach},
         lighting::{self, LightingKey, LightingRole, Lookup},
     },
     pool::{Binding, ViewKey},
@@ -154,7 +154,8 @@ impl Renderer {
     ) {
         let plan = shared.plan;
         let gpu = self.gpu.clone();
-        let emitters: Vec<EmitterGpu> = plan.lights.iter().map(|l| EmitterGpu::of(&l.light_gpu)).collect();
+        let emitters: Vec<crate::uniforms::EmitterGpu> =
+            plan.lights.iter().map(|l| l.light_gpu.emitter).collect();
         let uniform = LightListGpu {
             ambient: plan.lights[0].light_gpu.ambient,
             shown: plan.shown as u32,

@@ -36,10 +36,11 @@ impl LayerKey {
         // what the distance passes bias by.
         let uniform = light.light_gpu.for_layer(layer);
         let clip_from_world = uniform.clip_from_world;
-        let read = [uniform.position.x, uniform.position.y, uniform.position.z, uniform.range];
+        let emitter = uniform.emitter;
+        let read = [emitter.position.x, emitter.position.y, emitter.position.z, emitter.range];
         let mut bytes: Vec<u8> = bytemuck::cast_slice(&read).to_vec();
-        bytes.extend_from_slice(bytemuck::bytes_of(&uniform.depth_bias));
-        bytes.extend_from_slice(bytemuck::bytes_of(&uniform.slope_bias));
+        bytes.extend_from_slice(bytemuck::bytes_of(&uniform.bias.depth));
+        bytes.extend_from_slice(bytemuck::bytes_of(&uniform.bias.slope));
         // The pipeline's state, and where the still casters are.
         let BiasSettings { depth_bias, slope_bias, normal_offset: _, cull } = light.settings.shadow.bias;
         let state = format!(
@@ -241,7 +242,8 @@ fn create_cache(device: &wgpu::Device, size: wgpu::Extent3d) -> wgpu::Texture {
 #[cfg(test)]
 mod tests {
     /// What [`super::LayerKey`] holds of the light's uniform.
-    const KEYED: [&str; 5] = ["clip_from_world", "position", "range", "depth_bias", "slope_bias"];
+    const KEYED: [&str; 5] =
+        ["clip_from_world", "emitter.position", "emitter.range", "bias.depth", "bias.slope"];
 
     /// [`super::LayerKey`] keeps only the fields of the light's uniform that the
     /// shadow pass reads: sound only while `shadow_depth.wgsl` reads no other, and
@@ -254,15 +256,15 @@ mod tests {
             if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
                 continue;
             }
-            let field: String =
-                wgsl[at + 6..].chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            let path: String = wgsl[at + 6..]
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == '.')
+                .collect();
+            let field = path.trim_end_matches('.');
             if field.is_empty() {
                 continue; // the end of a sentence in a comment
             }
-            assert!(
-                KEYED.contains(&field.as_str()),
-                "shadow_depth.wgsl reads light.{field}, which no key holds"
-            );
+            assert!(KEYED.contains(&field), "shadow_depth.wgsl reads light.{field}, which no key holds");
         }
         let light_wgsl = include_str!("../passes/light.wgsl");
         for line in light_wgsl.lines().filter_map(|l| l.strip_prefix("fn ")) {

@@ -123,7 +123,7 @@ pub(super) fn report(
         for ((stats, light), listed) in timed.lights.iter_mut().zip(&plan.lights).zip(listed) {
             if light.refine != Refine::Off {
                 stats.traced_pixels = Some(listed);
-                stats.rays_per_pixel = light.light_gpu.penumbra_rays.max(1);
+                stats.rays_per_pixel = light.light_gpu.rays.penumbra_rays.max(1);
             }
         }
     }

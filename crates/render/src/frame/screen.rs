@@ -161,7 +161,7 @@ impl Renderer {
             // A penumbra filter reads the neighbours of its pixels, which may lie
             // outside the light's rectangle: they must hold this frame's values.
             let start = match refined {
-                Some(_) if light.light_gpu.penumbra_rays > 0 => MaskStart::Clear,
+                Some(_) if light.light_gpu.rays.penumbra_rays > 0 => MaskStart::Clear,
                 Some(_) | None => inputs.mask_start,
             };
             let target = MaskTarget { layer, rect: inputs.mask_rects[index], start };
@@ -179,7 +179,7 @@ impl Renderer {
                     counters: &lists.counters,
                 };
                 self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
-                if light.light_gpu.penumbra_rays > 0 {
+                if light.light_gpu.rays.penumbra_rays > 0 {
                     self.record_penumbra_filter(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
                 }
             }

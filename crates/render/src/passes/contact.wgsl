@@ -16,20 +16,20 @@ const CONTACT_OWN_PLANE: f32 = 1e-3;
 const CONTACT_EDGE_FADE: f32 = 0.05;
 
 // 1 when the ray from `world` toward the light (unit `l`) meets nothing in the depth
-// buffer within `light.contact_length`; down to 0 where it does, faded near the screen's
-// edges and over the last quarter of `light.contact_distance` in view depth.
+// buffer within `light.contact.length`; down to 0 where it does, faded near the screen's
+// edges and over the last quarter of `light.contact.distance` in view depth.
 fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pixel: vec2<f32>, view_depth: f32) -> f32 {
-    let far = light.contact_distance;
+    let far = light.contact.distance;
     let distance_fade = 1.0 - smoothstep(0.75 * far, far, view_depth);
     if distance_fade <= 0.0 {
         return 1.0;
     }
-    var ray_length = light.contact_length;
-    if light.kind != LIGHT_SUN {
+    var ray_length = light.contact.length;
+    if light.emitter.kind != LIGHT_SUN {
         // Never past a spot or point light.
-        ray_length = min(ray_length, distance(light.position, world));
+        ray_length = min(ray_length, distance(light.emitter.position, world));
     }
-    let start_world = world + geometric_n * light.contact_bias;
+    let start_world = world + geometric_n * light.contact.bias;
     let start = (camera.view_from_world * vec4<f32>(start_world, 1.0)).xyz;
     var end = (camera.view_from_world * vec4<f32>(start_world + l * ray_length, 1.0)).xyz;
     // Keep the ray in front of the camera's near plane.
@@ -37,7 +37,7 @@ fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pi
     if end.z > -near {
         end = mix(start, end, (-near - start.z) / (end.z - start.z) * 0.999);
     }
-    let steps = light.contact_steps;
+    let steps = light.contact.steps;
     let jitter = interleaved_gradient_noise(pixel);
     let own = vec2<i32>(pixel);
     for (var i = 0u; i < steps; i++) {
@@ -60,7 +60,7 @@ fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pi
             continue;
         }
         let behind = ray_depth - scene_depth;
-        if scene_depth > 0.0 && behind > 0.0 && behind < light.contact_thickness * scene_depth {
+        if scene_depth > 0.0 && behind > 0.0 && behind < light.contact.thickness * scene_depth {
             let edge = min(min(uv.x, 1.0 - uv.x), min(uv.y, 1.0 - uv.y));
             return 1.0 - smoothstep(0.0, CONTACT_EDGE_FADE, edge) * distance_fade;
         }

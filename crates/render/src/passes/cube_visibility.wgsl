@@ -7,7 +7,7 @@
 // The lit fraction at `world` and the cube face its direction falls on, as
 // (visibility, face). The screen derivatives give the receiver's plane, for
 // receiver-plane depth bias (when it is on).
-fn lookup_visibility(
+fn cube_lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,
@@ -17,17 +17,17 @@ fn lookup_visibility(
     view_depth: f32,
 ) -> vec2<f32> {
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let offset_world = light.normal_offset * cube_texel_world_size(world - light.position) * slope;
+    let offset_world = light.bias.normal_offset * cube_texel_world_size(world - light.emitter.position) * slope;
     var q: CubeQuery;
-    q.offset = world + n * offset_world - light.position;
-    q.depth = length(q.offset) / light.range;
+    q.offset = world + n * offset_world - light.emitter.position;
+    q.depth = length(q.offset) / light.emitter.range;
     q.texel_world = cube_texel_world_size(q.offset);
     q.pixel = pixel;
     let frame = orthonormal_pair(normalize(q.offset));
     q.tangent = frame[0];
     q.bitangent = frame[1];
     let plane = cross(world_dx, world_dy);
-    if light.receiver_plane_bias == 1u && dot(plane, plane) > 0.0 {
+    if light.bias.receiver_plane == 1u && dot(plane, plane) > 0.0 {
         q.plane_normal = normalize(plane);
     }
     return vec2<f32>(sample_shadow_cube(q), f32(cube_face(q.offset)));

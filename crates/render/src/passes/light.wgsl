@@ -2,10 +2,91 @@
 // geometry passes and the moment-map compute passes. Field meanings are documented
 // in `uniforms.rs` (`LightGpu`).
 
-// A technique's own parameters: what each puts where is documented by its module.
-struct TechniqueParams {
-    reals: vec4<f32>,
-    integers: vec4<u32>, // counts, variants, switches (0 or 1)
+// The parameters of a technique that has none, and of a shader composed without one
+// (`NoParams` in techniques/params.rs). `TechniqueParams` is a generated alias of the
+// composed technique's own struct (`VarianceParams`, …), 32 bytes each.
+struct NoParams {
+    _pad0: vec4<u32>,
+    _pad1: vec4<u32>,
+};
+
+// A light as it emits: the light uniform's first block, and an element of the
+// light-list pass's array (`EmitterGpu` in uniforms/light.rs).
+struct Emitter {
+    radiance: vec3<f32>,   // colour × intensity
+    kind: u32,             // LIGHT_SUN, LIGHT_SPOT or LIGHT_POINT
+    direction: vec3<f32>,  // the sun's travel direction or the spot's axis
+    range: f32,            // spot or point light range
+    position: vec3<f32>,   // spot or point light position
+    cos_inner: f32,        // cos of the spot's inner and outer half-angles
+    cos_outer: f32,
+    falloff: u32,          // FALLOFF_CONSTANT or FALLOFF_INVERSE_SQUARE
+    falloff_window: f32,   // where the inverse square's window reaches 0 (0: no window)
+    size: f32,             // radius in world units, or tan of the sun's angular radius
+};
+
+// The light's map: its layers, texel sizes and depth range.
+struct ShadowMap {
+    layer_count: u32,         // layers: cascades, cube faces, paraboloids
+    moment_layers: u32,       // moment-map layers per cascade
+    resolution: f32,          // texels per side of a layer
+    near: f32,                // the map's near and far planes along the light's axis
+    far: f32,
+    texel_ortho: f32,         // texel world size of an orthographic map
+    texel_per_distance: f32,  // texel world size per unit distance (perspective)
+    _pad0: u32,
+};
+
+// How a pixel picks its cascade (shadow.cascades).
+struct CascadeChoice {
+    by_projection: u32,  // 1 to pick cascades by projection, 0 by view depth
+    blend: f32,          // blend band, fraction of a cascade's depth range
+    _pad0: u32,
+    _pad1: u32,
+};
+
+// The biases against acne (shadow.bias).
+struct Bias {
+    normal_offset: f32,    // in texels
+    depth: f32,            // rasterizer constant bias (units), for passes writing their own depth
+    slope: f32,            // and its slope-scaled bias
+    receiver_plane: u32,   // 1 for receiver-plane depth bias
+};
+
+// The PCF kernel (shadow.filter), which PCSS's filtering step uses too.
+struct Pcf {
+    kernel_width: f32,     // texels or world units
+    kernel_in_world: u32,  // 1 when kernel_width is in world units
+    poisson_taps: u32,
+    _pad0: u32,
+};
+
+// PCSS's blocker search (shadow.filter.pcss); the light's size is the emitter's.
+struct Pcss {
+    blocker_taps: u32,
+    max_penumbra_texels: f32,  // largest filter radius
+    _pad0: u32,
+    _pad1: u32,
+};
+
+// Contact shadows (shadow.contact): all zero when off.
+struct Contact {
+    steps: u32,        // ray steps (0: off)
+    length: f32,       // ray length (world)
+    thickness: f32,    // fraction of view depth
+    bias: f32,         // start offset along the normal (world)
+    distance: f32,     // view depth where contact shadows end
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+// Refinement by rays (screen).
+struct Rays {
+    penumbra_rays: u32,  // rays per pixel over the light's area (0: hard, one ray)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // One layer (cascade) of the map.
@@ -23,43 +104,17 @@ struct Cascade {
 struct Light {
     clip_from_world: mat4x4<f32>,
     light_from_world: mat4x4<f32>,
-    radiance: vec3<f32>,          // colour × intensity
-    kind: u32,                    // LIGHT_SUN, LIGHT_SPOT or LIGHT_POINT
-    direction: vec3<f32>,         // the sun's travel direction or the spot's axis
-    range: f32,                   // spot or point light range
-    position: vec3<f32>,          // spot or point light position
-    layer_count: u32,             // layers of the map: cascades, cube faces, paraboloids
+    emitter: Emitter,
     ambient: vec3<f32>,           // ambient light (first light only)
-    moment_layers: u32,           // moment-map layers per cascade
-    cos_inner: f32,
-    cos_outer: f32,
-    map_near: f32,                // the map's near and far planes along the light's axis
-    map_far: f32,
-    texel_ortho: f32,             // texel world size of an orthographic map
-    texel_per_distance: f32,      // texel world size per unit distance (perspective)
-    normal_offset: f32,           // in texels
-    resolution: f32,              // texels per side of a layer
-    kernel_width: f32,            // PCF kernel width, texels or world units
-    kernel_in_world: u32,         // 1 when kernel_width is in world units
-    poisson_taps: u32,
-    receiver_plane_bias: u32,     // 1 for receiver-plane depth bias
-    light_size: f32,              // PCSS: light size (world radius, or tan of the sun's angular radius)
-    blocker_taps: u32,            // PCSS: blocker-search taps
-    max_penumbra_texels: f32,     // PCSS: largest filter radius
-    select_by_projection: u32,    // 1 to pick cascades by projection, 0 by view depth
-    cascade_blend: f32,           // blend band, fraction of a cascade's depth range
-    depth_bias: f32,              // rasterizer constant bias (units), for passes writing their own depth
-    slope_bias: f32,              // and its slope-scaled bias
-    contact_steps: u32,           // contact shadows: ray steps (0: off)
-    contact_length: f32,          // ray length (world)
-    contact_thickness: f32,       // thickness, fraction of view depth
-    contact_bias: f32,            // start offset along the normal (world)
-    contact_distance: f32,        // view depth where contact shadows end
-    penumbra_rays: u32,           // refinement: rays per pixel over the light's area (0: hard, one ray)
-    falloff: u32,                 // FALLOFF_CONSTANT or FALLOFF_INVERSE_SQUARE
-    falloff_window: f32,          // where the inverse square's window reaches 0 (0: no window)
     _pad0: u32,
-    params: TechniqueParams,
+    map: ShadowMap,
+    cascade_choice: CascadeChoice,
+    bias: Bias,
+    pcf: Pcf,
+    pcss: Pcss,
+    contact: Contact,
+    rays: Rays,
+    technique: TechniqueParams,   // the composed technique's own struct
     // One layer of the shadow map per cascade (one in all for a single map).
     cascade_clip_from_world: array<mat4x4<f32>, MAX_CASCADES>,
     cascades: array<Cascade, MAX_CASCADES>,
@@ -75,16 +130,16 @@ fn cascade_split(i: u32) -> f32 {
 
 // World size of one texel of layer `layer` at light distance `distance`.
 fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
-    return light.cascades[layer].texel_world + light.texel_per_distance * max(distance, 0.0);
+    return light.cascades[layer].texel_world + light.map.texel_per_distance * max(distance, 0.0);
 }
 
 // Distance along the light's axis (light view −z) of a point whose shadow-map depth
 // is `depth`. Orthographic maps store it linearly between the near and far planes;
 // perspective ones store the D3D-style f(z − n) / (z (f − n)).
 fn light_distance_from_depth(depth: f32) -> f32 {
-    let n = light.map_near;
-    let f = light.map_far;
-    if light.kind == LIGHT_SUN {
+    let n = light.map.near;
+    let f = light.map.far;
+    if light.emitter.kind == LIGHT_SUN {
         return n + depth * (f - n);
     }
     return n * f / (f - depth * (f - n));
@@ -93,7 +148,7 @@ fn light_distance_from_depth(depth: f32) -> f32 {
 // The depth that moment maps store: light distance, linear in [0, 1] from the near
 // to the far plane, so that filtering averages distances, not projected depths.
 fn moment_depth(depth: f32) -> f32 {
-    let n = light.map_near;
-    let f = light.map_far;
+    let n = light.map.near;
+    let f = light.map.far;
     return clamp((light_distance_from_depth(depth) - n) / (f - n), 0.0, 1.0);
 }

@@ -15,56 +15,11 @@ use super::{
     lighting::{self, SurfaceDepth, SurfacePipeline, TARGETS},
     texture, uniform_entry,
 };
-use crate::uniforms::LightGpu;
 
 /// Pixels per side of a tile of the light list.
 pub(crate) const LIGHT_TILE: u32 = 16;
 /// 32-bit words of light bits per tile: one bit per light a frame may have.
 pub(crate) const LIGHT_WORDS: usize = MAX_LIGHTS.div_ceil(32);
-
-/// One light as the light-list pass shades it (`Emitter` in shading.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct EmitterGpu {
-    /// Colour × intensity.
-    pub radiance: Vec3,
-    /// A `LightKindGpu`.
-    pub kind: u32,
-    /// The sun's travel direction or the spot's axis (unit).
-    pub direction: Vec3,
-    /// A spot or point light's range.
-    pub range: f32,
-    /// A spot or point light's position.
-    pub position: Vec3,
-    /// cos of the spot's inner half-angle.
-    pub cos_inner: f32,
-    /// cos of the spot's outer half-angle (−1 for other lights).
-    pub cos_outer: f32,
-    /// A `FalloffGpu`.
-    pub falloff: u32,
-    /// Where an inverse-square falloff's window reaches 0 (0 for no window).
-    pub falloff_window: f32,
-    /// Padding to WGSL's 16-byte struct alignment.
-    pub _pad0: u32,
-}
-
-impl EmitterGpu {
-    /// The emission fields of a light's uniform, as `light_emitter()` reads them in WGSL.
-    pub fn of(light: &LightGpu) -> Self {
-        Self {
-            radiance: light.radiance,
-            kind: light.kind,
-            direction: light.direction,
-            range: light.range,
-            position: light.position,
-            cos_inner: light.cos_inner,
-            cos_outer: light.cos_outer,
-            falloff: light.falloff,
-            falloff_window: light.falloff_window,
-            ..Self::default()
-        }
-    }
-}
 
 /// The light-list pass's uniform (`LightList` in light_list.wgsl).
 #[repr(C)]

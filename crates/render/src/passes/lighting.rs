@@ -7,6 +7,7 @@
 
 use std::collections::HashMap;
 
+use super::wgsl_interfaces::{LOOKUP_VISIBILITY, PIXEL_VISIBILITY};
 use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
 use gnomon_scene::settings::Refine;
 
@@ -78,7 +79,12 @@ pub(crate) enum Lookup {
 pub(crate) fn visibility_wgsl(technique: TechniqueRef, lookup: Lookup) -> Vec<String> {
     let map = match lookup {
         Lookup::Own(map) => map,
-        Lookup::Mask => return vec![include_str!("mask_lookup.wgsl").to_owned()],
+        Lookup::Mask => {
+            return vec![
+                include_str!("mask_lookup.wgsl").to_owned(),
+                PIXEL_VISIBILITY.bind("mask_pixel_visibility"),
+            ];
+        }
     };
     let mut parts = vec![techniques::SHADOW_BINDINGS_WGSL.to_owned()];
     parts.extend(resolved_lookup_wgsl(technique, map));
@@ -102,26 +108,28 @@ pub(crate) enum MapLookup {
 /// function and the rules of resolve_visibility.wgsl.
 pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -> Vec<String> {
     let mut parts = techniques::helper_wgsl();
-    let visibility = match lookup {
+    let (visibility, implementation) = match lookup {
         MapLookup::Cube => {
             parts.push(techniques::CUBE_WGSL.to_owned());
             let cube = technique.cube_wgsl().unwrap_or_else(|| {
                 unreachable!("{technique:?} has no cube lookup; the registry refuses it for point lights")
             });
-            parts.extend(cube.iter().map(|s| s.to_string()));
-            include_str!("cube_visibility.wgsl")
+            parts.extend(techniques::technique_wgsl(technique.get(), cube));
+            (include_str!("cube_visibility.wgsl"), "cube_lookup_visibility")
         }
         MapLookup::Map => {
-            parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
-            include_str!("map_visibility.wgsl")
+            parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+            (include_str!("map_visibility.wgsl"), "map_lookup_visibility")
         }
         MapLookup::Paraboloid => {
-            parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
-            include_str!("paraboloid_visibility.wgsl")
+            parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+            (include_str!("paraboloid_visibility.wgsl"), "paraboloid_lookup_visibility")
         }
     };
     parts.push(visibility.to_owned());
+    parts.push(LOOKUP_VISIBILITY.bind(implementation));
     parts.push(include_str!("resolve_visibility.wgsl").to_owned());
+    parts.push(PIXEL_VISIBILITY.bind("resolved_pixel_visibility"));
     parts
 }
 

@@ -43,7 +43,7 @@ fn fs_main(in: SurfaceVertex) -> FragmentOut {
     }
     let albedo = base_color_of(inst, in.uv).rgb;
     let v = normalize(camera.eye - seen.world);
-    let direct = light.radiance * cone * blinn_phong(albedo, inst.specular, inst.shininess, n, l, v);
+    let direct = light.emitter.radiance * cone * blinn_phong(albedo, inst.specular, inst.shininess, n, l, v);
     var color = light.ambient * albedo + visibility * direct;
     if camera.debug_view == DEBUG_VIEW_CASCADES {
         color *= CASCADE_TINTS[layer];

@@ -30,8 +30,8 @@ fn local_texel_world_size(layer: u32, world: vec3<f32>, distance: f32) -> f32 {
     let axis_x = vec3<f32>(m[0].x, m[1].x, m[2].x);
     let axis_y = vec3<f32>(m[0].y, m[1].y, m[2].y);
     let t = project_to_map(layer, world);
-    let dx = (project_to_map(layer, world + axis_x * step) - t) * light.resolution / step;
-    let dy = (project_to_map(layer, world + axis_y * step) - t) * light.resolution / step;
+    let dx = (project_to_map(layer, world + axis_x * step) - t) * light.map.resolution / step;
+    let dy = (project_to_map(layer, world + axis_y * step) - t) * light.map.resolution / step;
     let squares = dot(dx, dx) + dot(dy, dy);
     let det = abs(dx.x * dy.y - dy.x * dx.y);
     let sigma_max = sqrt(0.5 * (squares + sqrt(max(squares * squares - 4.0 * det * det, 0.0))));
@@ -42,7 +42,7 @@ fn shadow_coords(layer: u32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> ve
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
     let texel_world = local_texel_world_size(layer, world, distance);
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let p = world + n * (light.normal_offset * texel_world * slope);
+    let p = world + n * (light.bias.normal_offset * texel_world * slope);
     let clip = light.cascade_clip_from_world[layer] * vec4<f32>(p, 1.0);
     if clip.w <= 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, 0.0);
@@ -56,8 +56,8 @@ fn shadow_coords(layer: u32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> ve
 // The cascade that shades a point at `view_depth`: by depth, the one whose split
 // range holds it; by projection, the first whose map holds its lookup.
 fn select_cascade(view_depth: f32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> u32 {
-    let count = light.layer_count;
-    if light.select_by_projection == 0u {
+    let count = light.map.layer_count;
+    if light.cascade_choice.by_projection == 0u {
         var layer = 0u;
         for (var i = 1u; i < count; i++) {
             if view_depth > cascade_split(i) {
@@ -69,7 +69,7 @@ fn select_cascade(view_depth: f32, world: vec3<f32>, n: vec3<f32>, l: vec3<f32>)
     for (var i = 0u; i + 1u < count; i++) {
         let c = shadow_coords(i, world, n, l);
         // A margin of a few texels keeps the filter's footprint inside the map.
-        let margin = 4.0 / light.resolution;
+        let margin = 4.0 / light.map.resolution;
         if c.w > 0.5 && all(c.xy > vec2<f32>(margin)) && all(c.xy < vec2<f32>(1.0 - margin)) {
             return i;
         }
@@ -104,7 +104,7 @@ fn shadow_lookup(
 
 // The lit fraction at `world` and the layer that shaded it (the cascade), as
 // (visibility, layer).
-fn lookup_visibility(
+fn map_lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,
@@ -116,11 +116,11 @@ fn lookup_visibility(
     let layer = select_cascade(view_depth, world, n, l);
     var visibility = shadow_lookup(layer, world, n, l, world_dx, world_dy, pixel);
     // Blend into the next cascade over the last `cascades.z` of this one's depth range.
-    let count = light.layer_count;
-    if light.select_by_projection == 0u && layer + 1u < count && light.cascade_blend > 0.0 {
+    let count = light.map.layer_count;
+    if light.cascade_choice.by_projection == 0u && layer + 1u < count && light.cascade_choice.blend > 0.0 {
         let start = cascade_split(layer);
         let end = cascade_split(layer + 1u);
-        let band = light.cascade_blend * (end - start);
+        let band = light.cascade_choice.blend * (end - start);
         if view_depth > end - band {
             let next = shadow_lookup(layer + 1u, world, n, l, world_dx, world_dy, pixel);
             visibility = mix(visibility, next, clamp((view_depth - (end - band)) / band, 0.0, 1.0));

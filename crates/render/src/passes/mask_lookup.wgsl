@@ -5,7 +5,8 @@
 // (+ TRACED_LAYER_FLAG where rays decided the pixel, under the traced debug view).
 @group(2) @binding(7) var shadow_mask: texture_2d<f32>;
 
-fn pixel_visibility(
+// `pixel_visibility` on the mask path (passes/wgsl_interfaces.rs).
+fn mask_pixel_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     geometric_n: vec3<f32>,

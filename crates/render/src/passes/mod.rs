@@ -12,6 +12,7 @@ pub(crate) mod map_scroll;
 pub(crate) mod moments;
 pub(crate) mod screen_space;
 pub(crate) mod shadow;
+pub(crate) mod wgsl_interfaces;
 
 #[cfg(test)]
 mod interface_tests;
@@ -73,7 +74,9 @@ pub(crate) fn draw_fullscreen(
 }
 
 /// Concatenates WGSL sources into one module, after the constants generated from
-/// Rust ([`crate::uniforms::wgsl_constants`]). WGSL allows module-scope declarations
+/// Rust ([`crate::uniforms::wgsl_constants`]) and, when the light uniform is declared
+/// but no part types `TechniqueParams` (no technique is composed), the alias to
+/// `NoParams`. WGSL allows module-scope declarations
 /// in any order, so the shared declarations, the technique and the pass compose freely.
 /// Directives (`enable wgpu_ray_query;`, which the ray-query tracer needs) must come
 /// before every declaration: a part's are lifted to the top, each once.
@@ -86,6 +89,13 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     }
     let mut all: Vec<String> = directives.iter().map(|d| (*d).to_owned()).collect();
     all.push(crate::uniforms::wgsl_constants());
+    // `light.technique`'s type, where the light uniform is declared: the composed
+    // technique's struct, from the line `techniques::technique_wgsl` generates, or
+    // `NoParams` when no technique is composed.
+    let declares_light = parts.iter().any(|p| p.contains("struct Light {"));
+    if declares_light && !parts.iter().any(|p| p.contains("alias TechniqueParams")) {
+        all.push(crate::techniques::TechniqueParams::default().wgsl_alias());
+    }
     all.extend(
         parts
             .iter()

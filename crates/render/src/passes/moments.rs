@@ -108,7 +108,7 @@ pub(crate) struct MomentMap {
 pub(crate) fn encode_wgsl(technique: TechniqueRef, format: wgpu::TextureFormat) -> String {
     let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned()];
     parts.extend(techniques::shared_wgsl());
-    parts.extend(technique.wgsl().iter().map(|s| s.to_string()));
+    parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
     parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)

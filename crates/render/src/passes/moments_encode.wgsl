@@ -11,7 +11,7 @@ fn encode_main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     // id.z runs over cascades × the technique's layers.
-    let per_cascade = light.moment_layers;
+    let per_cascade = light.map.moment_layers;
     let d = moment_depth(textureLoad(shadow_map, vec2<i32>(id.xy), id.z / per_cascade, 0));
     textureStore(encoded, vec2<i32>(id.xy), i32(id.z), encode_moments(d, id.z % per_cascade));
 }

@@ -8,7 +8,7 @@ fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {
     let d = (light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0)).xyz;
     let len = length(d);
     let xy = d.xy / max(len + d.z, 1e-20);
-    return vec3<f32>(xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5), len / light.range);
+    return vec3<f32>(xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5), len / light.emitter.range);
 }
 
 // World size of a texel across the ray at `world`: xy = tan(θ/2) has dxy/dθ =
@@ -18,10 +18,10 @@ fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {
 fn paraboloid_texel_world_size(layer: u32, world: vec3<f32>) -> f32 {
     let d = (light.cascade_clip_from_world[layer] * vec4<f32>(world, 1.0)).xyz;
     let len = max(length(d), 1e-20);
-    return (len + d.z) * 2.0 / light.resolution;
+    return (len + d.z) * 2.0 / light.map.resolution;
 }
 
-fn lookup_visibility(
+fn paraboloid_lookup_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     l: vec3<f32>,
@@ -33,13 +33,13 @@ fn lookup_visibility(
     let below = (light.cascade_clip_from_world[0u] * vec4<f32>(world, 1.0)).z >= 0.0;
     let layer = select(1u, 0u, below);
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let p = world + n * (light.normal_offset * paraboloid_texel_world_size(layer, world) * slope);
+    let p = world + n * (light.bias.normal_offset * paraboloid_texel_world_size(layer, world) * slope);
     var q: ShadowQuery;
     q.coords = paraboloid_map_coords(layer, p);
     q.coords_dx = paraboloid_map_coords(layer, p + world_dx) - q.coords;
     q.coords_dy = paraboloid_map_coords(layer, p + world_dy) - q.coords;
     q.pixel = pixel;
-    q.distance = length(p - light.position);
+    q.distance = length(p - light.emitter.position);
     q.layer = layer;
     return vec2<f32>(sample_shadow(q), f32(layer));
 }

@@ -52,5 +52,5 @@ fn shadow_light_direction(world: vec3<f32>) -> vec4<f32> {
 
 // The light's colour times its intensity (linear RGB).
 fn shadow_light_radiance() -> vec3<f32> {
-    return light.radiance;
+    return light.emitter.radiance;
 }

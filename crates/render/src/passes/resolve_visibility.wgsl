@@ -1,12 +1,14 @@
 // A pixel's visibility of its light, resolved from the shadow map: the lookup of
 // `lookup_visibility` (map_visibility.wgsl, cube_visibility.wgsl or
-// paraboloid_visibility.wgsl), then the rules that hold whatever the map says. The
+// paraboloid_visibility.wgsl, bound in passes/wgsl_interfaces.rs), then the rules
+// that hold whatever the map says. The
 // forward lighting pass calls it per fragment; the shadow-mask pass once per pixel.
 
 // (visibility, layer that shaded it) of the surface at `world` with shading normal
 // `n` and camera-facing geometric normal `geometric_n`, lit from `l` with cone factor
 // `cone`. The world position's screen derivatives give the receiver's plane.
-fn pixel_visibility(
+// `pixel_visibility` on the paths that look the map up.
+fn resolved_pixel_visibility(
     world: vec3<f32>,
     n: vec3<f32>,
     geometric_n: vec3<f32>,
@@ -22,7 +24,7 @@ fn pixel_visibility(
     // a normal turned by the winding, which authored normals can contradict.
     let seen_n = facing_side(n, geometric_n);
     var shadow = lookup_visibility(world, seen_n, l, world_dx, world_dy, pixel, view_depth);
-    if light.kind != LIGHT_SUN && cone <= 0.0 {
+    if light.emitter.kind != LIGHT_SUN && cone <= 0.0 {
         // Outside a spot's cone or a light's range no light arrives: visibility 0 by
         // definition.
         shadow.x = 0.0;

@@ -6,27 +6,9 @@
 // quantisation that the slope bias (zero for it) cannot cover.
 const MIN_NORMAL_OFFSET_SCALE: f32 = 0.2;
 
-// What shading needs of a light: the light uniform's emission fields, and an element
-// of the light-list pass's array (`EmitterGpu` in passes/light_list.rs).
-struct Emitter {
-    radiance: vec3<f32>,
-    kind: u32,
-    direction: vec3<f32>,
-    range: f32,
-    position: vec3<f32>,
-    cos_inner: f32,
-    cos_outer: f32,
-    falloff: u32,
-    falloff_window: f32,
-    _pad0: u32,
-};
-
 // The light uniform's emitter.
 fn light_emitter() -> Emitter {
-    return Emitter(
-        light.radiance, light.kind, light.direction, light.range,
-        light.position, light.cos_inner, light.cos_outer, light.falloff, light.falloff_window, 0u,
-    );
+    return light.emitter;
 }
 
 // Distances below this count as this, so that a surface touching a light gets a

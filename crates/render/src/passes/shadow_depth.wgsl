@@ -69,10 +69,10 @@ fn vs_shadow_distance(
 }
 
 fn biased_distance(world: vec3<f32>) -> f32 {
-    let d = length(world - light.position) / light.range;
+    let d = length(world - light.emitter.position) / light.emitter.range;
     let slope = max(abs(dpdx(d)), abs(dpdy(d)));
     let unit = exp2(floor(log2(max(d, 1e-30))) - 23.0);
-    return d + light.depth_bias * unit + light.slope_bias * slope;
+    return d + light.bias.depth * unit + light.bias.slope * slope;
 }
 
 @fragment
@@ -107,7 +107,7 @@ fn vs_shadow_paraboloid(
     let n = d / max(length(d), 1e-20);
     var out: DistanceOut;
     // Directions far behind the hemisphere go far outside the disk, not to infinity.
-    out.clip = vec4<f32>(n.xy / max(1.0 + n.z, 1e-3), clamp(length(d) / light.range, 0.0, 1.0), 1.0);
+    out.clip = vec4<f32>(n.xy / max(1.0 + n.z, 1e-3), clamp(length(d) / light.emitter.range, 0.0, 1.0), 1.0);
     out.world = world.xyz;
     out.uv = v.uv;
     out.instance = instance_index;

@@ -61,7 +61,7 @@ fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     if traced {
         shadow.x = 1.0;
     }
-    if light.contact_steps > 0u && shadow.x > 0.0 {
+    if light.contact.steps > 0u && shadow.x > 0.0 {
         shadow.x = min(shadow.x, contact_visibility(world, geometric_n, l, frag.xy, view_depth));
     }
     if traced {

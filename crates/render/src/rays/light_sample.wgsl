@@ -140,33 +140,33 @@ fn cone_direction(u: vec2<f32>, axis: vec3<f32>, half_angle: f32) -> vec3<f32> {
 // which already makes its light fall off as the inverse square of the distance, so
 // they count alike, as do every ray of a constant light's and a sun's.
 fn light_sample_weight(len: f32) -> f32 {
-    if light.kind != LIGHT_SPOT {
+    if light.emitter.kind != LIGHT_SPOT {
         return 1.0;
     }
-    return distance_falloff(light.falloff, light.falloff_window, len);
+    return distance_falloff(light.emitter.falloff, light.emitter.falloff_window, len);
 }
 
 // A shadow ray from `p` toward the point `u` of the light's area: its direction, and
-// its length (past every caster for a sun). `light.light_size` is the tangent of the
+// its length (past every caster for a sun). `light.emitter.size` is the tangent of the
 // sun's angular radius, or the spot's disk or point's sphere radius.
 fn light_sample(p: vec3<f32>, u: vec2<f32>) -> vec4<f32> {
-    if light.kind == LIGHT_SUN {
-        return vec4<f32>(cone_direction(u, -light.direction, atan(light.light_size)), 3.0e38);
+    if light.emitter.kind == LIGHT_SUN {
+        return vec4<f32>(cone_direction(u, -light.emitter.direction, atan(light.emitter.size)), 3.0e38);
     }
-    if light.kind == LIGHT_SPOT {
+    if light.emitter.kind == LIGHT_SPOT {
         // A disk facing along the spot's axis.
-        let basis = orthonormal_pair(light.direction);
-        let q = concentric_disk(u) * light.light_size;
-        let to = light.position + basis[0] * q.x + basis[1] * q.y - p;
+        let basis = orthonormal_pair(light.emitter.direction);
+        let q = concentric_disk(u) * light.emitter.size;
+        let to = light.emitter.position + basis[0] * q.x + basis[1] * q.y - p;
         let len = length(to);
         return vec4<f32>(to / len, len);
     }
     // A sphere of uniform radiance: uniform over the cone it subtends, which is
     // uniform over its visible area; the ray ends where it enters the sphere.
-    let to = light.position - p;
+    let to = light.emitter.position - p;
     let dist = length(to);
     let axis = to / dist;
-    let radius = light.light_size;
+    let radius = light.emitter.size;
     if radius >= dist {
         return vec4<f32>(axis, dist);
     }

@@ -26,7 +26,7 @@ var<private> cube_plane: CubePlane;
 // depth past the range, so whatever it stores counts as a caster: with light
 // elsewhere in the footprint, the pixel is traced.
 fn texel_receiver(x: i32, y: i32) -> f32 {
-    let size = light.resolution;
+    let size = light.map.resolution;
     let ndc = vec2<f32>((f32(x) + 0.5) / size * 2.0 - 1.0, 1.0 - (f32(y) + 0.5) / size * 2.0);
     let direction = cube_plane.face_from_ndc * vec3<f32>(ndc, 1.0);
     let along = dot(direction, cube_plane.normal);
@@ -34,7 +34,7 @@ fn texel_receiver(x: i32, y: i32) -> f32 {
     if abs(along) < 1e-12 || s <= 0.0 {
         return 2.0;
     }
-    return s * length(direction) / light.range;
+    return s * length(direction) / light.emitter.range;
 }
 
 // The receiver's depth at the texels (x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y).
@@ -61,11 +61,11 @@ fn face_directions(clip_from_world: mat4x4<f32>) -> mat3x3<f32> {
 fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
     // The lookup's own point: the receiver pushed along its normal, as
     // cube_visibility.wgsl pushes it.
-    let to_world = world - light.position;
+    let to_world = world - light.emitter.position;
     let scale = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    let offset = to_world + n * (light.normal_offset * cube_texel_world_size(to_world) * scale);
+    let offset = to_world + n * (light.bias.normal_offset * cube_texel_world_size(to_world) * scale);
     let clip_from_world = light.cascade_clip_from_world[layer];
-    let clip = clip_from_world * vec4<f32>(light.position + offset, 1.0);
+    let clip = clip_from_world * vec4<f32>(light.emitter.position + offset, 1.0);
     if clip.w <= 0.0 {
         return true;
     }
@@ -78,10 +78,10 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(geometric_n.x) > 0.9);
     let ta = normalize(cross(geometric_n, helper)) * texel_world;
     let tb = cross(geometric_n, normalize(ta)) * texel_world;
-    let per_range = 1.0 / (distance * light.range);
+    let per_range = 1.0 / (distance * light.emitter.range);
     let a = vec3<f32>(map_step(clip_from_world, ndc, clip.w, ta).xy, dot(offset, ta) * per_range);
     let b = vec3<f32>(map_step(clip_from_world, ndc, clip.w, tb).xy, dot(offset, tb) * per_range);
-    let size = light.resolution;
+    let size = light.map.resolution;
     let det = a.x * b.y - a.y * b.x;
     if abs(det) < 1e-12 / (size * size) {
         return true;
@@ -89,14 +89,14 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     // ∂(distance / range)/∂(u, v), by the 2×2 inverse, then per texel.
     let gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
     let slope = abs(gradient.x) + abs(gradient.y);
-    let margin = UNSURE_DEPTH_TEXELS * texel_world / light.range + (light.slope_bias + 1.0) * slope;
-    let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), distance / light.range);
+    let margin = UNSURE_DEPTH_TEXELS * texel_world / light.emitter.range + (light.bias.slope + 1.0) * slope;
+    let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), distance / light.emitter.range);
     cube_plane = CubePlane(geometric_n, dot(offset, geometric_n), face_directions(clip_from_world));
     // The surface itself lies behind the lookup's plane along the light's ray through
     // the lookup, by the normal offset's push over the ray's cosine with the plane
     // (which faces the light; an edge-on plane was refused above).
     let cosine = max(-dot(offset / distance, geometric_n), 1e-6);
-    let surface = (cube_plane.reach - dot(to_world, geometric_n)) / cosine / light.range;
+    let surface = (cube_plane.reach - dot(to_world, geometric_n)) / cosine / light.emitter.range;
     let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
     return footprint_unsure(uv, FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing), layer);
 }

@@ -61,7 +61,7 @@ struct FootprintBounds {
 // the same itself, shadow_depth.wgsl).
 fn receiver_bias(slope: f32, depth: f32) -> f32 {
     let unit = exp2(floor(log2(max(depth, 1e-30))) - 23.0);
-    return light.slope_bias * slope + max(light.depth_bias, 0.0) * unit;
+    return light.bias.slope * slope + max(light.bias.depth, 0.0) * unit;
 }
 
 // Whether the footprint of a lookup at `uv` (in [0, 1]) in layer `layer` is unsure:
@@ -89,7 +89,7 @@ fn receiver_bias(slope: f32, depth: f32) -> f32 {
 // against its surface traced a quarter more of `columns`, whose coarse facets'
 // biases differ, for fewer errors past folds than this: docs/rays.md.)
 fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool {
-    let size = light.resolution;
+    let size = light.map.resolution;
     // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels.
     let base = vec2<i32>(floor(uv * size - vec2<f32>(0.5)));
     let first = base - vec2<i32>(UNSURE_RING_TEXELS);

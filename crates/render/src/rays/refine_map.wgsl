@@ -16,7 +16,7 @@
 // it shadows, as just past a fold (refine_footprint.wgsl).
 // The pixel is unsure when any texel is, or when the footprint holds both kinds.
 //
-// Under a light with an area (light.penumbra_rays > 0), the pixel is also unsure
+// Under a light with an area (light.rays.penumbra_rays > 0), the pixel is also unsure
 // where the light's own footprint in the map (`area_unsure`) holds casters over part
 // of it: the penumbra as the geometry bounds it, not as the technique estimated it.
 //
@@ -52,7 +52,7 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
         // Outside every layer: the map has nothing to say.
         return true;
     }
-    let size = light.resolution;
+    let size = light.map.resolution;
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
     let texel_world = local_texel_world_size(layer, world, distance);
     // The receiver's plane, through two tangents a texel long, in map coordinates.
@@ -72,7 +72,7 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
     let gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
     let along_ray = abs(map_step(clip_from_world, ndc, w, -l * texel_world).z);
     let slope = abs(gradient.x) + abs(gradient.y);
-    let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.slope_bias + 1.0) * slope;
+    let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.bias.slope + 1.0) * slope;
     let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), c.z);
 
     // The surface itself, where the lookup's point came from: its plane is parallel
@@ -94,12 +94,12 @@ fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f3
 const AREA_SEARCH_TAPS: i32 = 6;
 
 // The radius, in world units, of the cone from a receiver at light distance
-// `receiver` to the light's area, at light distance `at`: light.light_size × (d − at)
-// for a sun (the tangent of its angular radius), light.light_size × (d − at) / d for
+// `receiver` to the light's area, at light distance `at`: light.emitter.size × (d − at)
+// for a sun (the tangent of its angular radius), light.emitter.size × (d − at) / d for
 // a spot's disk or a point's sphere (similar triangles from the light's centre).
 fn light_cone_radius(receiver: f32, at: f32) -> f32 {
-    let reach = light.light_size * max(receiver - at, 0.0);
-    return select(reach / receiver, reach, light.kind == LIGHT_SUN);
+    let reach = light.emitter.size * max(receiver - at, 0.0);
+    return select(reach / receiver, reach, light.emitter.kind == LIGHT_SUN);
 }
 
 // Under a light with an area: whether the map shows, for the receiver at texel
@@ -110,14 +110,14 @@ fn light_cone_radius(receiver: f32, at: f32) -> f32 {
 // grid's spacing) and a
 // texel with nothing in front of the receiver. The grid covers the cone's
 // cross-section at the map's near plane, PCSS's blocker-search region (Fernando
-// 2005), capped at light.max_penumbra_texels. A technique's own estimate of the
+// 2005), capped at light.pcss.max_penumbra_texels. A technique's own estimate of the
 // penumbra can be too narrow (PCSS's under a low sun is half the true width); this
 // bounds it by the geometry instead. Casters over the whole region leave the
 // technique's answer: most likely the umbra.
 fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, layer: u32, distance: f32) -> bool {
-    let near = light.map_near;
-    let radius = clamp(light_cone_radius(distance, near) / texel_world_size_at(layer, near), 1.0, light.max_penumbra_texels);
-    let last = vec2<i32>(i32(light.resolution) - 1);
+    let near = light.map.near;
+    let radius = clamp(light_cone_radius(distance, near) / texel_world_size_at(layer, near), 1.0, light.pcss.max_penumbra_texels);
+    let last = vec2<i32>(i32(light.map.resolution) - 1);
     let spacing = max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
     var casters = false;
     var light_seen = false;

@@ -5,7 +5,7 @@
 // pass stored each listed pixel lit, and a blocked ray stores it shadowed
 // (visibility 0, with its map layer for the cascade view).
 //
-// Under a light with an area, `light.penumbra_rays` rays per pixel toward points
+// Under a light with an area, `light.rays.penumbra_rays` rays per pixel toward points
 // stratified over the light (light_sample.wgsl), and the pixel stores the share that
 // arrive: a Monte Carlo estimate of the same integral as the CPU reference's, whose
 // noise the filter pass (`cs_filter_penumbra`) then smooths. The estimate replaces
@@ -44,9 +44,9 @@ fn penumbra_width_px(blocker: f32, world: vec3<f32>, geometric_n: vec3<f32>, vie
     if blocker < 0.0 {
         return UNBLOCKED_WIDTH_PX;
     }
-    var width = 2.0 * light.light_size * blocker;
-    if light.kind != LIGHT_SUN {
-        width /= max(length(light.position - world) - blocker, 1e-6);
+    var width = 2.0 * light.emitter.size * blocker;
+    if light.emitter.kind != LIGHT_SUN {
+        width /= max(length(light.emitter.position - world) - blocker, 1e-6);
     }
     // On screen the receiver's plane is foreshortened by |n·v| across its steepest
     // direction: the penumbra is at least that narrow there.
@@ -132,7 +132,7 @@ const NEGLIGIBLE_WEIGHT: f32 = 1e-3;
 // binomial standard deviations √(v(1 − v)/N). Two estimates of 0 and 1 have none, and never mix: a
 // contact shadow's hard edge stays hard, where a penumbra's noisy middle is averaged.
 fn range_weight(p: f32, q: f32) -> f32 {
-    let variance = max(p * (1.0 - p), q * (1.0 - q)) / f32(light.penumbra_rays);
+    let variance = max(p * (1.0 - p), q * (1.0 - q)) / f32(light.rays.penumbra_rays);
     let d = p - q;
     return select(exp(-d * d / (2.0 * RANGE_SIGMAS * RANGE_SIGMAS * variance)), select(0.0, 1.0, d == 0.0), variance == 0.0);
 }

@@ -28,13 +28,13 @@ fn surface_ray_origin(world: vec3<f32>, geometric_n: vec3<f32>, view_depth: f32)
 // harmless); a local light's stops at the light.
 fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool {
     var t_max = 3.0e38;
-    if light.kind != LIGHT_SUN {
-        t_max = length(light.position - world);
+    if light.emitter.kind != LIGHT_SUN {
+        t_max = length(light.emitter.position - world);
     }
     return ray_blocked(origin, l, t_max);
 }
 
-// The share of `light.penumbra_rays` rays from `origin` to points stratified over the
+// The share of `light.rays.penumbra_rays` rays from `origin` to points stratified over the
 // light's area that arrive, each weighted by its point's falloff
 // (`light_sample_weight`), and the mean distance to the caster that each blocked
 // ray met (-1 when none was blocked). `pixel` seeds the pixel's own pattern, so
@@ -42,7 +42,7 @@ fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool
 // sample below the surface's horizon is blocked by the surface itself, as in the
 // reference, and has no caster's distance.
 fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, pixel: u32) -> vec2<f32> {
-    let count = light.penumbra_rays;
+    let count = light.rays.penumbra_rays;
     let grid = cmj_grid(count);
     let pattern = lowbias32(pixel ^ 0x9e3779b9u);
     var arrived = 0.0;

@@ -39,7 +39,7 @@ const MAX_RECEIVER_SLOPE_PER_TEXEL: f32 = 0.01;
 // techniques", GDC 2006; Schüler, "Eliminating surface acne with gradient shadow
 // mapping", ShaderX4 2006).
 fn receiver_depth_gradient(q: ShadowQuery) -> vec2<f32> {
-    if light.receiver_plane_bias == 0u {
+    if light.bias.receiver_plane == 0u {
         return vec2<f32>(0.0);
     }
     let a = q.coords_dx;
@@ -49,7 +49,7 @@ fn receiver_depth_gradient(q: ShadowQuery) -> vec2<f32> {
         return vec2<f32>(0.0);
     }
     var g = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det;
-    let limit = MAX_RECEIVER_SLOPE_PER_TEXEL * light.resolution;
+    let limit = MAX_RECEIVER_SLOPE_PER_TEXEL * light.map.resolution;
     let len = length(g);
     if len > limit {
         g *= limit / len;
@@ -60,7 +60,7 @@ fn receiver_depth_gradient(q: ShadowQuery) -> vec2<f32> {
 // One bilinear comparison tap `offset` texels from the lookup, with the compared
 // depth moved along the receiver plane `gradient`.
 fn compare_tap(q: ShadowQuery, gradient: vec2<f32>, offset: vec2<f32>) -> f32 {
-    let duv = offset / light.resolution;
+    let duv = offset / light.map.resolution;
     return textureSampleCompareLevel(
         shadow_map, shadow_compare, q.coords.xy + duv, q.layer, q.coords.z + dot(gradient, duv)
     );
@@ -82,8 +82,8 @@ fn pcf_poisson(q: ShadowQuery, radius: f32, count: u32) -> f32 {
 // The kernel width in texels at this receiver: --pcf-kernel as given, or converted
 // from world units by the texel size there (at least 1, at most 32 texels).
 fn kernel_width_texels(q: ShadowQuery) -> f32 {
-    if light.kernel_in_world == 1u {
-        return clamp(light.kernel_width / texel_world_size(q), 1.0, MAX_KERNEL_TEXELS);
+    if light.pcf.kernel_in_world == 1u {
+        return clamp(light.pcf.kernel_width / texel_world_size(q), 1.0, MAX_KERNEL_TEXELS);
     }
-    return light.kernel_width;
+    return light.pcf.kernel_width;
 }

@@ -1,11 +1,31 @@
 //! `convolution`: convolution shadow maps (Annen et al. 2007), a truncated Fourier
 //! series of the depth test with ringing attenuation.
 
-use glam::{UVec4, Vec4};
+use bytemuck::{Pod, Zeroable};
+use glam::UVec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
-use crate::uniforms::TechniqueParams;
+use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+
+/// Convolution shadow maps' parameters (`ConvolutionParams` in convolution.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ConvolutionParams {
+    /// M, the Fourier terms kept.
+    pub terms: u32,
+    /// α, the attenuation of the higher terms against ringing.
+    pub attenuation: f32,
+    /// s, the reconstruction's sharpening scale.
+    pub scale: f32,
+    /// o, its offset.
+    pub offset: f32,
+    /// Padding to `PARAMS_BYTES`.
+    pub _pad0: UVec4,
+}
+
+impl GpuParams for ConvolutionParams {
+    const WGSL_NAME: &'static str = "ConvolutionParams";
+}
 
 pub struct Convolution;
 
@@ -34,13 +54,16 @@ impl ShadowTechnique for Convolution {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("convolution.wgsl")]
     }
-    /// integers.x = terms M; reals = (attenuation α, scale s, offset o, 0).
+    /// The terms M, the attenuation α, the scale s and the offset o.
     fn params(&self, s: &FilterSettings, _: MapPrecision) -> TechniqueParams {
         let m = &s.moments;
-        TechniqueParams {
-            reals: Vec4::new(m.csm_attenuation, m.csm_scale, m.csm_offset, 0.0),
-            integers: UVec4::new(m.csm_terms, 0, 0, 0),
-        }
+        TechniqueParams::new(ConvolutionParams {
+            terms: m.csm_terms,
+            attenuation: m.csm_attenuation,
+            scale: m.csm_scale,
+            offset: m.csm_offset,
+            ..Default::default()
+        })
     }
     fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {
         // A sin and a cos per term, four channels per layer.

@@ -7,7 +7,14 @@
 // high terms. The reconstruction f is then sharpened: visibility = s·(f − ½ + o) + ½.
 //
 // Layer j holds (sin, cos) of terms 2j and 2j + 1 (0-based).
-// params.integers.x: M; params.reals: x: α, y: s, z: o.
+// Its parameters (`ConvolutionParams` in convolution.rs).
+struct ConvolutionParams {
+    terms: u32,        // M, the Fourier terms kept
+    attenuation: f32,  // α, the ringing suppression
+    scale: f32,        // s, the reconstruction's sharpening scale
+    offset: f32,       // o, its offset
+    _pad0: vec4<u32>,
+};
 
 const PI: f32 = 3.14159265;
 
@@ -22,9 +29,9 @@ fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
-    let terms = light.params.integers.x;
+    let terms = light.technique.terms;
     let m = f32(terms);
-    let alpha = light.params.reals.x;
+    let alpha = light.technique.attenuation;
     let z = receiver_moment_depth(q);
     var f = 0.5;
     for (var layer = 0u; 2u * layer < terms; layer++) {
@@ -41,5 +48,5 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
             f += 2.0 * a / c * (sin_d * cos(c * z) - cos_d * sin(c * z));
         }
     }
-    return clamp(light.params.reals.y * (f - 0.5 + light.params.reals.z) + 0.5, 0.0, 1.0);
+    return clamp(light.technique.scale * (f - 0.5 + light.technique.offset) + 0.5, 0.0, 1.0);
 }

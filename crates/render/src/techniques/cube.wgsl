@@ -41,8 +41,8 @@ fn cube_tap_depth(q: CubeQuery, direction: vec3<f32>) -> f32 {
     if s <= 0.0 {
         return q.depth;
     }
-    let depth = s * length(direction) / light.range;
-    let reach = MAX_CUBE_RECEIVER_SLOPE * length(direction - q.offset) / light.range;
+    let depth = s * length(direction) / light.emitter.range;
+    let reach = MAX_CUBE_RECEIVER_SLOPE * length(direction - q.offset) / light.emitter.range;
     return clamp(depth, q.depth - reach, q.depth + reach);
 }
 
@@ -51,7 +51,7 @@ fn cube_tap_depth(q: CubeQuery, direction: vec3<f32>) -> f32 {
 // of that across the ray (gnomon_math::omni::cube_texel_world_size).
 fn cube_texel_world_size(offset: vec3<f32>) -> f32 {
     let m = max(abs(offset.x), max(abs(offset.y), abs(offset.z)));
-    return 2.0 * m * m / (light.resolution * max(length(offset), 1e-20));
+    return 2.0 * m * m / (light.map.resolution * max(length(offset), 1e-20));
 }
 
 // The lookup direction `texels` (across the ray) from the receiver's.
@@ -103,8 +103,8 @@ fn cube_pcf_grid(q: CubeQuery, width: f32, tent: bool) -> f32 {
 
 // The kernel width in texels at this receiver (kernel_width_texels for the cube).
 fn cube_kernel_width_texels(q: CubeQuery) -> f32 {
-    if light.kernel_in_world == 1u {
-        return clamp(light.kernel_width / q.texel_world, 1.0, MAX_KERNEL_TEXELS);
+    if light.pcf.kernel_in_world == 1u {
+        return clamp(light.pcf.kernel_width / q.texel_world, 1.0, MAX_KERNEL_TEXELS);
     }
-    return light.kernel_width;
+    return light.pcf.kernel_width;
 }

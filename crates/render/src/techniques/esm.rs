@@ -1,10 +1,30 @@
 //! `esm`: exponential shadow maps (Annen et al. 2008), filtered in log space.
 
-use glam::Vec4;
+use bytemuck::{Pod, Zeroable};
+use glam::UVec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
-use crate::uniforms::TechniqueParams;
+use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+
+/// ESM's parameters (`EsmParams` in esm.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EsmParams {
+    /// The exponent c of exp(c·d).
+    pub exponent: f32,
+    /// Padding to `PARAMS_BYTES`.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
+    /// Padding.
+    pub _pad3: UVec4,
+}
+
+impl GpuParams for EsmParams {
+    const WGSL_NAME: &'static str = "EsmParams";
+}
 
 pub struct Esm;
 
@@ -35,7 +55,7 @@ impl ShadowTechnique for Esm {
     }
     /// reals.x = the exponent c.
     fn params(&self, s: &FilterSettings, _: MapPrecision) -> TechniqueParams {
-        TechniqueParams { reals: Vec4::new(s.moments.esm_exponent, 0.0, 0.0, 0.0), ..Default::default() }
+        TechniqueParams::new(EsmParams { exponent: s.moments.esm_exponent, ..Default::default() })
     }
     fn filterable_map(&self, s: &FilterSettings) -> Option<FilterableMap> {
         // The lookup filters bilinearly in log space by hand, at the top level only.

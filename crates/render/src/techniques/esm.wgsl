@@ -6,21 +6,28 @@
 // w·exp(c·(d − d_max)), so large c cannot overflow (Salvi, "Rendering filtered
 // shadows with exponential shadow maps", ShaderX6 2008).
 //
-// params.reals.x: c.
+// Its parameters (`EsmParams` in esm.rs).
+struct EsmParams {
+    exponent: f32,  // c
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    _pad3: vec4<u32>,
+};
 
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
     return vec4<f32>(d, 0.0, 0.0, 0.0);
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
-    let c = light.params.reals.x;
+    let c = light.technique.exponent;
     let dims = vec2<i32>(textureDimensions(moment_map));
     let x = q.coords.xy * vec2<f32>(dims) - vec2<f32>(0.5);
     let base = floor(x);
     let f = x - base;
     let i = vec2<i32>(base);
     let hi = dims - vec2<i32>(1);
-    let layer = q.layer * light.moment_layers;
+    let layer = q.layer * light.map.moment_layers;
     let d00 = textureLoad(moment_map, clamp(i, vec2<i32>(0), hi), layer, 0).x;
     let d10 = textureLoad(moment_map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), hi), layer, 0).x;
     let d01 = textureLoad(moment_map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), hi), layer, 0).x;

@@ -4,7 +4,7 @@
 // The filtered value of `layer` at the lookup, trilinear when the map has mipmaps
 // (the screen derivatives choose the level; they were taken in uniform control flow).
 fn sample_moments(q: ShadowQuery, layer: u32) -> vec4<f32> {
-    let index = q.layer * light.moment_layers + layer;
+    let index = q.layer * light.map.moment_layers + layer;
     return textureSampleGrad(moment_map, moment_sampler, q.coords.xy, index, q.coords_dx.xy, q.coords_dy.xy);
 }
 

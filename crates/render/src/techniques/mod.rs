@@ -7,24 +7,26 @@
 //!
 //! A technique's WGSL defines `fn sample_shadow(q: ShadowQuery) -> f32` (the lookup,
 //! see `common.wgsl`), returning the lit fraction in [0, 1]. It may read the shadow
-//! bindings of `bindings.wgsl`, the `light` uniform, whose `params` carry the values
-//! of [`ShadowTechnique::params`], and the helpers of `common.wgsl`. A filterable
+//! bindings of `bindings.wgsl`, the `light` uniform, whose `technique` block carries
+//! the typed values of [`ShadowTechnique::params`] (see [`params`]), and the helpers
+//! of `common.wgsl`. A filterable
 //! technique also defines `fn encode_moments(d: f32, layer: u32) -> vec4<f32>`,
 //! which the moment pass applies to every texel's linear depth d ∈ [0, 1].
 
-mod convolution;
-mod esm;
+pub(crate) mod convolution;
+pub(crate) mod esm;
 mod hard;
-mod msm;
+pub(crate) mod msm;
+mod params;
 mod pcf;
 mod pcss;
 mod raytraced;
 mod registry;
-mod variance;
+pub(crate) mod variance;
 
 use gnomon_scene::settings::{FilterSettings, RayUse, SettingsError, Technique};
 
-use crate::uniforms::TechniqueParams;
+pub use params::{GpuParams, NoParams, PARAMS_BYTES, ParamsBlockGpu, TechniqueParams};
 pub use registry::{RegistryError, TechniqueRef, TechniqueRegistry};
 
 /// Every built-in technique, in the order the command line lists them. Adding one
@@ -125,10 +127,16 @@ pub trait ShadowTechnique: Sync {
     fn summary(&self) -> &'static str;
     /// WGSL sources, concatenated after the shared ones, defining `sample_shadow`.
     fn wgsl(&self) -> &'static [&'static str];
-    /// The technique's parameters, passed to the shader as `light.params`; the
-    /// technique documents what it puts where.
+    /// The technique's parameters, typed ([`GpuParams`]), passed to the shader as
+    /// `light.technique`. Their WGSL struct is a property of the type, not of the
+    /// values: [`ShadowTechnique::params_struct`] asks it of the defaults.
     fn params(&self, _settings: &FilterSettings, _precision: MapPrecision) -> TechniqueParams {
         TechniqueParams::default()
+    }
+    /// The WGSL struct its parameters take, for the generated
+    /// `alias TechniqueParams = …;` of every shader it is composed into.
+    fn params_struct(&self) -> TechniqueParams {
+        self.params(&FilterSettings::default(), MapPrecision::Single)
     }
     /// WGSL sources defining `fn sample_shadow_cube(q: CubeQuery) -> f32`, the lookup
     /// in a point light's cube map (see `cube.wgsl`), for the techniques that can
@@ -164,6 +172,14 @@ pub trait ShadowTechnique: Sync {
     fn validate(&self, _settings: &FilterSettings) -> Result<(), SettingsError> {
         Ok(())
     }
+}
+
+/// A technique's WGSL (its cube lookup's when `cube`), after the generated line that
+/// types `light.technique` as its parameter struct.
+pub(crate) fn technique_wgsl(technique: &dyn ShadowTechnique, sources: &[&str]) -> Vec<String> {
+    let mut parts = vec![technique.params_struct().wgsl_alias()];
+    parts.extend(sources.iter().map(|s| (*s).to_owned()));
+    parts
 }
 
 /// The helpers every cube lookup shares, composed before a technique's cube WGSL.

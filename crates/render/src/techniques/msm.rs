@@ -1,11 +1,31 @@
 //! Moment shadow maps (Peters & Klein 2015): four moments, with the Hamburger and
 //! the Hausdorff bounds, and their optimised quantisation for 16-bit maps.
 
-use glam::{UVec4, Vec4};
+use bytemuck::{Pod, Zeroable};
+use glam::UVec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
-use crate::uniforms::TechniqueParams;
+use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+
+/// The moment maps' parameters (`MsmParams` in msm.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MsmParams {
+    /// α, the moment bias toward ½δ₀ + ½δ₁.
+    pub moment_bias: f32,
+    /// 1 for the Hausdorff bound, 0 for Hamburger.
+    pub hausdorff: u32,
+    /// 1 when the map stores the optimised 16-bit basis.
+    pub quantised: u32,
+    /// Padding to `PARAMS_BYTES`.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: UVec4,
+}
+
+impl GpuParams for MsmParams {
+    const WGSL_NAME: &'static str = "MsmParams";
+}
 
 /// One moment-map technique: the two differ only in the bound they reconstruct.
 pub struct Msm {
@@ -50,14 +70,15 @@ impl ShadowTechnique for Msm {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("msm.wgsl")]
     }
-    /// reals.x = moment bias; integers = (1 for Hausdorff, 1 for the optimised 16-bit
-    /// basis, 0, 0).
+    /// The moment bias, the bound, and whether a 16-bit map stores the optimised basis.
     fn params(&self, s: &FilterSettings, precision: MapPrecision) -> TechniqueParams {
         let quantised = precision == MapPrecision::Half;
-        TechniqueParams {
-            reals: Vec4::new(s.moments.moment_bias, 0.0, 0.0, 0.0),
-            integers: UVec4::new(self.hausdorff.into(), quantised.into(), 0, 0),
-        }
+        TechniqueParams::new(MsmParams {
+            moment_bias: s.moments.moment_bias,
+            hausdorff: self.hausdorff.into(),
+            quantised: quantised.into(),
+            ..Default::default()
+        })
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })

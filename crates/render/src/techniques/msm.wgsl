@@ -17,8 +17,14 @@
 // section 4.3): an affine map chosen so that rounding to half floats perturbs the
 // reconstructed moments as little as possible. Filtering commutes with it.
 //
-// params.reals.x: moment bias α; params.integers: x: 1 for the Hausdorff bound,
-// y: 1 for the optimised 16-bit basis.
+// Its parameters (`MsmParams` in msm.rs).
+struct MsmParams {
+    moment_bias: f32,  // α
+    hausdorff: u32,    // 1 for the Hausdorff bound, 0 for Hamburger
+    quantised: u32,    // 1 for the optimised 16-bit basis
+    _pad0: u32,
+    _pad1: vec4<u32>,
+};
 
 // Columns are the rows of the paper's matrix: b_opt = QUANTISE · b + (0.0359558848, 0, 0, 0).
 const QUANTISE: mat4x4<f32> = mat4x4<f32>(
@@ -39,7 +45,7 @@ const QUANTISE_OFFSET: vec4<f32> = vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
     let d2 = d * d;
     let b = vec4<f32>(d, d2, d2 * d, d2 * d2);
-    if light.params.integers.y == 1u {
+    if light.technique.quantised == 1u {
         return QUANTISE * b + QUANTISE_OFFSET;
     }
     return b;
@@ -55,10 +61,10 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     // The moment bias pulls the moments toward those of ½δ₀ + ½δ₁, strictly inside
     // the moment space, so the system stays well-conditioned after quantisation.
     var stored = sample_moments(q, 0u);
-    if light.params.integers.y == 1u {
+    if light.technique.quantised == 1u {
         stored = DEQUANTISE * (stored - QUANTISE_OFFSET);
     }
-    let b = mix(stored, vec4<f32>(0.5), light.params.reals.x);
+    let b = mix(stored, vec4<f32>(0.5), light.technique.moment_bias);
     let z = receiver_moment_depth(q);
 
     // LDLᵀ of the Hankel matrix (first column (1, b₁, b₂), d₁ = 1).
@@ -86,7 +92,7 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     } else {
         intensity = 1.0 - atom_weight(z, z2, z3, b.x, b.y);
     }
-    if light.params.integers.x == 1u && (z2 < 0.0 || z3 > 1.0) {
+    if light.technique.hausdorff == 1u && (z2 < 0.0 || z3 > 1.0) {
         // Four atoms at {0, z, z_free, 1}. Weighting each atom by its depth gives a
         // measure on {1, z, z_free} with moments (b₁, b₂, b₃, b₄), whence z_free, and
         // the weights by Lagrange interpolation on its first three moments.

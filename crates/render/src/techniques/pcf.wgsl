@@ -43,7 +43,7 @@ fn pair_tap(p: f32, i: f32, h: f32, tent: bool) -> vec2<f32> {
 fn pcf_kernel(q: ShadowQuery, width: f32, tent: bool) -> f32 {
     let gradient = receiver_depth_gradient(q);
     let h = 0.5 * width;
-    let p = q.coords.xy * light.resolution;
+    let p = q.coords.xy * light.map.resolution;
     let first = floor(p - vec2<f32>(h));
     let cells = i32(floor(p.x + h) - first.x) + 1;
     let rows = i32(floor(p.y + h) - first.y) + 1;

@@ -1,5 +1,5 @@
 // Percentage-closer soft shadows (R. Fernando, "Percentage-closer soft shadows",
-// SIGGRAPH 2005 sketch), for a light of size w_light (light.light_size: the spot's disk
+// SIGGRAPH 2005 sketch), for a light of size w_light (light.emitter.size: the spot's disk
 // radius in world units, or tan of the sun's angular radius):
 // 1. Blocker search: average the distance d_blocker of the map texels nearer the
 //    light than the receiver, over the region where a blocker could hide part of
@@ -18,11 +18,11 @@ fn world_to_texels(layer: u32, world: f32, at: f32) -> f32 {
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
-    let size = light.light_size;
-    let max_radius = light.max_penumbra_texels;
+    let size = light.emitter.size;
+    let max_radius = light.pcss.max_penumbra_texels;
     let d_receiver = q.distance;
-    let near = light.map_near;
-    let is_spot = light.kind != LIGHT_SUN;
+    let near = light.map.near;
+    let is_spot = light.emitter.kind != LIGHT_SUN;
 
     // 1. The search region: the cross-section at the near plane of the cone from the
     // receiver to the light, where the nearest possible blockers lie.
@@ -38,14 +38,14 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
     let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
     let dims = vec2<i32>(textureDimensions(shadow_map));
-    let taps = light.blocker_taps;
+    let taps = light.pcss.blocker_taps;
     var blocker_sum = 0.0;
     var blockers = 0.0;
     for (var i = 0u; i < taps; i++) {
         let offset = rotation * POISSON_DISK[i] * search;
-        let duv = offset / light.resolution;
+        let duv = offset / light.map.resolution;
         let uv = q.coords.xy + duv;
-        let texel = clamp(vec2<i32>(floor(uv * light.resolution)), vec2<i32>(0), dims - vec2<i32>(1));
+        let texel = clamp(vec2<i32>(floor(uv * light.map.resolution)), vec2<i32>(0), dims - vec2<i32>(1));
         let stored = textureLoad(shadow_map, texel, q.layer, 0);
         if stored < q.coords.z + dot(gradient, duv) {
             blocker_sum += light_distance_from_depth(stored);
@@ -65,5 +65,5 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
         penumbra = world_to_texels(q.layer, size * max(d_receiver - d_blocker, 0.0), d_receiver);
     }
     // 3. At least the bilinear tap's own half-texel footprint.
-    return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.poisson_taps);
+    return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.pcf.poisson_taps);
 }

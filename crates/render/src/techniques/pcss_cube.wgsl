@@ -1,12 +1,12 @@
 // PCSS on a point light's cube map (Fernando 2005, as pcss.wgsl), for a sphere of
-// radius w_light (light.light_size). Distances are from the light's centre; every
+// radius w_light (light.emitter.size). Distances are from the light's centre; every
 // offset is across the ray, in texels at the receiver.
 
 fn sample_shadow_cube(q: CubeQuery) -> f32 {
-    let size = light.light_size;
-    let max_radius = light.max_penumbra_texels;
-    let range = light.range;
-    let near = light.map_near;
+    let size = light.emitter.size;
+    let max_radius = light.pcss.max_penumbra_texels;
+    let range = light.emitter.range;
+    let near = light.map.near;
     let d_receiver = q.depth * range;
 
     // 1. The search region: a blocker at distance t hides the light from the receiver
@@ -14,7 +14,7 @@ fn sample_shadow_cube(q: CubeQuery) -> f32 {
     let search = clamp(size * (d_receiver - near) / near / q.texel_world, 1.0, max_radius);
     let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
     let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
-    let taps = light.blocker_taps;
+    let taps = light.pcss.blocker_taps;
     var blocker_sum = 0.0;
     var blockers = 0.0;
     for (var i = 0u; i < taps; i++) {
@@ -32,5 +32,5 @@ fn sample_shadow_cube(q: CubeQuery) -> f32 {
     // 2. The penumbra's radius at the receiver, by similar triangles.
     let penumbra = size * max(d_receiver - d_blocker, 0.0) / d_blocker / q.texel_world;
     // 3. At least the bilinear tap's own half-texel footprint.
-    return cube_pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.poisson_taps);
+    return cube_pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.pcf.poisson_taps);
 }

@@ -2,11 +2,36 @@
 //! exponential variance shadow maps in two- and four-component forms (Lauritzen &
 //! McCool 2008).
 
-use glam::{UVec4, Vec4};
+use bytemuck::{Pod, Zeroable};
 use gnomon_scene::settings::{FilterSettings, MomentFormat, SettingsError, Technique};
 
-use super::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables};
-use crate::uniforms::TechniqueParams;
+use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+
+/// The Chebyshev family's parameters (`VarianceParams` in variance.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct VarianceParams {
+    /// c⁺, the positive warp's exponent (EVSM).
+    pub positive_exponent: f32,
+    /// c⁻, the negative warp's exponent (EVSM4).
+    pub negative_exponent: f32,
+    /// The least variance the bound assumes, in depth units.
+    pub min_variance: f32,
+    /// The fraction of the bound cut away as light bleeding.
+    pub bleeding_reduction: f32,
+    /// 0 VSM, 2 EVSM2, 4 EVSM4: the moments of the warps kept.
+    pub variant: u32,
+    /// Padding to `PARAMS_BYTES`.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
+}
+
+impl GpuParams for VarianceParams {
+    const WGSL_NAME: &'static str = "VarianceParams";
+}
 
 /// The largest EVSM exponent whose warped depth squared, exp(2c), stays finite in a
 /// 16-bit float (max 65504): ln(65504) / 2.
@@ -86,20 +111,18 @@ impl ShadowTechnique for Chebyshev {
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("variance.wgsl")]
     }
-    /// integers.x = variant; reals = (c⁺, c⁻, minimum variance, bleeding reduction).
     /// At 16 bits the exponents are clamped to [`HALF_MAX_EXPONENT`].
     fn params(&self, s: &FilterSettings, precision: MapPrecision) -> TechniqueParams {
         let m = &s.moments;
         let limit = if precision == MapPrecision::Half { HALF_MAX_EXPONENT } else { f32::MAX };
-        TechniqueParams {
-            reals: Vec4::new(
-                m.evsm_positive.min(limit),
-                m.evsm_negative.min(limit),
-                m.min_variance,
-                m.bleeding_reduction,
-            ),
-            integers: UVec4::new(self.variant, 0, 0, 0),
-        }
+        TechniqueParams::new(VarianceParams {
+            positive_exponent: m.evsm_positive.min(limit),
+            negative_exponent: m.evsm_negative.min(limit),
+            min_variance: m.min_variance,
+            bleeding_reduction: m.bleeding_reduction,
+            variant: self.variant,
+            ..Default::default()
+        })
     }
     fn filterable_map(&self, _: &FilterSettings) -> Option<FilterableMap> {
         Some(FilterableMap { layers: 1, log_space_exponent: None, mipmapped: true })

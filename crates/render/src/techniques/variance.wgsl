@@ -6,19 +6,28 @@
 // shrinks the variance that causes light bleeding. Both bounds use the same
 // Chebyshev inequality; EVSM keeps the smaller.
 //
-// params.integers.x: variant (0 VSM, 2 EVSM2, 4 EVSM4); params.reals: x: c⁺, y: c⁻,
-// z: minimum variance, w: bleeding reduction.
+// Its parameters (`VarianceParams` in variance.rs).
+struct VarianceParams {
+    positive_exponent: f32,   // c⁺
+    negative_exponent: f32,   // c⁻
+    min_variance: f32,        // in depth units
+    bleeding_reduction: f32,  // the fraction of the bound cut away as light bleeding
+    variant: u32,             // 0 VSM, 2 EVSM2, 4 EVSM4: the moments of the warps kept
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
 
 fn warp_positive(d: f32) -> f32 {
-    return exp(light.params.reals.x * (2.0 * d - 1.0));
+    return exp(light.technique.positive_exponent * (2.0 * d - 1.0));
 }
 
 fn warp_negative(d: f32) -> f32 {
-    return -exp(-light.params.reals.y * (2.0 * d - 1.0));
+    return -exp(-light.technique.negative_exponent * (2.0 * d - 1.0));
 }
 
 fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
-    if light.params.integers.x == 0u {
+    if light.technique.variant == 0u {
         return vec4<f32>(d, d * d, 0.0, 0.0);
     }
     let p = warp_positive(d);
@@ -29,24 +38,24 @@ fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
 fn sample_shadow(q: ShadowQuery) -> f32 {
     let m = sample_moments(q, 0u);
     let d = receiver_moment_depth(q);
-    let min_variance = light.params.reals.z;
-    let variant = light.params.integers.x;
+    let min_variance = light.technique.min_variance;
+    let variant = light.technique.variant;
     var p = 1.0;
     if variant == 0u {
         p = chebyshev_upper_bound(m.x, m.y, d, min_variance);
     } else {
         // The minimum variance is given in depth units; a warp w stretches depths
         // near d by w'(d), so variances by w'(d)² (Lauritzen 2008).
-        let cp = light.params.reals.x;
+        let cp = light.technique.positive_exponent;
         let wp = warp_positive(d);
         let dp = 2.0 * cp * wp;
         p = chebyshev_upper_bound(m.x, m.y, wp, min_variance * dp * dp);
         if variant == 4u {
-            let cn = light.params.reals.y;
+            let cn = light.technique.negative_exponent;
             let wn = warp_negative(d);
             let dn = 2.0 * cn * wn;
             p = min(p, chebyshev_upper_bound(m.z, m.w, wn, min_variance * dn * dn));
         }
     }
-    return reduce_bleeding(p, light.params.reals.w);
+    return reduce_bleeding(p, light.technique.bleeding_reduction);
 }
