@@ -2,7 +2,7 @@
 //! build (technique × light lookup × forward or mask path × role × refinement, the moment passes
 //! per format, and every fixed pass) composes and validates with naga, as wgpu would
 //! compile it; and every uniform struct's WGSL size and field offsets equal the Rust
-//! type's (`uniforms::struct_layouts`).
+//! type's (`struct_layouts`).
 
 use std::collections::BTreeMap;
 
@@ -16,9 +16,95 @@ use super::{
 };
 use crate::{
     rays::{LightSize, Traversal},
+    techniques,
     techniques::{TechniqueRef, TechniqueRegistry},
-    uniforms::{self, FalloffGpu, LightKindGpu, StructLayout},
+    uniforms::{
+        BiasGpu, CameraGpu, CascadeChoiceGpu, CascadeGpu, ContactGpu, EmitterGpu, FalloffGpu, LightGpu,
+        LightKindGpu, MapGpu, PcfGpu, PcssGpu, RaysGpu,
+    },
 };
+
+/// A GPU struct's fields as Rust lays them out, for the layout test to compare with
+/// the WGSL struct of the same name.
+struct StructLayout {
+    pub wgsl_name: &'static str,
+    pub size: usize,
+    pub fields: Vec<(&'static str, usize)>,
+}
+
+/// `StructLayout` of a `repr(C)` struct, listing its fields by name.
+macro_rules! struct_layout {
+    ($ty:ty as $wgsl:literal { $($field:ident),* $(,)? }) => {
+        StructLayout {
+            wgsl_name: $wgsl,
+            size: std::mem::size_of::<$ty>(),
+            fields: vec![$((stringify!($field), std::mem::offset_of!($ty, $field))),*],
+        }
+    };
+}
+
+/// Every uniform struct shared with WGSL.
+fn struct_layouts() -> Vec<StructLayout> {
+    vec![
+        struct_layout!(LightGpu as "Light" {
+            clip_from_world, light_from_world, emitter, ambient, _pad0, map, cascade_choice, bias, pcf, pcss,
+            contact, rays, technique, cascade_clip_from_world, cascades,
+        }),
+        struct_layout!(EmitterGpu as "Emitter" {
+            radiance, kind, direction, range, position, cos_inner, cos_outer, falloff, falloff_window, size,
+        }),
+        struct_layout!(MapGpu as "ShadowMap" {
+            layer_count, moment_layers, resolution, near, far, texel_ortho, texel_per_distance, _pad0,
+        }),
+        struct_layout!(CascadeChoiceGpu as "CascadeChoice" { by_projection, blend, _pad0, _pad1 }),
+        struct_layout!(BiasGpu as "Bias" { normal_offset, depth, slope, receiver_plane }),
+        struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
+        struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, _pad0, _pad1 }),
+        struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
+        struct_layout!(RaysGpu as "Rays" { penumbra_rays, _pad0, _pad1, _pad2 }),
+        struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),
+        struct_layout!(techniques::variance::VarianceParams as "VarianceParams" {
+            positive_exponent, negative_exponent, min_variance, bleeding_reduction, variant, _pad0, _pad1, _pad2,
+        }),
+        struct_layout!(techniques::esm::EsmParams as "EsmParams" { exponent, _pad0, _pad1, _pad2, _pad3 }),
+        struct_layout!(techniques::msm::MsmParams as "MsmParams" { moment_bias, hausdorff, quantised, _pad0, _pad1 }),
+        struct_layout!(techniques::convolution::ConvolutionParams as "ConvolutionParams" {
+            terms, attenuation, scale, offset, _pad0,
+        }),
+        struct_layout!(light_list::LightListGpu as "LightList" {
+            ambient, shown, tiles_x, _pad0, _pad1, _pad2,
+        }),
+        struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
+            world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,
+            _pad2,
+        }),
+        struct_layout!(CascadeGpu as "Cascade" {
+            texel_world, warp_step, split_start, split_end, warped, _pad0, _pad1, _pad2,
+        }),
+        struct_layout!(CameraGpu as "Camera" {
+            clip_from_world, view_from_world, world_from_view, eye, debug_view, scale_x, scale_y, near,
+            far, width, height, inv_width, inv_height,
+        }),
+        struct_layout!(depth_reduce::BoundsParams as "BoundsParams" {
+            world_from_clip, light_from_world, splits, near, far, cascade_count, blend,
+        }),
+        struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
+        struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
+        struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
+        struct_layout!(crate::gpu_scene::shadow_items::ItemGpu as "ShadowItem" {
+            min, bucket, max, has_cone, axis, sin_half_angle, index_count, first_index, base_vertex,
+            first_instance,
+        }),
+        struct_layout!(gpu_cull::CullViewGpu as "CullView" { planes, centre, item_count, near, _pad0, _pad1 }),
+        struct_layout!(gpu_cull::BucketGpu as "CullBucket" { first_slot, culled }),
+        struct_layout!(crate::gpu_scene::DrawArgs as "DrawArgs" {
+            index_count, instance_count, first_index, base_vertex, first_instance,
+        }),
+        struct_layout!(moments::FilterParamsGpu as "FilterParams" {
+            direction, radius, log_c, sigma, _pad0, _pad1, _pad2,
+        }),
+    ]
+}
 
 /// The lookups a technique's map can be read through, from its stated facts.
 fn lookups(technique: TechniqueRef) -> Vec<Lookup> {
@@ -153,7 +239,7 @@ fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
     // Every technique reaches the lighting pass on the forward and mask paths.
     let techniques = TechniqueRegistry::builtin().iter().count();
     assert!(variants.len() > 3 * 2 * techniques, "{} variants", variants.len());
-    let layouts = uniforms::struct_layouts();
+    let layouts = struct_layouts();
     let mut found: BTreeMap<&str, usize> = layouts.iter().map(|l| (l.wgsl_name, 0)).collect();
     for (name, source) in &variants {
         let module = parse(name, source);
@@ -170,8 +256,10 @@ fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
 
 #[test]
 fn generated_constants_are_what_rust_says() {
-    let source =
-        format!("{}\nfn f() -> u32 {{ return MAX_CASCADES + LIGHT_POINT; }}", uniforms::wgsl_constants());
+    let source = format!(
+        "{}\nfn f() -> u32 {{ return MAX_CASCADES + LIGHT_POINT; }}",
+        super::generated::wgsl_constants()
+    );
     let module = parse("constants", &source);
     let value = |name: &str| {
         let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
@@ -180,7 +268,7 @@ fn generated_constants_are_what_rust_says() {
             ref other => panic!("{name} = {other:?}"),
         }
     };
-    assert_eq!(value("MAX_CASCADES") as usize, uniforms::MAX_CASCADES);
+    assert_eq!(value("MAX_CASCADES") as usize, crate::uniforms::MAX_CASCADES);
     for kind in LightKindGpu::ALL {
         assert_eq!(value(kind.wgsl_name()), kind as u32);
     }
@@ -197,7 +285,7 @@ fn generated_constants_are_what_rust_says() {
 #[test]
 #[should_panic(expected = "differ from Rust's")]
 fn a_moved_field_fails_the_layout_check() {
-    let mut layout = uniforms::struct_layouts().into_iter().find(|l| l.wgsl_name == "Light").unwrap();
+    let mut layout = struct_layouts().into_iter().find(|l| l.wgsl_name == "Light").unwrap();
     layout.fields.swap(2, 3);
     let module = parse("shadow", &shadow::shadow_wgsl());
     check_layout("shadow", &module, &layout);

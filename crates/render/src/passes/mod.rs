@@ -4,6 +4,7 @@
 pub(crate) mod blit;
 pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
+pub mod generated;
 pub(crate) mod gpu_cull;
 pub(crate) mod light_list;
 pub(crate) mod lighting;
@@ -74,7 +75,7 @@ pub(crate) fn draw_fullscreen(
 }
 
 /// Concatenates WGSL sources into one module, after the constants generated from
-/// Rust ([`crate::uniforms::wgsl_constants`]) and, when the light uniform is declared
+/// Rust ([`generated::wgsl_constants`]) and, when the light uniform is declared
 /// but no part types `TechniqueParams` (no technique is composed), the alias to
 /// `NoParams`. WGSL allows module-scope declarations
 /// in any order, so the shared declarations, the technique and the pass compose freely.
@@ -88,7 +89,7 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
         }
     }
     let mut all: Vec<String> = directives.iter().map(|d| (*d).to_owned()).collect();
-    all.push(crate::uniforms::wgsl_constants());
+    all.push(generated::wgsl_constants());
     // `light.technique`'s type, where the light uniform is declared: the composed
     // technique's struct, from the line `techniques::technique_wgsl` generates, or
     // `NoParams` when no technique is composed.
