@@ -1,5 +1,5 @@
-// The vertex stage of the passes that cover their whole target (the map preview, the
-// copy into a host's texture): one triangle, three vertices, no buffers.
+// The vertex stage of the passes that cover their whole target (the map preview and
+// scroll, the shadow mask, the copy into a host's texture): one triangle, three vertices, no buffers.
 
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {

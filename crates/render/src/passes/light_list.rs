@@ -191,7 +191,7 @@ impl LightListPass {
                 label: "light list",
                 layout,
                 module: &module,
-                fragment_entry: "fs_main",
+                fragment_entry: "fs_light_list",
                 targets: &targets,
                 depth: SurfaceDepth::Equal,
             }

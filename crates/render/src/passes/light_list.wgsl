@@ -33,7 +33,7 @@ fn listed_visibility(texel: vec2<u32>, i: u32) -> vec3<f32> {
 }
 
 @fragment
-fn fs_main(in: SurfaceVertex) -> FragmentOut {
+fn fs_light_list(in: SurfaceVertex) -> FragmentOut {
     let inst = instances[in.instance];
     if alpha_cut(inst, in.uv) {
         discard;

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use super::wgsl_interfaces::{LOOKUP_VISIBILITY, PIXEL_VISIBILITY};
+use super::wgsl_interfaces::{IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PIXEL_VISIBILITY, SEEN_SURFACE};
 use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
 use gnomon_scene::settings::Refine;
 
@@ -208,11 +208,15 @@ impl SurfacePipeline<'_> {
 /// The WGSL that defines `seen_surface`, the surface a lighting pass shades at a
 /// pixel: the fragment's own on the forward path, the prepass's on the mask path.
 pub(crate) fn seen_surface_wgsl(lookup: Lookup) -> Vec<String> {
-    let seen = match lookup {
-        Lookup::Own(_) => vec![include_str!("seen_own.wgsl")],
-        Lookup::Mask => vec![super::SCREEN_COMMON_WGSL, include_str!("seen_prepass.wgsl")],
+    let (seen, own) = match lookup {
+        Lookup::Own(_) => (vec![include_str!("seen_own.wgsl")], "own"),
+        Lookup::Mask => (vec![super::SCREEN_COMMON_WGSL, include_str!("seen_prepass.wgsl")], "prepass"),
     };
-    [super::OCTAHEDRON_WGSL].into_iter().chain(seen).map(str::to_owned).collect()
+    let mut parts: Vec<String> =
+        [super::OCTAHEDRON_WGSL].into_iter().chain(seen).map(str::to_owned).collect();
+    parts.push(SEEN_SURFACE.bind(&format!("{own}_seen_surface")));
+    parts.push(IS_SEEN_SURFACE.bind(&format!("{own}_is_seen_surface")));
+    parts
 }
 
 /// The lighting pass's WGSL for `key`, composed.
@@ -337,7 +341,7 @@ impl LightingPass {
                 label: "lighting",
                 layout,
                 module: &module,
-                fragment_entry: "fs_main",
+                fragment_entry: "fs_lighting",
                 targets: &targets,
                 depth: if first { SurfaceDepth::Nearest } else { SurfaceDepth::Equal },
             }

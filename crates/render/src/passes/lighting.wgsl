@@ -11,7 +11,7 @@
 // shading.wgsl; their outputs and tints: lighting_common.wgsl.
 
 @fragment
-fn fs_main(in: SurfaceVertex) -> FragmentOut {
+fn fs_lighting(in: SurfaceVertex) -> FragmentOut {
     let inst = instances[in.instance];
     // The surface this pixel shows: the fragment's own, or on the mask path the
     // prepass's (seen_own.wgsl, seen_prepass.wgsl).

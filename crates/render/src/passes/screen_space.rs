@@ -58,6 +58,7 @@ pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());
     parts.extend(crate::rays::mask_refine_wgsl(key.refine, key.lookup, key.size));
+    parts.push(super::FULLSCREEN_WGSL.to_owned());
     parts.push(include_str!("shadow_mask.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)

@@ -3,13 +3,13 @@
 // test keeps is the pixel's surface. (seen_prepass.wgsl is the mask path's.)
 
 // Must be called in uniform control flow (the normals take derivatives).
-fn seen_surface(in: SurfaceVertex) -> SeenSurface {
+fn own_seen_surface(in: SurfaceVertex) -> SeenSurface {
     let normals = surface_normals(in);
     let view_depth = -(camera.view_from_world * vec4<f32>(in.world, 1.0)).z;
     let encoded = vec4<f32>(octahedron_encode(normals.shading), octahedron_encode(normals.geometric));
     return SeenSurface(in.world, view_depth, normals.shading, normals.geometric, encoded);
 }
 
-fn is_seen_surface(in: SurfaceVertex) -> bool {
+fn own_is_seen_surface(in: SurfaceVertex) -> bool {
     return true;
 }

@@ -11,13 +11,13 @@
 // The instance the prepass kept at each pixel, + 1 (0 for the background).
 @group(1) @binding(3) var prepass_object: texture_2d<u32>;
 
-fn seen_surface(in: SurfaceVertex) -> SeenSurface {
+fn prepass_seen_surface(in: SurfaceVertex) -> SeenSurface {
     let texel = vec2<i32>(in.clip.xy);
     let surface = textureLoad(prepass_surface, texel, 0);
     let normals = textureLoad(prepass_normals, texel, 0);
     return SeenSurface(surface.xyz, surface.w, octahedron_decode(normals.xy), octahedron_decode(normals.zw), normals);
 }
 
-fn is_seen_surface(in: SurfaceVertex) -> bool {
+fn prepass_is_seen_surface(in: SurfaceVertex) -> bool {
     return textureLoad(prepass_object, vec2<i32>(in.clip.xy), 0).x == in.instance + 1u;
 }

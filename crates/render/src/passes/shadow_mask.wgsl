@@ -12,12 +12,7 @@
 @group(3) @binding(0) var base_color_texture: texture_2d<f32>;
 @group(3) @binding(1) var base_color_sampler: sampler;
 
-// One triangle covering the screen.
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
+// Its vertex stage is fullscreen.wgsl's `vs_fullscreen`.
 
 // Where the ray through `pixel` meets the plane through `origin` with normal `n`.
 fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {

@@ -4,6 +4,7 @@
 //! group 1 beside the camera. The classification and the rays are the mask path's;
 //! what differs is where they run (see the WGSL for what that costs).
 
+use crate::passes::wgsl_interfaces::REFINE_FORWARD;
 use gnomon_scene::settings::Refine;
 
 use super::{
@@ -31,10 +32,14 @@ pub(crate) fn forward_refine_wgsl(
     traversal: Traversal,
 ) -> Vec<String> {
     let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
-        return vec![include_str!("refine_forward_off.wgsl").to_owned()];
+        return vec![
+            include_str!("refine_forward_off.wgsl").to_owned(),
+            REFINE_FORWARD.bind("unrefined_refine_forward"),
+        ];
     };
     parts.extend(surface_rays_wgsl(GROUP, traversal));
     parts.push(include_str!("refine_forward.wgsl").to_owned());
+    parts.push(REFINE_FORWARD.bind("traced_refine_forward"));
     parts
 }
 

@@ -5,6 +5,7 @@
 //! (`refine_trace.wgsl`). Only listed pixels pay for a ray, and a group of the trace
 //! pass holds listed pixels only, so no lane waits on a neighbour's ray.
 
+use crate::passes::wgsl_interfaces::{DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES};
 use gnomon_scene::settings::Refine;
 
 use std::collections::HashMap;
@@ -44,10 +45,15 @@ fn list_wgsl() -> String {
 /// classification ([`classify_wgsl`]) and the list it appends to.
 pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) -> Vec<String> {
     let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
-        return vec![include_str!("refine_off.wgsl").to_owned()];
+        return vec![
+            include_str!("refine_off.wgsl").to_owned(),
+            RAY_DECIDES.bind("unrefined_ray_decides"),
+            DEFER_TO_RAY.bind("unrefined_defer_to_ray"),
+        ];
     };
     parts.push(list_wgsl());
     parts.push(include_str!("refine_append.wgsl").to_owned());
+    parts.push(DEFER_TO_RAY.bind("listed_defer_to_ray"));
     parts
 }
 
@@ -79,10 +85,22 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
         Refine::Auto | Refine::Rays => false,
         Refine::EveryPixel => true,
     };
-    let footprint: &[&str] = match lookup {
-        MapLookup::Map => &[include_str!("refine_footprint.wgsl"), include_str!("refine_map.wgsl")],
-        MapLookup::Cube => &[include_str!("refine_footprint.wgsl"), include_str!("refine_cube.wgsl")],
-        MapLookup::Paraboloid => &[include_str!("refine_omni.wgsl")],
+    let footprint = match lookup {
+        MapLookup::Map => vec![
+            include_str!("refine_footprint.wgsl").to_owned(),
+            include_str!("refine_map.wgsl").to_owned(),
+            FOOTPRINT_RECEIVER.bind("projected_footprint_receiver"),
+            MAP_UNSURE.bind("projected_map_unsure"),
+        ],
+        MapLookup::Cube => vec![
+            include_str!("refine_footprint.wgsl").to_owned(),
+            include_str!("refine_cube.wgsl").to_owned(),
+            FOOTPRINT_RECEIVER.bind("cube_footprint_receiver"),
+            MAP_UNSURE.bind("cube_map_unsure"),
+        ],
+        MapLookup::Paraboloid => {
+            vec![include_str!("refine_omni.wgsl").to_owned(), MAP_UNSURE.bind("paraboloid_map_unsure")]
+        }
     };
     let penumbrae = size == LightSize::Area;
     let mut parts = vec![
@@ -90,8 +108,9 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
             "const REFINE_EVERY_PIXEL: bool = {every_pixel};\nconst REFINE_PENUMBRAE: bool = {penumbrae};\n"
         ),
         include_str!("refine_classify.wgsl").to_owned(),
+        RAY_DECIDES.bind("classified_ray_decides"),
     ];
-    parts.extend(footprint.iter().map(|s| s.to_string()));
+    parts.extend(footprint);
     Some(parts)
 }
 

@@ -17,7 +17,7 @@ struct RefineCounters {
 
 // Appends `pixel` to the list, and counts one more workgroup for the trace pass at
 // the start of every REFINE_GROUP_SIZE pixels.
-fn defer_to_ray(pixel: vec2<u32>, layer: u32) {
+fn listed_defer_to_ray(pixel: vec2<u32>, layer: u32) {
     let index = atomicAdd(&refine_counters.count, 1u);
     if index == 0u {
         refine_counters.groups_y = 1u;

@@ -19,7 +19,7 @@
 // faces the light, and a ray decides that too: it leaves from the camera's side of
 // the surface, so it leaves the surface's plane where that side faces the light and
 // meets the surface itself where it does not.
-fn ray_decides(
+fn classified_ray_decides(
     shadow: vec2<f32>,
     world: vec3<f32>,
     n: vec3<f32>,

@@ -6,11 +6,6 @@
 // distance is where the ray from the light through the texel's centre meets the
 // receiver's plane, exactly. A receiver seen edge-on from the light is unsure.
 
-// A footprint past the face's edge would need the next face: a ray decides there
-// (the seams' band, UNSURE_RING_TEXELS + 1 texels wide on each side; a point-sampled
-// lookup's one tap has no disagreement to show there).
-const FOOTPRINT_EDGE_UNSURE: bool = true;
-
 // The receiver's plane, for `footprint_receiver`: its normal, `offset · normal` (the
 // lookup point's offset from the light), and the face's directions: a texel at
 // NDC (x, y) lies along `face_from_ndc` × (x, y, 1) from the light.
@@ -38,7 +33,7 @@ fn texel_receiver(x: i32, y: i32) -> f32 {
 }
 
 // The receiver's depth at the texels (x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y).
-fn footprint_receiver(x: i32, y: i32) -> vec4<f32> {
+fn cube_footprint_receiver(x: i32, y: i32) -> vec4<f32> {
     return vec4<f32>(texel_receiver(x, y + 1), texel_receiver(x + 1, y + 1), texel_receiver(x + 1, y), texel_receiver(x, y));
 }
 
@@ -58,7 +53,7 @@ fn face_directions(clip_from_world: mat4x4<f32>) -> mat3x3<f32> {
 
 // `layer` is the face the lookup shaded with; `n` is the normal it was offset along;
 // `geometric_n` gives the receiver's plane.
-fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
+fn cube_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
     // The lookup's own point: the receiver pushed along its normal, as
     // cube_visibility.wgsl pushes it.
     let to_world = world - light.emitter.position;

@@ -64,6 +64,12 @@ fn receiver_bias(slope: f32, depth: f32) -> f32 {
     return light.bias.slope * slope + max(light.bias.depth, 0.0) * unit;
 }
 
+// A footprint past the map's edge is unsure: a 2D map has nothing to say there, and
+// past a cube face's edge the answer would need the next face (the seams' band,
+// UNSURE_RING_TEXELS + 1 texels wide on each side; a point-sampled lookup's one tap
+// has no disagreement to show there). A ray decides.
+const FOOTPRINT_EDGE_UNSURE: bool = true;
+
 // Whether the footprint of a lookup at `uv` (in [0, 1]) in layer `layer` is unsure:
 // the bilinear 2×2 and a ring of UNSURE_RING_TEXELS texels, each texel's stored depth
 // against the receiver's plane there, which the including file's

@@ -17,7 +17,7 @@
 
 // The fragment's (visibility, layer): the map's `shadow`, or where a ray decides, the
 // rays' answer, with the traced view's mark on the layer.
-fn refine_forward(
+fn traced_refine_forward(
     shadow: vec2<f32>,
     world: vec3<f32>,
     n: vec3<f32>,

@@ -1,5 +1,5 @@
 // No refinement in the lighting pass: the map's answer, or the mask's, stands.
-fn refine_forward(
+fn unrefined_refine_forward(
     shadow: vec2<f32>,
     world: vec3<f32>,
     n: vec3<f32>,

@@ -23,9 +23,6 @@
 // What this cannot see: a caster thinner than a texel that the map's rasterization
 // missed altogether leaves no depth to disagree with.
 
-// A footprint past the map's edge: the map has nothing to say there.
-const FOOTPRINT_EDGE_UNSURE: bool = true;
-
 // The receiver's plane in the map, for `footprint_receiver`: depth `depth` at texel
 // position `p` (texel centres at whole numbers), changing by `gradient` per texel. A
 // map's depth is affine across a plane in an orthographic map, and in a perspective
@@ -38,7 +35,7 @@ struct MapPlane {
 var<private> map_plane: MapPlane;
 
 // The receiver's depth at the texels (x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y).
-fn footprint_receiver(x: i32, y: i32) -> vec4<f32> {
+fn projected_footprint_receiver(x: i32, y: i32) -> vec4<f32> {
     let g = map_plane.gradient;
     let r = map_plane.depth + dot(g, vec2<f32>(f32(x), f32(y)) - map_plane.p);
     return vec4<f32>(r + g.y, r + g.x + g.y, r + g.x, r);
@@ -46,7 +43,7 @@ fn footprint_receiver(x: i32, y: i32) -> vec4<f32> {
 
 // `layer` is the one the lookup shaded with; `n` is the normal it was offset along;
 // `geometric_n` gives the receiver's plane.
-fn map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
+fn projected_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
     let c = shadow_coords(layer, world, n, l);
     if c.w < 0.5 {
         // Outside every layer: the map has nothing to say.

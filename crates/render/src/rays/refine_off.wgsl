@@ -1,5 +1,5 @@
 // No refinement: the map's answer stands everywhere.
-fn ray_decides(
+fn unrefined_ray_decides(
     shadow: vec2<f32>,
     world: vec3<f32>,
     n: vec3<f32>,
@@ -11,4 +11,4 @@ fn ray_decides(
     return false;
 }
 
-fn defer_to_ray(pixel: vec2<u32>, layer: u32) {}
+fn unrefined_defer_to_ray(pixel: vec2<u32>, layer: u32) {}

@@ -127,7 +127,7 @@ fn enter_box(node: BvhNode, origin: vec3<f32>, inv_direction: vec3<f32>, t_max: 
 // first caster the walk meets before `t_max`, or -1 where none blocks it. Any hit
 // ends the walk: a shadow ray needs no closest one, so this is some caster's
 // distance, not the nearest's.
-fn ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
+fn bvh_ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
     let ray = shear_ray(origin, direction);
     // A zero component would give an infinite reciprocal, and 0 · ∞ a NaN slab
     // distance that loses the box; a tiny component of the same sign gives a huge,

@@ -21,7 +21,7 @@ enable wgpu_ray_query;
 // first caster the query meets before `t_max`, or -1 where none blocks it. The
 // first hit ends the query (a shadow ray needs no closest one), so this is some
 // caster's distance, not the nearest's.
-fn ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
+fn query_ray_first_hit(origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> f32 {
     var query: ray_query;
     rayQueryInitialize(&query, casters, RayDesc(RAY_FLAG_TERMINATE_ON_FIRST_HIT, 0xffu, 0.0, t_max, origin, direction));
     while rayQueryProceed(&query) {

@@ -80,17 +80,18 @@ pub enum RayQueriesUnavailable {
 /// The tracer's WGSL for `traversal`, with the constants it shares with [`bvh`], its
 /// bindings in `group` (2–6).
 pub(crate) fn trace_wgsl(group: u32, traversal: Traversal) -> String {
-    let walk = match traversal {
-        Traversal::Shader => include_str!("trace_bvh.wgsl"),
-        Traversal::RayQuery => include_str!("trace_query.wgsl"),
+    let (walk, first_hit) = match traversal {
+        Traversal::Shader => (include_str!("trace_bvh.wgsl"), "bvh_ray_first_hit"),
+        Traversal::RayQuery => (include_str!("trace_query.wgsl"), "query_ray_first_hit"),
     };
     format!(
-        "const TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}\n{}",
+        "const TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}\n{}\n{}",
         bvh::MAX_DEPTH,
         bvh::NO_ALPHA,
         bvh::NO_TEXTURE,
         include_str!("trace_common.wgsl"),
         walk,
+        crate::passes::wgsl_interfaces::RAY_FIRST_HIT.bind(first_hit),
     )
     .replace("TRACE_GROUP", &group.to_string())
 }
