@@ -57,7 +57,7 @@ enum Command {
 /// `--technique` and `--techniques` (the settings crate does not know them).
 fn parse_cli(techniques: &gnomon_render::techniques::TechniqueRegistry) -> Cli {
     use clap::{CommandFactory, FromArgMatches};
-    let command = gnomon_scene::settings::offer_techniques(Cli::command(), &techniques.choices());
+    let command = gnomon_scene::settings::settings_command(Cli::command(), &techniques.choices());
     let command = gnomon_scene::settings::accept_negative_values(command);
     let matches = command.get_matches();
     Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())

@@ -62,7 +62,16 @@ impl Target {
                 "--light\nall\n--light-index\n2\n--refine\nrays\n--shadow-path\nmask\n--width\n640\n--height\n360",
             ],
         };
-        texts.iter().map(|t| t.as_bytes().to_vec()).collect()
+        let mut seeds: Vec<Vec<u8>> = texts.iter().map(|t| t.as_bytes().to_vec()).collect();
+        if self == Target::Flags {
+            // Each ranged setting at both ends, for the mutator to step past them.
+            for (flag, range) in ranged_flags() {
+                for end in [range.min, range.max] {
+                    seeds.push(format!("--{flag}\n{end}").into_bytes());
+                }
+            }
+        }
+        seeds
     }
 
     /// Text the mutator inserts whole: the format's keys and punctuation.
@@ -185,13 +194,28 @@ fn resolve(settings: &Settings, scene: &gnomon_scene::Scene) -> Result<(), Strin
     Ok(())
 }
 
+/// Every setting with a fixed range ([`gnomon_scene::settings::ranges::ALL`]) whose
+/// ends are valid, with its flag's long name.
+fn ranged_flags() -> Vec<(String, &'static gnomon_scene::settings::ranges::SettingRange)> {
+    use clap::Args as _;
+    let command = Settings::augment_args(clap::Command::new("gnomon"));
+    gnomon_scene::settings::ranges::ALL
+        .iter()
+        .filter(|r| !r.min_open && !r.max_open)
+        .filter_map(|r| {
+            let flag = command.get_arguments().find(|a| a.get_id() == r.field())?.get_long()?.to_string();
+            Some((flag, *r))
+        })
+        .collect()
+}
+
 fn flags_target(input: &[u8]) -> Result<(), String> {
     use clap::{Args as _, FromArgMatches as _};
     let text = String::from_utf8_lossy(input);
     let arguments = std::iter::once("gnomon").chain(text.split(['\n', '\0']).filter(|a| !a.is_empty()));
     let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
     let command = Settings::augment_args(clap::Command::new("gnomon"));
-    let command = gnomon_scene::settings::offer_techniques(command, &techniques.choices());
+    let command = gnomon_scene::settings::settings_command(command, &techniques.choices());
     let command = gnomon_scene::settings::accept_negative_values(command);
     let matches = command.try_get_matches_from(arguments).map_err(|e| e.kind().to_string())?;
     let settings = Settings::from_arg_matches(&matches).map_err(|e| e.to_string())?;
@@ -212,6 +236,28 @@ fn outcome_kind(error: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A range declared once is what the flags accept: both ends of every fixed
+    /// range pass (the seeds above), and a value past either end is refused with the
+    /// flag named.
+    #[test]
+    fn every_flag_with_a_range_refuses_a_value_past_it() {
+        let ranged = ranged_flags();
+        assert!(ranged.len() >= 20, "{} ranged flags", ranged.len());
+        for (flag, range) in ranged {
+            for past in [range.min - range.min.abs().max(1.0), range.max + range.max.abs().max(1.0)] {
+                let input = format!("--{flag}\n{past}");
+                let outcome = flags_target(input.as_bytes());
+                let error = outcome.expect_err(&input);
+                // Refused by the check, or by the flag's type (a negative count).
+                assert!(error.contains("invalid"), "{input}: {error}");
+            }
+        }
+        assert_eq!(
+            flags_target(b"--max-radius\n65").unwrap_err(),
+            "--max-radius = 65 is invalid: 1 to 64 texels"
+        );
+    }
 
     #[test]
     fn every_builtin_seed_is_a_valid_input() {

@@ -42,6 +42,8 @@ pub struct Field {
     pub kind: FieldKind,
     /// The flag has no default: left unset, the scene decides.
     pub optional: bool,
+    /// The valid values of a number with a fixed range, which bound its drag value.
+    pub range: Option<&'static gnomon_scene::settings::ranges::SettingRange>,
 }
 
 /// Every flag of [`Settings`], in `--help` order.
@@ -53,7 +55,7 @@ pub struct SettingsForm {
 fn settings_command() -> clap::Command {
     let command = Settings::augment_args(clap::Command::new("gnomon").no_binary_name(true));
     let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
-    gnomon_scene::settings::offer_techniques(command, &techniques.choices())
+    gnomon_scene::settings::settings_command(command, &techniques.choices())
 }
 
 impl Default for SettingsForm {
@@ -110,6 +112,7 @@ impl SettingsForm {
                     kind,
                     optional: arg.get_default_values().is_empty()
                         && !matches!(arg.get_action(), ArgAction::SetTrue),
+                    range: gnomon_scene::settings::ranges::of_field(arg.get_id().as_str()),
                 }
             })
             .collect();
@@ -310,5 +313,20 @@ mod tests {
         for field in SettingsForm::new().fields() {
             assert!(field.help.len() > 10, "--{} has no tooltip", field.long);
         }
+    }
+
+    /// The settings' declared ranges reach the panel: the drag value's bounds and the
+    /// tooltip's words are the checks' own.
+    #[test]
+    fn every_ranged_number_is_bounded_by_its_declared_range() {
+        let form = SettingsForm::new();
+        let mut bounded = 0;
+        for range in gnomon_scene::settings::ranges::ALL {
+            let Some(field) = form.field(range.field()) else { continue };
+            assert_eq!(field.range.map(|r| r.setting), Some(range.setting), "--{}", field.long);
+            assert!(field.help.contains(&range.describe()), "--{}: {}", field.long, field.help);
+            bounded += 1;
+        }
+        assert!(bounded >= 20, "{bounded} bounded fields");
     }
 }

@@ -1,6 +1,7 @@
 //! The shadow filter: the technique and its parameters (PCF kernel, PCSS, the
 //! moment maps of the filterable techniques), with their checks.
 
+use super::ranges::SettingRange;
 use std::borrow::Cow;
 
 use super::*;
@@ -128,6 +129,14 @@ pub fn offer_techniques(command: clap::Command, choices: &[(String, String)]) ->
     command.mut_subcommands(|sub| offer_techniques(sub, choices))
 }
 
+/// The settings' command as the front ends show it: the registry's techniques
+/// offered ([`offer_techniques`]) and every ranged flag's range in its help
+/// ([`super::ranges::annotate_ranges`]).
+#[cfg(feature = "cli")]
+pub fn settings_command(command: clap::Command, choices: &[(String, String)]) -> clap::Command {
+    super::ranges::annotate_ranges(offer_techniques(command, choices))
+}
+
 /// The unit of a PCF kernel's width.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
@@ -159,14 +168,14 @@ pub struct FilterSettings {
         arg(long, value_name = "NAME", default_value_t, help_heading = "Shadow filter")
     )]
     pub technique: Technique,
-    /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units:
-    /// 1 to 32 texels, or a world width in (0, 1e7].
+    /// Kernel width of `pcf`, `pcf-tent` and `pcf-poisson`, in --kernel-unit units (a
+    /// world width in (0, 1e7] when those are world units).
     #[cfg_attr(feature = "cli", arg(long, value_name = "WIDTH", default_value_t = FilterSettings::default().pcf_kernel, help_heading = "Shadow filter"))]
     pub pcf_kernel: f32,
     /// Unit of --pcf-kernel.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
     pub kernel_unit: KernelUnit,
-    /// Taps of `pcf-poisson` and of PCSS's filtering step: 8 to 64 ([`POISSON_TAPS`]).
+    /// Taps of `pcf-poisson` and of PCSS's filtering step ([`POISSON_TAPS`]).
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter"))]
     pub poisson_samples: u32,
     /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
@@ -192,6 +201,64 @@ pub const POISSON_TAPS: std::ops::RangeInclusive<u32> = 8..=64;
 /// The widest blur of a moment map, in texels on each side (`moments.blur_radius`):
 /// the filter pass's arrays hold `2 × MAX_BLUR_RADIUS + 1` taps (`MAX_BLUR_TAPS` in WGSL).
 pub const MAX_BLUR_RADIUS: u32 = 16;
+
+/// `shadow.filter.pcf_kernel`'s range when in texels (in world units it is any
+/// distance, [`crate::limits::LIGHT_RANGE`]).
+pub const PCF_KERNEL_TEXELS_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.pcf_kernel", 1.0, MAX_KERNEL_TEXELS as f64, "texels");
+/// `shadow.filter.poisson_samples`' range: [`POISSON_TAPS`].
+pub const POISSON_SAMPLES_RANGE: SettingRange = SettingRange::closed(
+    "shadow.filter.poisson_samples",
+    *POISSON_TAPS.start() as f64,
+    *POISSON_TAPS.end() as f64,
+    "taps",
+);
+/// `shadow.filter.pcss.blocker_samples`' range: [`POISSON_TAPS`].
+pub const BLOCKER_SAMPLES_RANGE: SettingRange = SettingRange::closed(
+    "shadow.filter.pcss.blocker_samples",
+    *POISSON_TAPS.start() as f64,
+    *POISSON_TAPS.end() as f64,
+    "taps",
+);
+/// `shadow.filter.pcss.max_radius`' range.
+pub const PCSS_MAX_RADIUS_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.pcss.max_radius", 1.0, 64.0, "texels");
+/// `shadow.filter.moments.blur_radius`' range: [`MAX_BLUR_RADIUS`].
+pub const BLUR_RADIUS_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.blur_radius", 0.0, MAX_BLUR_RADIUS as f64, "texels");
+/// `shadow.filter.moments.min_variance`' range.
+pub const MIN_VARIANCE_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.min_variance", 0.0, 1.0, "");
+/// `shadow.filter.moments.bleeding_reduction`'s range.
+pub const BLEEDING_REDUCTION_RANGE: SettingRange =
+    SettingRange::below("shadow.filter.moments.bleeding_reduction", 0.0, 1.0, "");
+/// `shadow.filter.moments.esm_exponent`'s range. ESM stores d itself and
+/// exponentiates in the shader: exp(88) is near `f32::MAX`.
+pub const ESM_EXPONENT_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.esm_exponent", 1.0, 88.0, "");
+/// `shadow.filter.moments.evsm_positive`'s range. EVSM stores exp(c·d) and its
+/// square, so at 32 bits its exponents stay below ln(f32::MAX) / 2; a 16-bit format
+/// bounds them further (EVSM's own check, `techniques::variance`).
+pub const EVSM_POSITIVE_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.evsm_positive", 0.0, 42.0, "");
+/// `shadow.filter.moments.evsm_negative`'s range, as [`EVSM_POSITIVE_RANGE`].
+pub const EVSM_NEGATIVE_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.evsm_negative", 0.0, 42.0, "");
+/// `shadow.filter.moments.moment_bias`' range.
+pub const MOMENT_BIAS_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.moment_bias", 0.0, 0.1, "");
+/// `shadow.filter.moments.csm_terms`' range.
+pub const CSM_TERMS_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.csm_terms", 1.0, 16.0, "terms");
+/// `shadow.filter.moments.csm_attenuation`'s range.
+pub const CSM_ATTENUATION_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.csm_attenuation", 0.0, 1000.0, "");
+/// `shadow.filter.moments.csm_scale`'s range.
+pub const CSM_SCALE_RANGE: SettingRange =
+    SettingRange::above("shadow.filter.moments.csm_scale", 0.0, 100.0, "");
+/// `shadow.filter.moments.csm_offset`'s range.
+pub const CSM_OFFSET_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.moments.csm_offset", -0.5, 0.5, "");
 
 impl Default for FilterSettings {
     fn default() -> Self {
@@ -220,11 +287,11 @@ impl Default for FilterSettings {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct PcssSettings {
-    /// Depth taps of PCSS's blocker search: 8 to 64 ([`POISSON_TAPS`]).
+    /// Depth taps of PCSS's blocker search ([`POISSON_TAPS`]).
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS"))]
     pub blocker_samples: u32,
-    /// Largest blocker-search and penumbra radius, in texels: 1 to 64. Wider
-    /// penumbrae are clipped to it.
+    /// Largest blocker-search and penumbra radius, in texels. Wider penumbrae are
+    /// clipped to it.
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS"))]
     pub max_radius: f32,
 }
@@ -263,8 +330,8 @@ pub enum MomentFormat {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct MomentSettings {
-    /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2):
-    /// 0 (no blur) to 16 ([`MAX_BLUR_RADIUS`]).
+    /// Radius of the separable Gaussian blur of the moment map, in texels (σ = radius / 2;
+    /// 0 is no blur).
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = MomentSettings::default().blur_radius, help_heading = "Filterable maps"))]
     pub blur_radius: u32,
     /// Build mipmaps of the moment map and sample them trilinearly (VSM, EVSM, MSM,
@@ -279,35 +346,34 @@ pub struct MomentSettings {
     #[cfg_attr(feature = "cli", arg(long, value_name = "VARIANCE", default_value_t = MomentSettings::default().min_variance, help_heading = "Filterable maps"))]
     pub min_variance: f32,
     /// Light-bleeding reduction (VSM, EVSM, MSM): the bound below this is cut to 0
-    /// and the rest rescaled to [0, 1] (Lauritzen's linstep). In [0, 1).
+    /// and the rest rescaled to [0, 1] (Lauritzen's linstep).
     #[cfg_attr(feature = "cli", arg(long, value_name = "AMOUNT", default_value_t = MomentSettings::default().bleeding_reduction, help_heading = "Filterable maps"))]
     pub bleeding_reduction: f32,
-    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)). 1 to 88 (the map
-    /// stores d and filters in log space, so c is not limited by the format).
+    /// ESM exponent c: visibility = exp(c·(d_occluder − d_receiver)) (the map stores d
+    /// and filters in log space, so c is not limited by the format).
     #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().esm_exponent, help_heading = "Filterable maps"))]
     pub esm_exponent: f32,
-    /// EVSM positive exponent: 0 to 42 (5.54 for 16-bit).
+    /// EVSM positive exponent (at most 5.54 for a 16-bit map).
     #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_positive, help_heading = "Filterable maps"))]
     pub evsm_positive: f32,
-    /// EVSM negative exponent (evsm4): 0 to 42 (5.54 for 16-bit).
+    /// EVSM negative exponent (evsm4; at most 5.54 for a 16-bit map).
     #[cfg_attr(feature = "cli", arg(long, value_name = "C", default_value_t = MomentSettings::default().evsm_negative, help_heading = "Filterable maps"))]
     pub evsm_negative: f32,
     /// MSM moment bias α: the moments are blended toward those of a two-point
     /// distribution by this fraction (Peters & Klein use 3e-5 at 32 bits, 6e-5 at 16).
-    /// In [0, 0.1].
     #[cfg_attr(feature = "cli", arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().moment_bias, help_heading = "Filterable maps"))]
     pub moment_bias: f32,
-    /// Fourier terms M of convolution shadow maps: 1 to 16 (2M channels).
+    /// Fourier terms M of convolution shadow maps (2M channels).
     #[cfg_attr(feature = "cli", arg(long, value_name = "M", default_value_t = MomentSettings::default().csm_terms, help_heading = "Filterable maps"))]
     pub csm_terms: u32,
     /// Ringing attenuation α of convolution shadow maps: term k is weighted by
     /// exp(−α (k/M)²); 0 is the raw truncated series. ≥ 0.
     #[cfg_attr(feature = "cli", arg(long, value_name = "ALPHA", default_value_t = MomentSettings::default().csm_attenuation, help_heading = "Filterable maps"))]
     pub csm_attenuation: f32,
-    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½. In (0, 100].
+    /// Scale s of the convolution reconstruction: visibility = s·(f − ½ + o) + ½.
     #[cfg_attr(feature = "cli", arg(long, value_name = "S", default_value_t = MomentSettings::default().csm_scale, help_heading = "Filterable maps"))]
     pub csm_scale: f32,
-    /// Offset o of the convolution reconstruction (see --csm-scale): in [−0.5, 0.5].
+    /// Offset o of the convolution reconstruction (see --csm-scale).
     #[cfg_attr(feature = "cli", arg(long, value_name = "O", default_value_t = MomentSettings::default().csm_offset, help_heading = "Filterable maps"))]
     pub csm_offset: f32,
 }
@@ -334,76 +400,17 @@ impl Default for MomentSettings {
 
 impl MomentSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
-        let in_range = |x: f32, lo: f32, hi: f32| x.is_finite() && x >= lo && x <= hi;
-        check(
-            self.blur_radius <= MAX_BLUR_RADIUS,
-            "shadow.filter.moments.blur_radius",
-            self.blur_radius,
-            format!("0 to {MAX_BLUR_RADIUS} texels"),
-        )?;
-        check(
-            in_range(self.min_variance, 0.0, 1.0),
-            "shadow.filter.moments.min_variance",
-            self.min_variance,
-            "0 to 1",
-        )?;
-        check(
-            self.bleeding_reduction.is_finite() && (0.0..1.0).contains(&self.bleeding_reduction),
-            "shadow.filter.moments.bleeding_reduction",
-            self.bleeding_reduction,
-            "in [0, 1)",
-        )?;
-        // ESM stores d itself and exponentiates in the shader; EVSM stores exp(c·d) and
-        // its square, so at 32 bits its exponents stay below ln(f32::MAX) / 2. A 16-bit
-        // format bounds them further: EVSM's own check (`techniques::variance`) says so.
-        check(
-            in_range(self.esm_exponent, 1.0, 88.0),
-            "shadow.filter.moments.esm_exponent",
-            self.esm_exponent,
-            "1 to 88",
-        )?;
-        check(
-            in_range(self.evsm_positive, 0.0, 42.0),
-            "shadow.filter.moments.evsm_positive",
-            self.evsm_positive,
-            "0 to 42",
-        )?;
-        check(
-            in_range(self.evsm_negative, 0.0, 42.0),
-            "shadow.filter.moments.evsm_negative",
-            self.evsm_negative,
-            "0 to 42",
-        )?;
-        check(
-            in_range(self.moment_bias, 0.0, 0.1),
-            "shadow.filter.moments.moment_bias",
-            self.moment_bias,
-            "0 to 0.1",
-        )?;
-        check(
-            (1..=16).contains(&self.csm_terms),
-            "shadow.filter.moments.csm_terms",
-            self.csm_terms,
-            "1 to 16",
-        )?;
-        check(
-            in_range(self.csm_attenuation, 0.0, 1e3),
-            "shadow.filter.moments.csm_attenuation",
-            self.csm_attenuation,
-            "0 to 1000",
-        )?;
-        check(
-            self.csm_scale.is_finite() && self.csm_scale > 0.0 && self.csm_scale <= 100.0,
-            "shadow.filter.moments.csm_scale",
-            self.csm_scale,
-            "in (0, 100]",
-        )?;
-        check(
-            in_range(self.csm_offset, -0.5, 0.5),
-            "shadow.filter.moments.csm_offset",
-            self.csm_offset,
-            "-0.5 to 0.5",
-        )?;
+        BLUR_RADIUS_RANGE.check(self.blur_radius)?;
+        MIN_VARIANCE_RANGE.check(self.min_variance)?;
+        BLEEDING_REDUCTION_RANGE.check(self.bleeding_reduction)?;
+        ESM_EXPONENT_RANGE.check(self.esm_exponent)?;
+        EVSM_POSITIVE_RANGE.check(self.evsm_positive)?;
+        EVSM_NEGATIVE_RANGE.check(self.evsm_negative)?;
+        MOMENT_BIAS_RANGE.check(self.moment_bias)?;
+        CSM_TERMS_RANGE.check(self.csm_terms)?;
+        CSM_ATTENUATION_RANGE.check(self.csm_attenuation)?;
+        CSM_SCALE_RANGE.check(self.csm_scale)?;
+        CSM_OFFSET_RANGE.check(self.csm_offset)?;
         Ok(())
     }
 }

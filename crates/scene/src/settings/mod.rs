@@ -14,6 +14,7 @@ use crate::{Camera, Light, Scene, limits, sun_direction};
 mod error;
 mod filter;
 mod light;
+pub mod ranges;
 mod screen;
 mod shadow;
 mod unused;
@@ -78,7 +79,7 @@ pub struct SceneOptions {
 #[serde(default, deny_unknown_fields)]
 pub struct ReferenceSettings {
     /// Shadow rays per pixel for an area light (a spot with --spot-radius > 0 or a sun
-    /// with --sun-angular-diameter > 0): 8 to 65536, stratified. A point light needs one.
+    /// with --sun-angular-diameter > 0), stratified. A point light needs one.
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = ReferenceSettings::default().samples, help_heading = "Reference"))]
     pub samples: u32,
 }
@@ -110,13 +111,11 @@ pub enum DebugView {
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 #[serde(default, deny_unknown_fields)]
 pub struct ImageSettings {
-    /// Image width in pixels: 1 to 16384, and as the device allows (its largest
-    /// texture, and its largest buffer for 16 bytes a pixel), checked before
-    /// rendering.
+    /// Image width in pixels, at most as the device allows too (its largest texture,
+    /// and its largest buffer for 16 bytes a pixel), checked before rendering.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().width, help_heading = "Image"))]
     pub width: u32,
-    /// Image height in pixels: 1 to 16384, and as the device allows (see
-    /// `--width`).
+    /// Image height in pixels, at most as the device allows too (see `--width`).
     #[cfg_attr(feature = "cli", arg(long, default_value_t = ImageSettings::default().height, help_heading = "Image"))]
     pub height: u32,
     /// A diagnostic view over the image.
@@ -181,14 +180,23 @@ pub const MAX_KERNEL_TEXELS: f32 = 32.0;
 /// The smallest shadow map Gnomon allows.
 pub const MIN_SHADOW_RESOLUTION: u32 = 256;
 
+/// `image.width`'s range.
+pub const WIDTH_RANGE: ranges::SettingRange =
+    ranges::SettingRange::closed("image.width", 1.0, MAX_IMAGE_SIDE as f64, "pixels");
+/// `image.height`'s range.
+pub const HEIGHT_RANGE: ranges::SettingRange =
+    ranges::SettingRange::closed("image.height", 1.0, MAX_IMAGE_SIDE as f64, "pixels");
+/// `reference.samples`' range.
+pub const REFERENCE_SAMPLES_RANGE: ranges::SettingRange =
+    ranges::SettingRange::closed("reference.samples", 8.0, 65536.0, "shadow rays per pixel");
+
 impl Settings {
     /// Checks every value against its documented range. Device-dependent limits (the
     /// largest texture) are checked by the renderer, which knows the device.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let i = &self.image;
-        let valid = format!("1 to {MAX_IMAGE_SIDE} pixels");
-        check((1..=MAX_IMAGE_SIDE).contains(&i.width), "image.width", i.width, &valid)?;
-        check((1..=MAX_IMAGE_SIDE).contains(&i.height), "image.height", i.height, &valid)?;
+        WIDTH_RANGE.check(i.width)?;
+        HEIGHT_RANGE.check(i.height)?;
         let c = &self.camera;
         check_vec(c.eye, "camera.eye")?;
         check_vec(c.target, "camera.target")?;
@@ -209,15 +217,8 @@ impl Settings {
         check_limit(l.point_range, "light.point_range", &limits::LIGHT_RANGE)?;
         check_limit(l.point_radius, "light.point_radius", &limits::LIGHT_RADIUS)?;
         self.shadow.validate()?;
-        let rays = self.screen.penumbra_rays;
-        check(
-            (1..=MAX_PENUMBRA_RAYS).contains(&rays),
-            "screen.penumbra_rays",
-            rays,
-            format!("1 to {MAX_PENUMBRA_RAYS} shadow rays per refined pixel"),
-        )?;
-        let n = self.reference.samples;
-        check((8..=65536).contains(&n), "reference.samples", n, "8 to 65536 shadow rays per pixel")?;
+        PENUMBRA_RAYS_RANGE.check(self.screen.penumbra_rays)?;
+        REFERENCE_SAMPLES_RANGE.check(self.reference.samples)?;
         Ok(())
     }
 

@@ -1,6 +1,7 @@
 //! Screen-space settings: where each pixel's shadow is resolved (forward or the
 //! shadow mask), and contact shadows.
 
+use super::ranges::SettingRange;
 use super::*;
 
 /// Where each pixel's shadow is resolved.
@@ -161,6 +162,22 @@ pub struct ScreenSpaceSettings {
 
 /// The most shadow rays a refined pixel casts under a light with an area.
 pub const MAX_PENUMBRA_RAYS: u32 = 256;
+/// `screen.penumbra_rays`' range.
+pub const PENUMBRA_RAYS_RANGE: SettingRange = SettingRange::closed(
+    "screen.penumbra_rays",
+    1.0,
+    MAX_PENUMBRA_RAYS as f64,
+    "shadow rays per refined pixel",
+);
+/// `shadow.contact.contact_length`'s range.
+pub const CONTACT_LENGTH_RANGE: SettingRange =
+    SettingRange::above("shadow.contact.contact_length", 0.0, 10.0, "world units");
+/// `shadow.contact.contact_steps`' range.
+pub const CONTACT_STEPS_RANGE: SettingRange =
+    SettingRange::closed("shadow.contact.contact_steps", 1.0, 64.0, "steps");
+/// `shadow.contact.contact_thickness`'s range.
+pub const CONTACT_THICKNESS_RANGE: SettingRange =
+    SettingRange::above("shadow.contact.contact_thickness", 0.0, 1.0, "of the view depth");
 
 impl Default for ScreenSpaceSettings {
     fn default() -> Self {
@@ -196,13 +213,13 @@ pub struct ContactSettings {
     /// Length of the ray toward the light, in world units (> 0, at most 10).
     #[cfg_attr(feature = "cli", arg(long, value_name = "DISTANCE", default_value_t = ContactSettings::default().contact_length, help_heading = "Contact shadows"))]
     pub contact_length: f32,
-    /// Depth-buffer samples along the ray, 1 to 64; the start is jittered per pixel by
+    /// Depth-buffer samples along the ray; the start is jittered per pixel by
     /// interleaved gradient noise.
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = ContactSettings::default().contact_steps, help_heading = "Contact shadows"))]
     pub contact_steps: u32,
     /// Assumed thickness of what the depth buffer holds, as a fraction of its view
     /// depth: a sample behind the depth buffer by less than this occludes the ray,
-    /// one farther behind passes behind the surface. 0 to 1.
+    /// one farther behind passes behind the surface.
     #[cfg_attr(feature = "cli", arg(long, value_name = "FRACTION", default_value_t = ContactSettings::default().contact_thickness, help_heading = "Contact shadows"))]
     pub contact_thickness: f32,
     /// The ray starts this far along the surface's normal, in world units, so that its
@@ -230,25 +247,9 @@ impl Default for ContactSettings {
 
 impl ContactSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
-        let finite = |x: f32| x.is_finite();
-        check(
-            finite(self.contact_length) && self.contact_length > 0.0 && self.contact_length <= 10.0,
-            "shadow.contact.contact_length",
-            self.contact_length,
-            "a distance in (0, 10]",
-        )?;
-        check(
-            (1..=64).contains(&self.contact_steps),
-            "shadow.contact.contact_steps",
-            self.contact_steps,
-            "1 to 64",
-        )?;
-        check(
-            finite(self.contact_thickness) && self.contact_thickness > 0.0 && self.contact_thickness <= 1.0,
-            "shadow.contact.contact_thickness",
-            self.contact_thickness,
-            "a fraction of the view depth in (0, 1]",
-        )?;
+        CONTACT_LENGTH_RANGE.check(self.contact_length)?;
+        CONTACT_STEPS_RANGE.check(self.contact_steps)?;
+        CONTACT_THICKNESS_RANGE.check(self.contact_thickness)?;
         check(
             crate::limits::LIGHT_RADIUS.allows(self.contact_bias),
             "shadow.contact.contact_bias",

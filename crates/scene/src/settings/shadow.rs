@@ -2,6 +2,7 @@
 //! format, fit and warp, the point lights' map, cascades, and the checks that tie
 //! them together.
 
+use super::ranges::SettingRange;
 use super::*;
 
 /// Which faces the shadow pass culls.
@@ -41,19 +42,19 @@ pub enum CullMode {
 pub struct BiasSettings {
     /// Rasterizer constant depth bias, in the depth format's units (D3D `DepthBias`).
     /// For Depth32Float one unit is 2^(e−23) for a primitive whose largest depth has
-    /// exponent e: about 6e-8 at depth 0.5. At most ±16777216 (2^24 units, the whole
-    /// [0, 1] depth range at depths in [0.5, 1)).
+    /// exponent e: about 6e-8 at depth 0.5. Its bound, 2^24 units either way, is the
+    /// whole [0, 1] depth range at depths in [0.5, 1).
     #[cfg_attr(feature = "cli", arg(long, value_name = "UNITS", default_value_t = BiasSettings::default().depth_bias, help_heading = "Shadow bias"))]
     pub depth_bias: i32,
     /// Rasterizer slope-scaled depth bias (D3D `SlopeScaledDepthBias`): multiplies the
     /// caster's depth slope per shadow texel, so 1 pushes a surface back by the depth
-    /// it spans across one texel. In [0, 100].
+    /// it spans across one texel.
     #[cfg_attr(feature = "cli", arg(long, value_name = "FACTOR", default_value_t = BiasSettings::default().slope_bias, help_heading = "Shadow bias"))]
     pub slope_bias: f32,
     /// Normal-offset bias: the receiver is pushed along its surface normal by this many
     /// shadow texels (world size of a texel at the receiver) times 1 − N·L before the
     /// lookup, so surfaces facing the light are hardly moved and grazing ones fully
-    /// (Holbert, "Normal offset shadows", 2011). In [0, 64] texels.
+    /// (Holbert, "Normal offset shadows", 2011).
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = BiasSettings::default().normal_offset, help_heading = "Shadow bias"))]
     pub normal_offset: f32,
     /// Faces culled when drawing casters into the shadow map.
@@ -70,6 +71,35 @@ pub const MAX_DEPTH_BIAS: i32 = 1 << 24;
 pub const MAX_SLOPE_BIAS: f32 = 100.0;
 /// The largest normal offset, in shadow texels: twice the widest PCF kernel.
 pub const MAX_NORMAL_OFFSET: f32 = 2.0 * MAX_KERNEL_TEXELS;
+/// `shadow.bias.depth_bias`'s range.
+pub const DEPTH_BIAS_RANGE: SettingRange = SettingRange::closed(
+    "shadow.bias.depth_bias",
+    -(MAX_DEPTH_BIAS as f64),
+    MAX_DEPTH_BIAS as f64,
+    "depth units",
+);
+/// `shadow.bias.slope_bias`'s range: a factor.
+pub const SLOPE_BIAS_RANGE: SettingRange =
+    SettingRange::closed("shadow.bias.slope_bias", 0.0, MAX_SLOPE_BIAS as f64, "");
+/// `shadow.bias.normal_offset`'s range.
+pub const NORMAL_OFFSET_RANGE: SettingRange =
+    SettingRange::closed("shadow.bias.normal_offset", 0.0, MAX_NORMAL_OFFSET as f64, "texels");
+/// `shadow.map.resolution`'s range.
+pub const RESOLUTION_RANGE: SettingRange = SettingRange::closed(
+    "shadow.map.resolution",
+    MIN_SHADOW_RESOLUTION as f64,
+    MAX_SHADOW_RESOLUTION as f64,
+    "texels",
+);
+/// `shadow.cascades.count`'s range.
+pub const CASCADE_COUNT_RANGE: SettingRange =
+    SettingRange::closed("shadow.cascades.count", 1.0, MAX_CASCADES as f64, "");
+/// `shadow.cascades.split_lambda`'s range.
+pub const SPLIT_LAMBDA_RANGE: SettingRange =
+    SettingRange::closed("shadow.cascades.split_lambda", 0.0, 1.0, "");
+/// `shadow.cascades.cascade_blend`'s range: a fraction of a cascade's depth range.
+pub const CASCADE_BLEND_RANGE: SettingRange =
+    SettingRange::closed("shadow.cascades.cascade_blend", 0.0, 0.5, "");
 
 impl BiasSettings {
     /// No bias at all, for demonstrating acne.
@@ -120,8 +150,8 @@ pub enum Fit {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct MapSettings {
-    /// Shadow map width and height in texels: 256 to 8192, and at most the device's
-    /// maximum 2D texture size.
+    /// Shadow map width and height in texels, at most the device's largest 2D texture
+    /// too.
     #[cfg_attr(feature = "cli", arg(long = "shadow-res", value_name = "TEXELS", default_value_t = MapSettings::default().resolution, help_heading = "Shadow map"))]
     pub resolution: u32,
     /// Shadow map texel format.
@@ -338,13 +368,13 @@ pub enum CascadeSelection {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct CascadeSettings {
-    /// Number of cascades: 1 to 8.
+    /// Number of cascades.
     #[cfg_attr(feature = "cli", arg(long = "cascades", value_name = "N", default_value_t = CascadeSettings::default().count, help_heading = "Cascades"))]
     pub count: u32,
     /// Split scheme of the view depth range.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Cascades"))]
     pub split: SplitScheme,
-    /// λ of the practical split scheme, in [0, 1]: 1 is fully logarithmic.
+    /// λ of the practical split scheme: 1 is fully logarithmic, 0 uniform.
     #[cfg_attr(feature = "cli", arg(long, value_name = "LAMBDA", default_value_t = CascadeSettings::default().split_lambda, help_heading = "Cascades"))]
     pub split_lambda: f32,
     /// Farthest view depth the cascades cover, in world units, > 0 [default: the
@@ -358,7 +388,7 @@ pub struct CascadeSettings {
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Cascades"))]
     pub cascade_selection: CascadeSelection,
     /// Width of the band at the far end of each cascade over which it blends into the
-    /// next, as a fraction of the cascade's depth range: 0 to 0.5.
+    /// next, as a fraction of the cascade's depth range.
     #[cfg_attr(feature = "cli", arg(long, value_name = "FRACTION", default_value_t = CascadeSettings::default().cascade_blend, help_heading = "Cascades"))]
     pub cascade_blend: f32,
     /// Keep the cascades fitted to the first frame while the camera moves (along
@@ -469,13 +499,7 @@ impl ShadowSettings {
         }
         s.cascades.validate()?;
         s.bias.validate()?;
-        let r = s.map.resolution;
-        check(
-            (MIN_SHADOW_RESOLUTION..=MAX_SHADOW_RESOLUTION).contains(&r),
-            "shadow.map.resolution",
-            r,
-            format!("{MIN_SHADOW_RESOLUTION} to {MAX_SHADOW_RESOLUTION} texels"),
-        )?;
+        RESOLUTION_RANGE.check(s.map.resolution)?;
         s.contact.validate()?;
         Ok(())
     }
@@ -486,11 +510,12 @@ impl FilterSettings {
         let f = self;
         match f.kernel_unit {
             KernelUnit::Texels => check(
-                f.pcf_kernel.is_finite() && (1.0..=MAX_KERNEL_TEXELS).contains(&f.pcf_kernel),
+                PCF_KERNEL_TEXELS_RANGE.allows(f.pcf_kernel),
                 "shadow.filter.pcf_kernel",
                 f.pcf_kernel,
                 format!(
-                    "1 to {MAX_KERNEL_TEXELS} texels (or a world width with `shadow.filter.kernel_unit` world)"
+                    "{} (or a world width with `shadow.filter.kernel_unit` world)",
+                    PCF_KERNEL_TEXELS_RANGE.describe()
                 ),
             )?,
             KernelUnit::World => check(
@@ -500,25 +525,9 @@ impl FilterSettings {
                 "a world width in (0, 1e7]",
             )?,
         }
-        let taps = format!("{} to {}", POISSON_TAPS.start(), POISSON_TAPS.end());
-        check(
-            POISSON_TAPS.contains(&f.poisson_samples),
-            "shadow.filter.poisson_samples",
-            f.poisson_samples,
-            &taps,
-        )?;
-        check(
-            POISSON_TAPS.contains(&f.pcss.blocker_samples),
-            "shadow.filter.pcss.blocker_samples",
-            f.pcss.blocker_samples,
-            &taps,
-        )?;
-        check(
-            f.pcss.max_radius.is_finite() && (1.0..=64.0).contains(&f.pcss.max_radius),
-            "shadow.filter.pcss.max_radius",
-            f.pcss.max_radius,
-            "1 to 64 texels",
-        )?;
+        POISSON_SAMPLES_RANGE.check(f.poisson_samples)?;
+        BLOCKER_SAMPLES_RANGE.check(f.pcss.blocker_samples)?;
+        PCSS_MAX_RADIUS_RANGE.check(f.pcss.max_radius)?;
         f.moments.validate()?;
         Ok(())
     }
@@ -527,24 +536,9 @@ impl FilterSettings {
 impl CascadeSettings {
     fn validate(&self) -> Result<(), SettingsError> {
         let c = self;
-        check(
-            (1..=MAX_CASCADES).contains(&c.count),
-            "shadow.cascades.count",
-            c.count,
-            format!("1 to {MAX_CASCADES}"),
-        )?;
-        check(
-            c.split_lambda.is_finite() && (0.0..=1.0).contains(&c.split_lambda),
-            "shadow.cascades.split_lambda",
-            c.split_lambda,
-            "0 to 1",
-        )?;
-        check(
-            c.cascade_blend.is_finite() && (0.0..=0.5).contains(&c.cascade_blend),
-            "shadow.cascades.cascade_blend",
-            c.cascade_blend,
-            "0 to 0.5",
-        )?;
+        CASCADE_COUNT_RANGE.check(c.count)?;
+        SPLIT_LAMBDA_RANGE.check(c.split_lambda)?;
+        CASCADE_BLEND_RANGE.check(c.cascade_blend)?;
         check_limit(c.shadow_distance, "shadow.cascades.shadow_distance", &crate::limits::CLIP_DISTANCE)?;
         if c.sdsm_bounds {
             check(
@@ -567,24 +561,9 @@ impl CascadeSettings {
 impl BiasSettings {
     fn validate(&self) -> Result<(), SettingsError> {
         let b = self;
-        check(
-            (-MAX_DEPTH_BIAS..=MAX_DEPTH_BIAS).contains(&b.depth_bias),
-            "shadow.bias.depth_bias",
-            b.depth_bias,
-            format!("-{MAX_DEPTH_BIAS} to {MAX_DEPTH_BIAS} depth units"),
-        )?;
-        check(
-            b.slope_bias.is_finite() && (0.0..=MAX_SLOPE_BIAS).contains(&b.slope_bias),
-            "shadow.bias.slope_bias",
-            b.slope_bias,
-            format!("a factor in [0, {MAX_SLOPE_BIAS}]"),
-        )?;
-        check(
-            b.normal_offset.is_finite() && (0.0..=MAX_NORMAL_OFFSET).contains(&b.normal_offset),
-            "shadow.bias.normal_offset",
-            b.normal_offset,
-            format!("in [0, {MAX_NORMAL_OFFSET}] texels"),
-        )?;
+        DEPTH_BIAS_RANGE.check(b.depth_bias)?;
+        SLOPE_BIAS_RANGE.check(b.slope_bias)?;
+        NORMAL_OFFSET_RANGE.check(b.normal_offset)?;
         Ok(())
     }
 }

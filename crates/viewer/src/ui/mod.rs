@@ -427,14 +427,23 @@ fn field_widget(
         (FieldKind::Integer, Some(value)) if !field.optional => {
             let mut n: i64 = value.parse().unwrap_or_default();
             let speed = (n.abs() as f64 * 0.02).max(0.05);
-            if ui.add(egui::DragValue::new(&mut n).speed(speed)).changed() {
+            let mut drag = egui::DragValue::new(&mut n).speed(speed);
+            if let Some(r) = field.range {
+                drag = drag.range(r.min.ceil() as i64..=r.max.floor() as i64);
+            }
+            if ui.add(drag).changed() {
                 edits.push((id, Some(n.to_string())));
             }
         }
         (FieldKind::Float, Some(value)) if !field.optional => {
             let mut x: f32 = value.parse().unwrap_or_default();
             let speed = (x.abs() * 0.01).max(1e-3);
-            if ui.add(egui::DragValue::new(&mut x).speed(speed).max_decimals(4)).changed() {
+            let mut drag = egui::DragValue::new(&mut x).speed(speed).max_decimals(4);
+            if let Some(r) = field.range {
+                // An open end is left to the check, which names it when reached.
+                drag = drag.range(r.min as f32..=r.max as f32);
+            }
+            if ui.add(drag).changed() {
                 edits.push((id, Some(x.to_string())));
             }
         }
