@@ -1,11 +1,21 @@
 #!/usr/bin/env python3
 """Lists WGSL names (fn, struct, alias, const, override, module-scope var) defined in
 more than one .wgsl file of the crates: the definitions whose winner, when files are
-concatenated, depends on which were composed. Usage: wgsl-duplicates.py [ROOT]
-(default: the repository). Exits 0; prints a count last."""
+concatenated, depends on which were composed. Usage:
+wgsl-duplicates.py [ROOT] [--allow NAME,NAME...] (ROOT defaults to the repository).
+Prints a count last; exits 1 when a name not allowed is defined twice. The technique
+contract's entry points (`sample_shadow`, `sample_shadow_cube`, `encode_moments`),
+which every technique's own file defines and exactly one of which a shader composes
+(`techniques::technique_wgsl`), are what `.ci/run` allows."""
 import collections, pathlib, re, sys
 
-root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parent.parent)
+args = sys.argv[1:]
+allowed = set()
+if "--allow" in args:
+    i = args.index("--allow")
+    allowed = set(args[i + 1].split(","))
+    del args[i : i + 2]
+root = pathlib.Path(args[0] if args else pathlib.Path(__file__).resolve().parent.parent)
 definition = re.compile(r"^(?:fn|struct|alias|const|override|var(?:<[^>]*>)?)\s+([A-Za-z_][A-Za-z0-9_]*)", re.M)
 where = collections.defaultdict(set)
 for path in sorted(root.glob("crates/**/*.wgsl")):
@@ -16,3 +26,7 @@ duplicates = {n: sorted(f) for n, f in where.items() if len(f) > 1}
 for name, files in sorted(duplicates.items()):
     print(f"{name}: {len(files)} files: {', '.join(files)}")
 print(f"{len(duplicates)} names defined in more than one file")
+refused = sorted(set(duplicates) - allowed)
+if allowed and refused:
+    print(f"not allowed: {', '.join(refused)}")
+    sys.exit(1)

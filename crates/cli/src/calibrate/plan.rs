@@ -5,7 +5,10 @@
 //! each with a message that says what would be valid.
 
 use gnomon_render::techniques::{TechniqueRegistry, Tunables};
-use gnomon_scene::settings::{BiasSettings, KernelUnit, MAX_KERNEL_TEXELS};
+use gnomon_scene::settings::{
+    BiasSettings, DEPTH_BIAS_RANGE, KernelUnit, NORMAL_OFFSET_RANGE, PCF_KERNEL_TEXELS_RANGE,
+    SLOPE_BIAS_RANGE,
+};
 
 use super::sweep::SweepRange;
 
@@ -59,7 +62,8 @@ struct Knob {
     flag: &'static str,
     /// Whether a technique's shadow depends on it.
     moves: fn(&Tunables) -> bool,
-    /// Whether a value is within the setting's own range.
+    /// Whether a value is within the setting's own range (declared with the setting,
+    /// `settings::ranges`).
     valid: fn(f32, KernelUnit) -> bool,
     /// That range, for the message.
     range: fn(KernelUnit) -> String,
@@ -69,34 +73,34 @@ const DEPTH_BIAS: Knob = Knob {
     setting: "depth bias",
     flag: "--sweep-depth-bias",
     moves: |t| t.raster_bias,
-    valid: |v, _| v.abs() <= i32::MAX as f32,
-    range: |_| format!("rasterizer units within ±{}", i32::MAX),
+    valid: |v, _| DEPTH_BIAS_RANGE.allows(v),
+    range: |_| DEPTH_BIAS_RANGE.describe(),
 };
 const SLOPE_BIAS: Knob = Knob {
     setting: "slope bias",
     flag: "--sweep-slope-bias",
     moves: |t| t.raster_bias,
-    valid: |v, _| v >= 0.0,
-    range: |_| "≥ 0".into(),
+    valid: |v, _| SLOPE_BIAS_RANGE.allows(v),
+    range: |_| SLOPE_BIAS_RANGE.describe(),
 };
 const NORMAL_OFFSET: Knob = Knob {
     setting: "normal offset",
     flag: "--sweep-normal-offset",
     moves: |t| t.normal_offset,
-    valid: |v, _| v >= 0.0,
-    range: |_| "≥ 0 texels".into(),
+    valid: |v, _| NORMAL_OFFSET_RANGE.allows(v),
+    range: |_| NORMAL_OFFSET_RANGE.describe(),
 };
 const KERNEL: Knob = Knob {
     setting: "PCF kernel",
     flag: "--sweep-kernel",
     moves: |t| t.kernel,
     valid: |v, unit| match unit {
-        KernelUnit::Texels => (1.0..=MAX_KERNEL_TEXELS).contains(&v),
-        KernelUnit::World => v > 0.0,
+        KernelUnit::Texels => PCF_KERNEL_TEXELS_RANGE.allows(v),
+        KernelUnit::World => gnomon_scene::limits::LIGHT_RANGE.allows(v),
     },
     range: |unit| match unit {
-        KernelUnit::Texels => format!("1 to {MAX_KERNEL_TEXELS} texels"),
-        KernelUnit::World => "a world width in (0, 1e7]".into(),
+        KernelUnit::Texels => PCF_KERNEL_TEXELS_RANGE.describe(),
+        KernelUnit::World => gnomon_scene::limits::LIGHT_RANGE.valid.into(),
     },
 };
 

@@ -25,8 +25,8 @@ fn flags_beyond_their_finite_range_are_refused_before_any_work() {
     for (flag, value, range) in [
         ("--depth-bias", "2147483647", "16777216"),
         ("--depth-bias", "-2147483647", "16777216"),
-        ("--slope-bias", "1e30", "[0, 100]"),
-        ("--normal-offset", "1e9", "[0, 64]"),
+        ("--slope-bias", "1e30", "0 to 100"),
+        ("--normal-offset", "1e9", "0 to 64 texels"),
         ("--sun-elevation", "-30", "(0, 90]"),
         ("--sun-azimuth", "inf", "[-360, 360]"),
         ("--sun-angular-diameter", "1e30", "[0, 30]"),
