@@ -3,7 +3,8 @@
 one file, of its files' `crate::`, `super::` and `self::` references (a `use` or a
 path in code; comments and strings blanked). A parent's `mod child;` and its
 unprefixed `child::` paths are its own structure, not imports, and are not counted.
-`--edges` lists each circle's references. Usage: import-circles.py [CRATE_SRC]
+`--edges` lists each circle's references; `--gate` exits 1 when a circle holds more
+than two files (issue 50: none larger than a pair). Usage: import-circles.py [CRATE_SRC]
 (default crates/render/src). Prints each circle's files and a count last."""
 import pathlib, re, sys
 
@@ -109,3 +110,6 @@ if "--edges" in sys.argv:
                 for w in sorted(graph[v]):
                     if w in c:
                         print(f"  {'::'.join(v) or 'lib'} -> {'::'.join(w) or 'lib'}")
+
+if "--gate" in sys.argv and any(len(c) > 2 for c in circles):
+    sys.exit(1)

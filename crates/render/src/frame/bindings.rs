@@ -186,6 +186,12 @@ pub(crate) fn camera_arguments(
         return None;
     }
     let mut args = uploaded.visible_arguments(visible);
-    args.resize(super::depth_pass::argument_slots(args.len()), Default::default());
+    args.resize(argument_slots(args.len()), Default::default());
     Some(pool.storage(&gpu.queue, "camera draw arguments", &args, wgpu::BufferUsages::INDIRECT))
+}
+
+/// How many draw arguments an arguments buffer holds for `draws`: the next power of
+/// two (at least 64), so that the pool keeps reusing a buffer while the count moves.
+pub(crate) fn argument_slots(draws: usize) -> usize {
+    draws.next_power_of_two().max(64)
 }

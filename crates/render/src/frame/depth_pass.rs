@@ -8,7 +8,11 @@
 
 use gnomon_scene::{Motion, Settings, settings::DrawSubmission};
 
-use super::{Renderer, bindings::scene_group, outputs::DrawStats};
+use super::{
+    Renderer,
+    bindings::{argument_slots, scene_group},
+    recording::DrawStats,
+};
 use crate::{
     GpuScene,
     gpu_scene::{
@@ -250,12 +254,6 @@ fn open_depth_pass<'e>(
     pass.set_bind_group(0, group, &[]);
     stats.bind_group_changes += 1;
     pass
-}
-
-/// How many draw arguments an arguments buffer holds for `draws`: the next power of
-/// two (at least 64), so that the pool keeps reusing a buffer while the count moves.
-pub(super) fn argument_slots(draws: usize) -> usize {
-    draws.next_power_of_two().max(64)
 }
 
 impl Renderer {

@@ -4,10 +4,7 @@
 
 use gnomon_scene::{Scene, Settings};
 
-use super::{
-    DrawStats, Renderer,
-    record::{Readback, Recording},
-};
+use super::{DrawStats, Renderer, record::Readback, recording::Recording};
 use crate::{GpuScene, RenderError, passes::blit::HostTarget, timing::PassClock};
 
 impl Renderer {

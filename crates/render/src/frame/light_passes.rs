@@ -11,7 +11,7 @@ use super::{
     Renderer,
     bindings::CameraDraws,
     plan::FramePlan,
-    record::{LightBindings, Recording},
+    recording::{LightBindings, Recording},
 };
 use crate::{
     GpuScene,

@@ -17,6 +17,7 @@ mod outputs;
 mod plan;
 mod receiver;
 mod record;
+mod recording;
 mod refine;
 mod screen;
 mod shadow_maps;
@@ -26,10 +27,10 @@ use gnomon_scene::{Scene, Settings, settings::MomentFormat};
 pub use crate::pool::Creations;
 pub use map_cache::LayerCache;
 pub use outputs::{
-    CpuTimings, DrawStats, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings,
-    ShadowMapImage,
+    CpuTimings, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, ShadowMapImage,
 };
 pub use receiver::{LightShadows, ReceiverVariant, Shadows};
+pub use recording::DrawStats;
 
 use crate::{
     Gpu, GpuScene, RenderError,

@@ -12,11 +12,11 @@ use gnomon_scene::{
     settings::{DrawSubmission, Technique},
 };
 
+use super::recording::{DrawStats, FrameReadbacks, LayerCommands, Recorded};
 use crate::{
     Gpu, RenderError,
     gpu_scene::Visible,
     layout::ShadowLayout,
-    readback::PendingReadback,
     timing::{FrameTimes, PassKind, PassTime, TimingSource},
 };
 
@@ -216,44 +216,6 @@ impl LightStats {
     }
 }
 
-/// What a frame submitted: the CPU-side cost of drawing the scene.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct DrawStats {
-    /// Draws in the shadow passes, every layer of every light together.
-    pub shadow_draws: u32,
-    /// Draw commands recorded into the shadow passes: one per draw, or one per
-    /// multi-draw where draws come from a buffer of arguments (`DrawSubmission`).
-    pub shadow_commands: u32,
-    /// Draw calls in the lighting pass.
-    pub lighting_draws: u32,
-    /// Draw calls in the mask path's prepass.
-    pub prepass_draws: u32,
-    /// Pipeline changes, every pass together.
-    pub pipeline_changes: u32,
-    /// Bind group changes, every pass together.
-    pub bind_group_changes: u32,
-    /// Instances drawn into shadow maps, every layer of every light together.
-    pub shadow_instances: u32,
-    /// Triangles drawn into shadow maps, every layer of every light together.
-    pub shadow_triangles: u64,
-    /// Instances the camera sees, drawn by the lighting pass.
-    pub lighting_instances: u32,
-}
-
-impl DrawStats {
-    pub(crate) fn add(&mut self, other: &DrawStats) {
-        self.shadow_draws += other.shadow_draws;
-        self.shadow_commands += other.shadow_commands;
-        self.lighting_draws += other.lighting_draws;
-        self.prepass_draws += other.prepass_draws;
-        self.pipeline_changes += other.pipeline_changes;
-        self.bind_group_changes += other.bind_group_changes;
-        self.shadow_instances += other.shadow_instances;
-        self.shadow_triangles += other.shadow_triangles;
-        self.lighting_instances += other.lighting_instances;
-    }
-}
-
 /// What a frame cost the CPU, in milliseconds: fitting the lights' projections,
 /// culling (every layer and the camera, in parallel), and recording and submitting
 /// the commands. `submit_ms` is the whole, from the call to the queue's submit.
@@ -341,17 +303,6 @@ impl Frame {
     }
 }
 
-/// The copies a frame recorded, waiting for its submission.
-#[derive(Default)]
-pub(super) struct FrameReadbacks {
-    /// Every render target, in `lighting::TARGETS` order; empty when not asked for.
-    pub targets: Vec<PendingReadback>,
-    /// The reported light's map, every layer.
-    pub shadow_map: Option<PendingReadback>,
-    /// With refinement by rays, a copy of the lights' counters (`rays::RefineLists`).
-    pub refine_counters: Option<wgpu::Buffer>,
-}
-
 /// A frame submitted to the GPU, its pass times read, its images waiting.
 pub(super) struct Submitted {
     readbacks: FrameReadbacks,
@@ -376,7 +327,7 @@ impl Submitted {
     /// Reads the pass times of a recorded frame and gathers what it reports.
     pub(super) fn new(
         plan: super::plan::FramePlan,
-        recorded: super::record::Recorded,
+        recorded: Recorded,
         timed: TimedLights,
         cpu: CpuTimings,
     ) -> Self {
@@ -518,7 +469,7 @@ impl TimedLights {
         plan: &super::plan::FramePlan,
         culled: &super::cull::Culled,
         cache_uses: &[Vec<super::map_cache::LayerCache>],
-        commands: &super::record::LayerCommands,
+        commands: &LayerCommands,
     ) -> Self {
         let lights = plan
             .lights

@@ -8,7 +8,7 @@ use gnomon_scene::{
     settings::{Lighting, RayUse, Refine, ScreenSpaceSettings, Technique},
 };
 
-use super::{Renderer, bindings::ReceiverUniforms, record::Recording};
+use super::{Renderer, bindings::ReceiverUniforms, recording::Recording};
 use crate::{
     GpuScene, RenderError,
     frame::DrawStats,

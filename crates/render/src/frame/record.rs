@@ -13,12 +13,13 @@ use gnomon_scene::{
 
 use super::{
     Renderer,
-    bindings::{CameraDraws, ShadowViews, camera_arguments, scene_group},
+    bindings::{CameraDraws, camera_arguments, scene_group},
     cull::Culled,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
-    outputs::{DrawStats, FrameReadbacks, Submitted, TimedLights},
+    outputs::{Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
+    recording::{DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, Recorded, Recording},
     screen::MaskStart,
 };
 use crate::{
@@ -66,71 +67,6 @@ pub(super) enum TimesWanted {
     Now,
     /// A frame or two later, without waiting ([`super::late::LateTimes`]).
     Late,
-}
-
-/// What every recording step appends to: the encoder (the renderer's own, or the
-/// host's), the pass clock and the counts.
-pub(super) struct Recording<'e> {
-    pub encoder: &'e mut wgpu::CommandEncoder,
-    pub clock: PassClock,
-    pub stats: DrawStats,
-    pub layer_commands: LayerCommands,
-}
-
-/// The draw commands recorded into each layer of each light, every pass of a layer
-/// together (its still casters, its strips, its moving casters).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct LayerCommands(Vec<Vec<u32>>);
-
-impl LayerCommands {
-    /// Counts `commands` more for layer `layer` of light `light`.
-    pub fn add(&mut self, light: usize, layer: usize, commands: u32) {
-        if self.0.len() <= light {
-            self.0.resize(light + 1, Vec::new());
-        }
-        let layers = &mut self.0[light];
-        if layers.len() <= layer {
-            layers.resize(layer + 1, 0);
-        }
-        layers[layer] += commands;
-    }
-
-    /// Light `light`'s count per layer, for its `layers` layers (0 for a layer that
-    /// recorded nothing).
-    pub fn of(&self, light: usize, layers: usize) -> Vec<u32> {
-        let recorded = self.0.get(light).map(Vec::as_slice).unwrap_or(&[]);
-        (0..layers).map(|l| recorded.get(l).copied().unwrap_or(0)).collect()
-    }
-}
-
-/// A light's groups for its passes from the camera.
-pub(super) struct LightBindings {
-    /// Group 0: the instances and the light's uniform.
-    pub scene: wgpu::BindGroup,
-    /// Its uniform, which the mask pass's groups bind too.
-    pub lighting: wgpu::BindGroup,
-    /// The mask pass's shadow group, on the mask path.
-    pub mask: Option<wgpu::BindGroup>,
-    pub lookup: MapLookup,
-}
-
-/// A light's uniform and the views of its maps, for the passes from the camera.
-pub(super) struct LightMaps {
-    pub light_buffer: wgpu::Buffer,
-    /// The depth map, every layer.
-    pub map: wgpu::TextureView,
-    /// The filterable techniques' moment map.
-    pub moments: Option<wgpu::TextureView>,
-    /// A point light's map as a cube.
-    pub cube: Option<wgpu::TextureView>,
-    pub lookup: MapLookup,
-}
-
-impl LightMaps {
-    /// The views of a shadow group, with the light's layer of the mask where it has one.
-    pub fn views<'a>(&'a self, mask: Option<&'a wgpu::TextureView>) -> ShadowViews<'a> {
-        ShadowViews { map: &self.map, moments: self.moments.as_ref(), cube: self.cube.as_ref(), mask }
-    }
 }
 
 impl Renderer {
@@ -426,16 +362,4 @@ pub(super) struct Drawn {
     pub color: wgpu::Texture,
     /// The reported light's shadow map.
     pub shadow_map: wgpu::Texture,
-}
-
-/// What recording left for the frame to read.
-pub(super) struct Recorded {
-    pub readbacks: FrameReadbacks,
-    /// Taken by the frame's timing once submitted.
-    pub times: Option<PendingTimes>,
-    pub stats: DrawStats,
-    pub layer_commands: LayerCommands,
-    pub color: wgpu::Texture,
-    pub shadow_map: wgpu::Texture,
-    pub submitted_at: Instant,
 }

@@ -7,7 +7,7 @@ use super::{
     Renderer,
     bindings::CameraDraws,
     plan::{FramePlan, LightPlan},
-    record::{LightBindings, Recording},
+    recording::{LightBindings, Recording},
 };
 use crate::{
     GpuScene,

@@ -15,7 +15,7 @@ use super::{
     depth_pass::{Casters, DepthArea, DepthPass, DepthStart, LayerCulling, ScissorRect},
     map_cache::{LayerKey, LayerPlan},
     plan::LightPlan,
-    record::Recording,
+    recording::Recording,
 };
 use crate::{
     GpuScene,
