@@ -11,27 +11,10 @@ use gnomon_reference::{
     metrics::{self, RasterView},
     reference_visibility,
 };
-use gnomon_scene::{
-    Camera, DirectionalLight, Falloff, Instance, Light, Material, Mesh, Scene, SpotLight, builtin, geometry,
-};
+use gnomon_scene::{Camera, DirectionalLight, Falloff, Light, Material, Mesh, Scene, SpotLight, geometry};
 
 fn scene_with(meshes: Vec<(Mesh, Mat4)>) -> Scene {
-    let mut scene = builtin::spheres();
-    scene.materials = vec![Material::new("m", Vec3::splat(0.7))];
-    scene.meshes = meshes.iter().map(|(m, _)| m.clone()).collect();
-    scene.instances = meshes
-        .iter()
-        .enumerate()
-        .map(|(i, (_, t))| Instance {
-            name: format!("{i}"),
-            mesh: i,
-            material: 0,
-            world_from_object: *t,
-            casts_shadow: true,
-            motion: gnomon_scene::Motion::Static,
-        })
-        .collect();
-    scene
+    common::scene_of(meshes, Material::new("m", Vec3::splat(0.7)))
 }
 
 fn camera(eye: Vec3, target: Vec3, fov: f32) -> Camera {

@@ -11,32 +11,17 @@ use glam::{Mat4, Vec3};
 use gnomon_reference::{ReferenceOptions, TracedScene, reference_visibility};
 use gnomon_render::{OutputRequest, Renderer};
 use gnomon_scene::{
-    Camera, Falloff, Instance, Light, Material, Mesh, PointLight, Scene, Settings, SpotLight, builtin,
-    geometry,
+    Camera, Falloff, Light, Material, Mesh, PointLight, Scene, Settings, SpotLight, geometry,
     settings::{LightKind, Refine, Technique},
 };
 
 /// `builtin::spheres` emptied and refilled with `meshes`, in one grey material
 /// without a highlight, and no ambient light: the image is the direct light alone.
 fn scene_of(meshes: Vec<(Mesh, Mat4)>) -> Scene {
-    let mut scene = builtin::spheres();
     let mut grey = Material::new("grey", Vec3::splat(ALBEDO));
     grey.specular = 0.0;
-    scene.materials = vec![grey];
+    let mut scene = common::scene_of(meshes, grey);
     scene.ambient = Vec3::ZERO;
-    scene.meshes = meshes.iter().map(|(m, _)| m.clone()).collect();
-    scene.instances = meshes
-        .iter()
-        .enumerate()
-        .map(|(i, (_, t))| Instance {
-            name: format!("{i}"),
-            mesh: i,
-            material: 0,
-            world_from_object: *t,
-            casts_shadow: true,
-            motion: gnomon_scene::Motion::Static,
-        })
-        .collect();
     scene
 }
 

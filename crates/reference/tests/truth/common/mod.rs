@@ -82,6 +82,27 @@ pub fn disk_visible(u: f32) -> f32 {
 /// Width of the bars: a third of a texel of the 512² map that covers the view.
 pub const BAR_WIDTH: f32 = 0.004;
 
+/// The built-in spheres' camera and lights over `meshes`, each placed by its matrix
+/// and made of `material`, casting shadows: the analytic scenes' stage.
+pub fn scene_of(meshes: Vec<(gnomon_scene::Mesh, Mat4)>, material: Material) -> Scene {
+    let mut scene = builtin::spheres();
+    scene.materials = vec![material];
+    scene.meshes = meshes.iter().map(|(m, _)| m.clone()).collect();
+    scene.instances = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, (_, t))| Instance {
+            name: format!("{i}"),
+            mesh: i,
+            material: 0,
+            world_from_object: *t,
+            casts_shadow: true,
+            motion: gnomon_scene::Motion::Static,
+        })
+        .collect();
+    scene
+}
+
 /// A ground under a grid of bars 4 mm wide and a metre up, turned 30° about the
 /// vertical so that no bar follows the map's texel rows; the camera looks down at
 /// their shadows.
