@@ -1,32 +1,60 @@
 //! A technique defined only here, registered in one line, renders and is checked like
-//! a built-in one: its WGSL composes into the lighting pass, its stated facts decide
-//! which lights and maps it takes, and every message about it is generated from them.
+//! a built-in one: its WGSL composes into the lighting pass, its typed parameters reach
+//! its WGSL, its stated facts decide which lights and maps it takes, and every message
+//! about it is generated from them.
 
 use crate::support;
 
-use glam::Vec2;
+use glam::{UVec4, Vec2};
 use gnomon_render::{
     OutputRequest, RenderError, Renderer,
-    techniques::{MapSupport, ShadowTechnique, TechniqueRegistry, Tunables},
+    techniques::{
+        GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, TechniqueRegistry, Tunables,
+    },
 };
 use gnomon_scene::settings::{FilterSettings, LightKind, Settings, Technique, WarpKind};
 use support::*;
 
-/// `pcf-cross`: the mean of five hardware 2×2 comparison taps, at the lookup and one
-/// texel away along each axis, a footprint no built-in technique has.
-struct PcfCross;
+/// `pcf-cross`: the mean of five hardware 2×2 comparison taps, at the lookup and
+/// `reach` texels away along each axis, a footprint no built-in technique has.
+struct PcfCross {
+    name: Technique,
+    reach: f32,
+}
+
+/// Its parameters, typed: `CrossParams` in pcf_cross.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct CrossParams {
+    reach: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    _pad3: UVec4,
+}
+
+impl GpuParams for CrossParams {
+    const WGSL_NAME: &'static str = "CrossParams";
+}
 
 const CROSS: Technique = Technique::named("pcf-cross");
+/// The taps one texel out.
+static PCF_CROSS: PcfCross = PcfCross { name: CROSS, reach: 1.0 };
+/// The same lookup with its taps three texels out: only its parameters differ.
+static PCF_CROSS_WIDE: PcfCross = PcfCross { name: Technique::named("pcf-cross-wide"), reach: 3.0 };
 
 impl ShadowTechnique for PcfCross {
     fn technique(&self) -> Technique {
-        CROSS
+        self.name.clone()
     }
     fn summary(&self) -> &'static str {
         "Five bilinear comparison taps in a cross (a test's technique)."
     }
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("pcf_cross.wgsl")]
+    }
+    fn params(&self, _: &FilterSettings, _: MapPrecision) -> TechniqueParams {
+        TechniqueParams::new(CrossParams { reach: self.reach, ..Default::default() })
     }
     /// It only compares depths, so it reads any map; it has no cube lookup.
     fn maps(&self) -> MapSupport {
@@ -37,9 +65,9 @@ impl ShadowTechnique for PcfCross {
         Tunables::BIAS
     }
 
-    /// One texel each way.
+    /// `reach` texels each way.
     fn filter_reach_texels(&self, _: &FilterSettings, _: f32) -> f32 {
-        1.0
+        self.reach
     }
 }
 
@@ -52,7 +80,7 @@ fn with(technique: Technique, light: LightKind) -> Settings {
 
 #[test]
 fn a_technique_registered_in_one_line_renders_its_own_lookup() {
-    let registry = TechniqueRegistry::builtin().with(&PcfCross).unwrap();
+    let registry = TechniqueRegistry::builtin().with(&PCF_CROSS).unwrap();
     let mut renderer = Renderer::with_techniques(gpu(), registry).unwrap();
     let SquareOccluder { scene, shadow_center, shadow_half, .. } = square_under_sun();
 
@@ -93,9 +121,35 @@ fn a_technique_registered_in_one_line_renders_its_own_lookup() {
     );
 }
 
+/// A host's typed parameters reach its WGSL: the same lookup with its taps three
+/// texels out instead of one spreads the square's edge over a band about twice as
+/// wide ((2 × reach + 1) texels: 7 against 3).
+#[test]
+fn a_registered_technique_reads_its_own_typed_parameters() {
+    let registry = TechniqueRegistry::builtin().with(&PCF_CROSS).unwrap().with(&PCF_CROSS_WIDE).unwrap();
+    let mut renderer = Renderer::with_techniques(gpu(), registry).unwrap();
+    let scene = square_under_sun().scene;
+    let mut band = |technique: Technique| {
+        let frame =
+            renderer.render(&scene, &with(technique, LightKind::Sun), &OutputRequest::default()).unwrap();
+        (0..frame.pixel_count())
+            .filter(|&i| frame.object_id[i] == 1 && (0.02..0.98).contains(&frame.visibility[i]))
+            .count()
+    };
+    let (narrow, wide) = (band(CROSS), band(PCF_CROSS_WIDE.technique()));
+    assert!(narrow > 50, "{narrow} pixels in pcf-cross's band");
+    let ratio = wide as f64 / narrow as f64;
+    assert!(ratio > 1.6, "reach 3 spreads {wide} pixels against reach 1's {narrow}: ×{ratio:.2}");
+    support::figures::figure(
+        "custom technique: edge band, reach 3 over reach 1",
+        format!("×{ratio:.2}"),
+        "> 1.6",
+    );
+}
+
 #[test]
 fn a_registered_technique_is_checked_from_the_facts_it_states() {
-    let registry = TechniqueRegistry::builtin().with(&PcfCross).unwrap();
+    let registry = TechniqueRegistry::builtin().with(&PCF_CROSS).unwrap();
     let mut renderer = Renderer::with_techniques(gpu(), registry).unwrap();
     let scene = gnomon_scene::builtin::spheres();
 
