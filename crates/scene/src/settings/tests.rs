@@ -451,3 +451,39 @@ fn shadow_overrides_are_typed_and_lay_only_what_they_name() {
     };
     assert_eq!(base.with_overrides(&bad).unwrap_err().setting, "shadow.map.resolution");
 }
+
+/// Every setting an error can name is written as a string in the checks; a string that
+/// named no setting (a typo, a renamed field) would reach the user as a path nothing
+/// answers to, and `in_flags` could not turn it into a flag. Each must be a group of
+/// [`Settings`] and a field that is a flag's id.
+#[test]
+fn every_setting_path_the_checks_name_is_a_setting() {
+    let sources = [
+        include_str!("mod.rs"),
+        include_str!("filter.rs"),
+        include_str!("light.rs"),
+        include_str!("screen.rs"),
+        include_str!("shadow.rs"),
+        include_str!("unused.rs"),
+    ];
+    let ids: Vec<String> = Cli::command().get_arguments().map(|a| a.get_id().to_string()).collect();
+    let groups = toml::Table::try_from(Settings::default()).unwrap();
+    let mut named = 0;
+    for source in sources {
+        for quoted in source.split('"').skip(1).step_by(2) {
+            let Some((group, _)) = quoted.split_once('.') else { continue };
+            let is_path = quoted.chars().all(|c| c.is_ascii_lowercase() || c == '_' || c == '.');
+            if !is_path || !groups.contains_key(group) {
+                continue;
+            }
+            let field = quoted.rsplit('.').next().unwrap();
+            assert!(
+                ids.iter().any(|id| id == field),
+                "`{quoted}` names no setting: `{field}` is no flag's id"
+            );
+            assert!(in_flags(&format!("`{quoted}`")).starts_with("--"), "`{quoted}` has no flag");
+            named += 1;
+        }
+    }
+    assert!(named > 40, "only {named} setting paths found in the checks");
+}
