@@ -1,0 +1,59 @@
+#!/usr/bin/env sh
+# Renders the same settings with two `gnomon` binaries and compares the PNGs pixel
+# by pixel: the check behind "no behaviour change" for a refactor. Usage:
+#   sh scripts/same-images.sh OLD_GNOMON NEW_GNOMON [WORKDIR]
+# (build the old one from a worktree: `git worktree add /tmp/old REV` and
+# `CARGO_TARGET_DIR=$PWD/target cargo build -p gnomon` there, then copy
+# target/debug/gnomon aside before building the new one). Needs python3 with
+# numpy and Pillow. Exits 1 if any image differs or fails to render.
+set -eu
+old=$1
+new=$2
+dir=${3:-$(mktemp -d)}
+mkdir -p "$dir"
+i=0
+status=0
+while IFS= read -r args; do
+  [ -z "$args" ] && continue
+  i=$((i + 1))
+  # shellcheck disable=SC2086
+  "$old" render $args --width 320 --height 240 --out "$dir/old_$i.png" >/dev/null 2>"$dir/old_$i.err" || { echo "$i: the old binary failed: $args"; status=1; }
+  # shellcheck disable=SC2086
+  "$new" render $args --width 320 --height 240 --out "$dir/new_$i.png" >/dev/null 2>"$dir/new_$i.err" || { echo "$i: the new binary failed: $args"; status=1; }
+  echo "$i: $args" >>"$dir/list.txt"
+done <<'LIST'
+spheres
+spheres --technique vsm
+spheres --technique evsm4
+spheres --technique msm-hausdorff
+spheres --technique esm
+spheres --technique convolution
+spheres --technique msm-hamburger --moment-format rgba16float
+spheres --light spot --technique pcss --spot-radius 0.3
+spheres --light point --technique pcf-poisson
+spheres --light point --omni paraboloid --technique hard
+spheres --light spot --technique pcf --pcf-kernel 5 --shadow-path mask --contact-shadows
+lamps --light all --shadow-path mask
+columns --partition cascades --cascades 4 --sdsm
+spheres --light spot --spot-radius 0.2 --refine rays --shadow-path mask
+spheres --technique raytraced
+spheres --partition cascades --cascades 3 --receiver-plane-bias true --technique pcf-tent
+LIST
+python3 - "$dir" "$i" <<'PY' || status=1
+import sys
+import numpy as np
+from PIL import Image
+folder, count = sys.argv[1], int(sys.argv[2])
+names = open(f"{folder}/list.txt").read().splitlines()
+differ = 0
+for k in range(1, count + 1):
+    a = np.asarray(Image.open(f"{folder}/old_{k}.png")).astype(int)
+    b = np.asarray(Image.open(f"{folder}/new_{k}.png")).astype(int)
+    d = np.abs(a - b).max(axis=-1)
+    n = int(np.count_nonzero(d))
+    differ += n > 0
+    print(f"{names[k - 1]}: {'identical' if n == 0 else f'{n} pixels differ, by up to {d.max()}'}")
+print(f"{count - differ} of {count} images identical")
+sys.exit(1 if differ else 0)
+PY
+exit $status
