@@ -20,6 +20,7 @@ mod frame;
 mod gpu_scene;
 mod gpu_types;
 mod layout;
+mod light_map;
 mod passes;
 mod pool;
 pub mod rays;

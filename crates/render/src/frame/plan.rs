@@ -6,7 +6,7 @@ use glam::Vec3;
 use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
-    settings::{BiasSettings, CascadeSelection, LightKind, Lighting, OmniMap, Partition, RayUse, Refine},
+    settings::{BiasSettings, CascadeSelection, LightKind, Lighting, Partition, RayUse, Refine},
 };
 
 use super::Renderer;
@@ -62,20 +62,16 @@ pub(super) struct LightPlan {
 impl LightPlan {
     /// What its shadow pass stores.
     pub fn depth_target(&self) -> DepthTarget {
-        match (self.light, self.settings.shadow.map.omni) {
-            (Light::Point(_), OmniMap::Cube) => DepthTarget::CubeFace,
-            (Light::Point(_), OmniMap::Paraboloid) => DepthTarget::Paraboloid,
-            (Light::Directional(_) | Light::Spot(_), _) => DepthTarget::Projected,
+        match self.lookup() {
+            MapLookup::Cube => DepthTarget::CubeFace,
+            MapLookup::Paraboloid => DepthTarget::Paraboloid,
+            MapLookup::Map => DepthTarget::Projected,
         }
     }
 
     /// How the lighting pass looks its map up.
     pub fn lookup(&self) -> MapLookup {
-        match self.depth_target() {
-            DepthTarget::CubeFace => MapLookup::Cube,
-            DepthTarget::Paraboloid => MapLookup::Paraboloid,
-            DepthTarget::Projected => MapLookup::Map,
-        }
+        MapLookup::of(&self.light, self.settings.shadow.map.omni)
     }
 
     /// Layers of its map.

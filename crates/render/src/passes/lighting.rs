@@ -91,16 +91,7 @@ pub(crate) fn visibility_wgsl(technique: TechniqueRef, lookup: Lookup) -> Vec<St
     parts
 }
 
-/// How a receiver is found in its light's own map.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(crate) enum MapLookup {
-    /// Projected into 2D layers: a sun's map or cascades, a spot's map.
-    Map,
-    /// By direction in a point light's cube.
-    Cube,
-    /// Through a point light's dual paraboloids, into two 2D layers.
-    Paraboloid,
-}
+pub(crate) use crate::light_map::MapLookup;
 
 /// `pixel_visibility` of a technique and map lookup, without the declarations of the
 /// shadow resources it reads (those of `SHADOW_BINDINGS_WGSL`, in whichever group

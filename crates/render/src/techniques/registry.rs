@@ -8,10 +8,11 @@ use std::hash::{Hash, Hasher};
 
 use gnomon_scene::{
     Light, Scene, Settings,
-    settings::{OmniMap, ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
+    settings::{ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
 };
 
 use super::{BUILTIN, ShadowTechnique};
+use crate::light_map::MapLookup;
 
 /// A registered technique: a cheap handle that compares and hashes by name (names
 /// are unique within a registry), for the pipeline caches' keys.
@@ -154,17 +155,14 @@ impl TechniqueRegistry {
             value: technique.technique().to_string(),
             valid: format!("for point light `{name}` {map}: {}", self.names(fits)),
         };
-        match (light, shadow.map.omni) {
-            (Light::Point(_), OmniMap::Cube) if technique.cube_wgsl().is_none() => {
+        match MapLookup::of(light, shadow.map.omni) {
+            MapLookup::Cube if technique.cube_wgsl().is_none() => {
                 Err(refuse("(a cube map)", &|t| t.cube_wgsl().is_some()))
             }
-            (Light::Point(_), OmniMap::Paraboloid) if !technique.maps().paraboloid => {
+            MapLookup::Paraboloid if !technique.maps().paraboloid => {
                 Err(refuse("with `shadow.map.omni` paraboloid", &|t| t.maps().paraboloid))
             }
-            (
-                Light::Point(_) | Light::Spot(_) | Light::Directional(_),
-                OmniMap::Cube | OmniMap::Paraboloid,
-            ) => Ok(technique),
+            MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid => Ok(technique),
         }
     }
 
@@ -198,7 +196,10 @@ impl TechniqueRegistry {
 
 #[cfg(test)]
 mod tests {
-    use gnomon_scene::{PointLight, settings::FilterSettings};
+    use gnomon_scene::{
+        PointLight,
+        settings::{FilterSettings, OmniMap},
+    };
 
     use super::*;
     use crate::techniques::MapSupport;

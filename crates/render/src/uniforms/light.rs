@@ -12,12 +12,13 @@ use glam::{Mat4, Vec3};
 use gnomon_math::ProjectionKind;
 use gnomon_scene::{
     Light, Scene, Settings,
-    settings::{CascadeSelection, KernelUnit, OmniMap},
+    settings::{CascadeSelection, KernelUnit},
 };
 
 use super::{CascadeGpu, FalloffGpu, LightKindGpu, MAX_CASCADES};
 use crate::{
     layout::ShadowLayout,
+    light_map::MapLookup,
     techniques::{self, ParamsBlockGpu, TechniqueParams},
 };
 
@@ -342,7 +343,7 @@ impl LightGpu {
             };
         }
         uniform.set_layers(layout, resolution);
-        if let (Light::Point(_), OmniMap::Paraboloid) = (light, shadow.map.omni) {
+        if MapLookup::of(light, shadow.map.omni) == MapLookup::Paraboloid {
             uniform.set_paraboloids(layout, resolution);
         }
         uniform
