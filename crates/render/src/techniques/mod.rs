@@ -8,10 +8,10 @@
 //! A technique's WGSL defines `fn sample_shadow(q: ShadowQuery) -> f32` (the lookup,
 //! see `common.wgsl`), returning the lit fraction in [0, 1]. It may read the shadow
 //! bindings of `bindings.wgsl`, the `light` uniform, whose `technique` block carries
-//! the typed values of [`ShadowTechnique::params`] (see [`params`]), and the helpers
-//! of `common.wgsl`. A filterable
-//! technique also defines `fn encode_moments(d: f32, layer: u32) -> vec4<f32>`,
-//! which the moment pass applies to every texel's linear depth d ∈ [0, 1].
+//! the typed values of [`ShadowTechnique::params`] ([`TechniqueParams`]), and the
+//! helpers of `common.wgsl`. A filterable technique also defines
+//! `fn encode_moments(d: f32, layer: u32) -> vec4<f32>`, which the moment pass
+//! applies to every texel's linear depth d ∈ [0, 1].
 
 pub(crate) mod convolution;
 pub(crate) mod esm;
@@ -174,8 +174,8 @@ pub trait ShadowTechnique: Sync {
     }
 }
 
-/// A technique's WGSL (its cube lookup's when `cube`), after the generated line that
-/// types `light.technique` as its parameter struct.
+/// A technique's WGSL `sources` (its lookup's, or its cube lookup's), after the
+/// generated line that types `light.technique` as its parameter struct.
 pub(crate) fn technique_wgsl(technique: &dyn ShadowTechnique, sources: &[&str]) -> Vec<String> {
     let mut parts = vec![technique.params_struct().wgsl_alias()];
     parts.extend(sources.iter().map(|s| (*s).to_owned()));
