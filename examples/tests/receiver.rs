@@ -3,6 +3,8 @@
 //! sees the shadows Gnomon's own lighting pass draws, for every technique and every
 //! light kind (a sun, a spot, a point light through a cube or dual paraboloids).
 
+#[path = "../../crates/render/tests/gpu/support/device.rs"]
+mod device;
 #[path = "../../crates/render/tests/gpu/support/figures.rs"]
 #[allow(dead_code)]
 mod figures;
@@ -14,11 +16,7 @@ use gnomon_scene::{
     settings::{LightKind, OmniMap, RayUse, Refine, ShadowPath, Technique},
 };
 
-/// The device shared by this binary's tests.
-fn gpu() -> &'static Gpu {
-    static GPU: std::sync::OnceLock<Gpu> = std::sync::OnceLock::new();
-    GPU.get_or_init(|| Gpu::new_headless().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)"))
-}
+use device::gpu;
 
 // Wide enough that the sky shows beside the ground: background pixels are compared too.
 const WIDTH: u32 = 224;

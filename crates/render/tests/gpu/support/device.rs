@@ -1,6 +1,6 @@
 //! The device every GPU test of a binary shares, and a render with default outputs:
 //! used by the render crate's `gpu` tests and, through a `#[path]`, the reference
-//! crate's `truth` tests, so that there is one copy.
+//! crate's `truth` tests and the examples' receiver test, so that there is one copy.
 #![allow(dead_code)]
 
 use std::sync::OnceLock;
