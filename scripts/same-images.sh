@@ -2,15 +2,24 @@
 # Renders the same settings with two `gnomon` binaries and compares the PNGs pixel
 # by pixel: the check behind "no behaviour change" for a refactor. Usage:
 #   sh scripts/same-images.sh OLD_GNOMON NEW_GNOMON [WORKDIR]
-# (build the old one from a worktree: `git worktree add /tmp/old REV` and
-# `CARGO_TARGET_DIR=$PWD/target cargo build -p gnomon` there, then copy
-# target/debug/gnomon aside before building the new one). Needs python3 with
-# numpy and Pillow. Exits 1 if any image differs or fails to render.
+# Build the old one from a worktree (`git worktree add /tmp/old REV`). Sharing this
+# checkout's target directory saves the dependencies' build, but cargo keys a
+# workspace member's artifacts by its path inside the workspace and trusts them
+# while its files look older than the last build: touch every source of the
+# checkout being built first (`find crates examples -type f -exec touch {} +`),
+# then `CARGO_TARGET_DIR=/path/to/target cargo build -p gnomon`, and copy the
+# binary aside before building the other. Check that the two binaries differ
+# (`cmp`). Needs python3 with numpy and Pillow. Exits 1 if any image differs or
+# fails to render.
 set -eu
 old=$1
 new=$2
 dir=${3:-$(mktemp -d)}
 mkdir -p "$dir"
+if cmp -s "$old" "$new"; then
+  echo "$old and $new are the same binary: nothing would be compared"
+  exit 1
+fi
 i=0
 status=0
 while IFS= read -r args; do
