@@ -49,6 +49,10 @@ columns --refine off --partition cascades --cascades 4 --sdsm
 spheres --light spot --spot-radius 0.2 --refine rays --shadow-path mask
 spheres --technique raytraced
 spheres --refine off --partition cascades --cascades 3 --receiver-plane-bias true --technique pcf-tent
+spheres --refine off --technique pcss --sun-angular-diameter 3
+spheres --sun-angular-diameter 2 --refine rays --shadow-path mask
+spheres --light point --point-radius 0.2 --refine rays --shadow-path mask
+spheres --light point --point-radius 0.2 --refine rays --contact-shadows
 LIST
 python3 - "$dir" "$i" <<'PY' || status=1
 import sys

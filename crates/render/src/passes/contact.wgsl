@@ -24,11 +24,8 @@ fn contact_visibility(world: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, pi
     if distance_fade <= 0.0 {
         return 1.0;
     }
-    var ray_length = light.contact.length;
-    if light.emitter.kind != LIGHT_SUN {
-        // Never past a spot or point light.
-        ray_length = min(ray_length, distance(light.emitter.position, world));
-    }
+    // Never past a spot or point light.
+    let ray_length = min(light.contact.length, emitter_ray_length(light.emitter, world));
     let start_world = world + geometric_n * light.contact.bias;
     let start = (camera.view_from_world * vec4<f32>(start_world, 1.0)).xyz;
     var end = (camera.view_from_world * vec4<f32>(start_world + l * ray_length, 1.0)).xyz;

@@ -290,3 +290,45 @@ fn a_moved_field_fails_the_layout_check() {
     let module = parse("shadow", &shadow::shadow_wgsl());
     check_layout("shadow", &module, &layout);
 }
+
+/// Every WGSL file of the crate beside `dir`'s, recursively, as (path, source).
+fn wgsl_files(dir: &std::path::Path) -> Vec<(std::path::PathBuf, String)> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("the crate's sources") {
+        let path = entry.expect("a directory entry").path();
+        if path.is_dir() {
+            files.extend(wgsl_files(&path));
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            let source = std::fs::read_to_string(&path).expect("a WGSL file");
+            files.push((path, source));
+        }
+    }
+    files
+}
+
+/// A light kind's WGSL lives in one module: `light_kinds.wgsl` names every kind, and
+/// no other shader reads an emitter's kind, so a new kind is one more branch there
+/// and nothing elsewhere can silently treat it as another.
+#[test]
+fn only_light_kinds_wgsl_reads_a_lights_kind() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let files = wgsl_files(&root);
+    assert!(files.len() > 40, "found only {} WGSL files under {}", files.len(), root.display());
+    let home = root.join("passes/light_kinds.wgsl");
+    for (path, source) in &files {
+        let code: String =
+            source.lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n");
+        if *path == home {
+            for kind in LightKindGpu::ALL {
+                assert!(code.contains(kind.wgsl_name()), "light_kinds.wgsl never names {}", kind.wgsl_name());
+            }
+            continue;
+        }
+        for kind in LightKindGpu::ALL {
+            assert!(!code.contains(kind.wgsl_name()), "{} names {}", path.display(), kind.wgsl_name());
+        }
+        for reader in ["emitter.kind", "e.kind"] {
+            assert!(!code.contains(reader), "{} reads {reader}", path.display());
+        }
+    }
+}

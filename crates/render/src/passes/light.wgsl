@@ -14,7 +14,7 @@ struct NoParams {
 // light-list pass's array (`EmitterGpu` in uniforms/light.rs).
 struct Emitter {
     radiance: vec3<f32>,   // colour × intensity
-    kind: u32,             // LIGHT_SUN, LIGHT_SPOT or LIGHT_POINT
+    kind: u32,             // read only by light_kinds.wgsl
     direction: vec3<f32>,  // the sun's travel direction or the spot's axis
     range: f32,            // spot or point light range
     position: vec3<f32>,   // spot or point light position
@@ -134,15 +134,9 @@ fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
 }
 
 // Distance along the light's axis (light view −z) of a point whose shadow-map depth
-// is `depth`. Orthographic maps store it linearly between the near and far planes;
-// perspective ones store the D3D-style f(z − n) / (z (f − n)).
+// is `depth` (how each kind's map stores it: `emitter_distance_from_depth`).
 fn light_distance_from_depth(depth: f32) -> f32 {
-    let n = light.map.near;
-    let f = light.map.far;
-    if light.emitter.kind == LIGHT_SUN {
-        return n + depth * (f - n);
-    }
-    return n * f / (f - depth * (f - n));
+    return emitter_distance_from_depth(light.emitter, light.map.near, light.map.far, depth);
 }
 
 // The depth that moment maps store: light distance, linear in [0, 1] from the near

@@ -108,8 +108,16 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
 /// The vertex stage of the passes that cover their whole target.
 pub(crate) const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
 
-/// The light uniform's struct and depth conventions, shared by every pass.
-pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
+/// The light uniform's struct and depth conventions, shared by every pass, with what
+/// every light kind does differently (`light_kinds.wgsl`, the only WGSL that reads an
+/// emitter's kind) and the shapes it samples lights over (`light_shapes.wgsl`).
+pub(crate) const LIGHT_WGSL: &str = concat!(
+    include_str!("light.wgsl"),
+    "\n",
+    include_str!("light_kinds.wgsl"),
+    "\n",
+    include_str!("light_shapes.wgsl")
+);
 
 /// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");

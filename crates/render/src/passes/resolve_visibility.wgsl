@@ -24,7 +24,7 @@ fn resolved_pixel_visibility(
     // a normal turned by the winding, which authored normals can contradict.
     let seen_n = facing_side(n, geometric_n);
     var shadow = lookup_visibility(world, seen_n, l, world_dx, world_dy, pixel, view_depth);
-    if light.emitter.kind != LIGHT_SUN && cone <= 0.0 {
+    if emitter_unlit(light.emitter, cone) {
         // Outside a spot's cone or a light's range no light arrives: visibility 0 by
         // definition.
         shadow.x = 0.0;

@@ -1,10 +1,7 @@
-// Points on a light with an area, for the trace pass's penumbra rays: the CPU
-// reference's stratified patterns (gnomon_reference::sampling, seeded per pixel) and
-// its maps from the unit square to the light (visibility.rs's `Emitter::sample`), so
-// the GPU estimates the very integral the reference does.
-
-const TAU: f32 = 6.283185307179586;
-const FRAC_PI_4: f32 = 0.7853981633974483;
+// The stratified patterns of the trace pass's penumbra rays: the CPU reference's
+// (gnomon_reference::sampling, seeded per pixel), so that with the same maps from the
+// unit square to the light (`emitter_sample`, passes/light_kinds.wgsl) the GPU
+// estimates the very integral the reference does.
 
 // A 32-bit integer hash ("lowbias32"), seeding a pixel's pattern.
 fn lowbias32(value: u32) -> u32 {
@@ -102,76 +99,4 @@ fn cmj(s: u32, count: u32, grid: vec2<u32>, pattern: u32) -> vec2<f32> {
         (f32(sy) + (f32(px) + jy) / f32(m)) / f32(n),
     );
     return min(u, vec2<f32>(1.0 - 1.1920929e-7));
-}
-
-// The unit square to the unit disk, keeping strata compact (Shirley & Chiu, "A Low
-// Distortion Map Between Disk and Square", JGT 1997).
-fn concentric_disk(u: vec2<f32>) -> vec2<f32> {
-    let a = 2.0 * u - vec2<f32>(1.0);
-    if a.x == 0.0 && a.y == 0.0 {
-        return vec2<f32>(0.0);
-    }
-    var r: f32;
-    var theta: f32;
-    if abs(a.x) > abs(a.y) {
-        r = a.x;
-        theta = FRAC_PI_4 * (a.y / a.x);
-    } else {
-        r = a.y;
-        theta = 2.0 * FRAC_PI_4 - FRAC_PI_4 * (a.x / a.y);
-    }
-    return r * vec2<f32>(cos(theta), sin(theta));
-}
-
-// The unit square to directions within `half_angle` of `axis`, uniform in solid
-// angle: cos θ = 1 − u (1 − cos θ_max), φ = 2π v.
-fn cone_direction(u: vec2<f32>, axis: vec3<f32>, half_angle: f32) -> vec3<f32> {
-    let cos_theta = 1.0 - u.x * (1.0 - cos(half_angle));
-    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
-    let phi = TAU * u.y;
-    let basis = orthonormal_pair(axis);
-    return normalize(axis * cos_theta + (basis[0] * cos(phi) + basis[1] * sin(phi)) * sin_theta);
-}
-
-// The weight of a penumbra ray of length `len` in the light's visibility, relative to
-// its other rays: under an inverse-square falloff, each point of a spot's disk is a
-// point light of that falloff, so nearer points count for more (the reference's
-// `Emitter::weight`). A sphere's rays are uniform in the solid angle it subtends,
-// which already makes its light fall off as the inverse square of the distance, so
-// they count alike, as do every ray of a constant light's and a sun's.
-fn light_sample_weight(len: f32) -> f32 {
-    if light.emitter.kind != LIGHT_SPOT {
-        return 1.0;
-    }
-    return distance_falloff(light.emitter.falloff, light.emitter.falloff_window, len);
-}
-
-// A shadow ray from `p` toward the point `u` of the light's area: its direction, and
-// its length (past every caster for a sun). `light.emitter.size` is the tangent of the
-// sun's angular radius, or the spot's disk or point's sphere radius.
-fn light_sample(p: vec3<f32>, u: vec2<f32>) -> vec4<f32> {
-    if light.emitter.kind == LIGHT_SUN {
-        return vec4<f32>(cone_direction(u, -light.emitter.direction, atan(light.emitter.size)), 3.0e38);
-    }
-    if light.emitter.kind == LIGHT_SPOT {
-        // A disk facing along the spot's axis.
-        let basis = orthonormal_pair(light.emitter.direction);
-        let q = concentric_disk(u) * light.emitter.size;
-        let to = light.emitter.position + basis[0] * q.x + basis[1] * q.y - p;
-        let len = length(to);
-        return vec4<f32>(to / len, len);
-    }
-    // A sphere of uniform radiance: uniform over the cone it subtends, which is
-    // uniform over its visible area; the ray ends where it enters the sphere.
-    let to = light.emitter.position - p;
-    let dist = length(to);
-    let axis = to / dist;
-    let radius = light.emitter.size;
-    if radius >= dist {
-        return vec4<f32>(axis, dist);
-    }
-    let d = cone_direction(u, axis, asin(radius / dist));
-    let along = dot(d, to);
-    let entry = along - sqrt(max(radius * radius - (dist * dist - along * along), 0.0));
-    return vec4<f32>(d, max(entry, 0.0));
 }

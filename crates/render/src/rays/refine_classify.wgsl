@@ -31,7 +31,7 @@ fn classified_ray_decides(
     // Outside the light's cone or range, or facing away from it: dark by
     // definition, which the map's answer already says.
     let facing = dot(geometric_n, l);
-    if facing <= -facing_error || (light.emitter.kind != LIGHT_SUN && cone <= 0.0) {
+    if facing <= -facing_error || emitter_unlit(light.emitter, cone) {
         return false;
     }
     return REFINE_EVERY_PIXEL || facing < facing_error || (shadow.x > 0.0 && shadow.x < 1.0)

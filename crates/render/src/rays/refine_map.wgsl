@@ -90,15 +90,6 @@ fn projected_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, 
 // Taps a side of `area_unsure`'s grid over the light's footprint.
 const AREA_SEARCH_TAPS: i32 = 6;
 
-// The radius, in world units, of the cone from a receiver at light distance
-// `receiver` to the light's area, at light distance `at`: light.emitter.size × (d − at)
-// for a sun (the tangent of its angular radius), light.emitter.size × (d − at) / d for
-// a spot's disk or a point's sphere (similar triangles from the light's centre).
-fn light_cone_radius(receiver: f32, at: f32) -> f32 {
-    let reach = light.emitter.size * max(receiver - at, 0.0);
-    return select(reach / receiver, reach, light.emitter.kind == LIGHT_SUN);
-}
-
 // Under a light with an area: whether the map shows, for the receiver at texel
 // position `p` (its plane: depth `receiver` + `gradient` per texel, at light
 // distance `distance`), both a caster inside the cone from the receiver to the light
@@ -113,7 +104,7 @@ fn light_cone_radius(receiver: f32, at: f32) -> f32 {
 // technique's answer: most likely the umbra.
 fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, layer: u32, distance: f32) -> bool {
     let near = light.map.near;
-    let radius = clamp(light_cone_radius(distance, near) / texel_world_size_at(layer, near), 1.0, light.pcss.max_penumbra_texels);
+    let radius = clamp(emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near), 1.0, light.pcss.max_penumbra_texels);
     let last = vec2<i32>(i32(light.map.resolution) - 1);
     let spacing = max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
     var casters = false;
@@ -131,7 +122,7 @@ fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, la
             // A caster seen at this tap may reach as far as the next tap toward the
             // receiver: the tap grid's spacing is the slack of the test.
             let at = light_distance_from_depth(stored);
-            if (length(offset) - spacing) * texel_world_size_at(layer, at) <= light_cone_radius(distance, at) {
+            if (length(offset) - spacing) * texel_world_size_at(layer, at) <= emitter_cone_radius(light.emitter, distance, at) {
                 casters = true;
             }
         }

@@ -44,10 +44,8 @@ fn penumbra_width_px(blocker: f32, world: vec3<f32>, geometric_n: vec3<f32>, vie
     if blocker < 0.0 {
         return UNBLOCKED_WIDTH_PX;
     }
-    var width = 2.0 * light.emitter.size * blocker;
-    if light.emitter.kind != LIGHT_SUN {
-        width /= max(length(light.emitter.position - world) - blocker, 1e-6);
-    }
+    let light_to_blocker = max(length(light.emitter.position - world) - blocker, 1e-6);
+    var width = 2.0 * emitter_penumbra_radius(light.emitter, blocker, light_to_blocker);
     // On screen the receiver's plane is foreshortened by |n·v| across its steepest
     // direction: the penumbra is at least that narrow there.
     width *= abs(dot(geometric_n, normalize(camera.eye - world)));

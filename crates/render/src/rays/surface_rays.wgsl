@@ -27,16 +27,12 @@ fn surface_ray_origin(world: vec3<f32>, geometric_n: vec3<f32>, view_depth: f32)
 // caster. A sun's ray runs past every caster (t_max beyond the BVH's bounds is
 // harmless); a local light's stops at the light.
 fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool {
-    var t_max = 3.0e38;
-    if light.emitter.kind != LIGHT_SUN {
-        t_max = length(light.emitter.position - world);
-    }
-    return ray_blocked(origin, l, t_max);
+    return ray_blocked(origin, l, emitter_ray_length(light.emitter, world));
 }
 
 // The share of `light.rays.penumbra_rays` rays from `origin` to points stratified over the
 // light's area that arrive, each weighted by its point's falloff
-// (`light_sample_weight`), and the mean distance to the caster that each blocked
+// (`emitter_sample_weight`), and the mean distance to the caster that each blocked
 // ray met (-1 when none was blocked). `pixel` seeds the pixel's own pattern, so
 // neighbours' errors are independent and the filter pass averages them down. A
 // sample below the surface's horizon is blocked by the surface itself, as in the
@@ -50,8 +46,8 @@ fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, 
     var blocked = 0u;
     var blocker_distance = 0.0;
     for (var s = 0u; s < count; s++) {
-        let ray = light_sample(world, cmj(s, count, grid, pattern));
-        let weight = light_sample_weight(ray.w);
+        let ray = emitter_sample(light.emitter, world, cmj(s, count, grid, pattern));
+        let weight = emitter_sample_weight(light.emitter, ray.w);
         total += weight;
         if dot(ray.xyz, geometric_n) <= 0.0 {
             continue;

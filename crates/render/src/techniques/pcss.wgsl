@@ -7,6 +7,8 @@
 // 2. Penumbra estimate from similar triangles: w = (d_receiver − d_blocker) ·
 //    w_light / d_blocker for a spot (distances from the light), or
 //    (d_receiver − d_blocker) · tan(angular radius) for a sun.
+//    Both are each kind's similar triangles: `emitter_cone_radius` and
+//    `emitter_penumbra_radius` (passes/light_kinds.wgsl).
 // 3. PCF over a Poisson disk of that radius.
 // Both the search region and the penumbra are converted to texels with the map's
 // projection: perspective texels grow with distance, orthographic ones do not.
@@ -18,21 +20,14 @@ fn world_to_texels(layer: u32, world: f32, at: f32) -> f32 {
 }
 
 fn sample_shadow(q: ShadowQuery) -> f32 {
-    let size = light.emitter.size;
     let max_radius = light.pcss.max_penumbra_texels;
     let d_receiver = q.distance;
     let near = light.map.near;
-    let is_spot = light.emitter.kind != LIGHT_SUN;
 
     // 1. The search region: the cross-section at the near plane of the cone from the
     // receiver to the light, where the nearest possible blockers lie.
-    var search = 0.0;
-    if is_spot {
-        search = world_to_texels(q.layer, size * (d_receiver - near) / d_receiver, near);
-    } else {
-        search = world_to_texels(q.layer, size * (d_receiver - near), near);
-    }
-    search = clamp(search, 1.0, max_radius);
+    let search_world = emitter_cone_radius(light.emitter, d_receiver, near);
+    let search = clamp(world_to_texels(q.layer, search_world, near), 1.0, max_radius);
 
     let gradient = receiver_depth_gradient(q);
     let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
@@ -58,12 +53,8 @@ fn sample_shadow(q: ShadowQuery) -> f32 {
     let d_blocker = blocker_sum / blockers;
 
     // 2. The penumbra's radius at the receiver.
-    var penumbra = 0.0;
-    if is_spot {
-        penumbra = world_to_texels(q.layer, size * max(d_receiver - d_blocker, 0.0) / d_blocker, d_receiver);
-    } else {
-        penumbra = world_to_texels(q.layer, size * max(d_receiver - d_blocker, 0.0), d_receiver);
-    }
+    let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
+    let penumbra = world_to_texels(q.layer, penumbra_world, d_receiver);
     // 3. At least the bilinear tap's own half-texel footprint.
     return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.pcf.poisson_taps);
 }
