@@ -188,7 +188,7 @@ fn stage_outputs(args: &RenderArgs, frame: &Frame) -> anyhow::Result<Staged> {
         let linear = output::shadow_map_to_gray16(
             map,
             &frame.light_projection,
-            matches!(frame.light, gnomon_scene::Light::Point(_)),
+            matches!(frame.light.shadow_view(), gnomon_scene::lights::ShadowView::Omni { .. }),
         );
         staged.png_gray16(path, map.resolution, map.resolution, &linear)?;
     }

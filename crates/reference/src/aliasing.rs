@@ -14,7 +14,10 @@
 //! is exact for warped (projective) maps as well as for orthographic ones.
 
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
-use gnomon_scene::{Camera, Light};
+use gnomon_scene::{
+    Camera, Light,
+    lights::{Origin, ShadowView},
+};
 
 /// A frame's geometry and shadow layout, as the aliasing measure needs them.
 #[derive(Clone, Copy)]
@@ -65,8 +68,8 @@ pub struct AliasingImage {
 /// `select_cascade` in the renderer's `map_visibility.wgsl`; the normal offset is
 /// ignored): for a point light, the cube face its direction falls on.
 pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usize {
-    if let Light::Point(point) = input.light {
-        let d = world - point.position;
+    if let ShadowView::Omni { position, .. } = input.light.shadow_view() {
+        let d = world - position;
         return match input.layers.len() {
             // Dual paraboloids: the lower hemisphere is layer 0.
             2 => usize::from(d.y > 0.0),
@@ -122,6 +125,7 @@ pub fn measure(input: &AliasingInput) -> AliasingImage {
         (world_from_clip.project_point3(ndc) - eye).normalize()
     };
     let texels = input.resolution as f32;
+    let origin = input.light.emission().origin;
     let m: Vec<f32> = (0..w * h)
         .map(|i| {
             let p = input.position[i];
@@ -134,10 +138,9 @@ pub fn measure(input: &AliasingInput) -> AliasingImage {
             let centre = ray(x, y);
             let angle = |d: Vec3| centre.angle_between(d);
             let pixel = p.distance(eye) * angle(ray(x + 1.0, y)).max(angle(ray(x, y + 1.0)));
-            let travel = match input.light {
-                Light::Directional(sun) => sun.direction.normalize(),
-                Light::Spot(spot) => (p - spot.position).normalize(),
-                Light::Point(point) => (p - point.position).normalize(),
+            let travel = match origin {
+                Origin::Infinite { travel } => travel,
+                Origin::Local { position, .. } => (p - position).normalize(),
             };
             let (across_u, across_v) = travel.any_orthonormal_pair();
             let layer = input.layers[shading_layer(input, p, input.depth[i])];

@@ -3,7 +3,10 @@
 //! that holds every ray toward it.
 
 use glam::{Vec2, Vec3};
-use gnomon_scene::{Falloff, Light};
+use gnomon_scene::{
+    Falloff, Light,
+    lights::{Area, Origin},
+};
 
 use crate::{
     Hit,
@@ -24,22 +27,26 @@ pub(crate) enum Emitter {
 
 impl Emitter {
     pub(crate) fn new(light: &Light) -> Self {
-        match light {
-            Light::Directional(sun) => Emitter::Sun {
-                to_light: -sun.direction.normalize(),
-                half_angle: 0.5 * sun.angular_diameter_degrees.to_radians(),
+        let emission = light.emission();
+        // Which shapes a kind can have: its origin and its area, from its own file in
+        // `gnomon_scene::lights`. An area that needs a local origin has one.
+        let local = match emission.origin {
+            Origin::Infinite { travel } => Err(travel),
+            Origin::Local { position, range, axis } => Ok((position, range, axis)),
+        };
+        match (emission.area, local) {
+            (Area::Directions { half_angle }, Err(travel)) => Emitter::Sun { to_light: -travel, half_angle },
+            (Area::Disk { radius }, Ok((center, range, axis))) => Emitter::Disk {
+                center,
+                axis,
+                radius,
+                cos_outer: emission.cone.map_or(-1.0, |c| c.cos_outer),
+                range,
+                falloff: emission.falloff,
             },
-            Light::Spot(spot) => Emitter::Disk {
-                center: spot.position,
-                axis: spot.direction.normalize(),
-                radius: spot.radius,
-                cos_outer: spot.outer_angle_degrees.to_radians().cos(),
-                range: spot.range,
-                falloff: spot.falloff,
-            },
-            Light::Point(point) => {
-                Emitter::Sphere { center: point.position, radius: point.radius, range: point.range }
-            }
+            (Area::Sphere { radius }, Ok((center, range, _))) => Emitter::Sphere { center, radius, range },
+            // `gnomon_scene::lights`' tests hold every kind to these pairs.
+            (area, origin) => unreachable!("a light whose area {area:?} does not fit its origin {origin:?}"),
         }
     }
 

@@ -13,6 +13,7 @@ use gnomon_math::{
 };
 use gnomon_scene::{
     Camera, Light, Settings,
+    lights::ShadowView,
     settings::{CascadeFit, CascadeSelection, Fit, KernelUnit, OmniMap, Partition, SplitScheme, WarpKind},
 };
 
@@ -82,14 +83,14 @@ pub fn shadow_layout(
     sampled: Option<&SampleDistribution>,
     drawing: MapDrawing,
 ) -> ShadowLayout {
-    if let Light::Point(point) = light {
+    let view = light.shadow_view();
+    if let ShadowView::Omni { position, near, far } = view {
         // Six 90° faces from the light's position, or two paraboloids; near and far
         // from its range.
-        let (near, far) = (point.shadow_near(), point.range);
         return ShadowLayout {
             projections: match settings.shadow.map.omni {
-                OmniMap::Cube => cube_face_projections(point.position, near, far).to_vec(),
-                OmniMap::Paraboloid => paraboloid_projections(point.position, near, far).to_vec(),
+                OmniMap::Cube => cube_face_projections(position, near, far).to_vec(),
+                OmniMap::Paraboloid => paraboloid_projections(position, near, far).to_vec(),
             },
             splits: vec![0.0, f32::INFINITY],
             depth_clamp: false,
@@ -99,19 +100,19 @@ pub fn shadow_layout(
         drawing.unclipped_depth && settings.shadow.map.depth_clamp && drawing.technique.maps().clamped_depth;
     let single = || {
         let fit = settings.shadow.map.fit;
-        let clamped = pancake && fit == Fit::Receivers && matches!(light, Light::Directional(_));
+        let clamped = pancake && fit == Fit::Receivers && matches!(view, ShadowView::Parallel { .. });
         ShadowLayout {
             projections: vec![light_projection(scene_bounds, light, camera, aspect, fit, clamped)],
             splits: vec![0.0, f32::INFINITY],
             depth_clamp: clamped,
         }
     };
-    if let (Light::Directional(sun), Partition::Single, Some(warp)) =
-        (light, settings.shadow.partition, warp_of(settings.shadow.map.warp))
+    if let (ShadowView::Parallel { travel }, Partition::Single, Some(warp)) =
+        (view, settings.shadow.partition, warp_of(settings.shadow.map.warp))
     {
-        return warped_layout(scene_bounds, sun.direction, camera, aspect, warp).unwrap_or_else(single);
+        return warped_layout(scene_bounds, travel, camera, aspect, warp).unwrap_or_else(single);
     }
-    let (Light::Directional(sun), Partition::Cascades) = (light, settings.shadow.partition) else {
+    let (ShadowView::Parallel { travel }, Partition::Cascades) = (view, settings.shadow.partition) else {
         return single();
     };
     let Some(splits) =
@@ -146,7 +147,7 @@ pub fn shadow_layout(
             let exact_slice = || cascades::view_slice(&view, from, splits[i + 1]);
             match c.cascade_fit {
                 CascadeFit::Tight => {
-                    let tight = cascades::fit_cascade_tight(sun.direction, &bounds, &slice, pancake);
+                    let tight = cascades::fit_cascade_tight(travel, &bounds, &slice, pancake);
                     match samples.and_then(|s| s.get(i).copied().flatten()) {
                         Some(window) => cascades::fit_cascade_to_samples(
                             &tight,
@@ -158,7 +159,7 @@ pub fn shadow_layout(
                     }
                 }
                 CascadeFit::Stable => {
-                    cascades::fit_cascade_stable(sun.direction, &bounds, &exact_slice(), resolution)
+                    cascades::fit_cascade_stable(travel, &bounds, &exact_slice(), resolution)
                 }
             }
         })
@@ -280,22 +281,18 @@ pub fn light_projection(
     fit: Fit,
     depth_clamp: bool,
 ) -> LightProjection {
-    match light {
-        Light::Directional(sun) if fit == Fit::Receivers => {
+    match light.shadow_view() {
+        ShadowView::Parallel { travel } if fit == Fit::Receivers => {
             let bounds = *scene_bounds;
             let frustum = Hexahedron::from_clip_from_world(camera.clip_from_world(aspect));
             let receivers = intersection_vertices(&frustum, &Hexahedron::from_aabb(&bounds));
-            let fitted = fit_directional_to_receivers(sun.direction, &bounds, &receivers);
+            let fitted = fit_directional_to_receivers(travel, &bounds, &receivers);
             if depth_clamp { fitted.pancaked(&receivers) } else { fitted }
         }
-        Light::Directional(sun) => directional_light_projection(sun.direction, scene_bounds),
-        Light::Spot(spot) => spot_light_projection(
-            spot.position,
-            spot.direction,
-            spot.outer_angle_degrees.to_radians(),
-            spot.shadow_near(),
-            spot.range,
-        ),
-        Light::Point(point) => cube_face_projections(point.position, point.shadow_near(), point.range)[0],
+        ShadowView::Parallel { travel } => directional_light_projection(travel, scene_bounds),
+        ShadowView::Frustum { position, axis, half_angle, near, far } => {
+            spot_light_projection(position, axis, half_angle, near, far)
+        }
+        ShadowView::Omni { position, near, far } => cube_face_projections(position, near, far)[0],
     }
 }

@@ -14,7 +14,7 @@ mod light;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use gnomon_scene::{
-    Camera, Falloff,
+    Camera, Falloff, Light,
     settings::{DebugView, MAX_CASCADES as SETTINGS_MAX_CASCADES},
 };
 
@@ -26,29 +26,26 @@ pub use light::{
 /// The most cascades (array layers) a light's uniform holds: the settings' limit.
 pub const MAX_CASCADES: usize = SETTINGS_MAX_CASCADES as usize;
 
-/// What kind of light a [`LightGpu`] describes (`LIGHT_SUN`, … in WGSL).
-#[repr(u32)]
+/// A light kind as the shaders know it: its id ([`Light::kind_id`], the index of its
+/// name in [`Light::KIND_NAMES`]) and its WGSL constant (`LIGHT_SUN`, …), generated
+/// from the scene's kinds so that a new kind needs nothing here.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LightKindGpu {
-    /// A directional light (`LIGHT_SUN`).
-    Sun = 0,
-    /// A spot light (`LIGHT_SPOT`).
-    Spot = 1,
-    /// A point light (`LIGHT_POINT`).
-    Point = 2,
+pub struct LightKindGpu {
+    /// The kind's id, as `EmitterGpu::kind` holds it.
+    pub id: u32,
+    /// The kind's name in the scene (`sun`).
+    pub name: &'static str,
 }
 
 impl LightKindGpu {
     /// Every kind, for generating the WGSL constants.
-    pub const ALL: [LightKindGpu; 3] = [LightKindGpu::Sun, LightKindGpu::Spot, LightKindGpu::Point];
+    pub fn all() -> impl Iterator<Item = LightKindGpu> {
+        Light::KIND_NAMES.iter().enumerate().map(|(id, &name)| LightKindGpu { id: id as u32, name })
+    }
 
-    /// Its name in WGSL.
-    pub const fn wgsl_name(self) -> &'static str {
-        match self {
-            LightKindGpu::Sun => "LIGHT_SUN",
-            LightKindGpu::Spot => "LIGHT_SPOT",
-            LightKindGpu::Point => "LIGHT_POINT",
-        }
+    /// Its name in WGSL: `LIGHT_` and the kind's name in capitals.
+    pub fn wgsl_name(self) -> String {
+        format!("LIGHT_{}", self.name.to_uppercase())
     }
 }
 

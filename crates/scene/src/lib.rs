@@ -9,6 +9,7 @@ mod casters;
 pub mod framing;
 pub mod geometry;
 pub mod gltf_loader;
+pub mod lights;
 pub mod limits;
 mod model;
 mod scene_error;
@@ -16,9 +17,9 @@ pub mod scene_file;
 pub mod settings;
 
 pub use casters::OpenCasters;
+pub use lights::{DirectionalLight, Falloff, Light, PointLight, SpotLight};
 pub use model::{
-    AlphaMode, Camera, DirectionalLight, Falloff, Instance, Light, Material, Mesh, Motion, PointLight, Scene,
-    SceneLight, SpotLight, Texture, Wrap, sun_direction,
+    AlphaMode, Camera, Instance, Material, Mesh, Motion, Scene, SceneLight, Texture, Wrap, sun_direction,
 };
 pub use scene_error::SceneError;
 pub use settings::Settings;

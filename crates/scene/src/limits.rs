@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use crate::{Camera, DirectionalLight, Falloff, Light, PointLight, SpotLight};
+use crate::Camera;
 
 /// The largest coordinate or distance, in world units: `f32`'s spacing is 1 there.
 pub const MAX_COORDINATE: f32 = 1.0e7;
@@ -104,7 +104,11 @@ pub struct LimitError {
 }
 
 impl LimitError {
-    fn new(quantity: &'static str, value: impl std::fmt::Display, valid: impl Into<String>) -> Self {
+    pub(crate) fn new(
+        quantity: &'static str,
+        value: impl std::fmt::Display,
+        valid: impl Into<String>,
+    ) -> Self {
         Self { quantity, value: value.to_string(), valid: valid.into() }
     }
 }
@@ -119,69 +123,11 @@ pub fn check_vec3(limit: &Limit, quantity: &'static str, v: Vec3) -> Result<Vec3
 }
 
 /// A unit direction: finite and of length 1 (within rounding).
-fn check_direction(quantity: &'static str, d: Vec3) -> Result<(), LimitError> {
+pub(crate) fn check_direction(quantity: &'static str, d: Vec3) -> Result<(), LimitError> {
     if d.is_finite() && (d.length() - 1.0).abs() < 1e-3 {
         Ok(())
     } else {
         Err(LimitError::new(quantity, format!("[{}, {}, {}]", d.x, d.y, d.z), "a unit direction"))
-    }
-}
-
-impl Light {
-    /// Checks every number of the light against its [`Limit`]. Errors name the
-    /// quantity as scene files do.
-    pub fn validate(&self) -> Result<(), LimitError> {
-        match self {
-            Light::Directional(sun) => sun.validate(),
-            Light::Spot(spot) => spot.validate(),
-            Light::Point(point) => point.validate(),
-        }
-    }
-}
-
-impl DirectionalLight {
-    fn validate(&self) -> Result<(), LimitError> {
-        check_direction("direction", self.direction)?;
-        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
-        INTENSITY.check("intensity", self.intensity)?;
-        SUN_ANGULAR_DIAMETER.check("angular_diameter", self.angular_diameter_degrees)?;
-        Ok(())
-    }
-}
-
-impl SpotLight {
-    fn validate(&self) -> Result<(), LimitError> {
-        check_vec3(&COORDINATE, "position", self.position)?;
-        check_direction("direction", self.direction)?;
-        let outer = SPOT_OUTER_ANGLE.check("outer_angle", self.outer_angle_degrees)?;
-        let inner = SPOT_INNER_ANGLE.check("inner_angle", self.inner_angle_degrees)?;
-        if inner > outer {
-            return Err(LimitError::new("inner_angle", inner, format!("at most the outer angle {outer}")));
-        }
-        LIGHT_RANGE.check("range", self.range)?;
-        LIGHT_RADIUS.check("radius", self.radius)?;
-        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
-        INTENSITY.check("intensity", self.intensity)?;
-        check_falloff(self.falloff)
-    }
-}
-
-impl PointLight {
-    fn validate(&self) -> Result<(), LimitError> {
-        check_vec3(&COORDINATE, "position", self.position)?;
-        LIGHT_RANGE.check("range", self.range)?;
-        LIGHT_RADIUS.check("radius", self.radius)?;
-        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
-        INTENSITY.check("intensity", self.intensity)?;
-        check_falloff(self.falloff)
-    }
-}
-
-/// A falloff's window is a distance, as a range is.
-fn check_falloff(falloff: Falloff) -> Result<(), LimitError> {
-    match falloff {
-        Falloff::Constant | Falloff::InverseSquare { window: None } => Ok(()),
-        Falloff::InverseSquare { window: Some(window) } => LIGHT_RANGE.check("range", window).map(|_| ()),
     }
 }
 
@@ -211,6 +157,7 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{Falloff, Light, SpotLight};
 
     #[test]
     fn every_limit_refuses_non_finite_values_and_accepts_its_documented_edges() {

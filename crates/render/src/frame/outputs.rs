@@ -9,6 +9,7 @@ use gnomon_math::{
 };
 use gnomon_scene::{
     Camera, Light,
+    lights::ShadowView,
     settings::{DrawSubmission, Technique},
 };
 
@@ -289,14 +290,14 @@ impl Frame {
 
     /// World size of one shadow texel at `world` (which must be in front of the light).
     pub fn shadow_texel_world_size(&self, world: Vec3) -> f32 {
-        if let Light::Point(point) = self.light {
+        if let ShadowView::Omni { position, .. } = self.light.shadow_view() {
             if let [lower, upper] = self.cascades.as_slice() {
                 // Dual paraboloids: the lower hemisphere holds y at or below the light.
-                let hemisphere = if world.y <= point.position.y { lower } else { upper };
+                let hemisphere = if world.y <= position.y { lower } else { upper };
                 let offset = hemisphere.light_from_world.transform_point3(world);
                 return paraboloid_texel_world_size(offset, self.shadow_resolution);
             }
-            return cube_texel_world_size(world - point.position, self.shadow_resolution);
+            return cube_texel_world_size(world - position, self.shadow_resolution);
         }
         let distance = -self.light_projection.light_from_world.transform_point3(world).z;
         self.light_projection.texel_world_size(self.shadow_resolution, distance)

@@ -6,6 +6,7 @@ use glam::Vec3;
 use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
+    lights::ShadowView,
     settings::{BiasSettings, CascadeSelection, LightKind, Lighting, Partition, RayUse, Refine},
 };
 
@@ -177,9 +178,9 @@ impl Renderer {
         aspect: f32,
     ) -> Result<ShadowLayout, RenderError> {
         let shadow = &settings.shadow;
-        let sampled = match (light, shadow.partition, shadow.cascades.sdsm) {
-            (Light::Directional(sun), Partition::Cascades, true) => {
-                self.sample_distribution(uploaded, sun.direction, settings, camera, aspect)?
+        let sampled = match (light.shadow_view(), shadow.partition, shadow.cascades.sdsm) {
+            (ShadowView::Parallel { travel }, Partition::Cascades, true) => {
+                self.sample_distribution(uploaded, travel, settings, camera, aspect)?
             }
             _ => None,
         };

@@ -28,8 +28,8 @@ pub fn wgsl_constants() -> String {
     {
         s += &format!("const DEBUG_VIEW_{name}: u32 = {}u;\n", debug_view_code(view));
     }
-    for kind in LightKindGpu::ALL {
-        s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind as u32);
+    for kind in LightKindGpu::all() {
+        s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind.id);
     }
     for falloff in FalloffGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", falloff.wgsl_name(), falloff as u32);

@@ -8,7 +8,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use gnomon_math::screen_bounds::{PerspectiveCamera, PixelRect, Viewport};
-use gnomon_scene::{Light, settings::MAX_LIGHTS};
+use gnomon_scene::{Light, lights::Origin, settings::MAX_LIGHTS};
 
 use super::{
     Layouts, compose_wgsl, fragment_entry,
@@ -49,10 +49,9 @@ pub(crate) enum Reach {
 
 impl Reach {
     pub fn of(light: &Light) -> Self {
-        match light {
-            Light::Directional(_) => Reach::Everywhere,
-            Light::Spot(s) => Reach::Ball { centre: s.position, radius: s.range },
-            Light::Point(p) => Reach::Ball { centre: p.position, radius: p.range },
+        match light.emission().origin {
+            Origin::Infinite { .. } => Reach::Everywhere,
+            Origin::Local { position, range, .. } => Reach::Ball { centre: position, radius: range },
         }
     }
 

@@ -12,10 +12,13 @@ use glam::{Mat4, Vec3};
 use gnomon_math::ProjectionKind;
 use gnomon_scene::{
     Light, Scene, Settings,
+    lights::{Cone, Origin},
     settings::{CascadeSelection, KernelUnit},
 };
 
-use super::{CascadeGpu, FalloffGpu, LightKindGpu, MAX_CASCADES};
+#[cfg(doc)]
+use super::LightKindGpu;
+use super::{CascadeGpu, FalloffGpu, MAX_CASCADES};
 use crate::{
     layout::ShadowLayout,
     light_map::MapLookup,
@@ -29,7 +32,7 @@ use crate::{
 pub struct EmitterGpu {
     /// Colour × intensity.
     pub radiance: Vec3,
-    /// A [`LightKindGpu`].
+    /// The light's kind ([`LightKindGpu`]), which only `light_kinds.wgsl` reads.
     pub kind: u32,
     /// The sun's travel direction or the spot's axis (unit).
     pub direction: Vec3,
@@ -54,34 +57,25 @@ pub struct EmitterGpu {
 }
 
 impl EmitterGpu {
-    /// How `light` emits.
+    /// How `light` emits: its kind's [`Emission`], packed.
     pub fn of(light: &Light) -> Self {
-        let mut e = EmitterGpu { cos_inner: 1.0, cos_outer: -1.0, ..Default::default() };
-        match light {
-            Light::Directional(sun) => {
-                e.kind = LightKindGpu::Sun as u32;
-                e.radiance = sun.color * sun.intensity;
-                e.direction = sun.direction.normalize();
-                e.size = (0.5 * sun.angular_diameter_degrees.to_radians()).tan();
-            }
-            Light::Spot(spot) => {
-                e.kind = LightKindGpu::Spot as u32;
-                e.radiance = spot.color * spot.intensity;
-                e.direction = spot.direction.normalize();
-                e.position = spot.position;
-                e.range = spot.range;
-                (e.falloff, e.falloff_window) = FalloffGpu::of(spot.falloff);
-                e.cos_inner = spot.inner_angle_degrees.to_radians().cos();
-                e.cos_outer = spot.outer_angle_degrees.to_radians().cos();
-                e.size = spot.radius;
-            }
-            Light::Point(point) => {
-                e.kind = LightKindGpu::Point as u32;
-                e.radiance = point.color * point.intensity;
-                e.position = point.position;
-                e.range = point.range;
-                (e.falloff, e.falloff_window) = FalloffGpu::of(point.falloff);
-                e.size = point.radius;
+        let emission = light.emission();
+        let (falloff, falloff_window) = FalloffGpu::of(emission.falloff);
+        let cone = emission.cone.unwrap_or(Cone { cos_inner: 1.0, cos_outer: -1.0 });
+        let mut e = EmitterGpu {
+            radiance: emission.radiance,
+            kind: light.kind_id(),
+            falloff,
+            falloff_window,
+            cos_inner: cone.cos_inner,
+            cos_outer: cone.cos_outer,
+            size: emission.area.size(),
+            ..Default::default()
+        };
+        match emission.origin {
+            Origin::Infinite { travel } => e.direction = travel,
+            Origin::Local { position, range, axis } => {
+                (e.position, e.range, e.direction) = (position, range, axis)
             }
         }
         e

@@ -11,7 +11,7 @@
 use glam::{Mat4, Vec3};
 use gltf::khr_lights_punctual::Kind;
 
-use crate::{DirectionalLight, Falloff, Light, PointLight, SpotLight, sun_direction};
+use crate::{DirectionalLight, Falloff, Light, PointLight, SpotLight, lights::Origin, sun_direction};
 
 /// The light a file's `light` becomes where a node of world transform `world` places
 /// it; None where the node's transform leaves it no direction. A light without a
@@ -71,12 +71,12 @@ pub(super) fn from_file(
 /// which the loader makes reach past everything the file holds; the range is also the
 /// shadow map's far plane, so it must be finite. The falloff keeps no window.
 pub(super) fn give_range(light: &mut Light, reach: impl Fn(Vec3) -> f32) {
-    let (range, position) = match light {
-        Light::Spot(s) => (&mut s.range, s.position),
-        Light::Point(p) => (&mut p.range, p.position),
-        Light::Directional(_) => return,
+    let Origin::Local { position, .. } = light.emission().origin else {
+        return;
     };
-    if !range.is_finite() {
+    if let Some(range) = light.range_mut()
+        && !range.is_finite()
+    {
         *range = reach(position);
     }
 }

@@ -4,6 +4,7 @@
 //! ignored without a word.
 
 use super::*;
+use crate::lights::ShadowView;
 
 /// A setting changed from its default that has no effect on this render.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,7 +42,7 @@ const RULES: &[(&str, Uses, &str)] = &[
     ("light.point_radius", |s, _| s.light.kind == LightKind::Point, "`light.kind` point"),
     (
         "shadow.map.omni",
-        |_, lights| lights.iter().any(|l| matches!(l.light, Light::Point(_))),
+        |_, lights| lights.iter().any(|l| matches!(l.light.shadow_view(), ShadowView::Omni { .. })),
         "a point light",
     ),
     (
@@ -91,9 +92,10 @@ fn traces_rays(s: &Settings, lights: &[ResolvedLight]) -> bool {
 const CASCADES: &str = "`shadow.partition` cascades and a sun";
 
 fn uses_cascades(_: &Settings, lights: &[ResolvedLight]) -> bool {
-    lights
-        .iter()
-        .any(|l| l.shadow.partition == Partition::Cascades && matches!(l.light, Light::Directional(_)))
+    lights.iter().any(|l| {
+        l.shadow.partition == Partition::Cascades
+            && matches!(l.light.shadow_view(), ShadowView::Parallel { .. })
+    })
 }
 
 impl Settings {

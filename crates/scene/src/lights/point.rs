@@ -1,0 +1,66 @@
+//! The point light: every direction from a point (or a sphere, for soft shadows),
+//! drawn with a cube map or two paraboloids.
+
+use glam::Vec3;
+
+use super::{Area, Emission, Falloff, Kind, Origin, ShadowView, shadow_near};
+use crate::limits::{
+    COLOR_CHANNEL, COORDINATE, INTENSITY, LIGHT_RADIUS, LIGHT_RANGE, LimitError, check_vec3,
+};
+
+/// A light emitting in every direction from a point, or from a sphere for soft shadows.
+/// Its shadow map is a cube: six 90° views.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Position of the light (the centre of its sphere) in world space.
+    pub position: Vec3,
+    /// Distance in world units beyond which no light arrives; also the far plane of the
+    /// cube's faces.
+    pub range: f32,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Brightness: lit surfaces receive `color · intensity` times the [`Falloff`] at
+    /// their distance.
+    pub intensity: f32,
+    /// How the light weakens with distance inside `range`.
+    pub falloff: Falloff,
+    /// Radius in world units of the emitting sphere; 0 is a point (hard shadows). The
+    /// reference samples the sphere's solid angle for soft shadows.
+    pub radius: f32,
+}
+
+impl PointLight {
+    /// The cube faces' near plane: a fixed fraction of the range, as for a spot.
+    pub fn shadow_near(&self) -> f32 {
+        shadow_near(self.range)
+    }
+}
+
+impl Kind for PointLight {
+    fn name(&self) -> &'static str {
+        "point"
+    }
+
+    fn validate(&self) -> Result<(), LimitError> {
+        check_vec3(&COORDINATE, "position", self.position)?;
+        LIGHT_RANGE.check("range", self.range)?;
+        LIGHT_RADIUS.check("radius", self.radius)?;
+        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
+        INTENSITY.check("intensity", self.intensity)?;
+        self.falloff.validate()
+    }
+
+    fn emission(&self) -> Emission {
+        Emission {
+            radiance: self.color * self.intensity,
+            origin: Origin::Local { position: self.position, range: self.range, axis: Vec3::ZERO },
+            falloff: self.falloff,
+            cone: None,
+            area: Area::Sphere { radius: self.radius },
+        }
+    }
+
+    fn shadow_view(&self) -> ShadowView {
+        ShadowView::Omni { position: self.position, near: self.shadow_near(), far: self.range }
+    }
+}
