@@ -156,6 +156,51 @@ pub(crate) const FOOTPRINT_RECEIVER: WgslInterface = WgslInterface {
     returns: Some("vec4<f32>"),
 };
 
+/// The technique contract: a technique's lit fraction at a receiver of its 2D map
+/// (`pcf_box_sample_shadow` in `techniques/pcf_box.wgsl`, …), bound by
+/// `techniques::technique_wgsl` for the technique the registry picks.
+pub(crate) const SAMPLE_SHADOW: WgslInterface =
+    WgslInterface { name: "sample_shadow", params: &[("q", "ShadowQuery")], returns: Some("f32") };
+
+/// The technique contract's lookup in a point light's cube (`pcf_box_sample_shadow_cube`, …).
+pub(crate) const SAMPLE_SHADOW_CUBE: WgslInterface =
+    WgslInterface { name: "sample_shadow_cube", params: &[("q", "CubeQuery")], returns: Some("f32") };
+
+/// The technique contract's encoding of a texel's linear depth `d` into a filterable
+/// technique's moments (`variance_encode_moments`, …), which the moment pass applies.
+pub(crate) const ENCODE_MOMENTS: WgslInterface = WgslInterface {
+    name: "encode_moments",
+    params: &[("d", "f32"), ("layer", "u32")],
+    returns: Some("vec4<f32>"),
+};
+
+/// The contract's functions, for a composer to find each one a technique implements.
+pub(crate) const TECHNIQUE_CONTRACT: [&WgslInterface; 3] =
+    [&SAMPLE_SHADOW, &SAMPLE_SHADOW_CUBE, &ENCODE_MOMENTS];
+
+impl WgslInterface {
+    /// The function of `sources` implementing this interface: the one named
+    /// `<module>_<interface>` (`pcf_box_sample_shadow`), or the interface's own name,
+    /// which a host's technique may define directly. `Ok(None)` where no source
+    /// implements it; an error naming both where two do.
+    pub fn implementation_in(&self, sources: &[&str]) -> Result<Option<String>, String> {
+        let suffix = format!("_{}", self.name);
+        let mut found: Vec<String> = Vec::new();
+        for line in sources.iter().flat_map(|s| s.lines()) {
+            let Some(rest) = line.trim_start().strip_prefix("fn ") else { continue };
+            let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            if (name == self.name || name.ends_with(&suffix)) && !found.contains(&name) {
+                found.push(name);
+            }
+        }
+        match found.as_slice() {
+            [] => Ok(None),
+            [one] => Ok(Some(one.clone())),
+            [first, second, ..] => Err(format!("both `{first}` and `{second}` implement `{}`", self.name)),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,5 +226,20 @@ mod tests {
             ),
             "{wgsl}"
         );
+    }
+
+    #[test]
+    fn a_techniques_implementation_is_found_by_its_module_name_or_the_contracts_own() {
+        let own = "fn pcf_box_sample_shadow(q: ShadowQuery) -> f32 { return 1.0; }\nfn pcf_box_sample_shadow_cube(q: CubeQuery) -> f32 { return 1.0; }";
+        assert_eq!(SAMPLE_SHADOW.implementation_in(&[own]), Ok(Some("pcf_box_sample_shadow".into())));
+        assert_eq!(
+            SAMPLE_SHADOW_CUBE.implementation_in(&[own]),
+            Ok(Some("pcf_box_sample_shadow_cube".into()))
+        );
+        assert_eq!(ENCODE_MOMENTS.implementation_in(&[own]), Ok(None));
+        let host = "fn sample_shadow(q: ShadowQuery) -> f32 { return 1.0; }";
+        assert_eq!(SAMPLE_SHADOW.implementation_in(&[host]), Ok(Some("sample_shadow".into())));
+        let both = SAMPLE_SHADOW.implementation_in(&[own, host]).unwrap_err();
+        assert!(both.contains("pcf_box_sample_shadow") && both.contains("`sample_shadow`"), "{both}");
     }
 }

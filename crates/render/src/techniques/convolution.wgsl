@@ -22,13 +22,13 @@ fn frequency(k: u32) -> f32 {
     return PI * f32(2u * k + 1u);
 }
 
-fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
+fn convolution_encode_moments(d: f32, layer: u32) -> vec4<f32> {
     let c0 = frequency(2u * layer);
     let c1 = frequency(2u * layer + 1u);
     return vec4<f32>(sin(c0 * d), cos(c0 * d), sin(c1 * d), cos(c1 * d));
 }
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn convolution_sample_shadow(q: ShadowQuery) -> f32 {
     let terms = light.technique.terms;
     let m = f32(terms);
     let alpha = light.technique.attenuation;

@@ -15,11 +15,11 @@ struct EsmParams {
     _pad3: vec4<u32>,
 };
 
-fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
+fn esm_encode_moments(d: f32, layer: u32) -> vec4<f32> {
     return vec4<f32>(d, 0.0, 0.0, 0.0);
 }
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn esm_sample_shadow(q: ShadowQuery) -> f32 {
     let c = light.technique.exponent;
     let dims = vec2<i32>(textureDimensions(moment_map));
     let x = q.coords.xy * vec2<f32>(dims) - vec2<f32>(0.5);

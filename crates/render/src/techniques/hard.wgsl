@@ -1,6 +1,6 @@
 // `hard`: Williams (1978). Point-sample the nearest texel and compare once.
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn hard_sample_shadow(q: ShadowQuery) -> f32 {
     let size = vec2<i32>(textureDimensions(shadow_map));
     let texel = clamp(vec2<i32>(floor(q.coords.xy * vec2<f32>(size))), vec2<i32>(0), size - vec2<i32>(1));
     let occluder_depth = textureLoad(shadow_map, texel, q.layer, 0);

@@ -5,12 +5,15 @@
 //! settings' checks ask a [`TechniqueRegistry`] and know nothing else about it: a host
 //! registers a technique of its own with [`TechniqueRegistry::with`].
 //!
-//! A technique's WGSL defines `fn sample_shadow(q: ShadowQuery) -> f32` (the lookup,
-//! see `common.wgsl`), returning the lit fraction in [0, 1]. It may read the shadow
+//! A technique's WGSL implements the technique contract
+//! (`passes::wgsl_interfaces::TECHNIQUE_CONTRACT`) under its module's name:
+//! `fn pcf_box_sample_shadow(q: ShadowQuery) -> f32` (the lookup, see `common.wgsl`),
+//! returning the lit fraction in [0, 1], and the composer binds `sample_shadow` to it
+//! (a host's technique may define `sample_shadow` itself). It may read the shadow
 //! bindings of `bindings.wgsl`, the `light` uniform, whose `technique` block carries
 //! the typed values of [`ShadowTechnique::params`] ([`TechniqueParams`]), and the
 //! helpers of `common.wgsl`. A filterable technique also defines
-//! `fn encode_moments(d: f32, layer: u32) -> vec4<f32>`, which the moment pass
+//! `fn <module>_encode_moments(d: f32, layer: u32) -> vec4<f32>`, which the moment pass
 //! applies to every texel's linear depth d ∈ [0, 1].
 
 pub(crate) mod convolution;
@@ -28,6 +31,8 @@ use gnomon_scene::settings::{FilterSettings, RayUse, SettingsError, Technique};
 
 pub use params::{GpuParams, NoParams, PARAMS_BYTES, ParamsBlockGpu, TechniqueParams};
 pub use registry::{RegistryError, TechniqueRef, TechniqueRegistry};
+
+use crate::passes::wgsl_interfaces::TECHNIQUE_CONTRACT;
 
 /// Every built-in technique, in the order the command line lists them. Adding one
 /// is its module, its WGSL and one line here.
@@ -125,7 +130,8 @@ pub trait ShadowTechnique: Sync {
     /// What it does, in a line, with its reference: `gnomon techniques`, `--help` and
     /// the viewer show it.
     fn summary(&self) -> &'static str;
-    /// WGSL sources, concatenated after the shared ones, defining `sample_shadow`.
+    /// WGSL sources, concatenated after the shared ones, implementing `sample_shadow`
+    /// (as `<module>_sample_shadow`, or under the contract's own name).
     fn wgsl(&self) -> &'static [&'static str];
     /// The technique's parameters, typed ([`GpuParams`]), passed to the shader as
     /// `light.technique`. Their WGSL struct is a property of the type, not of the
@@ -138,7 +144,8 @@ pub trait ShadowTechnique: Sync {
     fn params_struct(&self) -> TechniqueParams {
         self.params(&FilterSettings::default(), MapPrecision::Single)
     }
-    /// WGSL sources defining `fn sample_shadow_cube(q: CubeQuery) -> f32`, the lookup
+    /// WGSL sources implementing `fn sample_shadow_cube(q: CubeQuery) -> f32` (as
+    /// `<module>_sample_shadow_cube`, or under the contract's own name), the lookup
     /// in a point light's cube map (see `cube.wgsl`), for the techniques that can
     /// shadow a point light; `None` for the others, which the settings' checks then
     /// refuse for point lights.
@@ -179,6 +186,16 @@ pub trait ShadowTechnique: Sync {
 pub(crate) fn technique_wgsl(technique: &dyn ShadowTechnique, sources: &[&str]) -> Vec<String> {
     let mut parts = vec![technique.params_struct().wgsl_alias()];
     parts.extend(sources.iter().map(|s| (*s).to_owned()));
+    for interface in TECHNIQUE_CONTRACT {
+        // Two implementations of one contract function leave the binding out, and
+        // naga then refuses the shader by the interface's name: the registry's test
+        // `every_technique_defines_its_entry_points` names the culprits first.
+        if let Ok(Some(implementation)) = interface.implementation_in(sources)
+            && implementation != interface.name
+        {
+            parts.push(interface.bind(&implementation));
+        }
+    }
     parts
 }
 

@@ -42,7 +42,7 @@ const DEQUANTISE: mat4x4<f32> = mat4x4<f32>(
 );
 const QUANTISE_OFFSET: vec4<f32> = vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
 
-fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
+fn msm_encode_moments(d: f32, layer: u32) -> vec4<f32> {
     let d2 = d * d;
     let b = vec4<f32>(d, d2, d2 * d, d2 * d2);
     if light.technique.quantised == 1u {
@@ -57,7 +57,7 @@ fn atom_weight(a: f32, u: f32, v: f32, m1: f32, m2: f32) -> f32 {
     return (m2 - (u + v) * m1 + u * v) / ((a - u) * (a - v));
 }
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn msm_sample_shadow(q: ShadowQuery) -> f32 {
     // The moment bias pulls the moments toward those of ½δ₀ + ½δ₁, strictly inside
     // the moment space, so the system stays well-conditioned after quantisation.
     var stored = sample_moments(q, 0u);

@@ -1,5 +1,5 @@
 // pcf2x2: one hardware 2×2 bilinear comparison tap.
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn pcf2x2_sample_shadow(q: ShadowQuery) -> f32 {
     return textureSampleCompareLevel(shadow_map, shadow_compare, q.coords.xy, q.layer, q.coords.z);
 }

@@ -1,5 +1,5 @@
 // pcf: a box kernel of the settings' width (pcf.wgsl's pcf_kernel, box weights).
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn pcf_box_sample_shadow(q: ShadowQuery) -> f32 {
     return pcf_kernel(q, kernel_width_texels(q), false);
 }

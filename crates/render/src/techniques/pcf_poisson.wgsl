@@ -1,5 +1,5 @@
 // pcf-poisson: `light.pcf.poisson_taps` taps of the shared Poisson disk over the kernel's radius.
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn pcf_poisson_sample_shadow(q: ShadowQuery) -> f32 {
     return pcf_poisson(q, 0.5 * kernel_width_texels(q), light.pcf.poisson_taps);
 }

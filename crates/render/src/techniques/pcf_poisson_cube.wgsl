@@ -1,5 +1,5 @@
 // pcf-poisson on a cube map: the Poisson disk across the direction (cube.wgsl).
 
-fn sample_shadow_cube(q: CubeQuery) -> f32 {
+fn pcf_poisson_sample_shadow_cube(q: CubeQuery) -> f32 {
     return cube_pcf_poisson(q, 0.5 * cube_kernel_width_texels(q), light.pcf.poisson_taps);
 }

@@ -1,5 +1,5 @@
 // pcf-tent: a tent kernel of the settings' width (pcf.wgsl's pcf_kernel, tent weights).
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn pcf_tent_sample_shadow(q: ShadowQuery) -> f32 {
     return pcf_kernel(q, kernel_width_texels(q), true);
 }

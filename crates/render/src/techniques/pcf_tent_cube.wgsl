@@ -1,5 +1,5 @@
 // pcf-tent on a cube map: a tent grid across the direction (cube.wgsl).
 
-fn sample_shadow_cube(q: CubeQuery) -> f32 {
+fn pcf_tent_sample_shadow_cube(q: CubeQuery) -> f32 {
     return cube_pcf_grid(q, cube_kernel_width_texels(q), true);
 }

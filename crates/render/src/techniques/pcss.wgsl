@@ -19,7 +19,7 @@ fn world_to_texels(layer: u32, world: f32, at: f32) -> f32 {
     return world / texel_world_size_at(layer, at);
 }
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn pcss_sample_shadow(q: ShadowQuery) -> f32 {
     let max_radius = light.pcss.max_penumbra_texels;
     let d_receiver = q.distance;
     let near = light.map.near;

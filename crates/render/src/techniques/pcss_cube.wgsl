@@ -2,7 +2,7 @@
 // radius w_light (light.emitter.size). Distances are from the light's centre; every
 // offset is across the ray, in texels at the receiver.
 
-fn sample_shadow_cube(q: CubeQuery) -> f32 {
+fn pcss_sample_shadow_cube(q: CubeQuery) -> f32 {
     let size = light.emitter.size;
     let max_radius = light.pcss.max_penumbra_texels;
     let range = light.emitter.range;

@@ -3,6 +3,6 @@
 // rays/refine_classify.wgsl); the rest receive no light, so they are shadowed, and
 // no map is read (the frame draws none).
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn raytraced_sample_shadow(q: ShadowQuery) -> f32 {
     return 0.0;
 }

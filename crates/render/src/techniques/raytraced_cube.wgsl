@@ -1,5 +1,5 @@
 // raytraced on a cube map: as raytraced.wgsl.
 
-fn sample_shadow_cube(q: CubeQuery) -> f32 {
+fn raytraced_sample_shadow_cube(q: CubeQuery) -> f32 {
     return 0.0;
 }

@@ -12,7 +12,10 @@ use gnomon_scene::{
 };
 
 use super::{BUILTIN, ShadowTechnique};
-use crate::light_map::MapLookup;
+use crate::{
+    light_map::MapLookup,
+    passes::wgsl_interfaces::{ENCODE_MOMENTS, SAMPLE_SHADOW, SAMPLE_SHADOW_CUBE},
+};
 
 /// A registered technique: a cheap handle that compares and hashes by name (names
 /// are unique within a registry), for the pipeline caches' keys.
@@ -68,6 +71,14 @@ pub enum RegistryError {
     /// The name is not one the settings could select.
     #[error("cannot register technique: {0}")]
     Name(SettingsError),
+    /// Its WGSL does not implement the technique contract exactly once.
+    #[error("cannot register technique `{name}`: {problem}")]
+    Contract {
+        /// The technique's name.
+        name: String,
+        /// What its WGSL lacks or has twice.
+        problem: String,
+    },
 }
 
 /// The techniques a renderer knows, by name, in the order they are listed.
@@ -79,6 +90,23 @@ pub struct TechniqueRegistry {
 impl Default for TechniqueRegistry {
     fn default() -> Self {
         Self::builtin()
+    }
+}
+
+/// What keeps `technique`'s WGSL from implementing the technique contract
+/// (`passes::wgsl_interfaces::TECHNIQUE_CONTRACT`) exactly once: its lookup, its cube
+/// lookup where it has one, and at most one encoding of moments. `None` if nothing.
+fn contract_problem(technique: &dyn ShadowTechnique) -> Option<String> {
+    let sources = technique.wgsl();
+    let lookup = SAMPLE_SHADOW.implementation_in(sources);
+    let encoding = ENCODE_MOMENTS.implementation_in(sources);
+    let cube = technique.cube_wgsl().map(|cube| SAMPLE_SHADOW_CUBE.implementation_in(cube));
+    let missing = |name: &str| format!("its WGSL defines neither `{name}` nor `<module>_{name}`");
+    match (lookup, encoding, cube) {
+        (Err(twice), _, _) | (_, Err(twice), _) | (_, _, Some(Err(twice))) => Some(twice),
+        (Ok(None), _, _) => Some(missing(SAMPLE_SHADOW.name)),
+        (_, _, Some(Ok(None))) => Some(missing(SAMPLE_SHADOW_CUBE.name)),
+        (Ok(Some(_)), Ok(_), None | Some(Ok(Some(_)))) => None,
     }
 }
 
@@ -96,6 +124,8 @@ impl TechniqueRegistry {
         if self.techniques.iter().any(|t| t.technique() == name) {
             return Err(RegistryError::Duplicate(name.to_string()));
         }
+        contract_problem(technique)
+            .map_or(Ok(()), |problem| Err(RegistryError::Contract { name: name.to_string(), problem }))?;
         self.techniques.push(TechniqueRef(technique));
         Ok(self)
     }
@@ -222,6 +252,47 @@ mod tests {
         assert_eq!(again.err(), Some(RegistryError::Duplicate("hard".into())));
     }
 
+    /// A technique whose WGSL implements `sample_shadow` twice, or not at all.
+    struct Broken(&'static [&'static str]);
+    impl ShadowTechnique for Broken {
+        fn technique(&self) -> Technique {
+            Technique::named("broken")
+        }
+        fn summary(&self) -> &'static str {
+            "implements the contract wrongly"
+        }
+        fn maps(&self) -> MapSupport {
+            MapSupport::LINEAR_DEPTH
+        }
+        fn tunables(&self) -> crate::techniques::Tunables {
+            crate::techniques::Tunables::NONE
+        }
+        fn filter_reach_texels(&self, _: &FilterSettings, _: f32) -> f32 {
+            0.0
+        }
+        fn wgsl(&self) -> &'static [&'static str] {
+            self.0
+        }
+    }
+
+    #[test]
+    fn a_technique_implements_the_contract_once_or_is_refused() {
+        static TWICE: Broken = Broken(&[
+            "fn a_sample_shadow(q: ShadowQuery) -> f32 { return 1.0; }",
+            "fn b_sample_shadow(q: ShadowQuery) -> f32 { return 0.0; }",
+        ]);
+        static NONE: Broken = Broken(&["fn sample_shadows(q: ShadowQuery) -> f32 { return 1.0; }"]);
+        static OWN: Broken = Broken(&["fn sample_shadow(q: ShadowQuery) -> f32 { return 1.0; }"]);
+        let twice = TechniqueRegistry::builtin().with(&TWICE).err().expect("refused").to_string();
+        assert!(twice.contains("`a_sample_shadow` and `b_sample_shadow`"), "{twice}");
+        let none = TechniqueRegistry::builtin().with(&NONE).err().expect("refused").to_string();
+        assert!(none.contains("neither `sample_shadow` nor `<module>_sample_shadow`"), "{none}");
+        assert!(
+            TechniqueRegistry::builtin().with(&OWN).is_ok(),
+            "the contract's own name is an implementation"
+        );
+    }
+
     #[test]
     fn an_unknown_name_lists_the_registered_ones() {
         let e = TechniqueRegistry::builtin().get(&Technique::named("nope")).unwrap_err();
@@ -287,7 +358,11 @@ mod tests {
             let cube = t.cube_wgsl();
             assert_eq!(registry.check_light(&shadow(t.technique()), &point(), "p").is_ok(), cube.is_some());
             if let Some(sources) = cube {
-                assert!(sources.concat().contains("fn sample_shadow_cube(q: CubeQuery) -> f32"));
+                let found = SAMPLE_SHADOW_CUBE.implementation_in(sources);
+                assert!(
+                    matches!(found, Ok(Some(ref name)) if name.ends_with("_sample_shadow_cube")),
+                    "{t:?}: {found:?}"
+                );
             }
         }
     }
@@ -296,11 +371,16 @@ mod tests {
     fn every_technique_defines_its_entry_points() {
         let settings = FilterSettings::default();
         for t in TechniqueRegistry::builtin().iter() {
-            let source = t.wgsl().concat();
-            assert!(source.contains("fn sample_shadow(q: ShadowQuery) -> f32"), "{t:?}");
+            assert_eq!(contract_problem(t.get()), None, "{t:?}");
+            // Built-ins implement the contract under their modules' names.
+            let lookup = SAMPLE_SHADOW.implementation_in(t.wgsl());
+            assert!(
+                matches!(lookup, Ok(Some(ref name)) if name.ends_with("_sample_shadow")),
+                "{t:?}: {lookup:?}"
+            );
             let filterable = t.filterable_map(&settings).is_some();
             assert_eq!(
-                source.contains("fn encode_moments(d: f32, layer: u32) -> vec4<f32>"),
+                ENCODE_MOMENTS.implementation_in(t.wgsl()).is_ok_and(|found| found.is_some()),
                 filterable,
                 "{t:?}: a filterable technique encodes its map, and only it"
             );

@@ -26,7 +26,7 @@ fn warp_negative(d: f32) -> f32 {
     return -exp(-light.technique.negative_exponent * (2.0 * d - 1.0));
 }
 
-fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
+fn variance_encode_moments(d: f32, layer: u32) -> vec4<f32> {
     if light.technique.variant == 0u {
         return vec4<f32>(d, d * d, 0.0, 0.0);
     }
@@ -35,7 +35,7 @@ fn encode_moments(d: f32, layer: u32) -> vec4<f32> {
     return vec4<f32>(p, p * p, n, n * n);
 }
 
-fn sample_shadow(q: ShadowQuery) -> f32 {
+fn variance_sample_shadow(q: ShadowQuery) -> f32 {
     let m = sample_moments(q, 0u);
     let d = receiver_moment_depth(q);
     let min_variance = light.technique.min_variance;

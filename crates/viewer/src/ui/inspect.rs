@@ -4,7 +4,7 @@
 use egui::RichText;
 use glam::Vec3;
 use gnomon_render::PassTimings;
-use gnomon_scene::{Light, settings::DebugView};
+use gnomon_scene::{Light, lights::Origin, settings::DebugView};
 
 use super::{Images, Model, vec3_drag};
 use crate::{Action, View};
@@ -150,34 +150,33 @@ impl Model {
     /// light's position; each sends its setting's flag.
     fn light_sliders(&mut self, ui: &mut egui::Ui, light: Option<Light>) {
         let xyz = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
-        match light {
-            Some(Light::Directional(sun)) => {
-                let to_sun = -sun.direction;
-                let mut elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
-                let mut azimuth = to_sun.x.atan2(to_sun.z).to_degrees().rem_euclid(360.0);
-                if ui.add(egui::Slider::new(&mut elevation, 1.0..=90.0).text("sun elevation (°)")).changed()
+        let Some(light) = light else { return };
+        // By where the light is, as `drag_light`: each kind's settings are named after it.
+        let kind = light.type_name();
+        match light.emission().origin {
+            Origin::Infinite { travel } => {
+                let to_light = -travel;
+                let mut elevation = to_light.y.clamp(-1.0, 1.0).asin().to_degrees();
+                let mut azimuth = to_light.x.atan2(to_light.z).to_degrees().rem_euclid(360.0);
+                let label = format!("{kind} elevation (°)");
+                if ui.add(egui::Slider::new(&mut elevation, 1.0..=90.0).text(label)).changed() {
+                    let id = format!("{kind}_elevation");
+                    self.pending.push(Action::Set { id, value: Some(elevation.to_string()) });
+                }
+                if ui
+                    .add(egui::Slider::new(&mut azimuth, 0.0..=360.0).text(format!("{kind} azimuth (°)")))
+                    .changed()
                 {
-                    self.pending
-                        .push(Action::Set { id: "sun_elevation".into(), value: Some(elevation.to_string()) });
-                }
-                if ui.add(egui::Slider::new(&mut azimuth, 0.0..=360.0).text("sun azimuth (°)")).changed() {
-                    self.pending
-                        .push(Action::Set { id: "sun_azimuth".into(), value: Some(azimuth.to_string()) });
+                    let id = format!("{kind}_azimuth");
+                    self.pending.push(Action::Set { id, value: Some(azimuth.to_string()) });
                 }
             }
-            Some(Light::Spot(spot)) => {
-                let mut p = spot.position;
-                if vec3_drag(ui, "spot position", &mut p, self.rig.distance()) {
-                    self.pending.push(Action::Set { id: "spot_position".into(), value: Some(xyz(p)) });
+            Origin::Local { mut position, .. } => {
+                if vec3_drag(ui, &format!("{kind} position"), &mut position, self.rig.distance()) {
+                    let id = format!("{kind}_position");
+                    self.pending.push(Action::Set { id, value: Some(xyz(position)) });
                 }
             }
-            Some(Light::Point(point)) => {
-                let mut p = point.position;
-                if vec3_drag(ui, "point position", &mut p, self.rig.distance()) {
-                    self.pending.push(Action::Set { id: "point_position".into(), value: Some(xyz(p)) });
-                }
-            }
-            None => {}
         }
     }
 

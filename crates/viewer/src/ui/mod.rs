@@ -12,7 +12,7 @@ use egui::{Color32, RichText};
 use glam::Vec3;
 use gnomon_math::solar;
 use gnomon_render::{LightStats, PassTimings};
-use gnomon_scene::{Light, Scene, Settings};
+use gnomon_scene::{Scene, Settings, lights::Origin};
 
 use crate::{
     Action, View,
@@ -157,18 +157,23 @@ impl Model {
         let world_per_pixel = self.rig.distance() / self.view_size[1].max(1) as f32;
         let moved = |p: Vec3| p + (right * dx - up * dy) * world_per_pixel;
         let xyz = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
-        match light {
-            Light::Directional(sun) => {
-                let to_sun = -sun.direction;
-                let elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
-                let azimuth = to_sun.x.atan2(to_sun.z).to_degrees();
+        // By where the light is, not by its kind: a light from infinitely far turns, a
+        // local one moves. Each kind's settings are named after it (`sun_azimuth`,
+        // `spot_position`).
+        let kind = light.type_name();
+        match light.emission().origin {
+            Origin::Infinite { travel } => {
+                let to_light = -travel;
+                let elevation = to_light.y.clamp(-1.0, 1.0).asin().to_degrees();
+                let azimuth = to_light.x.atan2(to_light.z).to_degrees();
                 let azimuth = (azimuth + 0.4 * dx).rem_euclid(360.0);
                 let elevation = (elevation - 0.3 * dy).clamp(1.0, 90.0);
-                self.set("sun_azimuth", Some(&azimuth.to_string()));
-                self.set("sun_elevation", Some(&elevation.to_string()));
+                self.set(&format!("{kind}_azimuth"), Some(&azimuth.to_string()));
+                self.set(&format!("{kind}_elevation"), Some(&elevation.to_string()));
             }
-            Light::Spot(spot) => self.set("spot_position", Some(&xyz(moved(spot.position)))),
-            Light::Point(point) => self.set("point_position", Some(&xyz(moved(point.position)))),
+            Origin::Local { position, .. } => {
+                self.set(&format!("{kind}_position"), Some(&xyz(moved(position))))
+            }
         }
     }
 
