@@ -90,11 +90,13 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     }
     let mut all: Vec<String> = directives.iter().map(|d| (*d).to_owned()).collect();
     all.push(generated::wgsl_constants());
-    // `light.technique`'s type, where the light uniform is declared: the composed
-    // technique's struct, from the line `techniques::technique_wgsl` generates, or
-    // `NoParams` when no technique is composed.
-    let declares_light = parts.iter().any(|p| p.contains("struct Light {"));
-    if declares_light && !parts.iter().any(|p| p.contains("alias TechniqueParams")) {
+    // `light.technique`'s type, where the light uniform is declared (the part is
+    // `LIGHT_WGSL` itself): the composed technique's struct, from the part that
+    // `techniques::technique_wgsl` generates, or `NoParams` when no technique is
+    // composed.
+    let declares_light = parts.contains(&LIGHT_WGSL);
+    let typed = parts.iter().any(|p| p.starts_with(crate::techniques::TechniqueParams::ALIAS_PREFIX));
+    if declares_light && !typed {
         all.push(crate::techniques::TechniqueParams::default().wgsl_alias());
     }
     all.extend(

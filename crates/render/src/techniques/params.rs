@@ -61,9 +61,12 @@ impl TechniqueParams {
         self.block
     }
 
+    /// How the generated line that types `light.technique` begins.
+    pub(crate) const ALIAS_PREFIX: &str = "alias TechniqueParams = ";
+
     /// The generated WGSL line that makes `light.technique` this struct.
     pub fn wgsl_alias(&self) -> String {
-        format!("alias TechniqueParams = {};\n", self.wgsl_name)
+        format!("{}{};\n", Self::ALIAS_PREFIX, self.wgsl_name)
     }
 }
 
