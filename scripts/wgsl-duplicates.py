@@ -3,10 +3,10 @@
 more than one .wgsl file of the crates: the definitions whose winner, when files are
 concatenated, depends on which were composed. Usage:
 wgsl-duplicates.py [ROOT] [--allow NAME,NAME...] (ROOT defaults to the repository).
-Prints a count last; exits 1 when a name not allowed is defined twice. The technique
-contract's entry points (`sample_shadow`, `sample_shadow_cube`, `encode_moments`),
-which every technique's own file defines and exactly one of which a shader composes
-(`techniques::technique_wgsl`), are what `.ci/run` allows."""
+Prints a count last; exits 1 when a name not allowed is defined twice. `.ci/run`
+allows none: even the technique contract (`sample_shadow`, …) is implemented under
+each module's name and bound by `techniques::technique_wgsl`. `--allow` is for
+measuring an older checkout, where the contract was defined in every technique."""
 import collections, pathlib, re, sys
 
 args = sys.argv[1:]
