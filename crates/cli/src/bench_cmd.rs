@@ -172,7 +172,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         driver_info: gpu.info.driver_info.clone(),
         timing: match source {
             Some(TimingSource::GpuTimestamps) => "GPU timestamps",
-            _ => "CPU wall clock (each pass submitted and waited for alone)",
+            Some(TimingSource::CpuWallClock) | None => {
+                "CPU wall clock (each pass submitted and waited for alone)"
+            }
         },
         scene: scene.name.clone(),
         instances: uploaded.instance_count(),

@@ -214,7 +214,7 @@ impl PassClock {
             Mode::Gpu { query_set, .. } if !self.labels.is_empty() => {
                 Some(readback::record_timestamps(pool, encoder, query_set, 2 * self.labels.len() as u32))
             }
-            _ => None,
+            Mode::Gpu { .. } | Mode::Cpu { .. } | Mode::Off => None,
         };
         PendingTimes { clock: self, ticks: pending.map(Ticks::Recorded) }
     }
@@ -300,7 +300,7 @@ impl PendingTimes {
                 frame_ms: (last - first).as_secs_f64() * 1e3,
                 source: TimingSource::CpuWallClock,
             })),
-            _ => Ok(None),
+            (Mode::Gpu { .. }, None) | (Mode::Cpu { .. }, _) | (Mode::Off, _) => Ok(None),
         }
     }
 }

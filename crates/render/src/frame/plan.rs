@@ -178,11 +178,13 @@ impl Renderer {
         aspect: f32,
     ) -> Result<ShadowLayout, RenderError> {
         let shadow = &settings.shadow;
-        let sampled = match (light.shadow_view(), shadow.partition, shadow.cascades.sdsm) {
-            (ShadowView::Parallel { travel }, Partition::Cascades, true) => {
+        // SDSM fits a sun's cascades to the depths the camera sees.
+        let sdsm = shadow.partition == Partition::Cascades && shadow.cascades.sdsm;
+        let sampled = match light.shadow_view() {
+            ShadowView::Parallel { travel } if sdsm => {
                 self.sample_distribution(uploaded, travel, settings, camera, aspect)?
             }
-            _ => None,
+            ShadowView::Parallel { .. } | ShadowView::Frustum { .. } | ShadowView::Omni { .. } => None,
         };
         let unclipped_depth = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
         let drawing = MapDrawing { technique, unclipped_depth };

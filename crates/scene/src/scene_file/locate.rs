@@ -53,7 +53,7 @@ pub fn locate(text: &str, path: &KeyPath) -> Option<(usize, usize)> {
                 t.iter().find(|(k, _)| k.get_ref().as_ref() == *key).map(|(_, v)| v)
             }
             (Step::Index(i), Some(DeValue::Array(a))) => a.get(*i),
-            _ => None,
+            (Step::Key(_), Some(_)) | (Step::Index(_), _) => None,
         };
         match next {
             Some(v) => {

@@ -452,7 +452,8 @@ fn field_widget(
                 edits.push((id, Some(x.to_string())));
             }
         }
-        _ => {
+        (FieldKind::Integer | FieldKind::Float | FieldKind::Text, _)
+        | (FieldKind::Choice(_) | FieldKind::Flag | FieldKind::Bool, None) => {
             // Text: vectors, and the optional fields (empty gives them back to the scene).
             let draft = drafts.entry(id.clone()).or_insert_with(|| current.unwrap_or_default().to_string());
             let hint = match (field.optional, &field.value_name) {
