@@ -44,7 +44,18 @@ impl Limit {
 
     /// `x`, or an error naming the quantity, the value and the range.
     pub fn check(&self, quantity: &'static str, x: f32) -> Result<f32, LimitError> {
-        if self.allows(x) { Ok(x) } else { Err(LimitError::new(quantity, x, self.valid)) }
+        if self.allows(x) { Ok(x) } else { Err(LimitError::new(quantity, shown(x), self.valid)) }
+    }
+}
+
+/// A number as an error shows it. An infinity says why it may be one: a scene file's
+/// or a flag's finite number past f32's range (`1e39`) is read as infinite, and the
+/// error would otherwise quote a value nobody wrote.
+pub fn shown(x: f32) -> String {
+    if x.is_infinite() {
+        format!("{x} (or a number past ±{:e}, which reads as infinite)", f32::MAX)
+    } else {
+        x.to_string()
     }
 }
 
@@ -186,6 +197,16 @@ mod tests {
         assert!(SPOT_INNER_ANGLE.allows(0.0) && !SPOT_INNER_ANGLE.allows(-50.0));
         assert!(LIGHT_RADIUS.allows(0.0) && !LIGHT_RANGE.allows(0.0));
         assert!(!FIELD_OF_VIEW.allows(0.0) && !CLIP_DISTANCE.allows(-1.0));
+    }
+
+    /// A finite number past f32's range is read as infinite: the error says so
+    /// rather than quote a bare `inf` that nobody wrote.
+    #[test]
+    fn a_number_past_f32s_range_is_refused_saying_why_it_reads_as_infinite() {
+        let written: f32 = "1e39".parse().unwrap();
+        let e = INTENSITY.check("intensity", written).unwrap_err();
+        assert!(e.value.starts_with("inf (or a number past ±3.4028235e38"), "{e}");
+        assert_eq!(INTENSITY.check("intensity", -5.0).unwrap_err().value, "-5");
     }
 
     #[test]

@@ -45,7 +45,7 @@ pub(super) fn check_limit(
     limit: &crate::limits::Limit,
 ) -> Result<(), SettingsError> {
     match v {
-        Some(x) => check(limit.allows(x), setting, x, limit.valid),
+        Some(x) => check(limit.allows(x), setting, crate::limits::shown(x), limit.valid),
         None => Ok(()),
     }
 }

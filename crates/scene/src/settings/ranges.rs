@@ -80,7 +80,7 @@ impl SettingRange {
         if self.allows(value) {
             Ok(())
         } else {
-            Err(SettingsError { setting: self.setting, value: value.to_string(), valid: self.describe() })
+            Err(SettingsError { setting: self.setting, value: value.shown(), valid: self.describe() })
         }
     }
 }
@@ -89,9 +89,17 @@ impl SettingRange {
 pub trait RangeValue: Copy + ToString {
     /// Whether `self` lies in `range`.
     fn within(self, range: &SettingRange) -> bool;
+    /// `self` as an error shows it.
+    fn shown(self) -> String {
+        self.to_string()
+    }
 }
 
 impl RangeValue for f32 {
+    fn shown(self) -> String {
+        crate::limits::shown(self)
+    }
+
     fn within(self, r: &SettingRange) -> bool {
         let (min, max) = (r.min as f32, r.max as f32);
         let above = if r.min_open { self > min } else { self >= min };
