@@ -57,7 +57,7 @@ pub struct EmitterGpu {
 }
 
 impl EmitterGpu {
-    /// How `light` emits: its kind's [`Emission`], packed.
+    /// How `light` emits: its kind's [`Emission`](gnomon_scene::lights::Emission), packed.
     pub fn of(light: &Light) -> Self {
         let emission = light.emission();
         let (falloff, falloff_window) = FalloffGpu::of(emission.falloff);
