@@ -17,7 +17,7 @@ pub use point::PointLight;
 pub use spot::SpotLight;
 pub use sun::DirectionalLight;
 
-use crate::limits::{LIGHT_RANGE, LimitError};
+use crate::limits::{COLOR_CHANNEL, INTENSITY, LIGHT_RADIUS, LIGHT_RANGE, LimitError, check_vec3};
 
 /// What every light kind tells the renderer, the reference and the front ends.
 pub trait Kind {
@@ -140,6 +140,26 @@ pub enum ShadowView {
         /// Far plane of each face: the light's range.
         far: f32,
     },
+}
+
+/// The numbers a spot and a point light share, checked in the same order for both.
+pub(crate) struct LocalNumbers {
+    pub range: f32,
+    pub radius: f32,
+    pub color: Vec3,
+    pub intensity: f32,
+    pub falloff: Falloff,
+}
+
+impl LocalNumbers {
+    /// Each against its [`crate::limits::Limit`].
+    pub(crate) fn validate(&self) -> Result<(), LimitError> {
+        LIGHT_RANGE.check("range", self.range)?;
+        LIGHT_RADIUS.check("radius", self.radius)?;
+        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
+        INTENSITY.check("intensity", self.intensity)?;
+        self.falloff.validate()
+    }
 }
 
 /// The shadow map's near plane for a light of `range`: close enough for casters

@@ -3,10 +3,8 @@
 
 use glam::Vec3;
 
-use super::{Area, Emission, Falloff, Kind, Origin, ShadowView, shadow_near};
-use crate::limits::{
-    COLOR_CHANNEL, COORDINATE, INTENSITY, LIGHT_RADIUS, LIGHT_RANGE, LimitError, check_vec3,
-};
+use super::{Area, Emission, Falloff, Kind, LocalNumbers, Origin, ShadowView, shadow_near};
+use crate::limits::{COORDINATE, LimitError, check_vec3};
 
 /// A light emitting in every direction from a point, or from a sphere for soft shadows.
 /// Its shadow map is a cube: six 90° views.
@@ -43,11 +41,14 @@ impl Kind for PointLight {
 
     fn validate(&self) -> Result<(), LimitError> {
         check_vec3(&COORDINATE, "position", self.position)?;
-        LIGHT_RANGE.check("range", self.range)?;
-        LIGHT_RADIUS.check("radius", self.radius)?;
-        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
-        INTENSITY.check("intensity", self.intensity)?;
-        self.falloff.validate()
+        LocalNumbers {
+            range: self.range,
+            radius: self.radius,
+            color: self.color,
+            intensity: self.intensity,
+            falloff: self.falloff,
+        }
+        .validate()
     }
 
     fn emission(&self) -> Emission {

@@ -3,10 +3,9 @@
 
 use glam::Vec3;
 
-use super::{Area, Cone, Emission, Falloff, Kind, Origin, ShadowView, shadow_near};
+use super::{Area, Cone, Emission, Falloff, Kind, LocalNumbers, Origin, ShadowView, shadow_near};
 use crate::limits::{
-    COLOR_CHANNEL, COORDINATE, INTENSITY, LIGHT_RADIUS, LIGHT_RANGE, LimitError, SPOT_INNER_ANGLE,
-    SPOT_OUTER_ANGLE, check_direction, check_vec3,
+    COORDINATE, LimitError, SPOT_INNER_ANGLE, SPOT_OUTER_ANGLE, check_direction, check_vec3,
 };
 
 /// A point light restricted to a cone.
@@ -55,11 +54,14 @@ impl Kind for SpotLight {
         if inner > outer {
             return Err(LimitError::new("inner_angle", inner, format!("at most the outer angle {outer}")));
         }
-        LIGHT_RANGE.check("range", self.range)?;
-        LIGHT_RADIUS.check("radius", self.radius)?;
-        check_vec3(&COLOR_CHANNEL, "color", self.color)?;
-        INTENSITY.check("intensity", self.intensity)?;
-        self.falloff.validate()
+        LocalNumbers {
+            range: self.range,
+            radius: self.radius,
+            color: self.color,
+            intensity: self.intensity,
+            falloff: self.falloff,
+        }
+        .validate()
     }
 
     fn emission(&self) -> Emission {
