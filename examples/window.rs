@@ -218,7 +218,7 @@ impl App {
         let Some(live) = self.live.as_mut() else { return Ok(()) };
         let last = self.args.frames.is_some_and(|n| self.frame + 1 >= n);
         let (width, height) = (live.config.width, live.config.height);
-        live.scene.sun = sun(self.frame);
+        live.scene.set_default(sun(self.frame));
         (self.settings.image.width, self.settings.image.height) = (width, height);
         let device = &live.gpu.device;
         let clip_from_world = live.scene.camera.clip_from_world(width as f32 / height as f32);

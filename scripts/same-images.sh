@@ -53,6 +53,9 @@ spheres --refine off --technique pcss --sun-angular-diameter 3
 spheres --sun-angular-diameter 2 --refine rays --shadow-path mask
 spheres --light point --point-radius 0.2 --refine rays --shadow-path mask
 spheres --light point --point-radius 0.2 --refine rays --contact-shadows
+lamps --light spot --refine off
+lamps:4 --light sun --refine off
+lamps:4 --light point --refine off
 LIST
 python3 - "$dir" "$i" <<'PY' || status=1
 import sys

@@ -280,7 +280,11 @@ fn single_out_light(
     settings: &mut gnomon_scene::Settings,
 ) -> anyhow::Result<()> {
     settings.resolve_light(scene)?;
-    let mut light = scene.lights.swap_remove(settings.light.light_index);
+    let index = settings.light.light_index;
+    // `resolve_light` checked the index against the listed lights.
+    let Some(mut light) = scene.listed_lights().nth(index).cloned() else {
+        anyhow::bail!("scene `{}` lists no light at index {index}", scene.name);
+    };
     if let Some(overrides) = light.shadow.as_mut() {
         overrides.filter.technique = None;
     }
@@ -290,7 +294,7 @@ fn single_out_light(
         light.name,
         light.light.type_name()
     );
-    scene.lights = vec![light];
+    scene.replace_listed_lights([light]);
     settings.light.light_index = 0;
     Ok(())
 }

@@ -14,12 +14,12 @@ pub mod limits;
 mod model;
 mod scene_error;
 pub mod scene_file;
+pub mod scene_lights;
 pub mod settings;
 
 pub use casters::OpenCasters;
 pub use lights::{DirectionalLight, Falloff, Light, PointLight, SpotLight};
-pub use model::{
-    AlphaMode, Camera, Instance, Material, Mesh, Motion, Scene, SceneLight, Texture, Wrap, sun_direction,
-};
+pub use model::{AlphaMode, Camera, Instance, Material, Mesh, Motion, Scene, Texture, Wrap, sun_direction};
 pub use scene_error::SceneError;
+pub use scene_lights::{LightRole, SceneLight};
 pub use settings::Settings;

@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_math::Aabb;
 
-use crate::{DirectionalLight, Falloff, Light, PointLight, SceneError, SpotLight};
+use crate::{DirectionalLight, Falloff, PointLight, SceneError, SceneLight, SpotLight};
 
 /// A triangle mesh in object space. Triangles are counter-clockwise when seen from
 /// the side their normals point to.
@@ -189,20 +189,6 @@ impl Camera {
     }
 }
 
-/// One light of a scene's light list (`--light all`): the light, and the shadow
-/// settings it changes from the render's (a table in the shape of
-/// [`crate::settings::ShadowSettings`], laid over them).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneLight {
-    /// The light's name, for reports and messages (from the scene file, glTF light or built-in).
-    pub name: String,
-    /// The light itself.
-    pub light: Light,
-    /// This light's own shadow settings, laid over the render's; `None` to draw it with the
-    /// render's settings unchanged.
-    pub shadow: Option<crate::settings::ShadowOverrides>,
-}
-
 /// Direction *toward* the sun for an elevation above the horizon and an azimuth
 /// measured from +z toward +x, both in degrees.
 pub fn sun_direction(elevation_degrees: f32, azimuth_degrees: f32) -> Vec3 {
@@ -223,14 +209,9 @@ pub struct Scene {
     pub instances: Vec<Instance>,
     /// The default view, which the settings' camera overrides change.
     pub camera: Camera,
-    /// The scene's default sun, used with `--light sun`.
-    pub sun: DirectionalLight,
-    /// The scene's default spot light, used with `--light spot`.
-    pub spot: SpotLight,
-    /// The scene's default point light, used with `--light point`.
-    pub point: PointLight,
-    /// Every light the scene defines, each with its own shadow settings: rendered
-    /// together with `--light all`. Empty for a scene that defines none.
+    /// Every light: the listed ones (`--light all`), each with its own shadow
+    /// settings, and each kind's default (`--light sun`, …); [`crate::scene_lights`]
+    /// holds the rule that picks a kind's light, [`Scene::light`].
     pub lights: Vec<SceneLight>,
     /// Linear RGB ambient light, added unshadowed.
     pub ambient: Vec3,
@@ -244,8 +225,8 @@ pub struct Scene {
 impl Scene {
     /// An empty scene seen by `camera` and lit by `sun`, for a program that keeps its
     /// own geometry to hand its shadow casters to Gnomon with [`Scene::place`]. Its
-    /// spot and point light (used only when settings pick them) hang 10 units above
-    /// the origin, the spot pointing down.
+    /// default spot and point light (used only when settings pick them) hang 10 units
+    /// above the origin, the spot pointing down.
     pub fn new(name: &str, camera: Camera, sun: DirectionalLight) -> Scene {
         let above = Vec3::new(0.0, 10.0, 0.0);
         let white = Vec3::ONE;
@@ -255,27 +236,28 @@ impl Scene {
             materials: Vec::new(),
             instances: Vec::new(),
             camera,
-            sun,
-            spot: SpotLight {
-                position: above,
-                direction: Vec3::NEG_Y,
-                inner_angle_degrees: 32.0,
-                outer_angle_degrees: 40.0,
-                range: 30.0,
-                color: white,
-                intensity: 1.0,
-                falloff: Falloff::Constant,
-                radius: 0.0,
-            },
-            point: PointLight {
-                position: above,
-                range: 30.0,
-                color: white,
-                intensity: 1.0,
-                falloff: Falloff::Constant,
-                radius: 0.0,
-            },
-            lights: Vec::new(),
+            lights: vec![
+                SceneLight::default_of_kind(sun),
+                SceneLight::default_of_kind(SpotLight {
+                    position: above,
+                    direction: Vec3::NEG_Y,
+                    inner_angle_degrees: 32.0,
+                    outer_angle_degrees: 40.0,
+                    range: 30.0,
+                    color: white,
+                    intensity: 1.0,
+                    falloff: Falloff::Constant,
+                    radius: 0.0,
+                }),
+                SceneLight::default_of_kind(PointLight {
+                    position: above,
+                    range: 30.0,
+                    color: white,
+                    intensity: 1.0,
+                    falloff: Falloff::Constant,
+                    radius: 0.0,
+                }),
+            ],
             ambient: Vec3::splat(0.12),
             textures: Vec::new(),
             has_ground: false,
@@ -425,21 +407,14 @@ impl Scene {
         self.validate_lights_and_camera()
     }
 
-    /// Checks the camera and every light, the default sun, spot and point and the
-    /// light list, against [`crate::limits`].
+    /// Checks the camera and every light, listed or default, against [`crate::limits`].
     pub(crate) fn validate_lights_and_camera(&self) -> Result<(), SceneError> {
         let scene = &self.name;
         self.camera.validate().map_err(|problem| SceneError::BadCamera { scene: scene.clone(), problem })?;
-        let defaults = [
-            ("sun", Light::Directional(self.sun)),
-            ("spot", Light::Spot(self.spot)),
-            ("point", Light::Point(self.point)),
-        ];
-        let listed = self.lights.iter().map(|l| (l.name.as_str(), l.light));
-        for (name, light) in defaults.into_iter().chain(listed) {
-            light.validate().map_err(|problem| SceneError::BadLight {
+        for l in &self.lights {
+            l.light.validate().map_err(|problem| SceneError::BadLight {
                 scene: scene.clone(),
-                light: name.into(),
+                light: l.name.clone(),
                 problem,
             })?;
         }

@@ -16,7 +16,7 @@ use gnomon_reference::{
 };
 use gnomon_render::{Frame, OutputRequest, Renderer};
 use gnomon_scene::{
-    Instance, Scene, Settings, builtin,
+    DirectionalLight, Instance, Scene, Settings, builtin,
     camera_path::{CameraPathKind, camera_on_path},
     geometry,
     settings::{
@@ -182,7 +182,7 @@ fn warps_lower_the_aliasing_error_and_the_mismatch() {
 fn warps_fall_back_when_the_light_is_along_the_view() {
     let mut scene = builtin::columns();
     let forward = (scene.camera.target - scene.camera.eye).normalize();
-    scene.sun.direction = forward;
+    scene.light_mut::<DirectionalLight>().unwrap().direction = forward;
     let plain = render(&scene, &single_map(WarpKind::None));
     for warp in [WarpKind::Psm, WarpKind::Lispsm, WarpKind::Tsm] {
         let frame = render(&scene, &single_map(warp));
@@ -195,7 +195,8 @@ fn warps_fall_back_when_the_light_is_along_the_view() {
     // Ten degrees off the view direction LiSPSM and TSM engage, and still agree with
     // the reference. PSM's centre of projection sits just beyond the receivers there,
     // so it falls back (see `warping::psm`).
-    scene.sun.direction = (forward + Vec3::new(0.0, -0.18, 0.0)).normalize();
+    scene.light_mut::<DirectionalLight>().unwrap().direction =
+        (forward + Vec3::new(0.0, -0.18, 0.0)).normalize();
     let truth = common::reference(&scene, &single_map(WarpKind::None));
     for warp in [WarpKind::Psm, WarpKind::Lispsm, WarpKind::Tsm] {
         let frame = render(&scene, &single_map(warp));
@@ -223,7 +224,7 @@ fn psm_agrees_with_the_reference_ahead_behind_and_beside() {
         ("behind", Vec3::new(-0.4, 1.0, 0.8)),
         ("beside", side + 0.8 * up),
     ] {
-        scene.sun.direction = -toward_sun.normalize();
+        scene.light_mut::<DirectionalLight>().unwrap().direction = -toward_sun.normalize();
         let truth = common::reference(&scene, &single_map(WarpKind::None));
         let mut rates = Vec::new();
         for warp in [WarpKind::None, WarpKind::Psm] {
@@ -365,7 +366,7 @@ fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
         motion: gnomon_scene::Motion::Static,
     };
     scene.instances = vec![instance("ground", 0, Vec3::ZERO), instance("box", 1, Vec3::new(0.0, 8.0, 0.0))];
-    scene.sun.direction = Vec3::new(0.3, -1.0, 0.2).normalize();
+    scene.light_mut::<DirectionalLight>().unwrap().direction = Vec3::new(0.3, -1.0, 0.2).normalize();
     scene.camera.eye = Vec3::new(2.4, 1.5, 6.0);
     scene.camera.target = Vec3::new(2.4, 0.0, 1.6);
     scene.camera.far = 12.0;

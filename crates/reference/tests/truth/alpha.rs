@@ -11,7 +11,7 @@ use common::{
 };
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_scene::{
-    AlphaMode, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry,
+    AlphaMode, DirectionalLight, Instance, Material, Scene, Settings, Texture, Wrap, builtin, geometry,
     settings::{Refine, ScreenSpaceSettings, Technique, value_name},
 };
 
@@ -66,9 +66,10 @@ fn checker_scene() -> Scene {
             motion: gnomon_scene::Motion::Static,
         },
     ];
-    scene.sun.direction = -gnomon_scene::sun_direction(60.0, 20.0);
+    scene.light_mut::<DirectionalLight>().unwrap().direction = -gnomon_scene::sun_direction(60.0, 20.0);
     // Seen from beyond the shadow, so that the quad hides as little of it as possible.
-    let shadow = shadow_offset(scene.sun.direction) + Vec2::new(QUAD_CENTER.x, QUAD_CENTER.z);
+    let shadow = shadow_offset(scene.light::<DirectionalLight>().unwrap().direction)
+        + Vec2::new(QUAD_CENTER.x, QUAD_CENTER.z);
     scene.camera.eye = Vec3::new(shadow.x - 1.0, 6.0, shadow.y - 5.0);
     scene.camera.target = Vec3::new(shadow.x, 0.0, shadow.y);
     scene
@@ -116,7 +117,7 @@ fn pixel_size(position: &[Vec3], ids: &[u32], w: usize, i: usize) -> f32 {
 #[test]
 fn a_checkerboard_alpha_quad_casts_a_checkerboard_shadow() {
     let scene = checker_scene();
-    let direction = scene.sun.direction;
+    let direction = scene.light::<DirectionalLight>().unwrap().direction;
     for technique in [Technique::HARD, Technique::PCF2X2] {
         let s = settings(technique.clone());
         let frame = render(&scene, &s);
@@ -209,7 +210,7 @@ fn tree_pcf2x2_agrees_with_the_alpha_aware_reference_with_and_without_rays() {
     let path = common::shipped_scene("tree/tree.glb");
     let (mut scene, extras) = gnomon_scene::gltf_loader::load(&path).unwrap();
     assert!(!extras.has_camera, "the tree ships without a camera: the loader fits one");
-    scene.sun.direction = -gnomon_scene::sun_direction(55.0, 200.0);
+    scene.light_mut::<DirectionalLight>().unwrap().direction = -gnomon_scene::sun_direction(55.0, 200.0);
     let mut s = settings(Technique::PCF2X2);
     s.image.width = 1280;
     s.image.height = 720;

@@ -47,14 +47,14 @@ const SHADE_TOLERANCE: f32 = 0.004;
 fn a_point_light_over_a_plane_falls_off_as_the_inverse_square() {
     let (height, intensity, range) = (2.0, 3.0, 7.0);
     let mut scene = scene_of(vec![(geometry::plane(20.0, 20.0), Mat4::IDENTITY)]);
-    scene.point = PointLight {
+    scene.set_default(PointLight {
         position: Vec3::new(0.0, height, 0.0),
         range,
         color: Vec3::ONE,
         intensity,
         falloff: Falloff::InverseSquare { window: Some(range) },
         radius: 0.0,
-    };
+    });
     scene.camera = Camera {
         eye: Vec3::new(0.0, 9.0, 7.0),
         target: Vec3::ZERO,
@@ -73,8 +73,8 @@ fn a_point_light_over_a_plane_falls_off_as_the_inverse_square() {
         if frame.object_id[i] != 1 {
             continue;
         }
-        let d = p.distance(scene.point.position);
-        let expected = ALBEDO * intensity * scene.point.falloff.at(d) * (height / d);
+        let d = p.distance(scene.light::<PointLight>().unwrap().position);
+        let expected = ALBEDO * intensity * scene.light::<PointLight>().unwrap().falloff.at(d) * (height / d);
         let shown = linear(frame.color[4 * i]);
         // The visibility output is 0 beyond a light's range, 1 within it: no caster.
         assert!(
@@ -113,7 +113,7 @@ fn half_hidden_disk() -> (Scene, Settings) {
         // Covers x in [−20, 0] at height 1.5.
         (geometry::plane(20.0, 40.0), Mat4::from_translation(Vec3::new(-10.0, 0.5 * DISK_HEIGHT, 0.0))),
     ]);
-    scene.spot = SpotLight {
+    scene.set_default(SpotLight {
         position: Vec3::new(0.0, DISK_HEIGHT, 0.0),
         direction: Vec3::NEG_Y,
         inner_angle_degrees: 70.0,
@@ -123,7 +123,7 @@ fn half_hidden_disk() -> (Scene, Settings) {
         intensity: 9.0,
         falloff: Falloff::InverseSquare { window: None },
         radius: DISK_RADIUS,
-    };
+    });
     // Under the occluder's edge, looking down at the penumbra's lit half (x > 0),
     // where nearer points of the disk are the visible ones.
     scene.camera = Camera {
@@ -197,9 +197,14 @@ const UNWEIGHTED_GAP: f64 = 0.02;
 fn the_reference_weights_each_point_of_a_disk_by_its_falloff() {
     let (scene, s) = half_hidden_disk();
     let options = ReferenceOptions { width: s.image.width, height: s.image.height, samples: 256 };
-    let light = Light::Spot(scene.spot);
+    let light = Light::Spot(*scene.light::<SpotLight>().unwrap());
     let image = reference_visibility(&TracedScene::build(&scene), &scene.camera, &light, &options, &|_| {});
-    let found = against_integrals(&image.visibility, &image.position, &image.object_id, scene.spot.falloff);
+    let found = against_integrals(
+        &image.visibility,
+        &image.position,
+        &image.object_id,
+        scene.light::<SpotLight>().unwrap().falloff,
+    );
     figure(
         "reference under a disk of inverse-square points: mean − weighted integral (− unweighted)",
         format!("{:+.4} ({:+.4})", found.weighted, found.unweighted),
@@ -221,7 +226,12 @@ fn penumbra_rays_weight_each_point_of_a_disk_by_its_falloff() {
     s.screen.refine = Refine::EveryPixel;
     s.screen.penumbra_rays = 256;
     let frame = Renderer::new(gpu()).unwrap().render(&scene, &s, &OutputRequest::default()).unwrap();
-    let found = against_integrals(&frame.visibility, &frame.position, &frame.object_id, scene.spot.falloff);
+    let found = against_integrals(
+        &frame.visibility,
+        &frame.position,
+        &frame.object_id,
+        scene.light::<SpotLight>().unwrap().falloff,
+    );
     figure(
         "GPU penumbra rays under a disk of inverse-square points: mean − weighted integral (− unweighted)",
         format!("{:+.4} ({:+.4})", found.weighted, found.unweighted),

@@ -35,7 +35,7 @@ fn all_lights(index: usize) -> Settings {
 #[test]
 fn eight_mixed_lights_each_match_the_reference() {
     let scene = builtin::lamps();
-    assert_eq!(scene.lights.len(), 8);
+    assert_eq!(scene.listed_lights().count(), 8);
     for (index, bound) in MISMATCH_BOUNDS.into_iter().enumerate() {
         let s = all_lights(index);
         let frame = render(&scene, &s);
@@ -50,11 +50,15 @@ fn eight_mixed_lights_each_match_the_reference() {
         assert_eq!(frame.lights[1].resolution, 1024);
         assert_eq!(frame.lights[2].technique, Technique::PCSS);
         assert!(frame.lights.iter().all(|l| l.shadow_draws() > 0), "{:?}", frame.lights);
-        assert_eq!(frame.light, scene.lights[index].light, "the frame reports the light asked for");
+        assert_eq!(
+            frame.light,
+            scene.listed_lights().nth(index).unwrap().light,
+            "the frame reports the light asked for"
+        );
 
         let truth = reference(&scene, &s);
         let m = compare(&frame, &truth);
-        let light = &scene.lights[index];
+        let light = scene.listed_lights().nth(index).unwrap();
         eprintln!(
             "lamps, light {index} `{}` ({}, {}): mismatch {:.3}% of light-facing pixels, {:.3}% of all surfaces, MAE {:.4}",
             light.name,
@@ -82,7 +86,7 @@ fn eight_mixed_lights_each_match_the_reference() {
         // path (the default refines the hard ones by rays); a light with an area,
         // alone, would take the forward one, so alone it is given the mask too.
         let mut alone = scene.clone();
-        alone.lights = vec![light.clone()];
+        alone.replace_listed_lights([light.clone()]);
         let mut alone_settings = all_lights(0);
         alone_settings.screen.shadow_path = ShadowPath::Mask;
         let single = render(&alone, &alone_settings);

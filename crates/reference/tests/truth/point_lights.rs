@@ -111,7 +111,8 @@ fn seam_scene() -> Scene {
             motion: gnomon_scene::Motion::Static,
         });
     }
-    scene.point = PointLight { position: Vec3::new(0.0, 2.0, 0.0), range: 30.0, ..scene.point };
+    let point = *scene.light::<PointLight>().unwrap();
+    scene.set_default(PointLight { position: Vec3::new(0.0, 2.0, 0.0), range: 30.0, ..point });
     scene.camera = Camera {
         eye: Vec3::new(0.0, 9.0, 3.0),
         target: Vec3::ZERO,
@@ -120,7 +121,7 @@ fn seam_scene() -> Scene {
         near: 0.1,
         far: 40.0,
     };
-    scene.lights.clear();
+    scene.replace_listed_lights([]);
     scene
 }
 
@@ -219,7 +220,8 @@ fn no_band_of_mismatch_along_cube_face_seams() {
             .iter()
             .zip(&truth.position)
             .map(|(&v, &p)| {
-                let on_seam = p.is_finite() && texels_from_seam(p, scene.point.position, 512) < 0.5;
+                let on_seam = p.is_finite()
+                    && texels_from_seam(p, scene.light::<PointLight>().unwrap().position, 512) < 0.5;
                 if on_seam { 0.0 } else { v }
             })
             .collect();

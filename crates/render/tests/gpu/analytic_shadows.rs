@@ -5,7 +5,7 @@
 use crate::support;
 
 use glam::{Vec2, Vec3};
-use gnomon_scene::{Light, settings::Technique};
+use gnomon_scene::{Light, SpotLight, settings::Technique};
 use support::*;
 
 #[derive(Debug)]
@@ -86,7 +86,7 @@ fn spot_light_cone_and_shadow_match_the_perspective_projection() {
         s.shadow.filter.pcf_kernel = kernel as f32;
         let frame = render(&scene, &s);
         let Light::Spot(spot) = frame.light else { panic!("spot expected") };
-        assert_eq!(spot.position, scene.spot.position);
+        assert_eq!(spot.position, scene.light::<SpotLight>().unwrap().position);
         let label = format!("{technique:?} {kernel}");
 
         // Outside the cone: no light at all, so visibility 0 and only ambient colour.

@@ -6,7 +6,7 @@ use crate::support;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use gnomon_scene::{
-    Scene, geometry,
+    DirectionalLight, Scene, geometry,
     settings::{Settings, Technique},
 };
 use support::{figures::figure, *};
@@ -37,7 +37,8 @@ fn shift(height: f32) -> f32 {
 /// so that no occluder hides the shadows it casts.
 fn low_sun(name: &str) -> Scene {
     let mut scene = ground_scene(name, 24.0);
-    scene.sun.direction = Vec3::new(30f32.to_radians().cos(), -30f32.to_radians().sin(), 0.0);
+    scene.light_mut::<DirectionalLight>().unwrap().direction =
+        Vec3::new(30f32.to_radians().cos(), -30f32.to_radians().sin(), 0.0);
     scene.camera.eye = Vec3::new(7.0, 7.0, 0.5);
     scene.camera.target = Vec3::new(-0.5, 0.0, 0.0);
     scene

@@ -38,7 +38,7 @@ fn colour_difference(a: &Frame, b: &Frame) -> (u8, f64) {
 fn agrees_with_per_light_passes(scene: &Scene) {
     let listed = support::render(scene, &settings(ShadowPath::Mask, Lighting::LightList));
     let forward = support::render(scene, &settings(ShadowPath::Forward, Lighting::PerLight));
-    let lights = scene.lights.len();
+    let lights = scene.listed_lights().count();
     assert!(listed.shadow_mask && !forward.shadow_mask);
     assert_eq!(listed.object_id, forward.object_id, "{}: the same surfaces", scene.name);
     // The mask pass looks the shadow up where it rebuilds the point from the

@@ -8,7 +8,7 @@ use crate::support;
 use glam::{Vec2, Vec3};
 use gnomon_render::techniques::TechniqueRegistry;
 use gnomon_scene::{
-    Scene,
+    DirectionalLight, Scene, SpotLight,
     settings::{LightKind, RayUse, Settings, Technique},
 };
 use support::*;
@@ -101,10 +101,10 @@ fn check(label: &str, o: &Outcome) {
 fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() {
     let SquareOccluder { mut scene, shadow_center, shadow_half: half, height } = square_under_sun();
     let angular_diameter = 1.0f32;
-    scene.sun.angular_diameter_degrees = angular_diameter;
+    scene.light_mut::<DirectionalLight>().unwrap().angular_diameter_degrees = angular_diameter;
     // The penumbra's half-width on the ground: the occluder's distance along the ray
     // times the tangent of the sun's angular radius, stretched by the ground's slant.
-    let slant = -scene.sun.direction.normalize().y;
+    let slant = -scene.light::<DirectionalLight>().unwrap().direction.normalize().y;
     let penumbra_half = height / slant * (0.5 * angular_diameter).to_radians().tan() / slant;
 
     for technique in TechniqueRegistry::builtin().iter().map(|t| t.technique()) {
@@ -124,7 +124,7 @@ fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_sun() 
 fn every_technique_darkens_the_umbra_and_keeps_the_lit_ground_lit_under_a_spot() {
     let SquareOccluder { mut scene, shadow_center, shadow_half, height } = square_under_spot();
     let radius = 0.1f32;
-    scene.spot.radius = radius;
+    scene.light_mut::<SpotLight>().unwrap().radius = radius;
     let cone_radius = SPOT_HEIGHT * SPOT_OUTER_DEGREES.to_radians().tan();
     // Similar triangles: the disk's radius scaled by h / (H − h) on the ground.
     let penumbra_half = radius * height / (SPOT_HEIGHT - height);
@@ -185,7 +185,7 @@ fn analytic_sun_texel(scene: &Scene, resolution: u32) -> f32 {
         .flat_map(|i| scene.meshes[i.mesh].positions.iter().map(|&p| i.world_from_object.transform_point3(p)))
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let size = hi - lo;
-    let forward = scene.sun.direction.normalize();
+    let forward = scene.light::<DirectionalLight>().unwrap().direction.normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
     let span = |axis: Vec3| (axis.abs() * size).element_sum();

@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 
 use super::{GROUND, SceneBuilder, at, point, spot, sun};
 use crate::{
-    Camera, DirectionalLight, Falloff, Light, PointLight, Scene, SceneLight, SpotLight, geometry,
+    Camera, Falloff, PointLight, Scene, SceneLight, geometry,
     settings::{FilterSettingsPatch, MAX_LIGHTS, MapSettingsPatch, Partition, ShadowOverrides, Technique},
 };
 
@@ -63,27 +63,24 @@ pub fn lamp_grid(count: usize) -> Scene {
         near: 0.1,
         far: 4.0 * size + 40.0,
     };
+    // The lamps are the list; `--light point` draws the first of them, and the sun and
+    // the spot are the teaching lights', the spot aimed from the first lamp.
     let first = lamps[0];
-    let mut scene = b.finish(
-        &format!("lamps:{count}"),
-        camera,
-        sun(50.0, 30.0),
-        spot(first.position, Vec3::ZERO, 40.0, first.range),
-        first,
-    );
-    scene.ambient = Vec3::splat(0.05);
-    scene.lights = lamps
+    let mut lights: Vec<SceneLight> = lamps
         .into_iter()
         .enumerate()
         .map(|(i, lamp)| SceneLight {
-            name: format!("lamp {i}"),
-            light: Light::Point(lamp),
             shadow: Some(ShadowOverrides {
                 map: MapSettingsPatch { resolution: Some(256), ..Default::default() },
                 ..Default::default()
             }),
+            ..SceneLight::listed(format!("lamp {i}"), lamp)
         })
         .collect();
+    lights.push(SceneLight::default_of_kind(sun(50.0, 30.0)));
+    lights.push(SceneLight::default_of_kind(spot(first.position, Vec3::ZERO, 40.0, first.range)));
+    let mut scene = b.finish(&format!("lamps:{count}"), camera, lights);
+    scene.ambient = Vec3::splat(0.05);
     scene
 }
 
@@ -134,26 +131,16 @@ pub fn lamps() -> Scene {
         near: 0.1,
         far: 80.0,
     };
-    let Courtyard { lights, sun, first_spot, first_lamp } = courtyard_lights();
-    let mut scene = b.finish("lamps", camera, sun, first_spot, first_lamp);
+    // Every kind is listed, so `--light sun`, `spot` and `point` draw the first of each.
+    let mut scene = b.finish("lamps", camera, courtyard_lights());
     scene.ambient = Vec3::splat(0.06);
-    scene.lights = lights;
     scene
-}
-
-/// The courtyard's light list, and its sun, first spot and first lamp, which are also
-/// the scene's `--light sun`, `spot` and `point`.
-struct Courtyard {
-    lights: Vec<SceneLight>,
-    sun: DirectionalLight,
-    first_spot: SpotLight,
-    first_lamp: PointLight,
 }
 
 /// The courtyard's eight lights, each with its own technique (and map resolution
 /// where it sets one): a low sun with cascades, three coloured spots and four lamps,
 /// the spots and lamps of physical falloff.
-fn courtyard_lights() -> Courtyard {
+fn courtyard_lights() -> Vec<SceneLight> {
     // Each light's own technique, and map resolution when it has one.
     let own = |technique: Technique, resolution: Option<u32>| ShadowOverrides {
         filter: FilterSettingsPatch { technique: Some(technique), ..Default::default() },
@@ -173,15 +160,12 @@ fn courtyard_lights() -> Courtyard {
         (Vec3::new(0.5, 2.5, -4.0), Vec3::new(1.0, 0.5, 0.8)),
         (Vec3::new(-5.0, 1.8, -0.5), Vec3::new(0.7, 1.0, 0.5)),
     ];
-    let mut spots_made = Vec::new();
-    let mut lamps_made = Vec::new();
     let mut lights = vec![SceneLight {
-        name: "sun".into(),
-        light: Light::Directional(sun_light),
         shadow: Some(ShadowOverrides {
             partition: Some(Partition::Cascades),
             ..own(Technique::PCF_POISSON, None)
         }),
+        ..SceneLight::listed("sun", sun_light)
     }];
     for (i, (position, target, color)) in spots.into_iter().enumerate() {
         let mut s = spot(position, target, 38.0, 25.0);
@@ -196,11 +180,9 @@ fn courtyard_lights() -> Courtyard {
         } else {
             Some(1024)
         };
-        spots_made.push(s);
         lights.push(SceneLight {
-            name: format!("spot {i}"),
-            light: Light::Spot(s),
             shadow: Some(own(technique, resolution)),
+            ..SceneLight::listed(format!("spot {i}"), s)
         });
     }
     for (i, (position, color)) in points.into_iter().enumerate() {
@@ -210,12 +192,10 @@ fn courtyard_lights() -> Courtyard {
         if technique == Technique::PCSS {
             p.radius = 0.15;
         }
-        lamps_made.push(p);
         lights.push(SceneLight {
-            name: format!("lamp {i}"),
-            light: Light::Point(p),
             shadow: Some(own(technique, Some(512))),
+            ..SceneLight::listed(format!("lamp {i}"), p)
         });
     }
-    Courtyard { lights, sun: sun_light, first_spot: spots_made[0], first_lamp: lamps_made[0] }
+    lights
 }

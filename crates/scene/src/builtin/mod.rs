@@ -8,8 +8,8 @@ mod lamps;
 pub use lamps::{MAX_LAMPS, lamp_grid, lamps};
 
 use crate::{
-    Camera, DirectionalLight, Falloff, Instance, Material, Mesh, PointLight, Scene, SpotLight, geometry,
-    sun_direction,
+    Camera, DirectionalLight, Falloff, Instance, Material, Mesh, PointLight, Scene, SceneLight, SpotLight,
+    geometry, sun_direction,
 };
 
 /// A built-in scene: its name, what it shows, and how to build it.
@@ -138,29 +138,28 @@ impl SceneBuilder {
         });
     }
 
-    fn finish(
-        self,
-        name: &str,
-        camera: Camera,
-        sun: DirectionalLight,
-        spot: SpotLight,
-        point: PointLight,
-    ) -> Scene {
+    fn finish(self, name: &str, camera: Camera, lights: Vec<SceneLight>) -> Scene {
         Scene {
             name: name.into(),
             meshes: self.meshes,
             materials: self.materials,
             instances: self.instances,
             camera,
-            sun,
-            spot,
-            point,
-            lights: Vec::new(),
+            lights,
             ambient: Vec3::splat(0.12),
             textures: Vec::new(),
             has_ground: true,
         }
     }
+}
+
+/// A teaching scene's lights: a default of each kind, and no list.
+fn defaults(sun: DirectionalLight, spot: SpotLight, point: PointLight) -> Vec<SceneLight> {
+    vec![
+        SceneLight::default_of_kind(sun),
+        SceneLight::default_of_kind(spot),
+        SceneLight::default_of_kind(point),
+    ]
 }
 
 fn sun(elevation_degrees: f32, azimuth_degrees: f32) -> DirectionalLight {
@@ -236,9 +235,11 @@ pub fn spheres() -> Scene {
     b.finish(
         "spheres",
         camera,
-        sun(48.0, 35.0),
-        spot(Vec3::new(4.0, 9.0, 5.0), Vec3::ZERO, 40.0, 30.0),
-        point(Vec3::new(1.5, 2.2, 1.5), 30.0),
+        defaults(
+            sun(48.0, 35.0),
+            spot(Vec3::new(4.0, 9.0, 5.0), Vec3::ZERO, 40.0, 30.0),
+            point(Vec3::new(1.5, 2.2, 1.5), 30.0),
+        ),
     )
 }
 
@@ -274,9 +275,11 @@ pub fn contact() -> Scene {
     b.finish(
         "contact",
         camera,
-        sun(35.0, 200.0),
-        spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0),
-        point(Vec3::new(0.5, 2.5, 0.0), 20.0),
+        defaults(
+            sun(35.0, 200.0),
+            spot(Vec3::new(-2.0, 6.0, -5.0), Vec3::new(0.0, 0.0, 0.5), 45.0, 25.0),
+            point(Vec3::new(0.5, 2.5, 0.0), 20.0),
+        ),
     )
 }
 
@@ -304,9 +307,11 @@ pub fn grazing() -> Scene {
     b.finish(
         "grazing",
         camera,
-        sun(6.0, 250.0),
-        spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0),
-        point(Vec3::new(-3.0, 1.0, 1.0), 40.0),
+        defaults(
+            sun(6.0, 250.0),
+            spot(Vec3::new(-18.0, 2.5, 6.0), Vec3::new(0.0, 0.0, -2.0), 35.0, 60.0),
+            point(Vec3::new(-3.0, 1.0, 1.0), 40.0),
+        ),
     )
 }
 
@@ -335,9 +340,11 @@ pub fn columns() -> Scene {
     b.finish(
         "columns",
         camera,
-        sun(40.0, 60.0),
-        spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0),
-        point(Vec3::new(0.0, 4.0, -20.0), 30.0),
+        defaults(
+            sun(40.0, 60.0),
+            spot(Vec3::new(0.0, 8.0, -10.0), Vec3::new(0.0, 0.0, -22.0), 50.0, 40.0),
+            point(Vec3::new(0.0, 4.0, -20.0), 30.0),
+        ),
     )
 }
 
@@ -412,9 +419,11 @@ pub fn instances(count: usize) -> Scene {
     b.finish(
         &name,
         camera,
-        sun(50.0, 30.0),
-        spot(Vec3::new(0.0, 18.0, 10.0), Vec3::ZERO, 50.0, 60.0),
-        point(Vec3::new(0.0, 4.0, 0.0), 30.0),
+        defaults(
+            sun(50.0, 30.0),
+            spot(Vec3::new(0.0, 18.0, 10.0), Vec3::ZERO, 50.0, 60.0),
+            point(Vec3::new(0.0, 4.0, 0.0), 30.0),
+        ),
     )
 }
 
@@ -429,8 +438,12 @@ mod tests {
             assert_eq!(scene.name, b.name);
             scene.validate().unwrap();
             assert!(scene.triangle_count() > 0);
-            assert!((scene.sun.direction.length() - 1.0).abs() < 1e-5);
-            assert!(scene.sun.direction.y < 0.0, "{}: the sun shines downward", b.name);
+            assert!((scene.light::<DirectionalLight>().unwrap().direction.length() - 1.0).abs() < 1e-5);
+            assert!(
+                scene.light::<DirectionalLight>().unwrap().direction.y < 0.0,
+                "{}: the sun shines downward",
+                b.name
+            );
         }
         assert_eq!(build("no-such-scene").unwrap_err(), BuiltinError::Unknown("no-such-scene".into()));
     }
@@ -472,10 +485,9 @@ mod tests {
             let scene = build(&format!("lamps:{count}")).unwrap();
             scene.validate().unwrap();
             assert_eq!(scene.name, format!("lamps:{count}"));
-            assert_eq!(scene.lights.len(), count);
+            assert_eq!(scene.listed_lights().count(), count);
             let lamps: Vec<PointLight> = scene
-                .lights
-                .iter()
+                .listed_lights()
                 .map(|l| match l.light {
                     crate::Light::Point(p) => p,
                     other => panic!("{}: {other:?} is not a lamp", l.name),
@@ -529,7 +541,7 @@ mod tests {
 
     #[test]
     fn grazing_sun_is_six_degrees_up() {
-        let d = grazing().sun.direction;
+        let d = grazing().light::<DirectionalLight>().unwrap().direction;
         assert!(((-d.y).asin().to_degrees() - 6.0).abs() < 1e-3);
     }
 }

@@ -9,9 +9,10 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::{FileExtras, images, lights, node_extras::node_motion, primitives, structure};
+use crate::lights::KindType;
 use crate::{
-    AlphaMode, Camera, DirectionalLight, Instance, Light, Material, Mesh, Motion, PointLight, Scene,
-    SceneLight, SpotLight, Texture,
+    AlphaMode, Camera, DirectionalLight, Instance, Material, Mesh, Motion, PointLight, Scene, SceneLight,
+    SpotLight, Texture,
 };
 
 /// The scene `document` describes.
@@ -192,7 +193,7 @@ fn walk(document: &gltf::Document, meshes: &Meshes, materials: &[Material]) -> R
             match lights::from_file(&light, world, &mut placed.extras.warnings) {
                 Some(l) => {
                     let name = light.name().map_or_else(|| format!("light {}", light.index()), str::to_owned);
-                    placed.lights.push((light.index(), SceneLight { name, light: l, shadow: None }));
+                    placed.lights.push((light.index(), SceneLight::listed(name, l)));
                 }
                 None => placed.extras.ignored_lights += 1,
             }
@@ -295,29 +296,6 @@ struct Parts {
     placed: Placed,
 }
 
-/// The first light of each kind in the file's order: the defaults of `--light sun`,
-/// `spot` and `point`.
-#[derive(Default)]
-struct FirstOfEach {
-    sun: Option<DirectionalLight>,
-    spot: Option<SpotLight>,
-    point: Option<PointLight>,
-}
-
-impl FirstOfEach {
-    fn of(lights: &[SceneLight]) -> Self {
-        let mut first = FirstOfEach::default();
-        for l in lights {
-            match l.light {
-                Light::Directional(d) => first.sun = first.sun.or(Some(d)),
-                Light::Spot(s) => first.spot = first.spot.or(Some(s)),
-                Light::Point(p) => first.point = first.point.or(Some(p)),
-            }
-        }
-        first
-    }
-}
-
 /// The scene: the file's camera and lights, and where it has none, a camera fitted
 /// to the bounds and Gnomon's default lights placed over them.
 fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
@@ -325,8 +303,11 @@ fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
     let Placed { instances, camera, lights: mut found, mut extras, .. } = placed;
     // The light list in the file's order.
     found.sort_by_key(|(index, _)| *index);
-    let mut lights: Vec<SceneLight> = found.into_iter().map(|(_, l)| l).collect();
-    let first = FirstOfEach::of(&lights);
+    let listed: Vec<SceneLight> = found.into_iter().map(|(_, l)| l).collect();
+    let has = |kind: &str| listed.iter().any(|l| l.light.type_name() == kind);
+    extras.has_sun = has(DirectionalLight::NAME);
+    extras.has_spot = has(SpotLight::NAME);
+    extras.has_point = has(PointLight::NAME);
     let mut scene = Scene {
         name,
         meshes,
@@ -340,9 +321,6 @@ fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
             near: 0.1,
             far: 100.0,
         },
-        sun: lights::default_sun(),
-        spot: lights::default_spot(),
-        point: lights::default_point(),
         lights: Vec::new(),
         ambient: Vec3::splat(0.12),
         textures,
@@ -352,32 +330,33 @@ fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
     let bounds = scene.bounds();
     let (center, radius) = (bounds.center(), bounds.bounding_radius().max(1e-3));
     extras.has_camera = camera.is_some();
-    extras.has_sun = first.sun.is_some();
-    extras.has_spot = first.spot.is_some();
-    extras.has_point = first.point.is_some();
     scene.camera = camera.unwrap_or_else(|| crate::framing::default_camera(&scene));
-    scene.sun = first.sun.unwrap_or(scene.sun);
-    // A spot without a file's: above and beside the centre, aimed at it.
-    let above = center + Vec3::new(0.3, 1.6, 0.5) * radius;
-    scene.spot = first.spot.unwrap_or(SpotLight {
-        position: above,
-        direction: (center - above).normalize(),
-        range: 4.0 * radius,
-        ..scene.spot
-    });
-    // A point light without a file's: above the centre, reaching past the bounds.
-    scene.point = first.point.unwrap_or(PointLight {
-        position: center + Vec3::new(0.2, 0.9, 0.3) * radius,
-        range: 4.0 * radius,
-        ..scene.point
-    });
+    scene.lights = listed;
+    // A kind the file lists no light of gets Gnomon's default; one it lists draws its first.
+    if !extras.has_sun {
+        scene.set_default(lights::default_sun());
+    }
+    if !extras.has_spot {
+        // Above and beside the centre, aimed at it.
+        let above = center + Vec3::new(0.3, 1.6, 0.5) * radius;
+        let direction = (center - above).normalize();
+        scene.set_default(SpotLight {
+            position: above,
+            direction,
+            range: 4.0 * radius,
+            ..lights::default_spot()
+        });
+    }
+    if !extras.has_point {
+        // Above the centre, reaching past the bounds.
+        let position = center + Vec3::new(0.2, 0.9, 0.3) * radius;
+        scene.set_default(PointLight { position, range: 4.0 * radius, ..lights::default_point() });
+    }
     // A light without a range reaches past everything the file holds.
     let reach = |position: Vec3| 4.0 * radius + position.distance(center);
-    lights::give_ranges(&mut scene.spot, &mut scene.point, reach);
-    for l in &mut lights {
+    for l in &mut scene.lights {
         lights::give_range(&mut l.light, reach);
     }
-    scene.lights = lights;
     scene.validate_lights_and_camera().map_err(|e| e.to_string())?;
     Ok((scene, extras))
 }

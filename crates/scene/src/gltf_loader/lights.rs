@@ -81,16 +81,6 @@ pub(super) fn give_range(light: &mut Light, reach: impl Fn(Vec3) -> f32) {
     }
 }
 
-/// [`give_range`] for the scene's default spot and point lights.
-pub(super) fn give_ranges(spot: &mut SpotLight, point: &mut PointLight, reach: impl Fn(Vec3) -> f32) {
-    if !spot.range.is_finite() {
-        spot.range = reach(spot.position);
-    }
-    if !point.range.is_finite() {
-        point.range = reach(point.position);
-    }
-}
-
 /// The sun of a file without one: Gnomon's own, of intensity 1 (no falloff).
 pub(super) fn default_sun() -> DirectionalLight {
     DirectionalLight {

@@ -7,6 +7,31 @@
 //! of [`Light::kind`] here, and its branch in the shaders' `light_kinds.wgsl`
 //! (docs/architecture.md, "Walk-through: add a light kind").
 
+/// A kind's struct as its variant of [`Light`]: `From<$kind> for Light` and
+/// [`KindType`], written once for every kind (`kind_type!(SpotLight, Spot, "spot")`).
+macro_rules! kind_type {
+    ($kind:ident, $variant:ident, $name:literal) => {
+        impl From<$kind> for Light {
+            fn from(light: $kind) -> Light {
+                Light::$variant(light)
+            }
+        }
+
+        impl KindType for $kind {
+            const NAME: &'static str = $name;
+
+            fn of(light: &Light) -> Option<&Self> {
+                // Any other kind is not this one: a new kind needs no case here.
+                if let Light::$variant(this) = light { Some(this) } else { None }
+            }
+
+            fn of_mut(light: &mut Light) -> Option<&mut Self> {
+                if let Light::$variant(this) = light { Some(this) } else { None }
+            }
+        }
+    };
+}
+
 mod point;
 mod spot;
 mod sun;
@@ -28,8 +53,32 @@ pub trait Kind {
     fn validate(&self) -> Result<(), LimitError>;
     /// How and where it emits.
     fn emission(&self) -> Emission;
+    /// Its colour and brightness.
+    fn tint(&self) -> Tint;
     /// The view its shadow map takes.
     fn shadow_view(&self) -> ShadowView;
+}
+
+/// A kind's own type ([`DirectionalLight`], [`SpotLight`], [`PointLight`]) as one
+/// variant of [`Light`]: what lets a scene hand out its light of a kind typed
+/// ([`crate::Scene::light`]) without a match on the kind.
+pub trait KindType: Copy + Into<Light> {
+    /// The kind's name, as [`Kind::name`] and the command line write it.
+    const NAME: &'static str;
+    /// The light as this kind, or `None` for a light of another kind.
+    fn of(light: &Light) -> Option<&Self>;
+    /// The light as this kind, to change it, or `None` for a light of another kind.
+    fn of_mut(light: &mut Light) -> Option<&mut Self>;
+}
+
+/// A light's colour and brightness, as a scene file writes them (and falls back on,
+/// for a light that names neither).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tint {
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Brightness, in the kind's unit.
+    pub intensity: f32,
 }
 
 /// How a light emits, in the terms every consumer shares: the GPU's emitter block,

@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use super::{Area, Emission, Falloff, Kind, LocalNumbers, Origin, ShadowView, shadow_near};
+use super::{
+    Area, Emission, Falloff, Kind, KindType, Light, LocalNumbers, Origin, ShadowView, Tint, shadow_near,
+};
 use crate::limits::{COORDINATE, LimitError, check_vec3};
 
 /// A light emitting in every direction from a point, or from a sphere for soft shadows.
@@ -34,9 +36,11 @@ impl PointLight {
     }
 }
 
+kind_type!(PointLight, Point, "point");
+
 impl Kind for PointLight {
     fn name(&self) -> &'static str {
-        "point"
+        Self::NAME
     }
 
     fn validate(&self) -> Result<(), LimitError> {
@@ -49,6 +53,10 @@ impl Kind for PointLight {
             falloff: self.falloff,
         }
         .validate()
+    }
+
+    fn tint(&self) -> Tint {
+        Tint { color: self.color, intensity: self.intensity }
     }
 
     fn emission(&self) -> Emission {

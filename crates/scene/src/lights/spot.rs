@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use super::{Area, Cone, Emission, Falloff, Kind, LocalNumbers, Origin, ShadowView, shadow_near};
+use super::{
+    Area, Cone, Emission, Falloff, Kind, KindType, Light, LocalNumbers, Origin, ShadowView, Tint, shadow_near,
+};
 use crate::limits::{
     COORDINATE, LimitError, SPOT_INNER_ANGLE, SPOT_OUTER_ANGLE, check_direction, check_vec3,
 };
@@ -41,9 +43,11 @@ impl SpotLight {
     }
 }
 
+kind_type!(SpotLight, Spot, "spot");
+
 impl Kind for SpotLight {
     fn name(&self) -> &'static str {
-        "spot"
+        Self::NAME
     }
 
     fn validate(&self) -> Result<(), LimitError> {
@@ -62,6 +66,10 @@ impl Kind for SpotLight {
             falloff: self.falloff,
         }
         .validate()
+    }
+
+    fn tint(&self) -> Tint {
+        Tint { color: self.color, intensity: self.intensity }
     }
 
     fn emission(&self) -> Emission {

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::{Area, Emission, Falloff, Kind, Origin, ShadowView};
+use super::{Area, Emission, Falloff, Kind, KindType, Light, Origin, ShadowView, Tint};
 use crate::limits::{
     COLOR_CHANNEL, INTENSITY, LimitError, SUN_ANGULAR_DIAMETER, check_direction, check_vec3,
 };
@@ -22,9 +22,11 @@ pub struct DirectionalLight {
     pub angular_diameter_degrees: f32,
 }
 
+kind_type!(DirectionalLight, Directional, "sun");
+
 impl Kind for DirectionalLight {
     fn name(&self) -> &'static str {
-        "sun"
+        Self::NAME
     }
 
     fn validate(&self) -> Result<(), LimitError> {
@@ -33,6 +35,10 @@ impl Kind for DirectionalLight {
         INTENSITY.check("intensity", self.intensity)?;
         SUN_ANGULAR_DIAMETER.check("angular_diameter", self.angular_diameter_degrees)?;
         Ok(())
+    }
+
+    fn tint(&self) -> Tint {
+        Tint { color: self.color, intensity: self.intensity }
     }
 
     fn emission(&self) -> Emission {

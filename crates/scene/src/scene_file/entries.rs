@@ -6,7 +6,8 @@ use glam::Vec3;
 use serde::Deserialize;
 
 use crate::{
-    DirectionalLight, Falloff, Light, PointLight, SpotLight, limits, settings::ShadowOverrides, sun_direction,
+    DirectionalLight, Falloff, Light, PointLight, SpotLight, lights::Tint, limits, settings::ShadowOverrides,
+    sun_direction,
 };
 
 #[derive(Deserialize)]
@@ -103,12 +104,6 @@ impl From<limits::LimitError> for EntryError {
     }
 }
 
-/// The colour and intensity a light table falls back on when it gives none.
-pub(super) struct Fallback {
-    pub color: Vec3,
-    pub intensity: f32,
-}
-
 impl From<&SunEntry> for LightEntry {
     fn from(sun: &SunEntry) -> Self {
         LightEntry {
@@ -173,7 +168,7 @@ impl LightEntry {
 
     /// The light this table describes, every number checked, with `fallback`'s colour
     /// and intensity where it gives none.
-    pub(super) fn to_light(&self, fallback: Fallback) -> Result<Light, EntryError> {
+    pub(super) fn to_light(&self, fallback: Tint) -> Result<Light, EntryError> {
         let color = match self.color {
             Some(c) => limits::check_vec3(&limits::COLOR_CHANNEL, "color", Vec3::from_array(c))?,
             None => fallback.color,

@@ -53,12 +53,14 @@ use std::path::{Path, PathBuf};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use serde::Deserialize;
 
-use crate::{Camera, Light, Scene, SceneLight, Settings, gltf_loader, limits, settings::ShadowSettings};
+use crate::{
+    Camera, Scene, SceneLight, Settings, gltf_loader, lights::Tint, limits, settings::ShadowSettings,
+};
 
 mod entries;
 mod locate;
 
-use entries::{EntryError, Fallback, LightEntry, PointEntry, SpotEntry, SunEntry};
+use entries::{EntryError, LightEntry, PointEntry, SpotEntry, SunEntry};
 pub use locate::{KeyPath, Step, display, locate};
 
 /// A scene file that could not be used.
@@ -352,48 +354,39 @@ fn start_scene(
 }
 
 /// The file's `[sun]`, `[spot]`, `[point]` and `[[light]]` tables, each checked and
-/// placed into `scene`.
+/// placed into `scene`: the first three as their kinds' defaults, the last as the
+/// scene's list ([`crate::scene_lights`]).
 fn apply_lights(file: &SceneFile, source: &Source, scene: &mut Scene) -> Result<(), SceneFileError> {
     let failed = |table: &str, key: &[Step], e: EntryError| {
         let mut path = key.to_vec();
         path.extend(e.key.map(Step::Key));
         source.fail_at(&path, format!("{table}: {}", e.problem))
     };
-    let keep = |color: Vec3, intensity: f32| Fallback { color, intensity };
-    // `[sun]`, `[spot]` and `[point]`: one light each, falling back on the scene's.
-    let single = |entry: LightEntry, key: &'static str, fallback: Fallback| {
-        entry.to_light(fallback).map_err(|e| failed(&format!("[{key}]"), &[Step::Key(key)], e))
+    // A light that names no colour takes that of the scene's light of its kind.
+    let tint_of = |scene: &Scene, kind: &str| {
+        scene.light_of_kind(kind).map_or(Tint { color: Vec3::ONE, intensity: 1.0 }, |l| l.kind().tint())
     };
-    if let Some(sun) = &file.sun
-        && let Light::Directional(sun) =
-            single(sun.into(), "sun", keep(scene.sun.color, scene.sun.intensity))?
-    {
-        scene.sun = sun;
+    // `[sun]`, `[spot]` and `[point]`: one light each, falling back on the scene's intensity too.
+    let singles = [
+        (file.sun.as_ref().map(LightEntry::from), "sun"),
+        (file.spot.as_ref().map(LightEntry::from), "spot"),
+        (file.point.as_ref().map(LightEntry::from), "point"),
+    ];
+    for (entry, key) in singles {
+        if let Some(entry) = entry {
+            let light = entry
+                .to_light(tint_of(scene, key))
+                .map_err(|e| failed(&format!("[{key}]"), &[Step::Key(key)], e))?;
+            scene.set_default(light);
+        }
     }
-    if let Some(spot) = &file.spot
-        && let Light::Spot(spot) = single(spot.into(), "spot", keep(scene.spot.color, scene.spot.intensity))?
-    {
-        scene.spot = spot;
-    }
-    if let Some(point) = &file.point
-        && let Light::Point(point) =
-            single(point.into(), "point", keep(scene.point.color, scene.point.intensity))?
-    {
-        scene.point = point;
-    }
-    if !file.light.is_empty() {
-        scene.lights.clear();
-    }
+    let mut listed = Vec::with_capacity(file.light.len());
     for (i, entry) in file.light.iter().enumerate() {
         let name = entry.name.clone().unwrap_or_else(|| format!("light {i}"));
         let table = format!("[[light]] `{name}`");
         let here = [Step::Key("light"), Step::Index(i)];
         // A listed light takes the colour of the scene's light of its type, at full intensity.
-        let fallback = match entry.kind() {
-            "spot" => keep(scene.spot.color, 1.0),
-            "point" => keep(scene.point.color, 1.0),
-            _ => keep(scene.sun.color, 1.0),
-        };
+        let fallback = Tint { intensity: 1.0, ..tint_of(scene, entry.kind()) };
         let light = entry.to_light(fallback).map_err(|e| failed(&table, &here, e))?;
         if let Some(overrides) = &entry.shadow {
             // Checked over the defaults here; over the render's settings when resolved.
@@ -402,7 +395,10 @@ fn apply_lights(file: &SceneFile, source: &Source, scene: &mut Scene) -> Result<
                 source.fail_at(&key, format!("{table} shadow: {e}"))
             })?;
         }
-        scene.lights.push(SceneLight { name, light, shadow: entry.shadow.clone() });
+        listed.push(SceneLight { shadow: entry.shadow.clone(), ..SceneLight::listed(name, light) });
+    }
+    if !listed.is_empty() {
+        scene.replace_listed_lights(listed);
     }
     Ok(())
 }

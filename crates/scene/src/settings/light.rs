@@ -2,6 +2,8 @@
 //! lights of a render are resolved with their own shadow settings.
 
 use super::*;
+use crate::lights::KindType;
+use crate::{DirectionalLight, PointLight, SpotLight};
 
 /// Which of the scene's lights is rendered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -107,14 +109,14 @@ impl Settings {
                 lights[l.light_index].light
             }
             LightKind::Point => {
-                let mut point = scene.point;
+                let mut point = *scene_light::<PointLight>(scene)?;
                 point.position = l.point_position.unwrap_or(point.position);
                 point.range = l.point_range.unwrap_or(point.range);
                 point.radius = l.point_radius.unwrap_or(point.radius);
                 Light::Point(point)
             }
             LightKind::Sun => {
-                let mut sun = scene.sun;
+                let mut sun = *scene_light::<DirectionalLight>(scene)?;
                 if l.sun_elevation.is_some() || l.sun_azimuth.is_some() {
                     let to_sun = -sun.direction;
                     let elevation = to_sun.y.clamp(-1.0, 1.0).asin().to_degrees();
@@ -128,7 +130,7 @@ impl Settings {
                 Light::Directional(sun)
             }
             LightKind::Spot => {
-                let mut spot = scene.spot;
+                let mut spot = *scene_light::<SpotLight>(scene)?;
                 let target = spot.position + spot.direction;
                 spot.position = l.spot_position.unwrap_or(spot.position);
                 if l.spot_position.is_some() || l.spot_target.is_some() {
@@ -200,9 +202,10 @@ impl Settings {
             .collect()
     }
 
-    fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<&'s [crate::SceneLight], SettingsError> {
+    fn scene_light_list<'s>(&self, scene: &'s Scene) -> Result<Vec<&'s crate::SceneLight>, SettingsError> {
+        let listed: Vec<&crate::SceneLight> = scene.listed_lights().collect();
         check(
-            !scene.lights.is_empty(),
+            !listed.is_empty(),
             "light.kind",
             "all",
             format!(
@@ -211,13 +214,22 @@ impl Settings {
             ),
         )?;
         check(
-            scene.lights.len() <= MAX_LIGHTS,
+            listed.len() <= MAX_LIGHTS,
             "light.kind",
             "all",
-            format!("at most {MAX_LIGHTS} lights; `{}` lists {}", scene.name, scene.lights.len()),
+            format!("at most {MAX_LIGHTS} lights; `{}` lists {}", scene.name, listed.len()),
         )?;
-        Ok(&scene.lights)
+        Ok(listed)
     }
+}
+
+/// The scene's light of kind `K` ([`Scene::light`]), or an error naming the scene.
+fn scene_light<K: KindType>(scene: &Scene) -> Result<&K, SettingsError> {
+    scene.light::<K>().ok_or_else(|| SettingsError {
+        setting: "light.kind",
+        value: K::NAME.into(),
+        valid: format!("a kind of light scene `{}` has; it has no {} light", scene.name, K::NAME),
+    })
 }
 
 /// The most lights one render draws: the lighting pass's tile lists hold a bit per

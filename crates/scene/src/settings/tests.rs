@@ -2,6 +2,7 @@
 //! setting and range; lights resolve with their own shadow settings.
 
 use super::*;
+use crate::{DirectionalLight, PointLight};
 use clap::{CommandFactory, FromArgMatches, Parser};
 
 #[derive(Parser)]
@@ -221,8 +222,15 @@ fn sun_overrides_keep_the_other_angle() {
     s.light.sun_elevation = Some(30.0);
     let Light::Directional(sun) = s.resolve_light(&scene).unwrap() else { panic!() };
     assert!(((-sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
-    let (a0, a1) =
-        (scene.sun.direction.x.atan2(scene.sun.direction.z), sun.direction.x.atan2(sun.direction.z));
+    let (a0, a1) = (
+        scene
+            .light::<DirectionalLight>()
+            .unwrap()
+            .direction
+            .x
+            .atan2(scene.light::<DirectionalLight>().unwrap().direction.z),
+        sun.direction.x.atan2(sun.direction.z),
+    );
     assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
 }
 
@@ -245,7 +253,7 @@ fn point_light_flags_override_the_scenes_and_are_checked() {
     parsed.validate().unwrap();
     let Light::Point(p) = parsed.resolve_light(&scene).unwrap() else { panic!("a point light") };
     assert_eq!((p.position, p.range, p.radius), (Vec3::new(1.0, 2.0, 3.0), 7.0, 0.2));
-    assert_eq!(p.color, scene.point.color, "what no flag names stays the scene's");
+    assert_eq!(p.color, scene.light::<PointLight>().unwrap().color, "what no flag names stays the scene's");
     let lights = parsed.resolve_lights(&scene).unwrap();
     assert_eq!((lights.len(), lights[0].name.as_str()), (1, "point"));
 

@@ -8,7 +8,7 @@ use std::path::Path;
 use common::{glb, hierarchy_json, temp_dir, triangle_bytes};
 
 use glam::{Mat4, Quat, Vec3};
-use gnomon_scene::{AlphaMode, Falloff, gltf_loader};
+use gnomon_scene::{AlphaMode, DirectionalLight, Falloff, PointLight, gltf_loader};
 
 fn check_hierarchy(path: &Path) {
     let (scene, extras) = gltf_loader::load(path).unwrap();
@@ -143,11 +143,11 @@ fn every_punctual_light_joins_the_light_list() {
     std::fs::write(dir.join("lights.glb"), glb(&json, &triangle_bytes())).unwrap();
     let (scene, extras) = gltf_loader::load(&dir.join("lights.glb")).unwrap();
     assert!(extras.has_point && extras.has_spot && !extras.has_sun);
-    assert_eq!(scene.lights.len(), 3);
+    assert_eq!(scene.listed_lights().count(), 3);
     assert_eq!(scene.lights[0].name, "bulb");
     let Light::Point(bulb) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
     assert_eq!((bulb.position, bulb.range), (Vec3::new(0.0, 3.0, 0.0), 6.0));
-    assert_eq!(scene.point, bulb, "the first point light is the default");
+    assert_eq!(*scene.light::<PointLight>().unwrap(), bulb, "the first point light is the default");
     // A light without a range reaches past the scene.
     let Light::Point(unranged) = scene.lights[2].light else { panic!() };
     assert!(unranged.range.is_finite() && unranged.range > 2.0);
@@ -187,5 +187,5 @@ fn a_suns_lux_are_its_intensity() {
     assert!(extras.has_sun);
     let Light::Directional(sun) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
     assert_eq!(sun.intensity, 3.5);
-    assert_eq!(scene.sun, sun, "the file's sun is the default");
+    assert_eq!(*scene.light::<DirectionalLight>().unwrap(), sun, "the file's sun is the default");
 }

@@ -4,7 +4,7 @@
 use crate::common;
 
 use glam::Vec3;
-use gnomon_scene::{Settings, scene_file, settings::Technique};
+use gnomon_scene::{DirectionalLight, PointLight, Settings, scene_file, settings::Technique};
 
 use common::{glb, hierarchy_json, temp_dir, triangle_bytes};
 
@@ -63,8 +63,10 @@ fn models_lights_views_and_settings_come_from_the_file() {
     // child's origin (0, 2, −2) in the model becomes (10, 4, −4).
     let second = scene.instances[1].world_from_object.transform_point3(Vec3::ZERO);
     assert!(second.abs_diff_eq(Vec3::new(10.0, 4.0, -4.0), 1e-4), "{second}");
-    assert!(((-scene.sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
-    assert_eq!(scene.sun.angular_diameter_degrees, 0.5);
+    assert!(
+        ((-scene.light::<DirectionalLight>().unwrap().direction.y).asin().to_degrees() - 30.0).abs() < 1e-3
+    );
+    assert_eq!(scene.light::<DirectionalLight>().unwrap().angular_diameter_degrees, 0.5);
     let top = scene_file::load(&path, Some("top")).unwrap().scene.camera;
     assert_eq!((top.eye, top.fov_y_degrees), (Vec3::new(5.0, 20.0, 0.1), 30.0));
 
@@ -145,17 +147,15 @@ fn point_lights_and_the_light_list_come_from_the_file() {
     let temp = temp_dir("scene-file-lights");
     let dir = temp.path();
     let scene = scene_file::load(&write_scene(dir, LIGHTS), None).unwrap().scene;
-    assert_eq!(
-        (scene.point.position, scene.point.range, scene.point.radius),
-        (Vec3::new(0.0, 3.0, 0.0), 12.0, 0.1)
-    );
-    let names: Vec<&str> = scene.lights.iter().map(|l| l.name.as_str()).collect();
+    let point = *scene.light::<PointLight>().unwrap();
+    assert_eq!((point.position, point.range, point.radius), (Vec3::new(0.0, 3.0, 0.0), 12.0, 0.1));
+    let names: Vec<&str> = scene.listed_lights().map(|l| l.name.as_str()).collect();
     assert_eq!(names, ["key", "lamp", "light 2"]);
     let Light::Point(lamp) = scene.lights[1].light else { panic!("{:?}", scene.lights[1]) };
     assert_eq!((lamp.range, lamp.color), (8.0, Vec3::new(1.0, 0.5, 0.25)));
     // `falloff` is glTF's, windowed at the range; a light without it keeps Gnomon's constant.
     assert_eq!(lamp.falloff, gnomon_scene::Falloff::InverseSquare { window: Some(8.0) });
-    assert_eq!(scene.point.falloff, gnomon_scene::Falloff::Constant);
+    assert_eq!(point.falloff, gnomon_scene::Falloff::Constant);
 
     // --light all resolves every light with its own shadow settings over the render's.
     let mut s = Settings::default();

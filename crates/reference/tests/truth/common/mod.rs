@@ -138,12 +138,12 @@ pub fn thin_bars() -> Scene {
             turn * Mat4::from_translation(Vec3::new(offset, 1.0, 0.0)),
         ));
     }
-    scene.sun = DirectionalLight {
+    scene.set_default(DirectionalLight {
         direction: -sun_direction(60.0, 40.0),
         color: Vec3::ONE,
         intensity: 1.0,
         angular_diameter_degrees: 0.0,
-    };
+    });
     scene.camera = Camera {
         eye: Vec3::new(0.3, 4.5, 2.5),
         target: Vec3::new(-0.4, 0.0, -0.3),

@@ -9,7 +9,7 @@ pub use device::{gpu, render};
 
 use glam::{Mat4, Vec3};
 use gnomon_render::Frame;
-use gnomon_scene::{Instance, Light, Material, Scene, Settings, geometry};
+use gnomon_scene::{DirectionalLight, Instance, Light, Material, Scene, Settings, SpotLight, geometry};
 
 /// The default settings at a size and map resolution, unrefined: these tests measure
 /// the shadow maps themselves, which the default's rays would correct where the map
@@ -166,7 +166,7 @@ pub fn square_under_sun() -> SquareOccluder {
     scene.camera.eye = Vec3::new(0.0, 9.0, 6.0);
     scene.camera.target = Vec3::ZERO;
     let sun_dir = -gnomon_scene::sun_direction(50.0, 30.0);
-    scene.sun.direction = sun_dir;
+    scene.light_mut::<DirectionalLight>().unwrap().direction = sun_dir;
     let offset = glam::Vec2::new(sun_dir.x, sun_dir.z) * (height / -sun_dir.y);
     SquareOccluder {
         scene,
@@ -191,11 +191,11 @@ pub fn square_under_spot() -> SquareOccluder {
     add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
     scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
     scene.camera.target = Vec3::ZERO;
-    scene.spot.position = Vec3::new(0.0, SPOT_HEIGHT, 0.0);
-    scene.spot.direction = Vec3::NEG_Y;
-    scene.spot.outer_angle_degrees = SPOT_OUTER_DEGREES;
-    scene.spot.inner_angle_degrees = 25.0;
-    scene.spot.range = 20.0;
+    scene.light_mut::<SpotLight>().unwrap().position = Vec3::new(0.0, SPOT_HEIGHT, 0.0);
+    scene.light_mut::<SpotLight>().unwrap().direction = Vec3::NEG_Y;
+    scene.light_mut::<SpotLight>().unwrap().outer_angle_degrees = SPOT_OUTER_DEGREES;
+    scene.light_mut::<SpotLight>().unwrap().inner_angle_degrees = 25.0;
+    scene.light_mut::<SpotLight>().unwrap().range = 20.0;
     let k = SPOT_HEIGHT / (SPOT_HEIGHT - height);
     SquareOccluder {
         scene,
