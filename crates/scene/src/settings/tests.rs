@@ -495,3 +495,17 @@ fn every_setting_path_the_checks_name_is_a_setting() {
     }
     assert!(named > 40, "only {named} setting paths found in the checks");
 }
+
+#[test]
+fn a_kind_the_scene_has_no_light_of_is_refused_by_name() {
+    let mut scene = crate::builtin::spheres();
+    let sun = *scene.light::<DirectionalLight>().unwrap();
+    scene.lights.clear();
+    scene.replace_listed_lights([crate::SceneLight::listed("key", sun)]);
+    let mut s = Settings::default();
+    assert!(s.resolve_light(&scene).is_ok(), "the listed sun is the scene's sun");
+    s.light.kind = LightKind::Point;
+    let e = s.resolve_light(&scene).unwrap_err();
+    assert_eq!((e.setting, e.value.as_str()), ("light.kind", "point"));
+    assert!(e.to_string().contains("`spheres` has; it has no point light"), "{e}");
+}
