@@ -129,7 +129,7 @@ pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
 
 /// The camera uniform of the passes that shade from the camera, bound at group 1.
 pub(crate) const CAMERA_WGSL: &str =
-    concat!(include_str!("camera.wgsl"), "\n@group(1) @binding(0) var<uniform> camera: Camera;\n");
+    concat!(include_str!("camera.wgsl"), "\n", include_str!("camera_binding.wgsl"));
 
 /// The octahedral encoding of the prepass's normals, for the passes that write or read
 /// them.
