@@ -272,7 +272,8 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 /// With `--light all`, a comparison measures one light, the one at `--light-index`,
-/// as the scene's only light: the reference traces that light alone, the timings are
+/// as the scene's only listed light (each kind's default stays, unused by `--light
+/// all`): the reference traces that light alone, the timings are
 /// its passes', and each compared technique replaces the technique its own shadow
 /// settings name (its other settings, such as its resolution, stay).
 fn single_out_light(

@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec2, Vec3};
 use gnomon_math::Aabb;
 
-use crate::{DirectionalLight, Falloff, PointLight, SceneError, SceneLight, SpotLight};
+use crate::{DirectionalLight, Falloff, Light, PointLight, SceneError, SceneLight, SpotLight};
 
 /// A triangle mesh in object space. Triangles are counter-clockwise when seen from
 /// the side their normals point to.
@@ -407,14 +407,19 @@ impl Scene {
         self.validate_lights_and_camera()
     }
 
-    /// Checks the camera and every light, listed or default, against [`crate::limits`].
+    /// Checks the camera and every light against [`crate::limits`]: first the light
+    /// each kind's `--light` draws, named by its kind, then the listed lights by
+    /// name; and that no kind has two defaults.
     pub(crate) fn validate_lights_and_camera(&self) -> Result<(), SceneError> {
         let scene = &self.name;
         self.camera.validate().map_err(|problem| SceneError::BadCamera { scene: scene.clone(), problem })?;
-        for l in &self.lights {
-            l.light.validate().map_err(|problem| SceneError::BadLight {
+        self.check_one_default_per_kind()?;
+        let chosen = Light::KIND_NAMES.iter().filter_map(|&kind| Some((kind, self.light_of_kind(kind)?)));
+        let listed = self.listed_lights().map(|l| (l.name.as_str(), &l.light));
+        for (name, light) in chosen.chain(listed) {
+            light.validate().map_err(|problem| SceneError::BadLight {
                 scene: scene.clone(),
-                light: l.name.clone(),
+                light: name.into(),
                 problem,
             })?;
         }

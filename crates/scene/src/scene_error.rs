@@ -99,6 +99,21 @@ pub enum SceneError {
         /// The value at fault and its valid range.
         problem: crate::limits::LimitError,
     },
+    /// A scene has two defaults of one kind: which one `--light <kind>` draws would be
+    /// a matter of order ([`crate::scene_lights`] allows one per kind).
+    #[error(
+        "scene `{scene}`: two default {kind} lights, `{first}` and `{second}`: a scene has one default per kind (Scene::set_default replaces it)"
+    )]
+    TwoDefaults {
+        /// Name of the scene at fault.
+        scene: String,
+        /// The kind, as `Light::KIND_NAMES` writes it.
+        kind: &'static str,
+        /// The first default's name.
+        first: String,
+        /// The second default's name.
+        second: String,
+    },
     /// The camera has a number outside its valid range ([`crate::limits`]).
     #[error("scene `{scene}`: camera: {problem}")]
     BadCamera {

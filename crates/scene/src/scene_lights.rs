@@ -11,7 +11,7 @@
 //! per kind ([`Scene::set_default`] replaces it).
 
 use crate::lights::KindType;
-use crate::{Light, Scene};
+use crate::{Light, Scene, SceneError};
 
 /// Whether a light belongs to the scene's list or stands in for its kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,15 +59,15 @@ impl Scene {
     }
 
     /// [`Scene::light`] by the kind's name (`"spot"`, as [`Light::KIND_NAMES`] writes it).
-    pub fn light_of_kind(&self, kind: &str) -> Option<&Light> {
-        let index = self.chosen_index(kind_id(kind)?)?;
+    pub(crate) fn light_of_kind(&self, kind: &str) -> Option<&Light> {
+        let index = self.chosen_index(Light::kind_id_of(kind)?)?;
         Some(&self.lights[index].light)
     }
 
     /// [`Scene::light`], to change it. Where the scene has no default of the kind this
     /// is its first listed light, which `--light all` then draws changed too.
     pub fn light_mut<K: KindType>(&mut self) -> Option<&mut K> {
-        let index = self.chosen_index(kind_id(K::NAME)?)?;
+        let index = self.chosen_index(Light::kind_id_of(K::NAME)?)?;
         K::of_mut(&mut self.lights[index].light)
     }
 
@@ -84,6 +84,11 @@ impl Scene {
     /// The listed lights, in order: what `--light all` draws and `--light-index` counts.
     pub fn listed_lights(&self) -> impl Iterator<Item = &SceneLight> {
         self.lights.iter().filter(|l| l.role == LightRole::Listed)
+    }
+
+    /// [`Scene::listed_lights`], to change them (a light's own shadow settings).
+    pub fn listed_lights_mut(&mut self) -> impl Iterator<Item = &mut SceneLight> {
+        self.lights.iter_mut().filter(|l| l.role == LightRole::Listed)
     }
 
     /// Replaces the listed lights with `listed`. Each kind keeps the light it drew: a
@@ -103,6 +108,25 @@ impl Scene {
         self.lights.extend(defaults);
     }
 
+    /// A kind with two defaults is refused ([`Scene::validate`]): which of them
+    /// `--light <kind>` drew would depend on their order.
+    pub(crate) fn check_one_default_per_kind(&self) -> Result<(), SceneError> {
+        let defaults: Vec<&SceneLight> =
+            self.lights.iter().filter(|l| l.role == LightRole::Default).collect();
+        for (i, first) in defaults.iter().enumerate() {
+            let same_kind = |l: &&&SceneLight| l.light.kind_id() == first.light.kind_id();
+            if let Some(second) = defaults[i + 1..].iter().find(same_kind) {
+                return Err(SceneError::TwoDefaults {
+                    scene: self.name.clone(),
+                    kind: first.light.type_name(),
+                    first: first.name.clone(),
+                    second: second.name.clone(),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Whether the light at `index` is the one its kind's `--light` draws.
     fn is_chosen(&self, index: usize) -> bool {
         let kind = self.lights[index].light.kind_id();
@@ -115,11 +139,6 @@ impl Scene {
             |role: LightRole| self.lights.iter().position(|l| l.role == role && l.light.kind_id() == kind);
         of_kind(LightRole::Default).or_else(|| of_kind(LightRole::Listed))
     }
-}
-
-/// A kind's id ([`Light::kind_id`]) from its name.
-fn kind_id(name: &str) -> Option<u32> {
-    Light::KIND_NAMES.iter().position(|n| *n == name).map(|index| index as u32)
 }
 
 #[cfg(test)]
@@ -191,5 +210,14 @@ mod tests {
         let defaults = scene.lights.iter().filter(|l| l.role == LightRole::Default);
         assert_eq!(defaults.count(), 3, "one default per kind");
         assert_eq!(*scene.light::<SpotLight>().unwrap(), spot_at(5.0));
+    }
+
+    #[test]
+    fn a_second_default_of_one_kind_is_refused_by_validate() {
+        let mut scene = empty();
+        scene.validate().unwrap();
+        scene.lights.push(SceneLight::default_of_kind(spot_at(6.0)));
+        let e = scene.validate().unwrap_err().to_string();
+        assert!(e.contains("two default spot lights"), "{e}");
     }
 }

@@ -63,8 +63,8 @@ pub fn lamp_grid(count: usize) -> Scene {
         near: 0.1,
         far: 4.0 * size + 40.0,
     };
-    // The lamps are the list; `--light point` draws the first of them, and the sun and
-    // the spot are the teaching lights', the spot aimed from the first lamp.
+    // The lamps are the list, and `--light point` draws the first of them; the sun
+    // and the spot are defaults, the spot hung at the first lamp and aimed at the centre.
     let first = lamps[0];
     let mut lights: Vec<SceneLight> = lamps
         .into_iter()

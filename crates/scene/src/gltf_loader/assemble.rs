@@ -296,6 +296,11 @@ struct Parts {
     placed: Placed,
 }
 
+/// Whether the file lists a light of kind `K`.
+fn lists<K: KindType>(listed: &[SceneLight]) -> bool {
+    listed.iter().any(|l| K::of(&l.light).is_some())
+}
+
 /// The scene: the file's camera and lights, and where it has none, a camera fitted
 /// to the bounds and Gnomon's default lights placed over them.
 fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
@@ -304,10 +309,9 @@ fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
     // The light list in the file's order.
     found.sort_by_key(|(index, _)| *index);
     let listed: Vec<SceneLight> = found.into_iter().map(|(_, l)| l).collect();
-    let has = |kind: &str| listed.iter().any(|l| l.light.type_name() == kind);
-    extras.has_sun = has(DirectionalLight::NAME);
-    extras.has_spot = has(SpotLight::NAME);
-    extras.has_point = has(PointLight::NAME);
+    extras.has_sun = lists::<DirectionalLight>(&listed);
+    extras.has_spot = lists::<SpotLight>(&listed);
+    extras.has_point = lists::<PointLight>(&listed);
     let mut scene = Scene {
         name,
         meshes,

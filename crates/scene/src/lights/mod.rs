@@ -2,9 +2,10 @@
 //! interface every kind answers ([`Kind`]): its name, its limits, what it emits
 //! ([`Emission`], with the area the reference samples) and the view its shadow map
 //! takes ([`ShadowView`]). Each kind is a file of its own (`sun.rs`, `spot.rs`,
-//! `point.rs`); the renderer, the reference and the front ends ask these facts
-//! instead of matching on the kind, so a new kind is its file, a variant and a line
-//! of [`Light::kind`] here, and its branch in the shaders' `light_kinds.wgsl`
+//! `point.rs`, each also naming itself with `kind_type!`); the renderer, the
+//! reference and the front ends ask these facts instead of matching on the kind, so
+//! a new kind is its file, a variant and a line of [`Light::kind`] here, and its
+//! branch in the shaders' `light_kinds.wgsl`
 //! (docs/architecture.md, "Walk-through: add a light kind").
 
 /// A kind's struct as its variant of [`Light`]: `From<$kind> for Light` and
@@ -291,8 +292,12 @@ impl Light {
     /// The light's kind as a number: its name's index in [`Light::KIND_NAMES`], which
     /// the shaders compare with (`LIGHT_SUN`, … in WGSL).
     pub fn kind_id(&self) -> u32 {
-        let name = self.type_name();
-        Light::KIND_NAMES.iter().position(|n| *n == name).expect("every kind's name is in KIND_NAMES") as u32
+        Light::kind_id_of(self.type_name()).expect("every kind's name is in KIND_NAMES")
+    }
+
+    /// A kind's id from its name, or `None` for a name that is no kind's.
+    pub fn kind_id_of(name: &str) -> Option<u32> {
+        Light::KIND_NAMES.iter().position(|n| *n == name).map(|index| index as u32)
     }
 
     /// A local light's range, to give one to a light loaded without it; `None` for a

@@ -366,20 +366,18 @@ fn apply_lights(file: &SceneFile, source: &Source, scene: &mut Scene) -> Result<
     let tint_of = |scene: &Scene, kind: &str| {
         scene.light_of_kind(kind).map_or(Tint { color: Vec3::ONE, intensity: 1.0 }, |l| l.kind().tint())
     };
-    // `[sun]`, `[spot]` and `[point]`: one light each, falling back on the scene's intensity too.
-    let singles = [
-        (file.sun.as_ref().map(LightEntry::from), "sun"),
-        (file.spot.as_ref().map(LightEntry::from), "spot"),
-        (file.point.as_ref().map(LightEntry::from), "point"),
-    ];
-    for (entry, key) in singles {
-        if let Some(entry) = entry {
-            let light = entry
-                .to_light(tint_of(scene, key))
-                .map_err(|e| failed(&format!("[{key}]"), &[Step::Key(key)], e))?;
-            scene.set_default(light);
-        }
-    }
+    // `[sun]`, `[spot]` and `[point]`: their kinds' defaults, falling back on the scene's intensity too.
+    let set_default = |scene: &mut Scene, entry: Option<LightEntry>, key: &'static str| {
+        let Some(entry) = entry else { return Ok(()) };
+        let light = entry
+            .to_light(tint_of(scene, key))
+            .map_err(|e| failed(&format!("[{key}]"), &[Step::Key(key)], e))?;
+        scene.set_default(light);
+        Ok::<(), SceneFileError>(())
+    };
+    set_default(scene, file.sun.as_ref().map(LightEntry::from), "sun")?;
+    set_default(scene, file.spot.as_ref().map(LightEntry::from), "spot")?;
+    set_default(scene, file.point.as_ref().map(LightEntry::from), "point")?;
     let mut listed = Vec::with_capacity(file.light.len());
     for (i, entry) in file.light.iter().enumerate() {
         let name = entry.name.clone().unwrap_or_else(|| format!("light {i}"));

@@ -222,15 +222,8 @@ fn sun_overrides_keep_the_other_angle() {
     s.light.sun_elevation = Some(30.0);
     let Light::Directional(sun) = s.resolve_light(&scene).unwrap() else { panic!() };
     assert!(((-sun.direction.y).asin().to_degrees() - 30.0).abs() < 1e-3);
-    let (a0, a1) = (
-        scene
-            .light::<DirectionalLight>()
-            .unwrap()
-            .direction
-            .x
-            .atan2(scene.light::<DirectionalLight>().unwrap().direction.z),
-        sun.direction.x.atan2(sun.direction.z),
-    );
+    let before = scene.light::<DirectionalLight>().unwrap().direction;
+    let (a0, a1) = (before.x.atan2(before.z), sun.direction.x.atan2(sun.direction.z));
     assert!((a0 - a1).abs() < 1e-4, "azimuth unchanged");
 }
 
@@ -281,7 +274,7 @@ fn light_all_takes_each_lights_own_shadow_settings() {
     );
     // A light whose own table is invalid over these settings is named.
     let mut broken = scene.clone();
-    broken.lights[3].shadow = Some(ShadowOverrides {
+    broken.listed_lights_mut().nth(3).unwrap().shadow = Some(ShadowOverrides {
         map: MapSettingsPatch { resolution: Some(100), ..Default::default() },
         ..Default::default()
     });
@@ -391,7 +384,7 @@ fn contact_shadows_choose_the_mask_path_and_are_checked() {
     s.screen.shadow_path = ShadowPath::Auto;
     s.light.kind = LightKind::All;
     let mut lit = scene.clone();
-    lit.lights[5].shadow = Some(ShadowOverrides {
+    lit.listed_lights_mut().nth(5).unwrap().shadow = Some(ShadowOverrides {
         contact: ContactSettingsPatch { contact_shadows: Some(true), ..Default::default() },
         ..Default::default()
     });
@@ -402,7 +395,8 @@ fn contact_shadows_choose_the_mask_path_and_are_checked() {
     s.screen.shadow_path = ShadowPath::Forward;
     let e = s.uses_shadow_mask(&lights).unwrap_err();
     assert!(
-        e.setting == "shadow.contact.contact_shadows" && e.to_string().contains(&lit.lights[5].name),
+        e.setting == "shadow.contact.contact_shadows"
+            && e.to_string().contains(&lit.listed_lights().nth(5).unwrap().name),
         "{e}"
     );
     // Each parameter's range is checked, naming the flag.

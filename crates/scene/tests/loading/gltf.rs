@@ -143,20 +143,21 @@ fn every_punctual_light_joins_the_light_list() {
     std::fs::write(dir.join("lights.glb"), glb(&json, &triangle_bytes())).unwrap();
     let (scene, extras) = gltf_loader::load(&dir.join("lights.glb")).unwrap();
     assert!(extras.has_point && extras.has_spot && !extras.has_sun);
-    assert_eq!(scene.listed_lights().count(), 3);
-    assert_eq!(scene.lights[0].name, "bulb");
-    let Light::Point(bulb) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
+    let listed: Vec<_> = scene.listed_lights().collect();
+    assert_eq!(listed.len(), 3);
+    assert_eq!(listed[0].name, "bulb");
+    let Light::Point(bulb) = listed[0].light else { panic!("{:?}", listed[0]) };
     assert_eq!((bulb.position, bulb.range), (Vec3::new(0.0, 3.0, 0.0), 6.0));
     assert_eq!(*scene.light::<PointLight>().unwrap(), bulb, "the first point light is the default");
     // A light without a range reaches past the scene.
-    let Light::Point(unranged) = scene.lights[2].light else { panic!() };
+    let Light::Point(unranged) = listed[2].light else { panic!() };
     assert!(unranged.range.is_finite() && unranged.range > 2.0);
     // The extension's units and falloff: candela, the inverse square windowed at the
     // range, and no window without one (the range Gnomon gives it is only the map's).
     assert_eq!(bulb.intensity, 40.0);
     assert_eq!(bulb.falloff, Falloff::InverseSquare { window: Some(6.0) });
     assert_eq!((unranged.intensity, unranged.falloff), (1.0, Falloff::InverseSquare { window: None }));
-    let Light::Spot(spot) = scene.lights[1].light else { panic!() };
+    let Light::Spot(spot) = listed[1].light else { panic!() };
     assert_eq!((spot.intensity, spot.falloff), (250.0, Falloff::InverseSquare { window: None }));
 }
 
@@ -185,7 +186,8 @@ fn a_suns_lux_are_its_intensity() {
     std::fs::write(dir.join("sun.glb"), glb(&json, &triangle_bytes())).unwrap();
     let (scene, extras) = gltf_loader::load(&dir.join("sun.glb")).unwrap();
     assert!(extras.has_sun);
-    let Light::Directional(sun) = scene.lights[0].light else { panic!("{:?}", scene.lights[0]) };
+    let listed: Vec<_> = scene.listed_lights().collect();
+    let Light::Directional(sun) = listed[0].light else { panic!("{:?}", listed[0]) };
     assert_eq!(sun.intensity, 3.5);
     assert_eq!(*scene.light::<DirectionalLight>().unwrap(), sun, "the file's sun is the default");
 }

@@ -151,7 +151,8 @@ fn point_lights_and_the_light_list_come_from_the_file() {
     assert_eq!((point.position, point.range, point.radius), (Vec3::new(0.0, 3.0, 0.0), 12.0, 0.1));
     let names: Vec<&str> = scene.listed_lights().map(|l| l.name.as_str()).collect();
     assert_eq!(names, ["key", "lamp", "light 2"]);
-    let Light::Point(lamp) = scene.lights[1].light else { panic!("{:?}", scene.lights[1]) };
+    let listed: Vec<_> = scene.listed_lights().collect();
+    let Light::Point(lamp) = listed[1].light else { panic!("{:?}", listed[1]) };
     assert_eq!((lamp.range, lamp.color), (8.0, Vec3::new(1.0, 0.5, 0.25)));
     // `falloff` is glTF's, windowed at the range; a light without it keeps Gnomon's constant.
     assert_eq!(lamp.falloff, gnomon_scene::Falloff::InverseSquare { window: Some(8.0) });

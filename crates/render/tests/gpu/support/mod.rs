@@ -191,11 +191,12 @@ pub fn square_under_spot() -> SquareOccluder {
     add(&mut scene, "square", geometry::plane(2.0 * half, 2.0 * half), Mat4::from_translation(center));
     scene.camera.eye = Vec3::new(0.0, 12.0, 8.0);
     scene.camera.target = Vec3::ZERO;
-    scene.light_mut::<SpotLight>().unwrap().position = Vec3::new(0.0, SPOT_HEIGHT, 0.0);
-    scene.light_mut::<SpotLight>().unwrap().direction = Vec3::NEG_Y;
-    scene.light_mut::<SpotLight>().unwrap().outer_angle_degrees = SPOT_OUTER_DEGREES;
-    scene.light_mut::<SpotLight>().unwrap().inner_angle_degrees = 25.0;
-    scene.light_mut::<SpotLight>().unwrap().range = 20.0;
+    let spot = scene.light_mut::<SpotLight>().unwrap();
+    spot.position = Vec3::new(0.0, SPOT_HEIGHT, 0.0);
+    spot.direction = Vec3::NEG_Y;
+    spot.outer_angle_degrees = SPOT_OUTER_DEGREES;
+    spot.inner_angle_degrees = 25.0;
+    spot.range = 20.0;
     let k = SPOT_HEIGHT / (SPOT_HEIGHT - height);
     SquareOccluder {
         scene,
