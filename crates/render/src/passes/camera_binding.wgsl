@@ -1,5 +1,7 @@
-// The camera uniform of the passes that shade from the camera (the lighting pass and
-// the screen-space shadow mask), bound at group 1; the host's shader binds its own
-// through the shadow receiver (receiver.wgsl).
+// The camera uniform, declared once for every pass that reads it, at the group and
+// binding its pass's generated constants name (`camera_binding_wgsl` in
+// passes/mod.rs): group 1 binding 0 in the passes that shade from the camera (the
+// lighting pass and the screen-space shadow mask); binding 1 of the host's group in
+// the shadow receiver.
 
-@group(1) @binding(0) var<uniform> camera: Camera;
+@group(CAMERA_GROUP) @binding(CAMERA_BINDING) var<uniform> camera: Camera;

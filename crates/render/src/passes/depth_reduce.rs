@@ -268,14 +268,17 @@ impl PendingSampleBounds {
     }
 }
 
+/// The depth buffer both passes read, at binding 0 of their group.
+const DEPTH_BUFFER_BINDING_WGSL: &str = include_str!("depth_buffer_binding.wgsl");
+
 /// `depth_reduce.wgsl`, composed.
 pub(crate) fn reduce_wgsl() -> String {
-    super::compose_wgsl(&[include_str!("depth_reduce.wgsl")])
+    super::compose_wgsl(&[DEPTH_BUFFER_BINDING_WGSL, include_str!("depth_reduce.wgsl")])
 }
 
 /// `sample_bounds.wgsl`, composed.
 pub(crate) fn bounds_wgsl() -> String {
-    super::compose_wgsl(&[include_str!("sample_bounds.wgsl")])
+    super::compose_wgsl(&[DEPTH_BUFFER_BINDING_WGSL, include_str!("sample_bounds.wgsl")])
 }
 
 #[cfg(test)]

@@ -4,7 +4,6 @@
 // the global range with one atomic pair. Positive floats order like their bit
 // patterns as u32, so atomicMin/atomicMax on the bits compare the depths.
 
-@group(0) @binding(0) var depth_buffer: texture_depth_2d;
 @group(0) @binding(1) var<storage, read_write> depth_range: array<atomic<u32>, 2>;
 struct Planes {
     near: f32,

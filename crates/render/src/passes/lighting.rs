@@ -8,7 +8,10 @@
 use std::collections::HashMap;
 
 use super::wgsl_interfaces::{IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PIXEL_VISIBILITY, SEEN_SURFACE};
-use super::{CAMERA_WGSL, LIGHT_WGSL, Layouts, SCENE_COMMON_WGSL, SHADING_WGSL, compose_wgsl};
+use super::{
+    CAMERA_MATERIAL_BINDINGS, CAMERA_STRUCT_WGSL, LIGHT_WGSL, Layouts, OWN_CAMERA_BINDING, OWN_LIGHT_BINDING,
+    SCENE_COMMON_WGSL, SHADING_WGSL, camera_binding_wgsl, compose_wgsl, light_binding_wgsl, material_bindings_wgsl,
+};
 use gnomon_scene::settings::Refine;
 
 use crate::{
@@ -86,7 +89,7 @@ pub(crate) fn visibility_wgsl(technique: TechniqueRef, lookup: Lookup) -> Vec<St
             ];
         }
     };
-    let mut parts = vec![techniques::SHADOW_BINDINGS_WGSL.to_owned()];
+    let mut parts = vec![techniques::shadow_bindings_wgsl(techniques::OWN_SHADOW_BINDINGS)];
     parts.extend(resolved_lookup_wgsl(technique, map));
     parts
 }
@@ -94,7 +97,7 @@ pub(crate) fn visibility_wgsl(technique: TechniqueRef, lookup: Lookup) -> Vec<St
 pub(crate) use crate::light_map::MapLookup;
 
 /// `pixel_visibility` of a technique and map lookup, without the declarations of the
-/// shadow resources it reads (those of `SHADOW_BINDINGS_WGSL`, in whichever group
+/// shadow resources it reads (`techniques::shadow_bindings_wgsl`, in whichever group
 /// the pass binds them): the technique's lookup, the light kind's visibility
 /// function and the rules of resolve_visibility.wgsl.
 pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -> Vec<String> {
@@ -127,7 +130,15 @@ pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -
 /// The start of every module that shades from the camera: the light, the scene's
 /// declarations, the camera and the shared shading helpers.
 pub(crate) fn camera_shading_wgsl() -> Vec<String> {
-    [LIGHT_WGSL, SCENE_COMMON_WGSL, CAMERA_WGSL, SHADING_WGSL].map(str::to_owned).to_vec()
+    vec![
+        LIGHT_WGSL.to_owned(),
+        SCENE_COMMON_WGSL.to_owned(),
+        light_binding_wgsl(OWN_LIGHT_BINDING),
+        material_bindings_wgsl(CAMERA_MATERIAL_BINDINGS),
+        CAMERA_STRUCT_WGSL.to_owned(),
+        camera_binding_wgsl(OWN_CAMERA_BINDING),
+        SHADING_WGSL.to_owned(),
+    ]
 }
 
 /// The vertex stage (`vs_surface`) and normals of the passes that draw the scene

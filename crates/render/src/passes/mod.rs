@@ -1,6 +1,7 @@
 //! The render passes and the resources they share: bind group layouts, the WGSL
 //! composition, and the pipeline caches.
 
+pub(crate) mod binding_place;
 pub(crate) mod blit;
 pub(crate) mod depth_baseline;
 pub(crate) mod depth_reduce;
@@ -14,6 +15,8 @@ pub(crate) mod moments;
 pub(crate) mod screen_space;
 pub(crate) mod shadow;
 pub(crate) mod wgsl_interfaces;
+
+pub(crate) use binding_place::BindingPlace;
 
 #[cfg(test)]
 mod interface_tests;
@@ -124,12 +127,34 @@ pub(crate) const LIGHT_WGSL: &str = concat!(
 /// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
 
+/// Gnomon's own passes bind the light uniform at group 0, after the instances.
+pub(crate) const OWN_LIGHT_BINDING: BindingPlace = BindingPlace { group: 0, binding: 1 };
+
+/// The passes that shade from the camera bind its uniform first in group 1.
+pub(crate) const OWN_CAMERA_BINDING: BindingPlace = BindingPlace { group: 1, binding: 0 };
+
+/// The passes that draw from the camera bind the material texture in group 3.
+pub(crate) const CAMERA_MATERIAL_BINDINGS: BindingPlace = BindingPlace { group: 3, binding: 0 };
+
+/// The light uniform (`light_binding.wgsl`) at `place`.
+pub(crate) fn light_binding_wgsl(place: BindingPlace) -> String {
+    place.declare("LIGHT", include_str!("light_binding.wgsl"))
+}
+
+/// The camera uniform (`camera_binding.wgsl`) at `place`.
+pub(crate) fn camera_binding_wgsl(place: BindingPlace) -> String {
+    place.declare("CAMERA", include_str!("camera_binding.wgsl"))
+}
+
+/// The material texture that [`SCENE_COMMON_WGSL`]'s helpers sample
+/// (`material_bindings.wgsl`), from `place`.
+pub(crate) fn material_bindings_wgsl(place: BindingPlace) -> String {
+    place.declare("MATERIAL", include_str!("material_bindings.wgsl"))
+}
+
 /// The camera uniform's struct.
 pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
 
-/// The camera uniform of the passes that shade from the camera, bound at group 1.
-pub(crate) const CAMERA_WGSL: &str =
-    concat!(include_str!("camera.wgsl"), "\n", include_str!("camera_binding.wgsl"));
 
 /// The octahedral encoding of the prepass's normals, for the passes that write or read
 /// them.

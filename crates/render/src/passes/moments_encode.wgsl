@@ -1,7 +1,6 @@
 // Moment-map encoding: every texel's stored depth, made linear (`moment_depth`),
 // becomes the technique's RGBA layers (`encode_moments`).
 
-@group(0) @binding(1) var<uniform> light: Light;
 @group(1) @binding(0) var encoded: texture_storage_2d_array<MOMENT_FORMAT, write>;
 
 @compute @workgroup_size(8, 8, 1)

@@ -14,7 +14,7 @@ struct FilterParams {
 
 @group(0) @binding(0) var filter_source: texture_2d_array<f32>;
 @group(0) @binding(1) var filter_target: texture_storage_2d_array<MOMENT_FORMAT, write>;
-@group(0) @binding(2) var<uniform> params: FilterParams;
+@group(0) @binding(2) var<uniform> filter_params: FilterParams;
 
 // Weighted average of up to MAX_BLUR_TAPS values in log space (channel x only).
 fn log_average(values: ptr<function, array<f32, MAX_BLUR_TAPS>>, weights: ptr<function, array<f32, MAX_BLUR_TAPS>>, count: i32) -> f32 {
@@ -24,9 +24,9 @@ fn log_average(values: ptr<function, array<f32, MAX_BLUR_TAPS>>, weights: ptr<fu
     }
     var sum = 0.0;
     for (var i = 0; i < count; i++) {
-        sum += (*weights)[i] * exp(params.log_c * ((*values)[i] - top));
+        sum += (*weights)[i] * exp(filter_params.log_c * ((*values)[i] - top));
     }
-    return top + log(sum) / params.log_c;
+    return top + log(sum) / filter_params.log_c;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -41,21 +41,21 @@ fn blur_main(@builtin(global_invocation_id) id: vec3<u32>) {
     var weights: array<f32, MAX_BLUR_TAPS>;
     var sum = vec4<f32>(0.0);
     var total = 0.0;
-    for (var i = -params.radius; i <= params.radius; i++) {
-        let q = clamp(p + i * params.direction, vec2<i32>(0), size - vec2<i32>(1));
-        let w = exp(-0.5 * pow(f32(i) / params.sigma, 2.0));
+    for (var i = -filter_params.radius; i <= filter_params.radius; i++) {
+        let q = clamp(p + i * filter_params.direction, vec2<i32>(0), size - vec2<i32>(1));
+        let w = exp(-0.5 * pow(f32(i) / filter_params.sigma, 2.0));
         let v = textureLoad(filter_source, q, layer, 0);
         sum += w * v;
         total += w;
-        values[i + params.radius] = v.x;
-        weights[i + params.radius] = w;
+        values[i + filter_params.radius] = v.x;
+        weights[i + filter_params.radius] = w;
     }
     var result = sum / total;
-    if params.log_c > 0.0 {
-        for (var i = 0; i < 2 * params.radius + 1; i++) {
+    if filter_params.log_c > 0.0 {
+        for (var i = 0; i < 2 * filter_params.radius + 1; i++) {
             weights[i] /= total;
         }
-        result = vec4<f32>(log_average(&values, &weights, 2 * params.radius + 1), 0.0, 0.0, 0.0);
+        result = vec4<f32>(log_average(&values, &weights, 2 * filter_params.radius + 1), 0.0, 0.0, 0.0);
     }
     textureStore(filter_target, p, layer, result);
 }
@@ -80,7 +80,7 @@ fn downsample_main(@builtin(global_invocation_id) id: vec3<u32>) {
         weights[i] = 0.25;
     }
     var result = 0.25 * sum;
-    if params.log_c > 0.0 {
+    if filter_params.log_c > 0.0 {
         result = vec4<f32>(log_average(&values, &weights, 4), 0.0, 0.0, 0.0);
     }
     textureStore(filter_target, p, layer, result);

@@ -2,18 +2,10 @@
 // shader. Composed after the light and camera structs, the technique's lookup and
 // the rules of resolve_visibility.wgsl; the host's shader follows it in one module.
 //
-// Every resource sits in one bind group, at the index the host chose
-// (RECEIVER_GROUP is replaced by it), in the order of `Layouts::receiver`.
-
-@group(RECEIVER_GROUP) @binding(0) var<uniform> light: Light;
-@group(RECEIVER_GROUP) @binding(1) var<uniform> camera: Camera;
-@group(RECEIVER_GROUP) @binding(2) var shadow_map: texture_depth_2d_array;
-@group(RECEIVER_GROUP) @binding(3) var shadow_compare: sampler_comparison;
-@group(RECEIVER_GROUP) @binding(4) var moment_map: texture_2d_array<f32>;
-@group(RECEIVER_GROUP) @binding(5) var moment_sampler: sampler;
-@group(RECEIVER_GROUP) @binding(6) var shadow_cube: texture_depth_cube;
-@group(RECEIVER_GROUP) @binding(7) var shadow_compare_nearest: sampler_comparison;
-@group(RECEIVER_GROUP) @binding(8) var shadow_gather: sampler;
+// Every resource sits in one bind group, at the index the host chose, in the order of
+// `Layouts::receiver`: the light (light_binding.wgsl) at binding 0, the camera
+// (camera_binding.wgsl) at 1, and the shadow resources (techniques/bindings.wgsl)
+// from 2, each placed by generated constants (`receiver_wgsl` in receiver.rs).
 
 // The fraction of this light that reaches the surface point `world` (world space), in
 // [0, 1]: 0 in shadow, on a surface turned away from the light, or outside a spot's

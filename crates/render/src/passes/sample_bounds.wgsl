@@ -19,10 +19,9 @@ struct BoundsParams {
     blend: f32,
 }
 
-@group(0) @binding(0) var depth_buffer: texture_depth_2d;
 // Per cascade: min x, min y, max x, max y, encoded.
 @group(0) @binding(1) var<storage, read_write> bounds: array<atomic<u32>, 4u * MAX_CASCADES>;
-@group(0) @binding(2) var<uniform> params: BoundsParams;
+@group(0) @binding(2) var<uniform> bounds_params: BoundsParams;
 
 var<workgroup> tile: array<atomic<u32>, 4u * MAX_CASCADES>;
 
@@ -34,7 +33,7 @@ fn encode(f: f32) -> u32 {
 }
 
 fn split(i: u32) -> f32 {
-    return params.splits[i / 4u][i % 4u];
+    return bounds_params.splits[i / 4u][i % 4u];
 }
 
 @compute @workgroup_size(16, 16)
@@ -51,22 +50,22 @@ fn bounds_of_samples(
     if all(id.xy < size) {
         let d = textureLoad(depth_buffer, vec2<i32>(id.xy), 0);
         if d < 1.0 {
-            let n = params.near;
-            let f = params.far;
-            let count = params.cascade_count;
+            let n = bounds_params.near;
+            let f = bounds_params.far;
+            let count = bounds_params.cascade_count;
             let view_depth = n * f / (f - d * (f - n));
             // The pixel's centre in NDC (y up), back to world space.
             let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
             let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, d, 1.0);
-            let world = params.world_from_clip * ndc;
-            let light = (params.light_from_world * vec4<f32>(world.xyz / world.w, 1.0)).xy;
+            let world = bounds_params.world_from_clip * ndc;
+            let light = (bounds_params.light_from_world * vec4<f32>(world.xyz / world.w, 1.0)).xy;
             let encoded = vec4<u32>(encode(light.x), encode(light.y), encode(light.x), encode(light.y));
             for (var i = 0u; i < count; i += 1u) {
                 // A cascade serves its own depths and, for blending, the band at the far
                 // end of the previous one.
                 var start = split(i);
                 if i > 0u {
-                    start -= params.blend * (split(i) - split(i - 1u));
+                    start -= bounds_params.blend * (split(i) - split(i - 1u));
                 }
                 if view_depth >= start && view_depth <= split(i + 1u) {
                     atomicMin(&tile[i * 4u], encoded.x);

@@ -40,7 +40,6 @@ fn world_from_object_of(t: InstanceTransform) -> mat4x4<f32> {
 // Fragment stages read the rest of an instance (material, alpha cut-off) here, by the
 // instance index the vertex stage passes on flat.
 @group(0) @binding(0) var<storage, read> instances: array<Instance>;
-@group(0) @binding(1) var<uniform> light: Light;
 
 // What carries object-space normals to world space: the cofactor matrix of
 // world_from_object's upper 3×3, which is its inverse transpose times the

@@ -215,7 +215,10 @@ pub(crate) struct ShadowPass {
 
 /// The shadow pass's WGSL, composed.
 pub(crate) fn shadow_wgsl() -> String {
-    compose_wgsl(&[LIGHT_WGSL, SCENE_COMMON_WGSL, include_str!("shadow_depth.wgsl")])
+    let light = super::light_binding_wgsl(super::OWN_LIGHT_BINDING);
+    // The alpha-masked casters' texture is the depth pass's group 1.
+    let material = super::material_bindings_wgsl(super::BindingPlace { group: 1, binding: 0 });
+    compose_wgsl(&[LIGHT_WGSL, SCENE_COMMON_WGSL, &light, &material, include_str!("shadow_depth.wgsl")])
 }
 
 impl ShadowPass {

@@ -10,9 +10,7 @@ fn vs_shadow(@location(0) position: vec3<f32>, transform: InstanceTransform) -> 
 }
 
 // Alpha-masked casters: the same projection, plus the cut-out test, so leaves and
-// fences cast their holes. The texture is bound as group 1.
-@group(1) @binding(0) var base_color_texture: texture_2d<f32>;
-@group(1) @binding(1) var base_color_sampler: sampler;
+// fences cast their holes. The texture is bound as group 1 (material_bindings.wgsl).
 
 struct MaskedOut {
     @builtin(position) clip: vec4<f32>,

@@ -8,9 +8,6 @@
 // 2 × the shadow-map layer that shaded it (for the cascade debug view), so that the
 // mask path keeps the forward path's visibility exactly.
 
-// Declared for scene_common.wgsl's material helpers, which this pass never calls.
-@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
-@group(3) @binding(1) var base_color_sampler: sampler;
 
 // Its vertex stage is fullscreen.wgsl's `vs_fullscreen`.
 

@@ -3,8 +3,6 @@
 // (the lighting passes test the prepass's for equality), and the normals both
 // derive per fragment. Also the material bindings (group 3) both read.
 
-@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
-@group(3) @binding(1) var base_color_sampler: sampler;
 
 struct SurfaceVertex {
     // Invariant: every pass drawing from the camera must rasterize the same depths.

@@ -12,7 +12,6 @@ struct RefineCounters {
     count: atomic<u32>,
 };
 
-@group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;
 @group(1) @binding(4) var<storage, read_write> refine_counters: RefineCounters;
 
 // Appends `pixel` to the list, and counts one more workgroup for the trace pass at

@@ -12,3 +12,6 @@ struct UnsurePixel {
     // before).
     layer: u32,
 };
+
+// Written by the mask pass (refine_append.wgsl), completed by the trace pass.
+@group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;

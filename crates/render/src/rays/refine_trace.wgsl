@@ -22,18 +22,17 @@ struct ListedPixels {
     count: u32,
 };
 
-// The list, whose entries the trace pass completes with their penumbra width.
-@group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;
+// The list itself is `unsure_pixels` (refine_list.wgsl), whose entries this pass
+// completes with their penumbra width; its counters are read-only here.
 @group(1) @binding(4) var<storage, read> listed: ListedPixels;
 
 @group(2) @binding(0) var refined_mask: texture_storage_2d<r32float, write>;
 // A copy of the mask as the trace pass left it, which the filter pass reads.
 @group(2) @binding(1) var traced_mask: texture_2d<f32>;
 
-// Declared for scene_common.wgsl's material helpers, which this pass never calls: the
-// two bindings of the tracer's group that trace.wgsl leaves free for them.
-@group(3) @binding(0) var base_color_texture: texture_2d<f32>;
-@group(3) @binding(1) var base_color_sampler: sampler;
+// The material bindings of scene_common.wgsl's helpers (material_bindings.wgsl), which
+// this pass never calls, take the two bindings of the tracer's group that trace.wgsl
+// leaves free for them.
 
 // The penumbra's width on screen, in pixels, at a pixel whose blocked rays met
 // casters `blocker` away on average (-1: none), on a surface of normal `geometric_n`

@@ -32,6 +32,7 @@ use gnomon_scene::settings::{FilterSettings, RayUse, SettingsError, Technique};
 pub use params::{GpuParams, NoParams, PARAMS_BYTES, ParamsBlockGpu, TechniqueParams};
 pub use registry::{RegistryError, TechniqueRef, TechniqueRegistry};
 
+use crate::passes::binding_place::BindingPlace;
 use crate::passes::wgsl_interfaces::TECHNIQUE_CONTRACT;
 
 /// Every built-in technique, in the order the command line lists them. Adding one
@@ -206,15 +207,20 @@ pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
 /// the settings' `POISSON_TAPS` (which `Settings::validate` holds every render to).
 pub const POISSON_DISK_SIZE: usize = *gnomon_scene::settings::POISSON_TAPS.end() as usize;
 
-/// The shadow resources a technique may read, as the lighting, mask and moment passes
-/// bind them (group 2). The shadow receiver declares the same names in the host's
-/// group (`passes/receiver.wgsl`).
-pub(crate) const SHADOW_BINDINGS_WGSL: &str = include_str!("bindings.wgsl");
+/// Where Gnomon's lighting, mask and moment passes bind the shadow resources a
+/// technique may read: group 2, from binding 0 (`Layouts::shadow`).
+pub(crate) const OWN_SHADOW_BINDINGS: BindingPlace = BindingPlace { group: 2, binding: 0 };
+
+/// The shadow resources a technique may read (`bindings.wgsl`, declared once), the
+/// first (`shadow_map`) at `place` and the other six after it.
+pub(crate) fn shadow_bindings_wgsl(place: BindingPlace) -> String {
+    place.declare("SHADOW", include_str!("bindings.wgsl"))
+}
 
 /// The WGSL every technique is composed with, before its own: the shadow bindings,
 /// the generated kernels, the lookup contract and its helpers.
 pub(crate) fn shared_wgsl() -> Vec<String> {
-    let mut parts = vec![SHADOW_BINDINGS_WGSL.to_owned()];
+    let mut parts = vec![shadow_bindings_wgsl(OWN_SHADOW_BINDINGS)];
     parts.extend(helper_wgsl());
     parts
 }
