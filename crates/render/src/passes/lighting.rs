@@ -10,7 +10,8 @@ use std::collections::HashMap;
 use super::wgsl_interfaces::{IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PIXEL_VISIBILITY, SEEN_SURFACE};
 use super::{
     CAMERA_MATERIAL_BINDINGS, CAMERA_STRUCT_WGSL, LIGHT_WGSL, Layouts, OWN_CAMERA_BINDING, OWN_LIGHT_BINDING,
-    SCENE_COMMON_WGSL, SHADING_WGSL, camera_binding_wgsl, compose_wgsl, light_binding_wgsl, material_bindings_wgsl,
+    SCENE_COMMON_WGSL, SHADING_WGSL, camera_binding_wgsl, compose_wgsl, light_binding_wgsl,
+    material_bindings_wgsl,
 };
 use gnomon_scene::settings::Refine;
 

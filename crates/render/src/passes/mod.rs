@@ -155,7 +155,6 @@ pub(crate) fn material_bindings_wgsl(place: BindingPlace) -> String {
 /// The camera uniform's struct.
 pub(crate) const CAMERA_STRUCT_WGSL: &str = include_str!("camera.wgsl");
 
-
 /// The octahedral encoding of the prepass's normals, for the passes that write or read
 /// them.
 pub(crate) const OCTAHEDRON_WGSL: &str = include_str!("octahedron.wgsl");

@@ -106,7 +106,8 @@ pub(crate) struct MomentMap {
 
 /// The moment pass's encoding WGSL for a technique and storage format, composed.
 pub(crate) fn encode_wgsl(technique: TechniqueRef, format: wgpu::TextureFormat) -> String {
-    let mut parts: Vec<String> = vec![LIGHT_WGSL.to_owned(), super::light_binding_wgsl(super::OWN_LIGHT_BINDING)];
+    let mut parts: Vec<String> =
+        vec![LIGHT_WGSL.to_owned(), super::light_binding_wgsl(super::OWN_LIGHT_BINDING)];
     parts.extend(techniques::shared_wgsl());
     parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
     parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
