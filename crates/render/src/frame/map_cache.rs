@@ -247,8 +247,8 @@ mod tests {
 
     /// [`super::LayerKey`] keeps only the fields of the light's uniform that the
     /// shadow pass reads: sound only while `shadow_depth.wgsl` reads no other, and
-    /// calls none of the functions composed with the light's structs (`LIGHT_WGSL`:
-    /// `light.wgsl`'s and the light kinds', which read more).
+    /// calls none of the functions of the light's modules (`light.wgsl`'s, the light
+    /// kinds' and their shapes', which read more).
     #[test]
     fn the_shadow_pass_reads_only_what_the_key_holds() {
         let wgsl = include_str!("../passes/shadow_depth.wgsl");
@@ -267,9 +267,16 @@ mod tests {
             }
             assert!(KEYED.contains(&field), "shadow_depth.wgsl reads light.{field}, which no key holds");
         }
-        for line in crate::passes::LIGHT_WGSL.lines().filter_map(|l| l.strip_prefix("fn ")) {
+        let light_modules = ["passes::light", "passes::light_kinds", "passes::light_shapes"];
+        let sources: Vec<&str> = crate::passes::link::MODULES
+            .iter()
+            .filter(|m| light_modules.contains(&m.path))
+            .map(|m| m.source)
+            .collect();
+        assert_eq!(sources.len(), light_modules.len(), "the light's modules moved");
+        for line in sources.iter().flat_map(|s| s.lines()).filter_map(|l| l.strip_prefix("fn ")) {
             let name: String = line.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
-            assert!(!wgsl.contains(&format!("{name}(")), "shadow_depth.wgsl calls LIGHT_WGSL's {name}");
+            assert!(!wgsl.contains(&format!("{name}(")), "shadow_depth.wgsl calls the light's {name}");
         }
     }
 

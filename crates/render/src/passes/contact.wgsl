@@ -7,6 +7,12 @@
 // never occludes: the depth buffer holds each texel's depth at its centre, half a
 // pixel from where the ray crosses it, which on a surface seen at a slant is more
 // than the ray rises over a step.
+import package::passes::camera_binding::camera;
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_ray_length;
+import package::passes::screen_common::prepass_surface;
+import package::passes::shadow_mask::plane_point;
+import package::techniques::common::interleaved_gradient_noise;
 
 // Relative depth difference within which a depth sample is on the receiver's plane.
 const CONTACT_OWN_PLANE: f32 = 1e-3;

@@ -3,6 +3,11 @@
 // maps), is looked up by direction in the cube with the technique's
 // `sample_shadow_cube`. The cube stores distance over range, so the compared depth
 // is the same whichever face a filter tap lands on.
+import package::passes::light_binding::light;
+import package::passes::light_shapes::orthonormal_pair;
+import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
+import package::techniques::cube::{CubeQuery, cube_texel_world_size};
+import package::variant::sample_shadow_cube;
 
 // The lit fraction at `world` and the cube face its direction falls on, as
 // (visibility, face). The screen derivatives give the receiver's plane, for

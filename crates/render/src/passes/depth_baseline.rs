@@ -104,11 +104,16 @@ impl BaselineRaster<'_> {
     }
 }
 
+/// The baseline's WGSL, linked.
+pub(crate) fn baseline_wgsl() -> String {
+    super::compose_wgsl(&[include_str!("depth_baseline.wgsl")])
+}
+
 impl DepthBaselinePass {
     pub fn new(device: &wgpu::Device) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("depth-only baseline"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("depth_baseline.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(baseline_wgsl().into()),
         });
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth-only baseline"),

@@ -3,6 +3,7 @@
 // buffer. Each workgroup reduces its 16×16 tile in shared memory, then folds it into
 // the global range with one atomic pair. Positive floats order like their bit
 // patterns as u32, so atomicMin/atomicMax on the bits compare the depths.
+import package::passes::depth_buffer_binding::depth_buffer;
 
 @group(0) @binding(1) var<storage, read_write> depth_range: array<atomic<u32>, 2>;
 struct Planes {

@@ -9,6 +9,7 @@
 // `gnomon_math::facing::NormalCone::winding`), in f32 where the CPU's cone test is in
 // f64, so both tests here leave a slack for rounding: they may keep a cluster the
 // CPU skips, never skip one the CPU keeps.
+import package::constants::{CULL_WORKGROUP, WINDING_CCW, WINDING_CW, WINDING_KEPT};
 
 struct ShadowItem {
     min: vec3f,

@@ -4,7 +4,7 @@
 //! compile it; and every uniform struct's WGSL size and field offsets equal the Rust
 //! type's (`struct_layouts`).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use gnomon_scene::settings::Refine;
 use wgpu::naga;
@@ -196,11 +196,13 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("map scroll".into(), map_scroll::scroll_wgsl()));
     out.push(("blit".into(), blit::blit_wgsl()));
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
+    out.push(("depth baseline".into(), super::depth_baseline::baseline_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);
             out.push((format!("ray trace {traversal:?} {size:?}"), source));
         }
+        out.push((format!("ray query {traversal:?}"), crate::rays::query::query_wgsl(traversal)));
     }
     out
 }
@@ -335,4 +337,59 @@ fn only_light_kinds_wgsl_reads_a_lights_kind() {
             assert!(!code.contains(reader), "{} reads {reader}", path.display());
         }
     }
+}
+
+/// Every module imports each name it uses from another module, and the shaders do
+/// not link by accident: linked with every declaration named by its module's path,
+/// each shader still parses, so no module reads a name it did not import
+/// (`link::Naming::ByModule`; `link::tests` shows the check failing). Every module
+/// is in some shader, so the check reaches them all.
+#[test]
+fn every_module_imports_what_it_uses() {
+    use wesl::Mangler as _;
+    super::link::TEST_NAMING.with(|naming| naming.set(super::link::Naming::ByModule));
+    let mut unlinked: BTreeMap<String, &str> = BTreeMap::new();
+    for module in super::link::MODULES {
+        let first = super::link::declared_names(module.source).expect("the module parses");
+        let first = first.first().unwrap_or_else(|| panic!("{} declares nothing", module.path));
+        unlinked
+            .insert(wesl::EscapeMangler.mangle(&super::link::module_path(module.path), first), module.path);
+    }
+    for (name, source) in every_variant() {
+        // The host's stage calls the receiver's functions by their written names.
+        let source = source.strip_suffix(HOST_SHADER).unwrap_or(&source);
+        naga::front::wgsl::parse_str(source)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+        let found = words(source);
+        unlinked.retain(|mangled, _| !found.contains(mangled.as_str()));
+    }
+    assert!(unlinked.is_empty(), "modules in no shader, whose imports this test never saw: {unlinked:?}");
+}
+
+/// The identifiers of WGSL `code` (comments removed), by word.
+fn words(code: &str) -> BTreeSet<&str> {
+    code.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect()
+}
+
+/// No module imports a name it does not use, so a module's imports list what it
+/// depends on.
+#[test]
+fn every_import_is_used() {
+    let mut imports = 0;
+    for module in super::link::MODULES {
+        let code: String =
+            module.source.lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n");
+        let (import_lines, body): (Vec<&str>, Vec<&str>) =
+            code.lines().partition(|l| l.starts_with("import "));
+        let body = body.join("\n");
+        let used = words(&body);
+        for line in import_lines {
+            let names = line.trim_end_matches(';').rsplit("::").next().unwrap_or("");
+            for name in names.trim_matches(|c| c == '{' || c == '}').split(',').map(str::trim) {
+                imports += 1;
+                assert!(used.contains(name), "{} imports `{name}` and never uses it", module.path);
+            }
+        }
+    }
+    assert!(imports > 100, "found only {imports} imports");
 }

@@ -1,6 +1,10 @@
 // The light uniform and the depth conventions of its shadow map, shared by the
 // geometry passes and the moment-map compute passes. Field meanings are documented
 // in `uniforms.rs` (`LightGpu`).
+import package::constants::MAX_CASCADES;
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_distance_from_depth;
+import package::variant::TechniqueParams;
 
 // The parameters of a technique that has none, and of a shader composed without one
 // (`NoParams` in techniques/params.rs). `TechniqueParams` is a generated alias of the

@@ -6,6 +6,9 @@
 // each function takes the emitter, so the light list's elements use it as the light
 // uniform's does. It needs only the generated constants and the sampling maps
 // (light_shapes.wgsl).
+import package::constants::{FALLOFF_INVERSE_SQUARE, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN};
+import package::passes::light::Emitter;
+import package::passes::light_shapes::{concentric_disk, cone_direction, orthonormal_pair};
 
 // Distances below this count as this, so that a surface touching a light gets a
 // large but finite irradiance (`Falloff::MIN_DISTANCE`).

@@ -7,6 +7,15 @@
 // the cascade view the sum is tinted by the reported light's layer (the per-light
 // passes tint each light's term by its own). Camera: camera.wgsl; vertex stage and
 // normals: surface.wgsl; their outputs and tints: lighting_common.wgsl.
+import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_TRACED, LIGHT_TILE, LIGHT_WORDS, TRACED_LAYER_FLAG};
+import package::passes::camera_binding::camera;
+import package::passes::light::Emitter;
+import package::passes::light_kinds::emitter_geometry;
+import package::passes::lighting_common::{CASCADE_TINTS, FragmentOut};
+import package::passes::scene_common::{alpha_cut, base_color_of, instances};
+import package::passes::shading::blinn_phong;
+import package::passes::surface::SurfaceVertex;
+import package::variant::{is_seen_surface, seen_surface};
 
 struct LightList {
     ambient: vec3<f32>,

@@ -9,6 +9,14 @@
 // mask stored for the pixel). Camera: camera.wgsl; the
 // vertex stage and normals: surface.wgsl; the light's direction and cone:
 // shading.wgsl; their outputs and tints: lighting_common.wgsl.
+import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
+import package::passes::camera_binding::camera;
+import package::passes::light_binding::light;
+import package::passes::lighting_common::{CASCADE_TINTS, FragmentOut};
+import package::passes::scene_common::{alpha_cut, base_color_of, instances};
+import package::passes::shading::{blinn_phong, facing_error, light_geometry};
+import package::passes::surface::SurfaceVertex;
+import package::variant::{is_seen_surface, pixel_visibility, refine_forward, seen_surface};
 
 @fragment
 fn fs_lighting(in: SurfaceVertex) -> FragmentOut {

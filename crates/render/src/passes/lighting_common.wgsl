@@ -1,6 +1,7 @@
 // What the lighting passes share: their outputs, in `lighting::TARGETS` order, the
 // surface each pixel shades, and the cascade debug view's tint of each shadow-map
 // layer.
+import package::constants::MAX_CASCADES;
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,

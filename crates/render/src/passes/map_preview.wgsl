@@ -1,5 +1,6 @@
 // The shadow map preview: every layer of a depth map side by side, in grayscale
 // (near black, far white), for the viewer's debug panel.
+import package::constants::MAX_CASCADES;
 
 struct PreviewLayer {
     perspective: u32,  // 1: its depth is linearized first

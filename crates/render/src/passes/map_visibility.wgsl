@@ -1,6 +1,11 @@
 // The shadow lookup of a light with 2D layers (a sun's map or cascades, a spot's
 // map): pick the cascade, look up the technique's `sample_shadow` there, and blend
 // into the next cascade near its end.
+import package::passes::light::{cascade_split, texel_world_size_at};
+import package::passes::light_binding::light;
+import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
+import package::techniques::common::ShadowQuery;
+import package::variant::sample_shadow;
 
 // Shadow-map coordinates of a receiver at `world` with unit normal `n`, lit from `l`:
 // the point is first pushed along its normal by the normal-offset bias (in texels of

@@ -9,6 +9,7 @@ pub mod generated;
 pub(crate) mod gpu_cull;
 pub(crate) mod light_list;
 pub(crate) mod lighting;
+pub(crate) mod link;
 pub(crate) mod map_preview;
 pub(crate) mod map_scroll;
 pub(crate) mod moments;
@@ -77,52 +78,42 @@ pub(crate) fn draw_fullscreen(
     pass.draw(0..3, 0..1);
 }
 
-/// Concatenates WGSL sources into one module, after the constants generated from
-/// Rust ([`generated::wgsl_constants`]) and, when the light uniform is declared
-/// but no part types `TechniqueParams` (no technique is composed), the alias to
-/// `NoParams`. WGSL allows module-scope declarations
-/// in any order, so the shared declarations, the technique and the pass compose freely.
-/// Directives (`enable wgpu_ray_query;`, which the ray-query tracer needs) must come
-/// before every declaration: a part's are lifted to the top, each once.
+/// Links WGSL `parts` into one shader ([`link`]): each part that is a module's text
+/// loads that module and what it imports; the others are generated and make up
+/// `package::variant`. When the parts name the light uniform's structs
+/// ([`LIGHT_WGSL`]) but none types `TechniqueParams` (no technique is composed), the
+/// variant types it as `NoParams`.
+///
+/// A part that does not link (a host's technique WGSL with an error) gives WGSL that
+/// names the link error, which the device then refuses by that name: composing never
+/// panics, and the shader's creation reports it as any other WGSL error.
 pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
-    let mut directives: Vec<&str> = Vec::new();
-    for line in parts.iter().flat_map(|p| p.lines()).map(str::trim) {
-        if line.starts_with("enable ") && !directives.contains(&line) {
-            directives.push(line);
-        }
-    }
-    let mut all: Vec<String> = directives.iter().map(|d| (*d).to_owned()).collect();
-    all.push(generated::wgsl_constants());
-    // `light.technique`'s type, where the light uniform is declared (the part is
-    // `LIGHT_WGSL` itself): the composed technique's struct, from the part that
-    // `techniques::technique_wgsl` generates, or `NoParams` when no technique is
-    // composed.
-    let declares_light = parts.contains(&LIGHT_WGSL);
     let typed = parts.iter().any(|p| p.starts_with(crate::techniques::TechniqueParams::ALIAS_PREFIX));
-    if declares_light && !typed {
-        all.push(crate::techniques::TechniqueParams::default().wgsl_alias());
+    let default_alias = crate::techniques::TechniqueParams::default().wgsl_alias();
+    let mut all: Vec<&str> = parts.to_vec();
+    if parts.contains(&LIGHT_WGSL) && !typed {
+        all.push(&default_alias);
     }
-    all.extend(
-        parts
-            .iter()
-            .map(|p| p.lines().filter(|l| !l.trim().starts_with("enable ")).collect::<Vec<_>>().join("\n")),
-    );
-    all.join("\n")
+    #[cfg(test)]
+    let naming = link::TEST_NAMING.with(std::cell::Cell::get);
+    #[cfg(not(test))]
+    let naming = link::Naming::AsWritten;
+    link::link(&all, naming).unwrap_or_else(|error| {
+        let comment: String = error.lines().map(|line| format!("// {line}\n")).collect();
+        format!(
+            "// WESL could not link this shader:\n{comment}const wesl_link_failed: u32 = wesl_link_error;\n"
+        )
+    })
 }
 
 /// The vertex stage of the passes that cover their whole target.
 pub(crate) const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
 
-/// The light uniform's struct and depth conventions, shared by every pass, with what
-/// every light kind does differently (`light_kinds.wgsl`, the only WGSL that reads an
-/// emitter's kind) and the shapes it samples lights over (`light_shapes.wgsl`).
-pub(crate) const LIGHT_WGSL: &str = concat!(
-    include_str!("light.wgsl"),
-    "\n",
-    include_str!("light_kinds.wgsl"),
-    "\n",
-    include_str!("light_shapes.wgsl")
-);
+/// The light uniform's struct and depth conventions, shared by every pass. It
+/// imports what every light kind does differently (`light_kinds.wgsl`, the only
+/// WGSL that reads an emitter's kind), which imports the shapes it samples lights
+/// over (`light_shapes.wgsl`).
+pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
 
 /// The WGSL every geometry pass starts with (after [`LIGHT_WGSL`]).
 pub(crate) const SCENE_COMMON_WGSL: &str = include_str!("scene_common.wgsl");
@@ -136,20 +127,21 @@ pub(crate) const OWN_CAMERA_BINDING: BindingPlace = BindingPlace { group: 1, bin
 /// The passes that draw from the camera bind the material texture in group 3.
 pub(crate) const CAMERA_MATERIAL_BINDINGS: BindingPlace = BindingPlace { group: 3, binding: 0 };
 
-/// The light uniform (`light_binding.wgsl`) at `place`.
+/// The light uniform (`light_binding.wgsl`, loaded by the modules that import
+/// `light`) placed at `place`.
 pub(crate) fn light_binding_wgsl(place: BindingPlace) -> String {
-    place.declare("LIGHT", include_str!("light_binding.wgsl"))
+    place.declare("LIGHT")
 }
 
-/// The camera uniform (`camera_binding.wgsl`) at `place`.
+/// The camera uniform (`camera_binding.wgsl`) placed at `place`.
 pub(crate) fn camera_binding_wgsl(place: BindingPlace) -> String {
-    place.declare("CAMERA", include_str!("camera_binding.wgsl"))
+    place.declare("CAMERA")
 }
 
 /// The material texture that [`SCENE_COMMON_WGSL`]'s helpers sample
-/// (`material_bindings.wgsl`), from `place`.
+/// (`material_bindings.wgsl`) placed from `place`.
 pub(crate) fn material_bindings_wgsl(place: BindingPlace) -> String {
-    place.declare("MATERIAL", include_str!("material_bindings.wgsl"))
+    place.declare("MATERIAL")
 }
 
 /// The camera uniform's struct.

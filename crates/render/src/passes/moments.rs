@@ -110,14 +110,21 @@ pub(crate) fn encode_wgsl(technique: TechniqueRef, format: wgpu::TextureFormat) 
         vec![LIGHT_WGSL.to_owned(), super::light_binding_wgsl(super::OWN_LIGHT_BINDING)];
     parts.extend(techniques::shared_wgsl());
     parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
-    parts.push(include_str!("moments_encode.wgsl").replace("MOMENT_FORMAT", wgsl_format(format)));
+    parts.push(moment_target_wgsl(format));
+    parts.push(include_str!("moments_encode.wgsl").to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
 }
 
 /// The blur and downsampling WGSL for a storage format, composed.
 pub(crate) fn filter_wgsl(format: wgpu::TextureFormat) -> String {
-    compose_wgsl(&[&include_str!("moments_filter.wgsl").replace("MOMENT_FORMAT", wgsl_format(format))])
+    compose_wgsl(&[&moment_target_wgsl(format), include_str!("moments_filter.wgsl")])
+}
+
+/// The generated type of the storage texture the moment passes write, in `format`:
+/// `MomentTarget`, which `moments_encode.wgsl` and `moments_filter.wgsl` import.
+fn moment_target_wgsl(format: wgpu::TextureFormat) -> String {
+    format!("alias MomentTarget = texture_storage_2d_array<{}, write>;\n", wgsl_format(format))
 }
 
 fn wgsl_format(format: wgpu::TextureFormat) -> &'static str {

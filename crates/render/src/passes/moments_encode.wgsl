@@ -1,7 +1,11 @@
 // Moment-map encoding: every texel's stored depth, made linear (`moment_depth`),
 // becomes the technique's RGBA layers (`encode_moments`).
+import package::passes::light::moment_depth;
+import package::passes::light_binding::light;
+import package::techniques::bindings::shadow_map;
+import package::variant::{MomentTarget, encode_moments};
 
-@group(1) @binding(0) var encoded: texture_storage_2d_array<MOMENT_FORMAT, write>;
+@group(1) @binding(0) var encoded: MomentTarget;
 
 @compute @workgroup_size(8, 8, 1)
 fn encode_main(@builtin(global_invocation_id) id: vec3<u32>) {

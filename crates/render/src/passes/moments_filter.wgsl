@@ -1,6 +1,8 @@
 // Filtering of moment maps: a separable Gaussian blur and a 2×2 mip reduction, both
 // linear, or in log space for ESM (log Σ wᵢ exp(c·dᵢ), computed relative to the
 // largest dᵢ so that it cannot overflow).
+import package::constants::MAX_BLUR_TAPS;
+import package::variant::MomentTarget;
 
 struct FilterParams {
     direction: vec2<i32>,   // (1, 0) or (0, 1) for the blur
@@ -13,7 +15,7 @@ struct FilterParams {
 };
 
 @group(0) @binding(0) var filter_source: texture_2d_array<f32>;
-@group(0) @binding(1) var filter_target: texture_storage_2d_array<MOMENT_FORMAT, write>;
+@group(0) @binding(1) var filter_target: MomentTarget;
 @group(0) @binding(2) var<uniform> filter_params: FilterParams;
 
 // Weighted average of up to MAX_BLUR_TAPS values in log space (channel x only).

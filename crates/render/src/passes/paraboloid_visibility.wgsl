@@ -2,6 +2,10 @@
 // receiver's direction picks the hemisphere, the paraboloid mapping gives its
 // texture coordinates, and the technique's 2D `sample_shadow` compares distance over
 // range there. Layer i's `cascade_clip_from_world` holds hemisphere i's frame.
+import package::passes::light_binding::light;
+import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
+import package::techniques::common::ShadowQuery;
+import package::variant::sample_shadow;
 
 // Texture coordinates and depth (distance over range) of `world` in hemisphere `layer`.
 fn paraboloid_map_coords(layer: u32, world: vec3<f32>) -> vec3<f32> {

@@ -11,6 +11,10 @@
 // grounds, which then shadowed themselves (`raytraced` 6.1 % wrong on Florence and
 // 20 % on `environment`, against 0.001 % on lavapipe, which interpolates at the
 // unsnapped triangle).
+import package::passes::camera_binding::camera;
+import package::passes::octahedron::octahedron_encode;
+import package::passes::scene_common::{alpha_cut, instances};
+import package::passes::surface::{SurfaceVertex, surface_normals};
 
 struct PrepassTargets {
     // xy: shading normal, zw: geometric normal, both facing the camera.

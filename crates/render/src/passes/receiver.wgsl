@@ -6,6 +6,10 @@
 // `Layouts::receiver`: the light (light_binding.wgsl) at binding 0, the camera
 // (camera_binding.wgsl) at 1, and the shadow resources (techniques/bindings.wgsl)
 // from 2, each placed by generated constants (`receiver_wgsl` in receiver.rs).
+import package::passes::camera_binding::camera;
+import package::passes::light_binding::light;
+import package::passes::shading::light_geometry;
+import package::variant::pixel_visibility;
 
 // The fraction of this light that reaches the surface point `world` (world space), in
 // [0, 1]: 0 in shadow, on a surface turned away from the light, or outside a spot's

@@ -3,6 +3,10 @@
 // paraboloid_visibility.wgsl, bound in passes/wgsl_interfaces.rs), then the rules
 // that hold whatever the map says. The
 // forward lighting pass calls it per fragment; the shadow-mask pass once per pixel.
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_unlit;
+import package::passes::shading::facing_side;
+import package::variant::lookup_visibility;
 
 // (visibility, layer that shaded it) of the surface at `world` with shading normal
 // `n` and camera-facing geometric normal `geometric_n`, lit from `l` with cone factor

@@ -5,6 +5,8 @@
 // smallest and largest x and y. Each workgroup reduces its 16×16 tile in shared
 // memory, then folds it into the global bounds with atomics. Floats are stored in an
 // order-preserving u32 encoding so that atomicMin/atomicMax compare them.
+import package::constants::MAX_CASCADES;
+import package::passes::depth_buffer_binding::depth_buffer;
 
 struct BoundsParams {
     world_from_clip: mat4x4<f32>,

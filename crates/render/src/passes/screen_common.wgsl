@@ -1,5 +1,6 @@
 // What every pass reading the mask path's prepass shares: the prepass's outputs (with
 // the camera, camera.wgsl, at group 1 binding 0) and the point each pixel sees.
+import package::passes::camera_binding::camera;
 
 // xyz: the world point the pixel sees, on its triangle (prepass.wgsl says why it is
 // not rebuilt from depth); w: its view depth, 0 for the background.

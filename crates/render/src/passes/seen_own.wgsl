@@ -1,6 +1,10 @@
 // The surface a forward lighting pass shades: the fragment's own, from its
 // interpolated world point and its normals (surface.wgsl). Every fragment the depth
 // test keeps is the pixel's surface. (seen_prepass.wgsl is the mask path's.)
+import package::passes::camera_binding::camera;
+import package::passes::lighting_common::SeenSurface;
+import package::passes::octahedron::octahedron_encode;
+import package::passes::surface::{SurfaceVertex, surface_normals};
 
 // Must be called in uniform control flow (the normals take derivatives).
 fn own_seen_surface(in: SurfaceVertex) -> SeenSurface {

@@ -7,6 +7,10 @@
 // discarded: colour, visibility and outputs then describe one surface. (Before, such
 // a pixel showed the roof's colour and normal with the wall's shadow.)
 // (seen_own.wgsl is the forward path's.) Needs screen_common.wgsl.
+import package::passes::lighting_common::SeenSurface;
+import package::passes::octahedron::octahedron_decode;
+import package::passes::screen_common::{prepass_normals, prepass_surface};
+import package::passes::surface::SurfaceVertex;
 
 // The instance the prepass kept at each pixel, + 1 (0 for the background).
 @group(1) @binding(3) var prepass_object: texture_2d<u32>;

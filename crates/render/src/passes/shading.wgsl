@@ -2,6 +2,9 @@
 // shadow receiver share about a surface point and its light: the light's direction
 // and cone at the point (`emitter_geometry`, light_kinds.wgsl, of the uniform's light),
 // the normal-offset floor, and the normal's side.
+import package::passes::light::Emitter;
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_geometry;
 
 // A surface facing the light keeps this fraction of the offset, against the depth
 // quantisation that the slope bias (zero for it) cannot cover.

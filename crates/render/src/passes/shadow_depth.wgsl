@@ -1,5 +1,7 @@
 // Shadow pass: depth only, from the light. No fragment stage, so the cheapest path
 // the rasterizer has; bias and culling come from the pipeline state.
+import package::passes::light_binding::light;
+import package::passes::scene_common::{InstanceTransform, VertexIn, alpha_cut, instances, world_from_object_of};
 
 // It reads the position-only vertex stream and the instance's matrix as attributes:
 // nothing else, and no storage buffer (a test holds it to that).

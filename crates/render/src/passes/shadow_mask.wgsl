@@ -7,6 +7,14 @@
 // (contact.wgsl), and stores the visibility in the light's layer of the mask, for its lighting pass to read: one 32-bit float, visibility +
 // 2 × the shadow-map layer that shaded it (for the cascade debug view), so that the
 // mask path keeps the forward path's visibility exactly.
+import package::constants::{DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
+import package::passes::camera_binding::camera;
+import package::passes::contact::contact_visibility;
+import package::passes::light_binding::light;
+import package::passes::octahedron::octahedron_decode;
+import package::passes::screen_common::{prepass_normals, prepass_surface, world_at};
+import package::passes::shading::{facing_error, light_geometry};
+import package::variant::{defer_to_ray, pixel_visibility, ray_decides};
 
 
 // Its vertex stage is fullscreen.wgsl's `vs_fullscreen`.

@@ -2,6 +2,9 @@
 // mask path's prepass: one vertex stage, so that both rasterize the same depths
 // (the lighting passes test the prepass's for equality), and the normals both
 // derive per fragment. Also the material bindings (group 3) both read.
+import package::passes::camera_binding::camera;
+import package::passes::scene_common::{InstanceTransform, VertexIn, normal_from_object, world_from_object_of};
+import package::passes::shading::facing_side;
 
 
 struct SurfaceVertex {

@@ -9,7 +9,7 @@
 mod accel;
 mod bvh;
 mod forward;
-mod query;
+pub(crate) mod query;
 mod refine;
 mod traversal;
 

@@ -33,6 +33,15 @@ struct RayGpu {
 /// Threads per workgroup of the query shader (`QUERY_WORKGROUP` there).
 const WORKGROUP: u32 = 64;
 
+/// The query pass's WGSL for `traversal`, linked.
+pub(crate) fn query_wgsl(traversal: Traversal) -> String {
+    crate::passes::compose_wgsl(&[
+        &format!("const QUERY_WORKGROUP: u32 = {WORKGROUP}u;"),
+        &super::trace_wgsl(GROUP, traversal),
+        include_str!("query.wgsl"),
+    ])
+}
+
 /// A scene's casters on the GPU, ready to answer shadow rays.
 pub struct ShadowRays {
     gpu: Gpu,
@@ -84,11 +93,7 @@ impl ShadowRays {
                 bind_group_layouts: &[Some(&io_layout), None, None, Some(rays_layout)],
                 immediate_size: 0,
             });
-            let source = crate::passes::compose_wgsl(&[
-                &format!("const QUERY_WORKGROUP: u32 = {WORKGROUP}u;"),
-                &super::trace_wgsl(GROUP, traversal),
-                include_str!("query.wgsl"),
-            ]);
+            let source = query_wgsl(traversal);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("shadow ray query"),
                 source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -1,4 +1,6 @@
 // One shadow ray per invocation (query.rs): 1 in `answers` where a caster blocks it.
+import package::rays::trace_common::ray_blocked;
+import package::variant::QUERY_WORKGROUP;
 
 struct QueryRay {
     origin: vec3<f32>,

@@ -32,12 +32,10 @@ const COUNTER_BYTES: u64 = 16;
 /// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
 pub(crate) const PIXEL_BYTES: u64 = 8;
 
-/// The list's declarations, with the constants they share with Rust.
+/// The constants the list (`refine_list.wgsl` and the passes that import it) shares
+/// with Rust.
 fn list_wgsl() -> String {
-    format!(
-        "const REFINE_GROUP_SIZE: u32 = {GROUP_SIZE}u;\nconst REFINE_MAX_GROUPS: u32 = {MAX_GROUPS}u;\n{}",
-        include_str!("refine_list.wgsl")
-    )
+    format!("const REFINE_GROUP_SIZE: u32 = {GROUP_SIZE}u;\nconst REFINE_MAX_GROUPS: u32 = {MAX_GROUPS}u;\n")
 }
 
 /// The WGSL of `ray_decides` and `defer_to_ray`, which the shadow-mask pass calls

@@ -1,5 +1,7 @@
 // The mask pass's list of the pixels it leaves to rays (refine_classify.wgsl decides
 // which), for the trace pass (refine_trace.wgsl).
+import package::rays::refine_list::{UnsurePixel, unsure_pixels};
+import package::variant::{REFINE_GROUP_SIZE, REFINE_MAX_GROUPS};
 
 // The first three words are the trace pass's `dispatch_workgroups_indirect`
 // arguments: one workgroup per REFINE_GROUP_SIZE pixels listed (at most

@@ -11,6 +11,10 @@
 // taps disagree: the edge band), or when `map_unsure` (refine_map.wgsl,
 // refine_cube.wgsl, refine_omni.wgsl) finds its footprint in the map ambiguous. `REFINE_EVERY_PIXEL`
 // lists every pixel instead: the exact baseline.
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_unlit;
+import package::passes::shading::facing_side;
+import package::variant::{REFINE_EVERY_PIXEL, map_unsure};
 
 // Whether a ray decides the pixel: it faces the light, lies inside its cone and range,
 // and the map is unsure of it (or every pixel traces). `shadow` is the lookup's

@@ -5,6 +5,10 @@
 // (shadow_depth.wgsl), which is not affine across a plane: each texel's receiver
 // distance is where the ray from the light through the texel's centre meets the
 // receiver's plane, exactly. A receiver seen edge-on from the light is unsure.
+import package::passes::light_binding::light;
+import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
+import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_unsure, map_step, receiver_bias};
+import package::techniques::cube::cube_texel_world_size;
 
 // The receiver's plane, for `footprint_receiver`: its normal, `offset · normal` (the
 // lookup point's offset from the light), and the face's directions: a texel at

@@ -1,6 +1,9 @@
 // The footprint test that 2D maps (refine_map.wgsl) and a point light's cube faces
 // (refine_cube.wgsl) share: the stored depths around a lookup against the receiver's
 // plane. Each caller works out the plane's depth and slope in its own map's terms.
+import package::passes::light_binding::light;
+import package::techniques::bindings::{shadow_gather, shadow_map};
+import package::variant::footprint_receiver;
 
 // Texels of ring around the bilinear footprint.
 const UNSURE_RING_TEXELS: i32 = 2;

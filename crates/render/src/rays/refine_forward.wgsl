@@ -14,6 +14,10 @@
 // that the depth test may not skip, so the driver runs it for every fragment drawn,
 // hidden ones included (counting with an atomic made Sponza's refined lighting pass
 // 2.6× slower on lavapipe).
+import package::constants::{DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
+import package::passes::camera_binding::camera;
+import package::rays::surface_rays::{area_visibility, centre_ray_blocked, surface_ray_origin};
+import package::variant::{REFINE_PENUMBRAE, ray_decides};
 
 // The fragment's (visibility, layer): the map's `shadow`, or where a ray decides, the
 // rays' answer, with the traced view's mark on the layer.

@@ -14,6 +14,15 @@
 // Rays leave from the pixel's surface point moved off the surface along the
 // camera-facing geometric normal (the side the light is on, or the pixel would face
 // away from it and not be listed).
+import package::passes::camera_binding::camera;
+import package::passes::light_binding::light;
+import package::passes::light_kinds::emitter_penumbra_radius;
+import package::passes::octahedron::octahedron_decode;
+import package::passes::screen_common::{prepass_normals, prepass_surface};
+import package::passes::shading::light_geometry;
+import package::rays::refine_list::unsure_pixels;
+import package::rays::surface_rays::{area_visibility, centre_ray_blocked, surface_ray_origin};
+import package::variant::{REFINE_GROUP_SIZE, REFINE_PENUMBRAE};
 
 // The light's counters, read only: they are also the pass's indirect dispatch, which
 // no pass may write while it reads them so.

@@ -3,6 +3,11 @@
 // (refine_forward.wgsl): where they start, the ray to a hard light's centre, and the
 // share of rays over a light's area that arrive. Needs trace.wgsl, light_sample.wgsl
 // and the light's uniform.
+import package::passes::light_binding::light;
+import package::passes::light_kinds::{emitter_ray_length, emitter_sample, emitter_sample_weight};
+import package::rays::light_sample::{cmj, cmj_grid, lowbias32};
+import package::rays::trace_common::{offset_ray_origin, ray_blocked};
+import package::variant::ray_first_hit;
 
 // A bound on how far the surface point off its triangle may lie: the point is the
 // rasterizer's interpolation of the vertices' world positions (the prepass's, or the

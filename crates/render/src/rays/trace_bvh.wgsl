@@ -5,6 +5,8 @@
 // the error of t, and cut-out casters alpha-tested (trace_common.wgsl).
 //
 // Bindings 2 and 3 of group TRACE_GROUP: the nodes and the triangles.
+import package::rays::trace_common::alpha_blocks;
+import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
 struct BvhNode {
     min: vec3<f32>,

@@ -10,6 +10,7 @@
 // passes, where 0 and 1 are left to the material texture that passes sharing
 // scene_common.wgsl declare, and 1 in the forward lighting pass, beside the camera.
 // Binding 2 (and 3) are the tracer's own.
+import package::variant::{NO_TEXTURE, TRACE_GROUP, ray_first_hit};
 
 struct AlphaTest {
     uv0: vec2<f32>,

@@ -1,3 +1,6 @@
+import package::rays::trace_common::alpha_blocks;
+import package::variant::TRACE_GROUP;
+
 enable wgpu_ray_query;
 
 // Shadow rays through the adapter's own acceleration structures (accel.rs), by ray

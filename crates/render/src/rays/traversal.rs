@@ -77,23 +77,22 @@ pub enum RayQueriesUnavailable {
     },
 }
 
-/// The tracer's WGSL for `traversal`, with the constants it shares with [`bvh`], its
-/// bindings in `group` (2–6).
+/// The tracer's generated WGSL for `traversal`: the constants it shares with [`bvh`],
+/// its bindings' group (`TRACE_GROUP`, bindings 2–6), and `ray_first_hit` bound to
+/// the walk (`trace_bvh.wgsl` or `trace_query.wgsl`, loaded by that import with
+/// `trace_common.wgsl`).
 pub(crate) fn trace_wgsl(group: u32, traversal: Traversal) -> String {
-    let (walk, first_hit) = match traversal {
-        Traversal::Shader => (include_str!("trace_bvh.wgsl"), "bvh_ray_first_hit"),
-        Traversal::RayQuery => (include_str!("trace_query.wgsl"), "query_ray_first_hit"),
+    let first_hit = match traversal {
+        Traversal::Shader => "bvh_ray_first_hit",
+        Traversal::RayQuery => "query_ray_first_hit",
     };
     format!(
-        "const TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}\n{}\n{}",
+        "const TRACE_GROUP: u32 = {group}u;\nconst TRACE_STACK_SIZE: u32 = {}u;\nconst NO_ALPHA: u32 = {}u;\nconst NO_TEXTURE: u32 = {}u;\n{}",
         bvh::MAX_DEPTH,
         bvh::NO_ALPHA,
         bvh::NO_TEXTURE,
-        include_str!("trace_common.wgsl"),
-        walk,
         crate::passes::wgsl_interfaces::RAY_FIRST_HIT.bind(first_hit),
     )
-    .replace("TRACE_GROUP", &group.to_string())
 }
 
 /// The first binding of the tracer's resources in whichever group holds them (0 and

@@ -3,6 +3,7 @@
 // (`ShadowBindings` in techniques/mod.rs): group 2 from binding 0 in Gnomon's
 // lighting, mask and moment passes; the host's group from binding 2 in the shadow
 // receiver, after its light and camera (receiver.wgsl).
+import package::variant::{SHADOW_BINDING, SHADOW_GROUP};
 
 // One layer per cascade (a single layer without cascades).
 @group(SHADOW_GROUP) @binding(SHADOW_BINDING) var shadow_map: texture_depth_2d_array;

@@ -1,4 +1,9 @@
 // What every technique's `sample_shadow` receives, and helpers they share.
+import package::constants::MAX_KERNEL_TEXELS;
+import package::passes::light::texel_world_size_at;
+import package::passes::light_binding::light;
+import package::techniques::bindings::{shadow_compare, shadow_map};
+import package::variant::POISSON_DISK;
 
 // One shadow lookup. `coords` is (u, v, depth) in shadow-map texture space (v down,
 // depth as stored in the map); the derivatives are those of `coords` across the

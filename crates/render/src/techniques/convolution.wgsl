@@ -8,6 +8,10 @@
 //
 // Layer j holds (sin, cos) of terms 2j and 2j + 1 (0-based).
 // Its parameters (`ConvolutionParams` in convolution.rs).
+import package::passes::light_binding::light;
+import package::techniques::common::ShadowQuery;
+import package::techniques::filterable::{receiver_moment_depth, sample_moments};
+
 struct ConvolutionParams {
     terms: u32,        // M, the Fourier terms kept
     attenuation: f32,  // α, the ringing suppression

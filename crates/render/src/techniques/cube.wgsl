@@ -2,6 +2,11 @@
 // a point light's cube map is sampled by direction, and the hardware picks the face
 // and filters across face seams (Vulkan always filters cube maps seamlessly), so
 // kernels are laid out in the plane across the ray and never meet a face edge.
+import package::constants::MAX_KERNEL_TEXELS;
+import package::passes::light_binding::light;
+import package::techniques::bindings::{shadow_compare, shadow_cube};
+import package::techniques::common::interleaved_gradient_noise;
+import package::variant::POISSON_DISK;
 
 // One cube lookup.
 struct CubeQuery {

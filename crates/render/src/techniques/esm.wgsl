@@ -7,6 +7,11 @@
 // shadows with exponential shadow maps", ShaderX6 2008).
 //
 // Its parameters (`EsmParams` in esm.rs).
+import package::passes::light_binding::light;
+import package::techniques::bindings::moment_map;
+import package::techniques::common::ShadowQuery;
+import package::techniques::filterable::receiver_moment_depth;
+
 struct EsmParams {
     exponent: f32,  // c
     _pad0: u32,

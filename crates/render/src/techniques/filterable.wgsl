@@ -1,5 +1,9 @@
 // Helpers of the filterable techniques, which sample a blurred map of functions of
 // depth (`moment_map`, an array of RGBA layers) instead of comparing depths.
+import package::passes::light::moment_depth;
+import package::passes::light_binding::light;
+import package::techniques::bindings::{moment_map, moment_sampler};
+import package::techniques::common::ShadowQuery;
 
 // The filtered value of `layer` at the lookup, trilinear when the map has mipmaps
 // (the screen derivatives choose the level; they were taken in uniform control flow).

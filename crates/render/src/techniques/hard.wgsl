@@ -1,4 +1,6 @@
 // `hard`: Williams (1978). Point-sample the nearest texel and compare once.
+import package::techniques::bindings::shadow_map;
+import package::techniques::common::ShadowQuery;
 
 fn hard_sample_shadow(q: ShadowQuery) -> f32 {
     let size = vec2<i32>(textureDimensions(shadow_map));

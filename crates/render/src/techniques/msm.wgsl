@@ -18,6 +18,10 @@
 // reconstructed moments as little as possible. Filtering commutes with it.
 //
 // Its parameters (`MsmParams` in msm.rs).
+import package::passes::light_binding::light;
+import package::techniques::common::ShadowQuery;
+import package::techniques::filterable::{receiver_moment_depth, sample_moments};
+
 struct MsmParams {
     moment_bias: f32,  // α
     hausdorff: u32,    // 1 for the Hausdorff bound, 0 for Hamburger

@@ -7,6 +7,8 @@
 // i + 1 with weights a and b are read by one bilinear tap placed b / (a + b) of the
 // way from texel centre i to centre i + 1, weighted a + b. A width-W kernel touches
 // ⌈W⌉ + 1 cells per axis, so it costs ⌈(⌈W⌉ + 1) / 2⌉² taps instead of (⌈W⌉ + 1)².
+import package::passes::light_binding::light;
+import package::techniques::common::{ShadowQuery, compare_tap, receiver_depth_gradient};
 
 // Integral from −∞ to t of the unit-area box of half-width h.
 fn box_cdf(t: f32, h: f32) -> f32 {

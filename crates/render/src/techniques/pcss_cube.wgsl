@@ -1,6 +1,11 @@
 // PCSS on a point light's cube map (Fernando 2005, as pcss.wgsl), for a sphere of
 // radius w_light (light.emitter.size). Distances are from the light's centre; every
 // offset is across the ray, in texels at the receiver.
+import package::passes::light_binding::light;
+import package::techniques::bindings::{shadow_cube, shadow_gather};
+import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::cube::{CubeQuery, cube_direction, cube_pcf_poisson, cube_tap_depth};
+import package::variant::POISSON_DISK;
 
 fn pcss_sample_shadow_cube(q: CubeQuery) -> f32 {
     let size = light.emitter.size;

@@ -7,6 +7,10 @@
 // Chebyshev inequality; EVSM keeps the smaller.
 //
 // Its parameters (`VarianceParams` in variance.rs).
+import package::passes::light_binding::light;
+import package::techniques::common::ShadowQuery;
+import package::techniques::filterable::{chebyshev_upper_bound, receiver_moment_depth, reduce_bleeding, sample_moments};
+
 struct VarianceParams {
     positive_exponent: f32,   // c⁺
     negative_exponent: f32,   // c⁻
