@@ -247,8 +247,8 @@ mod tests {
 
     /// [`super::LayerKey`] keeps only the fields of the light's uniform that the
     /// shadow pass reads: sound only while `shadow_depth.wgsl` reads no other, and
-    /// calls none of the functions of the light's modules (`light.wgsl`'s, the light
-    /// kinds' and their shapes', which read more).
+    /// calls none of the functions of the light's modules (`light_binding.wgsl`'s,
+    /// the light kinds' and their shapes', which read more).
     #[test]
     fn the_shadow_pass_reads_only_what_the_key_holds() {
         let wgsl = include_str!("../passes/shadow_depth.wgsl");
@@ -267,7 +267,8 @@ mod tests {
             }
             assert!(KEYED.contains(&field), "shadow_depth.wgsl reads light.{field}, which no key holds");
         }
-        let light_modules = ["passes::light", "passes::light_kinds", "passes::light_shapes"];
+        let light_modules =
+            ["passes::light", "passes::light_binding", "passes::light_kinds", "passes::light_shapes"];
         let sources: Vec<&str> = crate::passes::link::MODULES
             .iter()
             .filter(|m| light_modules.contains(&m.path))

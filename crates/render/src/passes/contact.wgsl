@@ -10,8 +10,7 @@
 import package::passes::camera_binding::camera;
 import package::passes::light_binding::light;
 import package::passes::light_kinds::emitter_ray_length;
-import package::passes::screen_common::prepass_surface;
-import package::passes::shadow_mask::plane_point;
+import package::passes::screen_common::{plane_point, prepass_surface};
 import package::techniques::common::interleaved_gradient_noise;
 
 // Relative depth difference within which a depth sample is on the receiver's plane.

@@ -393,3 +393,50 @@ fn every_import_is_used() {
     }
     assert!(imports > 100, "found only {imports} imports");
 }
+
+/// The modules' imports, as (module, the modules it imports from).
+fn module_imports() -> BTreeMap<&'static str, BTreeSet<String>> {
+    let mut graph = BTreeMap::new();
+    for module in super::link::MODULES {
+        let from: BTreeSet<String> = module
+            .source
+            .lines()
+            .filter_map(|l| l.strip_prefix("import package::"))
+            .filter_map(|l| l.rsplit_once("::").map(|(path, _)| path.to_owned()))
+            .collect();
+        graph.insert(module.path, from);
+    }
+    graph
+}
+
+/// No module imports, through others, one that imports it: each can be read after
+/// the ones it imports. (`light.wgsl`'s structs sit apart from the uniform's
+/// functions in `light_binding.wgsl` for this.)
+#[test]
+fn the_modules_import_one_another_without_a_circle() {
+    let graph = module_imports();
+    // Depth-first, with the path walked so far: a module met again on it closes a circle.
+    fn walk<'a>(
+        module: &'a str,
+        graph: &'a BTreeMap<&'static str, BTreeSet<String>>,
+        path: &mut Vec<&'a str>,
+        done: &mut BTreeSet<&'a str>,
+    ) {
+        if let Some(at) = path.iter().position(|m| *m == module) {
+            panic!("an import circle: {}", path[at..].join(" → ") + " → " + module);
+        }
+        if !done.insert(module) {
+            return;
+        }
+        path.push(module);
+        for next in graph.get(module).into_iter().flatten() {
+            walk(next, graph, path, done);
+        }
+        path.pop();
+    }
+    let mut done = BTreeSet::new();
+    for module in graph.keys() {
+        walk(module, &graph, &mut Vec::new(), &mut done);
+    }
+    assert!(done.len() >= graph.len(), "walked {} of {} modules", done.len(), graph.len());
+}

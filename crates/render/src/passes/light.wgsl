@@ -1,9 +1,7 @@
-// The light uniform and the depth conventions of its shadow map, shared by the
-// geometry passes and the moment-map compute passes. Field meanings are documented
-// in `uniforms.rs` (`LightGpu`).
+// The light uniform's structs, shared by every pass that reads a light (the uniform
+// itself and the functions that read it are light_binding.wgsl's). Field meanings
+// are documented in `uniforms/light.rs` (`LightGpu`).
 import package::constants::MAX_CASCADES;
-import package::passes::light_binding::light;
-import package::passes::light_kinds::emitter_distance_from_depth;
 import package::variant::TechniqueParams;
 
 // The parameters of a technique that has none, and of a shader composed without one
@@ -123,30 +121,3 @@ struct Light {
     cascade_clip_from_world: array<mat4x4<f32>, MAX_CASCADES>,
     cascades: array<Cascade, MAX_CASCADES>,
 };
-
-// The view depth where cascade `i` starts; `i + 1` where it ends.
-fn cascade_split(i: u32) -> f32 {
-    if i == 0u {
-        return light.cascades[0].split_start;
-    }
-    return light.cascades[i - 1u].split_end;
-}
-
-// World size of one texel of layer `layer` at light distance `distance`.
-fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
-    return light.cascades[layer].texel_world + light.map.texel_per_distance * max(distance, 0.0);
-}
-
-// Distance along the light's axis (light view −z) of a point whose shadow-map depth
-// is `depth` (how each kind's map stores it: `emitter_distance_from_depth`).
-fn light_distance_from_depth(depth: f32) -> f32 {
-    return emitter_distance_from_depth(light.emitter, light.map.near, light.map.far, depth);
-}
-
-// The depth that moment maps store: light distance, linear in [0, 1] from the near
-// to the far plane, so that filtering averages distances, not projected depths.
-fn moment_depth(depth: f32) -> f32 {
-    let n = light.map.near;
-    let f = light.map.far;
-    return clamp((light_distance_from_depth(depth) - n) / (f - n), 0.0, 1.0);
-}

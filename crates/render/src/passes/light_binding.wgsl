@@ -1,8 +1,36 @@
-// The light uniform, declared once for every pass that reads it, at the group and
-// binding its pass's generated constants name (`light_binding_wgsl` in passes/mod.rs):
+// The light uniform, declared once for every pass that reads it, and the functions
+// that read it, at the group and binding its pass's generated constants name (`light_binding_wgsl` in passes/mod.rs):
 // group 0 binding 1 in Gnomon's own passes, beside the instances; binding 0 of the
 // host's group in the shadow receiver.
 import package::passes::light::Light;
+import package::passes::light_kinds::emitter_distance_from_depth;
 import package::variant::{LIGHT_BINDING, LIGHT_GROUP};
 
 @group(LIGHT_GROUP) @binding(LIGHT_BINDING) var<uniform> light: Light;
+
+// The view depth where cascade `i` starts; `i + 1` where it ends.
+fn cascade_split(i: u32) -> f32 {
+    if i == 0u {
+        return light.cascades[0].split_start;
+    }
+    return light.cascades[i - 1u].split_end;
+}
+
+// World size of one texel of layer `layer` at light distance `distance`.
+fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
+    return light.cascades[layer].texel_world + light.map.texel_per_distance * max(distance, 0.0);
+}
+
+// Distance along the light's axis (light view −z) of a point whose shadow-map depth
+// is `depth` (how each kind's map stores it: `emitter_distance_from_depth`).
+fn light_distance_from_depth(depth: f32) -> f32 {
+    return emitter_distance_from_depth(light.emitter, light.map.near, light.map.far, depth);
+}
+
+// The depth that moment maps store: light distance, linear in [0, 1] from the near
+// to the far plane, so that filtering averages distances, not projected depths.
+fn moment_depth(depth: f32) -> f32 {
+    let n = light.map.near;
+    let f = light.map.far;
+    return clamp((light_distance_from_depth(depth) - n) / (f - n), 0.0, 1.0);
+}

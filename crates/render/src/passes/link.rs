@@ -10,10 +10,10 @@
 //! implementations (`passes::wgsl_interfaces`), the technique's parameter type, the
 //! binding places, the Poisson disk and the passes' own generated constants.
 //!
-//! A pass hands [`compose_wgsl`] its parts as before: a part that is a module's text
+//! A pass hands [`super::compose_wgsl`] its parts: a part that is a module's text
 //! (`include_str!` of it) loads that module, and with it everything it imports; any
 //! other part is generated and goes into `package::variant`, which imports what it
-//! names. The link keeps every declaration of every module loaded (`strip: false`),
+//! names, and which every shader loads. The link keeps every declaration of every module loaded (`strip: false`),
 //! as concatenating the same files did, and no name is mangled (`NoMangler`): no two
 //! modules declare one name (`scripts/wgsl-duplicates.py`), so entry points, structs
 //! and the layout test's names stay as written.
@@ -209,18 +209,23 @@ fn link_from(
             None => generated.push(part),
         }
     }
+    let variant = variant_module(library, &generated);
+    // The root loads the variant too, so that every generated part is in the
+    // shader (and checked) whether or not a module imports it, as with the modules.
+    let variant_names = declared_names(&variant)
+        .map_err(|e| format!("the generated WGSL of `package::{VARIANT_MODULE}` does not parse: {e}"))?;
     let root: String = roots
         .iter()
-        .filter_map(|path| {
-            library.first_name.get(path).map(|name| format!("import package::{path}::{name};\n"))
-        })
+        .filter_map(|path| library.first_name.get(path).map(|name| (*path, name)))
+        .chain(variant_names.first().map(|name| (VARIANT_MODULE, name)))
+        .map(|(path, name)| format!("import package::{path}::{name};\n"))
         .collect();
     let mut resolver = VirtualResolver::new();
     for module in modules {
         resolver.add_module(module_path(module.path), Cow::Borrowed(module.source));
     }
     resolver.add_module(module_path(CONSTANTS_MODULE), Cow::Borrowed(library.constants.as_str()));
-    resolver.add_module(module_path(VARIANT_MODULE), Cow::Owned(variant_module(library, &generated)));
+    resolver.add_module(module_path(VARIANT_MODULE), Cow::Owned(variant));
     resolver.add_module(module_path(ROOT_MODULE), Cow::Owned(root));
     // Keep every declaration of every module loaded, as concatenation did; naga
     // validates the result, so WESL's own partial checks are off.
@@ -230,7 +235,27 @@ fn link_from(
         Naming::AsWritten => wesl::compile(&root, &resolver, &NoMangler, &options),
         Naming::ByModule => wesl::compile(&root, &resolver, &EscapeMangler, &options),
     };
-    linked.map(|linked| linked.to_string()).map_err(|e| e.to_string())
+    linked.map(|linked| linked.to_string()).map_err(|e| without_ansi_styles(&e.to_string()))
+}
+
+/// `text` without the terminal's colour codes (`ESC [ … m`) that WESL's diagnostics
+/// carry, so that an error reads the same in a log, a file or a shader comment.
+fn without_ansi_styles(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c == '\u{1b}' {
+            // Skip to the end of the escape sequence, its final letter.
+            for c in chars.by_ref() {
+                if c.is_ascii_alphabetic() {
+                    break;
+                }
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -283,6 +308,18 @@ mod tests {
         parse_scene_common(without, Naming::AsWritten).expect("as written, a missing import goes unseen");
         let error = parse_scene_common(without, Naming::ByModule).expect_err("a missing import must fail");
         assert!(error.contains("base_color"), "{error}");
+    }
+
+    #[test]
+    fn an_error_loses_its_colour_codes() {
+        assert_eq!(without_ansi_styles("\u{1b}[1m\u{1b}[94m= \u{1b}[0mnote"), "= note");
+    }
+
+    /// A part that does not parse is an error naming what is wrong, not a panic.
+    #[test]
+    fn a_part_that_does_not_parse_is_an_error() {
+        let error = link(&["fn broken( -> f32 {"], Naming::AsWritten).expect_err("not WGSL");
+        assert!(error.contains("package::variant") && error.contains("does not parse"), "{error}");
     }
 
     /// The generated part's names resolve by import, not by a declaration in the part.

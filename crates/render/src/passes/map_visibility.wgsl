@@ -1,8 +1,7 @@
 // The shadow lookup of a light with 2D layers (a sun's map or cascades, a spot's
 // map): pick the cascade, look up the technique's `sample_shadow` there, and blend
 // into the next cascade near its end.
-import package::passes::light::{cascade_split, texel_world_size_at};
-import package::passes::light_binding::light;
+import package::passes::light_binding::{cascade_split, light, texel_world_size_at};
 import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
 import package::techniques::common::ShadowQuery;
 import package::variant::sample_shadow;

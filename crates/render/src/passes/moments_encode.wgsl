@@ -1,7 +1,6 @@
 // Moment-map encoding: every texel's stored depth, made linear (`moment_depth`),
 // becomes the technique's RGBA layers (`encode_moments`).
-import package::passes::light::moment_depth;
-import package::passes::light_binding::light;
+import package::passes::light_binding::{light, moment_depth};
 import package::techniques::bindings::shadow_map;
 import package::variant::{MomentTarget, encode_moments};
 

@@ -15,3 +15,13 @@ fn world_at(pixel: vec2<f32>, view_depth: f32) -> vec3<f32> {
     let view = vec3<f32>(ndc * view_depth / vec2<f32>(camera.scale_x, camera.scale_y), -view_depth);
     return (camera.world_from_view * vec4<f32>(view, 1.0)).xyz;
 }
+
+// Where the ray through `pixel` meets the plane through `origin` with normal `n`.
+fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let direction = world_at(pixel, 1.0) - camera.eye;
+    let along = dot(direction, n);
+    if abs(along) < 1e-12 {
+        return origin;
+    }
+    return camera.eye + direction * (dot(origin - camera.eye, n) / along);
+}

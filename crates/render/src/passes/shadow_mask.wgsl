@@ -12,22 +12,11 @@ import package::passes::camera_binding::camera;
 import package::passes::contact::contact_visibility;
 import package::passes::light_binding::light;
 import package::passes::octahedron::octahedron_decode;
-import package::passes::screen_common::{prepass_normals, prepass_surface, world_at};
+import package::passes::screen_common::{plane_point, prepass_normals, prepass_surface};
 import package::passes::shading::{facing_error, light_geometry};
 import package::variant::{defer_to_ray, pixel_visibility, ray_decides};
 
-
 // Its vertex stage is fullscreen.wgsl's `vs_fullscreen`.
-
-// Where the ray through `pixel` meets the plane through `origin` with normal `n`.
-fn plane_point(pixel: vec2<f32>, origin: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let direction = world_at(pixel, 1.0) - camera.eye;
-    let along = dot(direction, n);
-    if abs(along) < 1e-12 {
-        return origin;
-    }
-    return camera.eye + direction * (dot(origin - camera.eye, n) / along);
-}
 
 @fragment
 fn fs_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {

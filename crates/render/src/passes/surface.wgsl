@@ -6,7 +6,6 @@ import package::passes::camera_binding::camera;
 import package::passes::scene_common::{InstanceTransform, VertexIn, normal_from_object, world_from_object_of};
 import package::passes::shading::facing_side;
 
-
 struct SurfaceVertex {
     // Invariant: every pass drawing from the camera must rasterize the same depths.
     @builtin(position) @invariant clip: vec4<f32>,

@@ -22,8 +22,7 @@
 //
 // What this cannot see: a caster thinner than a texel that the map's rasterization
 // missed altogether leaves no depth to disagree with.
-import package::passes::light::{light_distance_from_depth, texel_world_size_at};
-import package::passes::light_binding::light;
+import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
 import package::passes::light_kinds::emitter_cone_radius;
 import package::passes::map_visibility::{local_texel_world_size, shadow_coords};
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_unsure, map_step, receiver_bias};

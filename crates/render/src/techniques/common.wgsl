@@ -1,7 +1,6 @@
 // What every technique's `sample_shadow` receives, and helpers they share.
 import package::constants::MAX_KERNEL_TEXELS;
-import package::passes::light::texel_world_size_at;
-import package::passes::light_binding::light;
+import package::passes::light_binding::{light, texel_world_size_at};
 import package::techniques::bindings::{shadow_compare, shadow_map};
 import package::variant::POISSON_DISK;
 

@@ -1,7 +1,6 @@
 // Helpers of the filterable techniques, which sample a blurred map of functions of
 // depth (`moment_map`, an array of RGBA layers) instead of comparing depths.
-import package::passes::light::moment_depth;
-import package::passes::light_binding::light;
+import package::passes::light_binding::{light, moment_depth};
 import package::techniques::bindings::{moment_map, moment_sampler};
 import package::techniques::common::ShadowQuery;
 

@@ -12,8 +12,7 @@
 // 3. PCF over a Poisson disk of that radius.
 // Both the search region and the penumbra are converted to texels with the map's
 // projection: perspective texels grow with distance, orthographic ones do not.
-import package::passes::light::{light_distance_from_depth, texel_world_size_at};
-import package::passes::light_binding::light;
+import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::bindings::shadow_map;
 import package::techniques::common::{ShadowQuery, interleaved_gradient_noise, pcf_poisson, receiver_depth_gradient};
