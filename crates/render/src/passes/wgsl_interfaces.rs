@@ -1,10 +1,12 @@
 //! The WGSL functions that several modules implement, each under its own name
 //! (`map_lookup_visibility`, `cube_lookup_visibility`, …), written down once: a
-//! composition picks the implementation in Rust, by the enum that names the choice,
-//! and [`WgslInterface::bind`] generates the interface's function forwarding to it.
-//! No two sources define the same name, so which one a shader runs never depends on
-//! which files were concatenated; naga checks each implementation's signature at the
-//! generated call (`passes::interface_tests`).
+//! pass picks the implementation in Rust, by the enum that names the choice, and
+//! [`WgslInterface::bind`] generates the interface's function forwarding to it, in
+//! the shader's generated module `package::variant`, which imports the
+//! implementation (`passes::link`). The callers import the interface from there
+//! (`import package::variant::lookup_visibility;`), so which one a shader runs is
+//! that import, never which files were linked; naga checks each implementation's
+//! signature at the generated call (`passes::interface_tests`).
 
 /// A WGSL function with several implementations.
 pub(crate) struct WgslInterface {

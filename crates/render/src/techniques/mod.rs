@@ -8,11 +8,15 @@
 //! A technique's WGSL implements the technique contract
 //! (`passes::wgsl_interfaces::TECHNIQUE_CONTRACT`) under its module's name:
 //! `fn pcf_box_sample_shadow(q: ShadowQuery) -> f32` (the lookup, see `common.wgsl`),
-//! returning the lit fraction in [0, 1], and the composer binds `sample_shadow` to it
-//! (a host's technique may define `sample_shadow` itself). It may read the shadow
-//! bindings of `bindings.wgsl`, the `light` uniform, whose `technique` block carries
-//! the typed values of [`ShadowTechnique::params`] ([`TechniqueParams`]), and the
-//! helpers of `common.wgsl`. A filterable technique also defines
+//! returning the lit fraction in [0, 1], and the shader's generated module binds
+//! `sample_shadow` to it (a host's technique may define `sample_shadow` itself). It
+//! may read the shadow bindings of `bindings.wgsl`, the `light` uniform
+//! (`passes/light_binding.wgsl`), whose `technique` block carries the typed values of
+//! [`ShadowTechnique::params`] ([`TechniqueParams`]), and the helpers of
+//! `common.wgsl`. A built-in technique's `.wgsl` is a WESL module that imports each
+//! of these (`import package::techniques::bindings::shadow_map;`); a host's WGSL is
+//! linked into the shader's `package::variant`, which imports them for it
+//! (`passes::link`). A filterable technique also defines
 //! `fn <module>_encode_moments(d: f32, layer: u32) -> vec4<f32>`, which the moment pass
 //! applies to every texel's linear depth d ∈ [0, 1].
 
@@ -131,8 +135,10 @@ pub trait ShadowTechnique: Sync {
     /// What it does, in a line, with its reference: `gnomon techniques`, `--help` and
     /// the viewer show it.
     fn summary(&self) -> &'static str;
-    /// WGSL sources, concatenated after the shared ones, implementing `sample_shadow`
-    /// (as `<module>_sample_shadow`, or under the contract's own name).
+    /// WGSL sources implementing `sample_shadow` (as `<module>_sample_shadow`, or
+    /// under the contract's own name): the renderer's own modules (`include_str!` of
+    /// a `.wgsl` under `src/`), or a host's WGSL, whose names from the renderer's
+    /// modules are imported for it (`passes::link`).
     fn wgsl(&self) -> &'static [&'static str];
     /// The technique's parameters, typed ([`GpuParams`]), passed to the shader as
     /// `light.technique`. Their WGSL struct is a property of the type, not of the
