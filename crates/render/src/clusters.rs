@@ -28,9 +28,11 @@ use gnomon_scene::Mesh;
 /// divisible by 4).
 pub(crate) const MAX_CLUSTER_TRIANGLES: usize = 124;
 /// The most distinct vertices in a cluster.
+#[cfg(feature = "clusters")]
 const MAX_CLUSTER_VERTICES: usize = 64;
 /// How much meshoptimizer weighs a tight normal cone against a compact cluster,
 /// in [0, 1]: cones decide the back-facing clusters a pass skips.
+#[cfg(feature = "clusters")]
 const CONE_WEIGHT: f32 = 0.5;
 /// The fewest triangles a mesh is clustered at: a smaller one is drawn whole, where
 /// clusters would add draws and save little.
@@ -51,6 +53,21 @@ pub(crate) fn cluster_mesh(mesh: &Mesh) -> Option<MeshClusters> {
     if mesh.triangle_count() < MIN_CLUSTERED_TRIANGLES {
         return None;
     }
+    let (indices, ranges) = build_clusters(mesh)?;
+    // Every triangle once: anything else would change the map, so the mesh is then
+    // drawn whole.
+    (same_triangles(&mesh.indices, &indices)).then_some(MeshClusters { indices, ranges })
+}
+
+/// Whether this build clusters large meshes (the `clusters` feature, on by default):
+/// without meshoptimizer, which is C++, a build for a target with no C++ compiler
+/// (wasm32) culls each mesh whole, per instance, and draws the same maps.
+pub const CLUSTERS_BUILT: bool = cfg!(feature = "clusters");
+
+/// meshoptimizer's clusters of `mesh`: the indices in cluster order and each
+/// cluster's range.
+#[cfg(feature = "clusters")]
+fn build_clusters(mesh: &Mesh) -> Option<(Vec<u32>, Vec<Range<u32>>)> {
     let positions: &[u8] = bytemuck::cast_slice(&mesh.positions);
     let adapter = meshopt::VertexDataAdapter::new(positions, std::mem::size_of::<Vec3>(), 0).ok()?;
     let meshlets = meshopt::build_meshlets(
@@ -67,9 +84,13 @@ pub(crate) fn cluster_mesh(mesh: &Mesh) -> Option<MeshClusters> {
         indices.extend(meshlet.triangles.iter().map(|&local| meshlet.vertices[usize::from(local)]));
         ranges.push(start..indices.len() as u32);
     }
-    // Every triangle once: anything else would change the map, so the mesh is then
-    // drawn whole.
-    (same_triangles(&mesh.indices, &indices)).then_some(MeshClusters { indices, ranges })
+    Some((indices, ranges))
+}
+
+/// Without the `clusters` feature no mesh is clustered ([`CLUSTERS_BUILT`]).
+#[cfg(not(feature = "clusters"))]
+fn build_clusters(_mesh: &Mesh) -> Option<(Vec<u32>, Vec<Range<u32>>)> {
+    None
 }
 
 /// Whether `a` and `b` hold the same triangles, each with the same turn of corners.

@@ -29,6 +29,7 @@ pub mod techniques;
 pub mod timing;
 pub mod uniforms;
 
+pub use clusters::CLUSTERS_BUILT;
 pub use device::{Gpu, GpuInfo};
 pub use frame::{
     CpuTimings, Creations, DrawStats, Frame, FrameCost, LayerCache, LightShadows, LightStats, LiveFrame,

@@ -3,7 +3,7 @@
 //! where the adapter has no timestamp queries, CPU wall-clock time around each pass
 //! with the frame cut into one submission per pass.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use crate::{Gpu, RenderError, pool::Pool, readback};
 

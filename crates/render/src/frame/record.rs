@@ -3,7 +3,7 @@
 //! passes on the mask path, and the lighting (`light_passes.rs`), into one command
 //! buffer. Every resource comes from the renderer's pool.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use gnomon_math::screen_bounds::Viewport;
 use gnomon_scene::{

@@ -5,7 +5,7 @@
 //! outputs (`outputs.rs`) all read these, and these read none of them, so the frame's
 //! files import one another in one direction.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use super::bindings::ShadowViews;
 use crate::{
