@@ -440,3 +440,65 @@ fn the_modules_import_one_another_without_a_circle() {
     }
     assert!(done.len() >= graph.len(), "walked {} of {} modules", done.len(), graph.len());
 }
+
+/// What one entry point reads, by the kind of resource WebGPU limits per stage.
+fn resources_read(module: &naga::Module, entry: &naga::valid::FunctionInfo) -> BTreeMap<&'static str, u32> {
+    use naga::{AddressSpace, ImageClass, TypeInner};
+    let mut counts = BTreeMap::new();
+    for (handle, var) in module.global_variables.iter() {
+        if entry[handle].is_empty() || var.binding.is_none() {
+            continue;
+        }
+        let kind = match (var.space, &module.types[var.ty].inner) {
+            (AddressSpace::Storage { .. }, _) => "storage buffers",
+            (AddressSpace::Uniform, _) => "uniform buffers",
+            (_, TypeInner::Image { class: ImageClass::Storage { .. }, .. }) => "storage textures",
+            (_, TypeInner::Image { .. }) => "sampled textures",
+            (_, TypeInner::Sampler { .. }) => "samplers",
+            (space, ty) => panic!("a binding in {space:?} of {ty:?}, which this check does not count"),
+        };
+        *counts.entry(kind).or_default() += 1;
+    }
+    counts
+}
+
+/// Every shader a browser can run fits WebGPU's default limits (wgpu's
+/// `Limits::default()`, the specification's): the bind groups it reads, and per
+/// stage its storage and uniform buffers, storage and sampled textures and
+/// samplers. Ray queries are not in WebGPU; those variants are left out.
+#[test]
+fn every_shader_fits_webgpus_default_limits() {
+    let limits = wgpu::Limits::default();
+    let per_stage = BTreeMap::from([
+        ("storage buffers", limits.max_storage_buffers_per_shader_stage),
+        ("uniform buffers", limits.max_uniform_buffers_per_shader_stage),
+        ("storage textures", limits.max_storage_textures_per_shader_stage),
+        ("sampled textures", limits.max_sampled_textures_per_shader_stage),
+        ("samplers", limits.max_samplers_per_shader_stage),
+    ]);
+    let mut checked = 0;
+    for (name, source) in every_variant().iter().filter(|(name, _)| !name.contains("RayQuery")) {
+        let module = parse(name, source);
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .expect("validated by parse");
+        let groups =
+            module.global_variables.iter().filter_map(|(_, v)| v.binding.as_ref()).map(|b| b.group + 1).max();
+        assert!(groups.unwrap_or(0) <= limits.max_bind_groups, "{name} reads {groups:?} bind groups");
+        for (index, entry) in module.entry_points.iter().enumerate() {
+            for (kind, count) in resources_read(&module, info.get_entry_point(index)) {
+                assert!(
+                    count <= per_stage[kind],
+                    "{name}, {}: {count} {kind}, over {}",
+                    entry.name,
+                    per_stage[kind]
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 300, "checked only {checked} entry points");
+}
