@@ -1,7 +1,8 @@
 //! The Rust↔WGSL interface, checked without a device: every shader variant Gnomon can
 //! build (technique × light lookup × forward or mask path × role × refinement, the moment passes
-//! per format, and every fixed pass) composes and validates with naga, as wgpu would
-//! compile it; and every uniform struct's WGSL size and field offsets equal the Rust
+//! per format, and every fixed pass) links and validates with naga, as wgpu would
+//! compile it, and links again with each declaration named by its module, so that a
+//! module that reads a name without importing it fails; and every uniform struct's WGSL size and field offsets equal the Rust
 //! type's (`struct_layouts`).
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -4,9 +4,9 @@
 import package::constants::MAX_CASCADES;
 import package::variant::TechniqueParams;
 
-// The parameters of a technique that has none, and of a shader composed without one
+// The parameters of a technique that has none, and of a shader linked without one
 // (`NoParams` in techniques/params.rs). `TechniqueParams` is a generated alias of the
-// composed technique's own struct (`VarianceParams`, …), 32 bytes each.
+// linked technique's own struct (`VarianceParams`, …), 32 bytes each.
 struct NoParams {
     _pad0: vec4<u32>,
     _pad1: vec4<u32>,

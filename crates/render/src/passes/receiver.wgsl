@@ -1,6 +1,7 @@
 // Gnomon's shadow receiver: the shadows of one light, for a host's own fragment
-// shader. Composed after the light and camera structs, the technique's lookup and
-// the rules of resolve_visibility.wgsl; the host's shader follows it in one module.
+// shader. Linked with what it imports (the light and camera, the technique's lookup
+// and the rules of resolve_visibility.wgsl) into plain WGSL; the host's shader
+// follows it in one module.
 //
 // Every resource sits in one bind group, at the index the host chose, in the order of
 // `Layouts::receiver`: the light (light_binding.wgsl) at binding 0, the camera

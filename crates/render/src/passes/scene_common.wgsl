@@ -1,6 +1,6 @@
 // Declarations shared by every pass that draws scene geometry: the per-instance
 // data, the vertex layout, and the light uniform's binding (its struct is in
-// light.wgsl). Concatenated before a pass's own WGSL by `passes::compose_wgsl`.
+// light.wgsl), imported by the passes that draw geometry.
 import package::passes::material_bindings::{base_color_sampler, base_color_texture};
 
 struct Instance {

@@ -1,10 +1,11 @@
-// What both shadow-ray tracers share (`rays::trace_wgsl` composes this file with
-// trace_bvh.wgsl, Gnomon's own BVH walked by the shader, or trace_query.wgsl, the
-// adapter's acceleration structures through ray queries): the alpha test of cut-out
-// casters against their texture's alpha at mip 0, as the CPU reference
-// (reference/texture.rs) samples it, and the ray's origin moved off its surface by
-// Wächter & Binder's offset (Ray Tracing Gems, ch. 6). Each tracer defines
-// `ray_first_hit`; `ray_blocked` asks it.
+// What both shadow-ray tracers share (imported by trace_bvh.wgsl, Gnomon's own BVH
+// walked by the shader, and trace_query.wgsl, the adapter's acceleration structures
+// through ray queries): the alpha test of cut-out casters against their texture's
+// alpha at mip 0, as the CPU reference (reference/texture.rs) samples it, and the
+// ray's origin moved off its surface by Wächter & Binder's offset (Ray Tracing Gems,
+// ch. 6). Each tracer implements `ray_first_hit` under its own name
+// (`bvh_ray_first_hit`, `query_ray_first_hit`); the shader's generated module binds
+// the one its pass chose (`rays::trace_wgsl`), and `ray_blocked` asks it.
 //
 // Bindings 4–6 of group TRACE_GROUP, which `trace_wgsl` sets: 3 in the compute
 // passes, where 0 and 1 are left to the material texture that passes sharing

@@ -206,7 +206,7 @@ pub(crate) fn technique_wgsl(technique: &dyn ShadowTechnique, sources: &[&str]) 
     parts
 }
 
-/// The helpers every cube lookup shares, composed before a technique's cube WGSL.
+/// The helpers every cube lookup shares, which a technique's cube WGSL imports.
 pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
 
 /// Taps in the shared Poisson disk: the most any technique may ask for, the end of
