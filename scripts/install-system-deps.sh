@@ -6,12 +6,21 @@
 # - with --tests, an X server for the viewer's window test when there is no display
 #   (xvfb, whose xvfb-run the test starts itself), and a lavapipe with ray queries in
 #   a folder of its own for the ray-query tests (fetch-lavapipe-ray-query.sh: the
-#   system's Mesa is left as it is).
+#   system's Mesa is left as it is);
+# - with --browser, Debian's Chromium and Node.js with npm, for the lab's browser
+#   test (web/test/browser-test.mjs; docs/web.md).
 # Does nothing when everything is already there.
 set -eu
 
 want_tests=no
-[ "${1:-}" = "--tests" ] && want_tests=yes
+want_browser=no
+for arg in "$@"; do
+    case "$arg" in
+        --tests) want_tests=yes ;;
+        --browser) want_browser=yes ;;
+        *) echo "install-system-deps: unknown option $arg (give --tests, --browser or nothing)" >&2; exit 2 ;;
+    esac
+done
 
 have_icd=no
 for f in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json; do
@@ -34,6 +43,14 @@ fi
 if [ "$want_tests" = yes ] && ! command -v xvfb-run >/dev/null 2>&1; then
     echo "install-system-deps: no xvfb-run; installing xvfb for the viewer's window test" >&2
     packages="$packages xvfb xauth"
+fi
+if [ "$want_browser" = yes ] && ! [ -x /usr/bin/chromium ]; then
+    echo "install-system-deps: no chromium; installing Debian's for the browser test" >&2
+    packages="$packages chromium"
+fi
+if [ "$want_browser" = yes ] && ! command -v npm >/dev/null 2>&1; then
+    echo "install-system-deps: no npm; installing Node.js for the browser test's driver" >&2
+    packages="$packages nodejs npm"
 fi
 # The ray-query tests skip, saying so, without it: a failed fetch is no failure here.
 fetch_ray_query() {

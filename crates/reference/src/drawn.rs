@@ -113,6 +113,25 @@ pub fn drawn_truth(
     }
 }
 
+/// Whether each surface the frame shows faces `light` (geometric N·L > 0 toward its
+/// centre) inside its cone and range: the pixels whose visibility a shadow decides,
+/// as [`drawn_truth`] finds them. With the visibility of a frame that traced every
+/// pixel (the GPU's `raytraced`), this makes a [`DrawnTruth`] without the CPU
+/// tracer: the browser's truth view does so.
+pub fn faces_light(light: &Light, surfaces: DrawnSurfaces) -> Vec<bool> {
+    let emitter = Emitter::new(light);
+    surfaces
+        .position
+        .iter()
+        .zip(surfaces.geometric_normal)
+        .map(|(&position, &normal)| {
+            position.is_finite()
+                && normal.is_finite()
+                && emitter.faces(&Hit { t: 0.0, position, normal, object_id: 0, triangle: 0 })
+        })
+        .collect()
+}
+
 struct DrawnPixel {
     visibility: f32,
     faces_light: bool,
@@ -219,6 +238,22 @@ mod tests {
             samples: 1,
             rays: n as u64,
         }
+    }
+
+    /// A sun's light-facing surfaces are those whose normal has a component toward
+    /// it; background (NaN) faces nothing.
+    #[test]
+    fn faces_light_is_the_side_of_the_surface_the_light_is_on() {
+        let sun = Light::Directional(gnomon_scene::DirectionalLight {
+            direction: -Vec3::Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            angular_diameter_degrees: 0.0,
+        });
+        let position = [Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::NAN];
+        let geometric_normal = [Vec3::Y, -Vec3::Y, Vec3::X, Vec3::Y];
+        let surfaces = DrawnSurfaces { width: 4, position: &position, geometric_normal: &geometric_normal };
+        assert_eq!(faces_light(&sun, surfaces), [true, false, false, false]);
     }
 
     /// False shadow, false lit and ambiguous pixels are counted apart; background

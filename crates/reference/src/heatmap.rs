@@ -58,6 +58,33 @@ pub fn hard(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClas
     })
 }
 
+/// RGBA8 image of the hard-shadow errors of `visibility` against the truth at its
+/// own surfaces ([`crate::drawn`]): every light-facing pixel is compared, ambiguous
+/// ones painted as the silhouette colour (counted apart, as the metric does).
+pub fn drawn(visibility: &[f32], truth: &crate::drawn::DrawnTruth) -> Vec<u8> {
+    visibility
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &v)| {
+            let [r, g, b] = if !v.is_finite() || !truth.visibility[i].is_finite() {
+                BACKGROUND
+            } else if !truth.faces_light[i] {
+                UNLIT
+            } else if truth.ambiguous[i] {
+                SILHOUETTE
+            } else {
+                match (truth.visibility[i] >= 0.5, v >= 0.5) {
+                    (true, false) => FALSE_SHADOW,
+                    (false, true) => FALSE_LIT,
+                    (true, true) => CORRECT_LIT,
+                    (false, false) => CORRECT_SHADOW,
+                }
+            };
+            [r, g, b, 255]
+        })
+        .collect()
+}
+
 /// The soft-error colour ramp for |V − R| in [0, 1]: black, violet, orange, yellow
 /// (a coarse approximation of matplotlib's "inferno").
 pub fn ramp(e: f32) -> [u8; 3] {
@@ -77,6 +104,22 @@ pub fn soft(visibility: &[f32], reference: &ReferenceImage, classes: &[PixelClas
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each pixel of the drawn heat-map is painted by its class against the truth.
+    #[test]
+    fn drawn_paints_each_class_its_colour() {
+        let truth = crate::drawn::DrawnTruth {
+            visibility: vec![1.0, 0.0, 1.0, 0.0, 0.0, 1.0, f32::NAN],
+            faces_light: vec![true, true, true, true, false, true, false],
+            ambiguous: vec![false, false, false, false, false, true, false],
+            samples: 1,
+            rays: 0,
+        };
+        let frame = [0.0, 1.0, 1.0, 0.0, 0.0, 1.0, f32::NAN];
+        let painted: Vec<[u8; 3]> = drawn(&frame, &truth).chunks(4).map(|p| [p[0], p[1], p[2]]).collect();
+        let expected = [FALSE_SHADOW, FALSE_LIT, CORRECT_LIT, CORRECT_SHADOW, UNLIT, SILHOUETTE, BACKGROUND];
+        assert_eq!(painted, expected);
+    }
 
     #[test]
     fn ramp_runs_dark_to_bright() {

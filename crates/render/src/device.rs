@@ -72,7 +72,17 @@ pub struct Gpu {
     /// ray queries in software, slower than the shader's own BVH, so `Tracer::Auto`
     /// takes them on a GPU only.
     pub device_type: wgpu::DeviceType,
+    /// Where a device error raised in a browser waits to be reported
+    /// ([`Gpu::deferred_error`]): there Gnomon cannot wait for its error scopes.
+    /// A clone of the `Gpu` shares it.
+    pub deferred: DeferredErrors,
 }
+
+/// The first device error that arrived after the call that raised it had returned
+/// (in a browser), kept until [`Gpu::deferred_error`] takes it. Opaque: a host only
+/// makes one (`Default`) or copies one along with its `Gpu`.
+#[derive(Clone, Debug, Default)]
+pub struct DeferredErrors(std::sync::Arc<std::sync::Mutex<Option<(&'static str, String)>>>);
 
 impl Gpu {
     /// Picks an adapter without a surface and opens a device on it, asking for the
@@ -80,6 +90,7 @@ impl Gpu {
     ///
     /// `GNOMON_MAX_TEXTURE_SIZE=N` caps the 2D texture size below the adapter's, to
     /// check settings against a smaller GPU than the one at hand.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new_headless() -> Result<Self, RenderError> {
         let cap = std::env::var("GNOMON_MAX_TEXTURE_SIZE").ok().and_then(|v| v.trim().parse::<u32>().ok());
         Self::new_headless_with(|limits| {
@@ -90,6 +101,7 @@ impl Gpu {
     }
 
     /// Like [`Gpu::new_headless`], letting `adjust` lower the limits asked for.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new_headless_with(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self, RenderError> {
         let adapter = headless_adapter()?;
         Self::with_adapter(&adapter, adjust)
@@ -97,7 +109,17 @@ impl Gpu {
 
     /// Opens a device on `adapter` (one picked for a window's surface, say), with the
     /// adapter's own limits lowered by `adjust` and the optional features Gnomon uses.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn with_adapter(
+        adapter: &wgpu::Adapter,
+        adjust: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<Self, RenderError> {
+        pollster::block_on(Self::with_adapter_async(adapter, adjust))
+    }
+
+    /// [`Gpu::with_adapter`], for a caller that cannot block (a browser, whose
+    /// device arrives through a promise).
+    pub async fn with_adapter_async(
         adapter: &wgpu::Adapter,
         adjust: impl FnOnce(&mut wgpu::Limits),
     ) -> Result<Self, RenderError> {
@@ -105,39 +127,41 @@ impl Gpu {
         let mut limits = adapter.limits();
         adjust(&mut limits);
         let ray_queries = adapter.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("gnomon"),
-            // Timestamps time each pass where the adapter has them (lavapipe does);
-            // 32-bit float filtering lets moment maps keep full precision; unclipped
-            // depth lets a sun's map clamp casters in front of its near plane onto it
-            // ("pancaking"), so the depth range need only span the receivers; a first
-            // instance in indirect draws lets a layer's draws be one multi-draw, and
-            // indirect count lets the backend issue it as one command; ray queries
-            // let the shadow rays use the adapter's own acceleration structures.
-            required_features: adapter.features()
-                & (wgpu::Features::TIMESTAMP_QUERY
-                    | wgpu::Features::FLOAT32_FILTERABLE
-                    | wgpu::Features::DEPTH_CLIP_CONTROL
-                    | wgpu::Features::INDIRECT_FIRST_INSTANCE
-                    | wgpu::Features::MULTI_DRAW_INDIRECT_COUNT
-                    | wgpu::Features::EXPERIMENTAL_RAY_QUERY),
-            required_limits: limits.clone(),
-            // wgpu names its ray queries experimental and asks for this token before it
-            // enables them. Gnomon holds them to the shader tracer's answers
-            // (reference/tests/truth/ray_queries.rs) wherever a device has them.
-            experimental_features: if ray_queries {
-                // SAFETY: the token only unlocks the EXPERIMENTAL_RAY_QUERY feature
-                // requested above; no other experimental API is used.
-                unsafe { wgpu::ExperimentalFeatures::enabled() }
-            } else {
-                wgpu::ExperimentalFeatures::disabled()
-            },
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::DeviceRequest {
-            adapter: adapter_info.name.clone(),
-            reason: e.to_string(),
-        })?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("gnomon"),
+                // Timestamps time each pass where the adapter has them (lavapipe does);
+                // 32-bit float filtering lets moment maps keep full precision; unclipped
+                // depth lets a sun's map clamp casters in front of its near plane onto it
+                // ("pancaking"), so the depth range need only span the receivers; a first
+                // instance in indirect draws lets a layer's draws be one multi-draw, and
+                // indirect count lets the backend issue it as one command; ray queries
+                // let the shadow rays use the adapter's own acceleration structures.
+                required_features: adapter.features()
+                    & (wgpu::Features::TIMESTAMP_QUERY
+                        | wgpu::Features::FLOAT32_FILTERABLE
+                        | wgpu::Features::DEPTH_CLIP_CONTROL
+                        | wgpu::Features::INDIRECT_FIRST_INSTANCE
+                        | wgpu::Features::MULTI_DRAW_INDIRECT_COUNT
+                        | wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+                required_limits: limits.clone(),
+                // wgpu names its ray queries experimental and asks for this token before it
+                // enables them. Gnomon holds them to the shader tracer's answers
+                // (reference/tests/truth/ray_queries.rs) wherever a device has them.
+                experimental_features: if ray_queries {
+                    // SAFETY: the token only unlocks the EXPERIMENTAL_RAY_QUERY feature
+                    // requested above; no other experimental API is used.
+                    unsafe { wgpu::ExperimentalFeatures::enabled() }
+                } else {
+                    wgpu::ExperimentalFeatures::disabled()
+                },
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| RenderError::DeviceRequest {
+                adapter: adapter_info.name.clone(),
+                reason: e.to_string(),
+            })?;
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, &device);
@@ -151,6 +175,7 @@ impl Gpu {
             timestamp_period_ns,
             indirect_draws,
             indirect_count,
+            deferred: DeferredErrors::default(),
         })
     }
 
@@ -174,11 +199,16 @@ impl Gpu {
             indirect_count,
             ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
             device_type,
+            deferred: DeferredErrors::default(),
         }
     }
 
     /// Runs `f`, turning any validation, out-of-memory or internal error it raises
     /// into a [`RenderError::Gpu`] instead of wgpu's default panic.
+    ///
+    /// A browser cannot wait for its error scopes: there `f`'s value is returned at
+    /// once and an error it raised is reported by the next [`Gpu::deferred_error`],
+    /// which the `async` entry points call once their readbacks have arrived.
     pub(crate) fn checked<T>(&self, during: &'static str, f: impl FnOnce() -> T) -> Result<T, RenderError> {
         let scopes = [
             self.device.push_error_scope(wgpu::ErrorFilter::Internal),
@@ -186,15 +216,47 @@ impl Gpu {
             self.device.push_error_scope(wgpu::ErrorFilter::Validation),
         ];
         let value = f();
-        let mut first = None;
-        for scope in scopes.into_iter().rev() {
-            if let Some(e) = pollster::block_on(scope.pop()) {
-                first.get_or_insert(e.to_string());
+        // Popped now, innermost first, as WebGPU asks; answered when awaited.
+        let answers: Vec<_> = scopes.into_iter().rev().map(wgpu::ErrorScopeGuard::pop).collect();
+        let popped = async move {
+            let mut first = None;
+            for answer in answers {
+                if let Some(e) = answer.await {
+                    first.get_or_insert(e.to_string());
+                }
+            }
+            first
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            match pollster::block_on(popped) {
+                Some(message) => Err(RenderError::Gpu { during, message }),
+                None => Ok(value),
             }
         }
-        match first {
-            Some(message) => Err(RenderError::Gpu { during, message }),
-            None => Ok(value),
+        #[cfg(target_arch = "wasm32")]
+        {
+            let deferred = self.deferred.0.clone();
+            wasm_bindgen_futures::spawn_local(async move {
+                if let Some(message) = popped.await {
+                    deferred
+                        .lock()
+                        .unwrap_or_else(std::sync::PoisonError::into_inner)
+                        .get_or_insert((during, message));
+                }
+            });
+            Ok(value)
+        }
+    }
+
+    /// The first device error [`Gpu::checked`] could not report when it was raised
+    /// (in a browser), taken so that it is reported once; `Ok` where there is none
+    /// (always, on a device Gnomon can wait for).
+    pub fn deferred_error(&self) -> Result<(), RenderError> {
+        let taken = self.deferred.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
+        match taken {
+            Some((during, message)) => Err(RenderError::Gpu { during, message }),
+            None => Ok(()),
         }
     }
 }
@@ -230,6 +292,7 @@ impl RenderError {
 /// visibility and AOV outputs need, and a user would meet a validation error instead
 /// of the install hint. An OpenGL adapter, chosen or fallen back to, is refused with
 /// that hint.
+#[cfg(not(target_arch = "wasm32"))]
 fn headless_adapter() -> Result<wgpu::Adapter, RenderError> {
     let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
     let chosen_by_user = std::env::var_os("WGPU_BACKEND").is_some();

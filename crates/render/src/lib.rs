@@ -30,7 +30,7 @@ pub mod timing;
 pub mod uniforms;
 
 pub use clusters::CLUSTERS_BUILT;
-pub use device::{Gpu, GpuInfo};
+pub use device::{DeferredErrors, Gpu, GpuInfo};
 pub use frame::{
     CpuTimings, Creations, DrawStats, Frame, FrameCost, LayerCache, LightShadows, LightStats, LiveFrame,
     OutputRequest, PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
@@ -39,7 +39,9 @@ pub use gpu_scene::{GpuCullUnavailable, GpuScene};
 pub use layout::{ShadowLayout, light_projection};
 pub use passes::blit::HostTarget;
 pub use passes::depth_baseline::DepthBaselineScene;
+#[cfg(not(target_arch = "wasm32"))]
 pub use readback::read_texture;
+pub use readback::read_texture_async;
 pub use wgpu;
 
 use gnomon_scene::{SceneError, settings::SettingsError};

@@ -1,7 +1,96 @@
-//! Copying textures back to the CPU: row padding to wgpu's 256-byte alignment on
-//! the way out, and removed again on the way in.
+//! Copying textures and buffers back to the CPU: row padding to wgpu's 256-byte
+//! alignment on the way out, removed again on the way in; and the wait for a
+//! mapping, as a future ([`Mapped`]).
+//!
+//! Every read is `async`, because a browser cannot block: WebGPU maps a buffer when
+//! the page's event loop runs again, so the wait must yield to it. On a native
+//! device the future is ready as soon as it is made: making it polls the device
+//! until the mapping is done, and `pollster::block_on` drives it to its end at once.
+
+use std::{
+    future::Future,
+    pin::Pin,
+    sync::{Arc, Mutex, PoisonError},
+    task::{Context, Poll, Waker},
+};
 
 use crate::{Gpu, RenderError, pool::Pool};
+
+/// What a `map_async` callback reports, and who waits for it.
+#[derive(Default)]
+struct MapState {
+    result: Option<Result<(), wgpu::BufferAsyncError>>,
+    waker: Option<Waker>,
+}
+
+/// A buffer's mapping for reading, as a future: ready once the GPU has finished the
+/// work before it and the buffer is mapped.
+pub(crate) struct Mapped {
+    state: Arc<Mutex<MapState>>,
+}
+
+impl Mapped {
+    /// Starts mapping `slice` for reading. On a native device it also waits for the
+    /// GPU, so that the future is ready at once; in a browser the mapping completes
+    /// when the page's event loop next runs.
+    fn begin(gpu: &Gpu, slice: &wgpu::BufferSlice<'_>) -> Result<Self, RenderError> {
+        let mapped = Self::start(slice);
+        wait_for_gpu(gpu)?;
+        Ok(mapped)
+    }
+
+    /// Starts mapping `slice` for reading, without waiting for the GPU.
+    fn start(slice: &wgpu::BufferSlice<'_>) -> Self {
+        let state = Arc::new(Mutex::new(MapState::default()));
+        let callback_state = state.clone();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let mut state = callback_state.lock().unwrap_or_else(PoisonError::into_inner);
+            state.result = Some(result);
+            if let Some(waker) = state.waker.take() {
+                waker.wake();
+            }
+        });
+        Self { state }
+    }
+
+    /// Whether the mapping has finished (done or failed).
+    fn is_done(&self) -> bool {
+        self.state.lock().unwrap_or_else(PoisonError::into_inner).result.is_some()
+    }
+}
+
+impl Future for Mapped {
+    type Output = Result<(), RenderError>;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
+        let mut state = self.state.lock().unwrap_or_else(PoisonError::into_inner);
+        match state.result.clone() {
+            Some(result) => Poll::Ready(result.map_err(|e| RenderError::Gpu {
+                during: "mapping a readback buffer",
+                message: e.to_string(),
+            })),
+            None => {
+                state.waker = Some(cx.waker().clone());
+                Poll::Pending
+            }
+        }
+    }
+}
+
+/// Waits for the GPU to finish what was submitted, which runs the mapping
+/// callbacks. A browser has no such wait: its callbacks run from the event loop.
+#[cfg(not(target_arch = "wasm32"))]
+fn wait_for_gpu(gpu: &Gpu) -> Result<(), RenderError> {
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(drop)
+        .map_err(|e| RenderError::Gpu { during: "waiting for the GPU", message: e.to_string() })
+}
+
+#[cfg(target_arch = "wasm32")]
+fn wait_for_gpu(_gpu: &Gpu) -> Result<(), RenderError> {
+    Ok(())
+}
 
 /// A texture copy recorded into an encoder, waiting to be mapped.
 pub(crate) struct PendingReadback {
@@ -47,28 +136,22 @@ pub(crate) fn record(
     PendingReadback { buffer, width, height, layers, bytes_per_texel, padded_bytes_per_row }
 }
 
-/// Copies mip 0 of a colour `texture` back to the CPU and waits for it: texels
-/// row-major, top row first, in the texture's own format.
-pub fn read_texture<T: bytemuck::Pod>(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<T>, RenderError> {
+/// Copies mip 0 of a colour `texture` back to the CPU: texels row-major, top row
+/// first, in the texture's own format.
+pub async fn read_texture_async<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+) -> Result<Vec<T>, RenderError> {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let pending = record(&mut Pool::new(&gpu.device), &mut encoder, texture, wgpu::TextureAspect::All);
     gpu.queue.submit([encoder.finish()]);
-    pending.read(gpu)
+    pending.read(gpu).await
 }
 
-/// Maps `slice` for reading and waits until it is.
-fn map_blocking(gpu: &Gpu, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    gpu.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Gpu { during: "waiting for the GPU", message: e.to_string() })?;
-    receiver
-        .recv()
-        .map_err(|e| RenderError::Gpu { during: "reading back", message: e.to_string() })?
-        .map_err(|e| RenderError::Gpu { during: "mapping a readback buffer", message: e.to_string() })
+/// [`read_texture_async`], waiting for it (not in a browser, which cannot wait).
+#[cfg(not(target_arch = "wasm32"))]
+pub fn read_texture<T: bytemuck::Pod>(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<T>, RenderError> {
+    pollster::block_on(read_texture_async(gpu, texture))
 }
 
 /// Timestamp queries resolved and copied into a mappable buffer.
@@ -79,28 +162,20 @@ pub(crate) struct PendingTimestamps {
 /// Timestamps being mapped in the background.
 pub(crate) struct MappingTimestamps {
     buffer: wgpu::Buffer,
-    state: std::sync::Arc<std::sync::Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>,
+    mapped: Mapped,
 }
 
 impl MappingTimestamps {
-    fn state(&self) -> Option<Result<(), wgpu::BufferAsyncError>> {
-        self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone()
-    }
-
     pub fn buffer(&self) -> &wgpu::Buffer {
         &self.buffer
     }
 
-    /// The ticks, waiting for the mapping if it has not finished.
-    pub fn read(self, gpu: &Gpu) -> Result<Vec<u64>, RenderError> {
-        while self.state().is_none() {
-            gpu.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| RenderError::Gpu { during: "waiting for the GPU", message: e.to_string() })?;
+    /// The ticks, once the mapping has finished.
+    pub async fn read(self, gpu: &Gpu) -> Result<Vec<u64>, RenderError> {
+        if !self.mapped.is_done() {
+            wait_for_gpu(gpu)?;
         }
-        if let Some(Err(e)) = self.state() {
-            return Err(RenderError::Gpu { during: "mapping timestamps", message: e.to_string() });
-        }
+        self.mapped.await?;
         let ticks = {
             let mapped = self
                 .buffer
@@ -140,24 +215,20 @@ impl PendingTimestamps {
         &self.buffer
     }
 
-    /// Starts mapping the buffer (after the submission) without waiting: the ticks
-    /// are ready once [`MappingTimestamps::is_ready`] says so.
+    /// Starts mapping the buffer (after the submission) without waiting for the GPU:
+    /// [`MappingTimestamps::read`] waits, if it must, when the ticks are wanted.
     pub fn begin_map(self) -> MappingTimestamps {
-        let state = std::sync::Arc::new(std::sync::Mutex::new(None));
-        let sender = state.clone();
-        self.buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            *sender.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
-        });
-        MappingTimestamps { buffer: self.buffer, state }
+        let mapped = Mapped::start(&self.buffer.slice(..));
+        MappingTimestamps { buffer: self.buffer, mapped }
     }
 }
 
 impl PendingReadback {
     /// Maps the buffer (after the copy's submission) and returns the tightly packed
     /// texels, top row first, layer after layer.
-    pub fn read<T: bytemuck::Pod>(self, gpu: &Gpu) -> Result<Vec<T>, RenderError> {
+    pub async fn read<T: bytemuck::Pod>(self, gpu: &Gpu) -> Result<Vec<T>, RenderError> {
         let slice = self.buffer.slice(..);
-        map_blocking(gpu, &slice)?;
+        Mapped::begin(gpu, &slice)?.await?;
         let row = (self.width * self.bytes_per_texel) as usize;
         let rows = (self.height * self.layers) as usize;
         let mut bytes = Vec::with_capacity(row * rows);
@@ -182,9 +253,12 @@ impl PendingReadback {
 
 /// Maps `buffer` (a MAP_READ copy destination, after the copy's submission) and
 /// returns its contents.
-pub(crate) fn read_buffer<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<T>, RenderError> {
+pub(crate) async fn read_buffer<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+) -> Result<Vec<T>, RenderError> {
     let slice = buffer.slice(..);
-    map_blocking(gpu, &slice)?;
+    Mapped::begin(gpu, &slice)?.await?;
     let out = {
         let mapped = slice
             .get_mapped_range()

@@ -272,7 +272,7 @@ impl PendingTimes {
 
     /// The times, waiting for them if they are not ready; None when the frame was
     /// not timed.
-    pub fn read(self, gpu: &Gpu) -> Result<Option<FrameTimes>, RenderError> {
+    pub async fn read(self, gpu: &Gpu) -> Result<Option<FrameTimes>, RenderError> {
         let labels = &self.clock.labels;
         let pass = |i: usize, ms: f64| {
             let (kind, light, layer) = labels[i];
@@ -281,8 +281,8 @@ impl PendingTimes {
         match (self.clock.mode, self.ticks) {
             (Mode::Gpu { .. }, Some(ticks)) => {
                 let ticks = match ticks {
-                    Ticks::Recorded(recorded) => recorded.begin_map().read(gpu)?,
-                    Ticks::Mapping(mapping) => mapping.read(gpu)?,
+                    Ticks::Recorded(recorded) => recorded.begin_map().read(gpu).await?,
+                    Ticks::Mapping(mapping) => mapping.read(gpu).await?,
                 };
                 let period = f64::from(gpu.timestamp_period_ns.unwrap_or(1.0)) * 1e-6;
                 let passes = (0..labels.len())

@@ -1,6 +1,9 @@
 //! The depth-only baseline of `gnomon bench --depth-only`: the shadow maps a frame
 //! would draw (same layers, resolution, cull mode, bias and depth clamp), drawn from
 //! world-space positions with no instance data, to time against the shadow pass.
+// `gnomon bench` runs the baseline, and a browser runs no bench: there its entry
+// points are left out, and what only they use is unused.
+#![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
 use gnomon_scene::{Scene, Settings};
 
@@ -44,6 +47,7 @@ impl Renderer {
     /// Times the depth-only baseline drawing the shadow maps this frame would draw
     /// (the same layers, resolution, cull mode and depth clamp): per light, the time
     /// of all its layers; None for a dual-paraboloid map, which no matrix can draw.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn time_depth_baseline(
         &mut self,
         baseline: &DepthBaselineScene,
@@ -52,8 +56,9 @@ impl Renderer {
         settings: &Settings,
         clock: ClockChoice,
     ) -> Result<Vec<Option<f64>>, RenderError> {
+        let purpose = BaselinePurpose::Time(clock);
         let run =
-            self.record_depth_baseline(baseline, uploaded, scene, settings, BaselinePurpose::Time(clock))?;
+            pollster::block_on(self.record_depth_baseline(baseline, uploaded, scene, settings, purpose))?;
         let times = run.times.map(|t| t.passes).unwrap_or_default();
         Ok((0..run.lights as u32)
             .map(|light| {
@@ -67,6 +72,7 @@ impl Renderer {
     /// The depth-only baseline's map of the reported light, every layer, read back
     /// (as [`crate::ShadowMapImage::depth`] lays them out): to check that it draws
     /// what the shadow pass draws.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn depth_baseline_map(
         &mut self,
         baseline: &DepthBaselineScene,
@@ -74,16 +80,18 @@ impl Renderer {
         scene: &Scene,
         settings: &Settings,
     ) -> Result<Vec<f32>, RenderError> {
+        let purpose = BaselinePurpose::ReadShownMap;
         let run =
-            self.record_depth_baseline(baseline, uploaded, scene, settings, BaselinePurpose::ReadShownMap)?;
+            pollster::block_on(self.record_depth_baseline(baseline, uploaded, scene, settings, purpose))?;
         run.shown_map.ok_or_else(|| RenderError::Gpu {
             during: "drawing the depth-only baseline",
             message: "a dual-paraboloid map has no baseline".into(),
         })
     }
 
-    /// Records and submits the baseline's maps for the frame `settings` plans.
-    fn record_depth_baseline(
+    /// Records and submits the baseline's maps for the frame `settings` plans
+    /// (for `gnomon bench`, which a browser does not run).
+    async fn record_depth_baseline(
         &mut self,
         baseline: &DepthBaselineScene,
         uploaded: &GpuScene,
@@ -94,7 +102,7 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_limits(settings)?;
-        let plan = self.plan_frame(uploaded, scene, settings, None)?;
+        let plan = self.plan_frame(uploaded, scene, settings, None).await?;
         let gpu = self.gpu.clone();
         let layers: u32 = plan.lights.iter().map(|p| p.layers()).sum();
         let clock = match purpose {
@@ -150,9 +158,9 @@ impl Renderer {
             gpu.queue.submit([encoder.finish()]);
             (pending_times, pending_map)
         })?;
-        let times = pending_times.read(&gpu)?;
+        let times = pending_times.read(&gpu).await?;
         let map = match pending_map {
-            Some(p) => Some(p.read::<f32>(&gpu)?),
+            Some(p) => Some(p.read::<f32>(&gpu).await?),
             None => None,
         };
         Ok(BaselineRun { times, shown_map: map, lights: plan.lights.len() })

@@ -13,10 +13,24 @@ impl Renderer {
     /// `scene.camera` to the host's, or override it in `settings.camera`); the image
     /// takes the target's size, whatever `settings.image` says. Linear colour is
     /// written: an sRGB target encodes it. Returns what the passes drew.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_into(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         target: &HostTarget,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<DrawStats, RenderError> {
+        pollster::block_on(self.render_into_async(encoder, target, uploaded, scene, settings))
+    }
+
+    /// [`Renderer::render_into`], for a host that cannot block (a browser): SDSM's
+    /// cascades wait for the camera's depths to be read back.
+    pub async fn render_into_async(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &HostTarget<'_>,
         uploaded: &GpuScene,
         scene: &Scene,
         settings: &Settings,
@@ -26,7 +40,7 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_limits(&settings)?;
-        let plan = self.plan_frame(uploaded, scene, &settings, None)?;
+        let plan = self.plan_frame(uploaded, scene, &settings, None).await?;
         let culled = self.cull_frame(uploaded, &plan)?;
         let gpu = self.gpu.clone();
         gpu.checked("rendering into the host's target", || {

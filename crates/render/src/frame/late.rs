@@ -29,7 +29,7 @@ pub(super) struct LateTimes {
 impl LateTimes {
     /// Adds a submitted frame and returns the latest frame's times that have arrived
     /// (this one's at the earliest), its stats replaced by `lights`' draws.
-    pub fn push(
+    pub async fn push(
         &mut self,
         gpu: &Gpu,
         pool: &mut Pool,
@@ -48,7 +48,7 @@ impl LateTimes {
         while self.in_flight.len() > 1 {
             let InFlight { times, lights: drawn } = self.in_flight.pop_front().expect("a front frame");
             let buffer = times.ticks_buffer().cloned();
-            let read = times.read(gpu);
+            let read = times.read(gpu).await;
             if let Some(buffer) = buffer {
                 pool.release(&buffer);
             }

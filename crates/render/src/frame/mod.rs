@@ -144,7 +144,19 @@ impl Renderer {
 
     /// Uploads `scene` and renders it. To render one scene many times, upload it once
     /// with [`Renderer::upload`] and call [`Renderer::render_uploaded`].
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
+        pollster::block_on(self.render_async(scene, settings, request))
+    }
+
+    /// [`Renderer::render`], for a caller that cannot block (a browser): the frame's
+    /// readbacks are awaited.
+    pub async fn render_async(
         &mut self,
         scene: &Scene,
         settings: &Settings,
@@ -152,7 +164,7 @@ impl Renderer {
     ) -> Result<Frame, RenderError> {
         settings.validate()?;
         let uploaded = self.upload(scene)?;
-        self.render_uploaded(&uploaded, scene, settings, request)
+        self.render_uploaded_async(&uploaded, scene, settings, request).await
     }
 
     /// Uploads a scene's geometry, instances and textures.
@@ -246,7 +258,20 @@ impl Renderer {
     }
 
     /// Renders an uploaded scene. `scene` must be the one `uploaded` was made from.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_uploaded(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        request: &OutputRequest,
+    ) -> Result<Frame, RenderError> {
+        pollster::block_on(self.render_uploaded_async(uploaded, scene, settings, request))
+    }
+
+    /// [`Renderer::render_uploaded`], for a caller that cannot block (a browser):
+    /// the frame's readbacks are awaited.
+    pub async fn render_uploaded_async(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
@@ -259,15 +284,28 @@ impl Renderer {
             clock: None,
             times: TimesWanted::Now,
         };
-        let submitted = self.submit(uploaded, scene, settings, submit)?;
-        submitted.read(&self.gpu, settings)
+        let submitted = self.submit(uploaded, scene, settings, submit).await?;
+        let frame = submitted.read(&self.gpu, settings).await?;
+        self.gpu.deferred_error()?;
+        Ok(frame)
     }
 
     /// Renders an uploaded scene and leaves the image and the shadow map on the GPU,
     /// for a window to draw ([`LiveFrame`]). Its textures stay valid until the next
     /// frame. It does not wait for the GPU to finish it: its pass times are the
     /// previous frame's, read once this one is submitted ([`LiveFrame::timings_age`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_live(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<LiveFrame, RenderError> {
+        pollster::block_on(self.render_live_async(uploaded, scene, settings))
+    }
+
+    /// [`Renderer::render_live`], for a caller that cannot block (a browser).
+    pub async fn render_live_async(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
@@ -279,7 +317,8 @@ impl Renderer {
             clock: None,
             times: TimesWanted::Late,
         };
-        let submitted = self.submit(uploaded, scene, settings, submit)?;
+        let submitted = self.submit(uploaded, scene, settings, submit).await?;
+        self.gpu.deferred_error()?;
         Ok(submitted.live(self.late_times.latest_age()))
     }
 
@@ -295,7 +334,19 @@ impl Renderer {
 
     /// Renders an uploaded scene for its pass times and draw counts alone: nothing is
     /// read back but the timestamps, so timing loops don't pay for image copies.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn time_passes(
+        &mut self,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+        clock: ClockChoice,
+    ) -> Result<FrameCost, RenderError> {
+        pollster::block_on(self.time_passes_async(uploaded, scene, settings, clock))
+    }
+
+    /// [`Renderer::time_passes`], for a caller that cannot block (a browser).
+    pub async fn time_passes_async(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
@@ -308,6 +359,8 @@ impl Renderer {
             clock: Some(clock),
             times: TimesWanted::Now,
         };
-        Ok(self.submit(uploaded, scene, settings, submit)?.cost())
+        let cost = self.submit(uploaded, scene, settings, submit).await?.cost();
+        self.gpu.deferred_error()?;
+        Ok(cost)
     }
 }

@@ -380,19 +380,23 @@ impl Submitted {
     }
 
     /// Reads the frame's images back and assembles the [`Frame`].
-    pub(super) fn read(self, gpu: &Gpu, settings: &gnomon_scene::Settings) -> Result<Frame, RenderError> {
+    pub(super) async fn read(
+        self,
+        gpu: &Gpu,
+        settings: &gnomon_scene::Settings,
+    ) -> Result<Frame, RenderError> {
         let (width, height) = (settings.image.width, settings.image.height);
         let resolution = self.resolution;
         let mut pending = self.readbacks.targets.into_iter();
         let mut next = || pending.next().expect("one readback per target");
-        let color: Vec<u8> = next().read(gpu)?;
-        let mut visibility: Vec<f32> = next().read(gpu)?;
-        let position_w: Vec<Vec4> = next().read(gpu)?;
-        let normal_w: Vec<Vec4> = next().read(gpu)?;
-        let object_id: Vec<u32> = next().read(gpu)?;
+        let color: Vec<u8> = next().read(gpu).await?;
+        let mut visibility: Vec<f32> = next().read(gpu).await?;
+        let position_w: Vec<Vec4> = next().read(gpu).await?;
+        let normal_w: Vec<Vec4> = next().read(gpu).await?;
+        let object_id: Vec<u32> = next().read(gpu).await?;
         let shadow_map = match self.readbacks.shadow_map {
             Some(p) => {
-                let depth: Vec<f32> = p.read(gpu)?;
+                let depth: Vec<f32> = p.read(gpu).await?;
                 let layers = (depth.len() / (resolution * resolution) as usize) as u32;
                 Some(ShadowMapImage { resolution, layers, depth })
             }

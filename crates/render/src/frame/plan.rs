@@ -101,7 +101,7 @@ impl Renderer {
     /// Everything about a frame that is decided before recording: the camera, and
     /// each light's settings, layout (fitted, or `fixed_layout` for the reported
     /// light) and uniform.
-    pub(super) fn plan_frame(
+    pub(super) async fn plan_frame(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
@@ -120,7 +120,7 @@ impl Renderer {
             let technique = self.techniques.check_light(&r.shadow, &r.light, &r.name)?;
             let layout = match fixed_layout {
                 Some(layout) if index == shown => layout.clone(),
-                _ => self.fit_layout(uploaded, &r.light, &light_settings, technique, &camera, aspect)?,
+                _ => self.fit_layout(uploaded, &r.light, &light_settings, technique, &camera, aspect).await?,
             };
             let shadow = &light_settings.shadow;
             let filterable_map = technique.filterable_map(&shadow.filter);
@@ -168,7 +168,7 @@ impl Renderer {
 
     /// A light's layout fitted to the camera (and for a sun's SDSM cascades, to the
     /// depths the camera sees).
-    fn fit_layout(
+    async fn fit_layout(
         &mut self,
         uploaded: &GpuScene,
         light: &Light,
@@ -182,7 +182,7 @@ impl Renderer {
         let sdsm = shadow.partition == Partition::Cascades && shadow.cascades.sdsm;
         let sampled = match light.shadow_view() {
             ShadowView::Parallel { travel } if sdsm => {
-                self.sample_distribution(uploaded, travel, settings, camera, aspect)?
+                self.sample_distribution(uploaded, travel, settings, camera, aspect).await?
             }
             ShadowView::Parallel { .. } | ShadowView::Frustum { .. } | ShadowView::Omni { .. } => None,
         };
@@ -194,8 +194,8 @@ impl Renderer {
     /// SDSM's sample distribution: draws the scene's depth from the camera and
     /// reduces it on the GPU to the nearest and farthest view depth seen, then, with
     /// SDSM bounds, to each cascade's light-space bounds of the samples it serves.
-    /// Blocks on the results, which the cascades' fit needs before the shadow pass.
-    fn sample_distribution(
+    /// Waits for the results, which the cascades' fit needs before the shadow pass.
+    async fn sample_distribution(
         &mut self,
         uploaded: &GpuScene,
         sun_direction: Vec3,
@@ -244,7 +244,7 @@ impl Renderer {
             gpu.queue.submit([encoder.finish()]);
             (depth, pending)
         })?;
-        let Some((near, far)) = pending.read(&gpu)? else { return Ok(None) };
+        let Some((near, far)) = pending.read(&gpu).await? else { return Ok(None) };
         let c = &settings.shadow.cascades;
         let splits = cascade_splits(&uploaded.bounds, camera, aspect, settings, Some((near, far)));
         let light_bounds = match splits {
@@ -274,7 +274,7 @@ impl Renderer {
                     gpu.queue.submit([encoder.finish()]);
                     pending
                 })?;
-                Some(pending.read(&gpu)?)
+                Some(pending.read(&gpu).await?)
             }
             _ => None,
         };

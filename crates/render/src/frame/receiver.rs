@@ -87,7 +87,20 @@ impl Renderer {
     /// has no map for the host to read ([`RenderError::ReceiverCannotTrace`]). The
     /// default refinement, `auto`, and the light list run only where Gnomon draws the
     /// image: here the maps' answer is the host's, and so is the lighting.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn record_shadows(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<Shadows, RenderError> {
+        pollster::block_on(self.record_shadows_async(encoder, uploaded, scene, settings))
+    }
+
+    /// [`Renderer::record_shadows`], for a host that cannot block (a browser): SDSM's
+    /// cascades wait for the camera's depths to be read back.
+    pub async fn record_shadows_async(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         uploaded: &GpuScene,
@@ -105,7 +118,7 @@ impl Renderer {
         };
         let screen = ScreenSpaceSettings { refine, lighting: Lighting::PerLight, ..settings.screen.clone() };
         let settings = &Settings { screen, ..settings.clone() };
-        let plan = self.plan_frame(uploaded, scene, settings, None)?;
+        let plan = self.plan_frame(uploaded, scene, settings, None).await?;
         if let Some(light) = plan.lights.iter().find(|l| l.technique.rays() == RayUse::EveryPixel) {
             return Err(RenderError::ReceiverCannotTrace {
                 light: light.name.clone(),

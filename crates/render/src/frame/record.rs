@@ -71,18 +71,18 @@ pub(super) enum TimesWanted {
 
 impl Renderer {
     /// Plans, culls, records and submits a frame, and reads its pass times.
-    pub(super) fn submit(
+    pub(super) async fn submit(
         &mut self,
         uploaded: &GpuScene,
         scene: &Scene,
         settings: &Settings,
-        request: SubmitRequest,
+        request: SubmitRequest<'_>,
     ) -> Result<Submitted, RenderError> {
         let started = Instant::now();
         self.pool.end_frame();
         settings.validate()?;
         self.check_limits(settings)?;
-        let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout)?;
+        let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout).await?;
         let fallbacks = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();
         let culled = self.cull_frame(uploaded, &plan)?;
@@ -101,8 +101,10 @@ impl Renderer {
         let times = recorded.times.take().map(PendingTimes::submitted);
         let mut timed = match (request.times, times) {
             (_, None) => untimed,
-            (TimesWanted::Now, Some(times)) => untimed.timed(times.read(&gpu)?),
-            (TimesWanted::Late, Some(times)) => self.late_times.push(&gpu, &mut self.pool, times, untimed)?,
+            (TimesWanted::Now, Some(times)) => untimed.timed(times.read(&gpu).await?),
+            (TimesWanted::Late, Some(times)) => {
+                self.late_times.push(&gpu, &mut self.pool, times, untimed).await?
+            }
         };
         let counters = recorded.readbacks.refine_counters.take();
         let traced = match request.times {
@@ -110,7 +112,7 @@ impl Renderer {
             TimesWanted::Now => counters,
             TimesWanted::Late => None,
         };
-        super::refine::report(&gpu, &plan, &mut timed, fallbacks, traced)?;
+        super::refine::report(&gpu, &plan, &mut timed, fallbacks, traced).await?;
         Ok(Submitted::new(plan, recorded, timed, cpu))
     }
 

@@ -99,7 +99,7 @@ impl Renderer {
 /// Writes into each light's stats how its rays traversed the casters, why it fell
 /// back, and, given the copy of the counters (`traced`, submitted), the pixels it
 /// traced.
-pub(super) fn report(
+pub(super) async fn report(
     gpu: &Gpu,
     plan: &FramePlan,
     timed: &mut TimedLights,
@@ -118,7 +118,7 @@ pub(super) fn report(
         }
     }
     if let Some(counters) = traced {
-        let words: Vec<u32> = readback::read_buffer(gpu, &counters)?;
+        let words: Vec<u32> = readback::read_buffer(gpu, &counters).await?;
         let listed = RefineLists::listed(&words, plan.lights.len());
         for ((stats, light), listed) in timed.lights.iter_mut().zip(&plan.lights).zip(listed) {
             if light.refine != Refine::Off {

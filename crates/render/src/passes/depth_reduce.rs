@@ -237,8 +237,8 @@ impl DepthReducePass {
 impl PendingDepthRange {
     /// The (nearest, farthest) view depth seen, after the submission; None when the
     /// camera sees no surface.
-    pub fn read(self, gpu: &crate::Gpu) -> Result<Option<(f32, f32)>, crate::RenderError> {
-        let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer)?;
+    pub async fn read(self, gpu: &crate::Gpu) -> Result<Option<(f32, f32)>, crate::RenderError> {
+        let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer).await?;
         let (near, far) = (f32::from_bits(bits[0]), f32::from_bits(bits[1]));
         Ok((bits[0] != u32::MAX && near <= far).then_some((near, far)))
     }
@@ -255,8 +255,8 @@ fn decode(bits: u32) -> f32 {
 impl PendingSampleBounds {
     /// Each cascade's (min x, min y, max x, max y) in light view space, after the
     /// submission; None for a cascade that serves no sample.
-    pub fn read(self, gpu: &crate::Gpu) -> Result<Vec<Option<[f32; 4]>>, crate::RenderError> {
-        let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer)?;
+    pub async fn read(self, gpu: &crate::Gpu) -> Result<Vec<Option<[f32; 4]>>, crate::RenderError> {
+        let bits: Vec<u32> = crate::readback::read_buffer(gpu, &self.buffer).await?;
         Ok(bits
             .chunks_exact(4)
             .take(self.count)

@@ -246,8 +246,8 @@ mod tests {
         encoder.copy_buffer_to_buffer(&culled.counts, 0, &counts, 0, None);
         encoder.copy_buffer_to_buffer(&culled.draws, 0, &draws, 0, None);
         gpu.queue.submit([encoder.finish()]);
-        let counts: Vec<u32> = crate::readback::read_buffer(gpu, &counts).unwrap();
-        let draws: Vec<DrawArgs> = crate::readback::read_buffer(gpu, &draws).unwrap();
+        let counts: Vec<u32> = pollster::block_on(crate::readback::read_buffer(gpu, &counts)).unwrap();
+        let draws: Vec<DrawArgs> = pollster::block_on(crate::readback::read_buffer(gpu, &draws)).unwrap();
         let mut triangles = 0;
         for (bucket, &count) in items.buckets.iter().zip(&counts) {
             assert!(count <= bucket.capacity, "{count} draws kept in a bucket of {}", bucket.capacity);

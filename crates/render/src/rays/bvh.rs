@@ -17,7 +17,12 @@ use std::ops::Range;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec3A};
 use gnomon_scene::{AlphaMode, Scene, Texture, Wrap};
-use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
+use obvhs::{
+    Boundable, BvhBuildParams,
+    aabb::Aabb,
+    bvh2::{Bvh2, leaf_collapser::collapse, reinsertion::ReinsertionOptimizer},
+    ploc::PlocBuilder,
+};
 use rayon::prelude::*;
 
 /// The deepest BVH `trace.wgsl` walks: the size of its traversal stack
@@ -178,7 +183,7 @@ impl CasterBvh {
             };
         }
         let boxes: Vec<Aabb> = gathered.triangles.iter().map(|t| triangle_box(t, pad)).collect();
-        let bvh = build_bvh2(
+        let bvh = build_tree(
             &boxes,
             // obvhs' slow build (a wider PLOC search, 20 % of nodes reinserted): traces
             // 6–21 % faster than its medium build for a build twice as long, paid once.
@@ -190,7 +195,6 @@ impl CasterBvh {
                 collapse_traversal_cost: 1.0,
                 ..BvhBuildParams::slow_build()
             },
-            &mut Default::default(),
         );
         let mut alpha = Vec::new();
         let triangles = bvh
@@ -486,6 +490,28 @@ fn tree_links(nodes: &[NodeGpu], triangles: usize) -> (Vec<u32>, Vec<u32>, Vec<u
         }
     }
     (parent, depth, leaf_node)
+}
+
+/// obvhs' `build_bvh2`, step for step (PLOC, reinsertion, leaves collapsed,
+/// reinsertion again), without its timer: `std::time::Instant`, which it reads,
+/// panics in a browser (`wasm32-unknown-unknown` has no clock there).
+fn build_tree<T: Boundable>(primitives: &[T], config: BvhBuildParams) -> Bvh2 {
+    let mut bvh = PlocBuilder::with_capacity(primitives.len()).build(
+        config.ploc_search_distance,
+        primitives,
+        (0..primitives.len() as u32).collect(),
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, config.reinsertion_batch_ratio, None);
+    collapse(&mut bvh, config.max_prims_per_leaf.clamp(1, 255), config.collapse_traversal_cost);
+    reinsertion.run(
+        &mut bvh,
+        config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh
 }
 
 #[cfg(test)]

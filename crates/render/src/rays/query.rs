@@ -134,7 +134,13 @@ impl ShadowRays {
     }
 
     /// For each ray, whether a caster blocks it.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn occluded(&self, rays: &[ShadowRay]) -> Result<Vec<bool>, RenderError> {
+        pollster::block_on(self.occluded_async(rays))
+    }
+
+    /// [`ShadowRays::occluded`], for a caller that cannot block (a browser).
+    pub async fn occluded_async(&self, rays: &[ShadowRay]) -> Result<Vec<bool>, RenderError> {
         if rays.is_empty() {
             return Ok(Vec::new());
         }
@@ -189,7 +195,7 @@ impl ShadowRays {
             self.gpu.queue.submit([encoder.finish()]);
             staging
         })?;
-        let words: Vec<u32> = readback::read_buffer(&self.gpu, &answers)?;
+        let words: Vec<u32> = readback::read_buffer(&self.gpu, &answers).await?;
         Ok(words.into_iter().take(rays.len()).map(|w| w != 0).collect())
     }
 }

@@ -67,11 +67,35 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
 
 /// Loads `path` into a scene as [`load`] does, with `options`.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtras), LoadError> {
+    let bytes = read_model(path).map_err(|problem| LoadError { path: path.to_path_buf(), problem })?;
+    load_bytes(&bytes, path, options)
+}
+
+/// Loads a model given as bytes (a `.glb`, or a `.gltf` whose data are `data:`
+/// URIs), as [`load`] does a file: a file dropped on a web page, say. `name` names
+/// it in errors. It may name no file ([`UriScope::EmbeddedOnly`]): it has no folder.
+pub fn load_from_bytes(bytes: &[u8], name: &str) -> Result<(Scene, FileExtras), LoadError> {
+    let path = Path::new(name);
+    let limit = crate::limits::MAX_MODEL_BYTES;
+    if bytes.len() as u64 > limit {
+        return Err(LoadError {
+            path: path.to_path_buf(),
+            problem: format!(
+                "the file is {}; a model may be at most {}",
+                sources::size(bytes.len() as u64),
+                sources::size(limit)
+            ),
+        });
+    }
+    load_bytes(bytes, path, &LoadOptions { uri_scope: UriScope::EmbeddedOnly })
+}
+
+/// Loads the model `bytes`, read from (or named) `path`.
+fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtras), LoadError> {
     let fail = |problem: String| LoadError { path: path.to_path_buf(), problem };
-    let bytes = read_model(path).map_err(fail)?;
-    glb_header_fits(&bytes).map_err(fail)?;
+    glb_header_fits(bytes).map_err(fail)?;
     // A first look without validation, for the problems validation would misname.
-    if let Ok(raw) = gltf::Gltf::from_slice_without_validation(&bytes) {
+    if let Ok(raw) = gltf::Gltf::from_slice_without_validation(bytes) {
         if raw.extensions_used().any(|e| e == "KHR_draco_mesh_compression") {
             return Err(fail(
                 "uses KHR_draco_mesh_compression, which Gnomon does not support; re-export the file without \
@@ -109,7 +133,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtra
     let base = path.parent().unwrap_or(Path::new("."));
     let mut budget = sources::Budget::default();
     let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(|e| describe(&e))?;
+        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| describe(&e))?;
         let buffers = sources::buffers(&document, base, blob, options.uri_scope, &mut budget)?;
         Ok::<_, String>((document, buffers))
     }))
@@ -120,12 +144,11 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtra
             // Validation insists on min/max for positions, which files with NaN or
             // infinite positions often lack; say what is really wrong when we can.
             // Only then: any other fault may make the unvalidated read panic.
-            let only_bounds_missing = gltf::Gltf::from_slice(&bytes).err().is_some_and(|e| {
+            let only_bounds_missing = gltf::Gltf::from_slice(bytes).err().is_some_and(|e| {
                 matches!(&e, gltf::Error::Validation(errors)
                     if errors.iter().all(|(path, _)| path.as_str().ends_with(".min") || path.as_str().ends_with(".max")))
             });
-            if only_bounds_missing
-                && let Some(problem) = non_finite_positions(path, &bytes, options.uri_scope)
+            if only_bounds_missing && let Some(problem) = non_finite_positions(path, bytes, options.uri_scope)
             {
                 return Err(fail(problem));
             }

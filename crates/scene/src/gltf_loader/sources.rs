@@ -27,6 +27,9 @@ pub enum UriScope {
     ModelFolder,
     /// Anywhere the process may read.
     Anywhere,
+    /// No file at all: only the GLB's binary chunk and `data:` URIs. For a model
+    /// given as bytes, which has no folder (a file dropped on a web page).
+    EmbeddedOnly,
 }
 
 /// The bytes a model may make the loader hold: its buffers, its decoded images and
@@ -80,6 +83,16 @@ pub fn resolve(base: &Path, uri: &str, scope: UriScope, what: &str) -> Result<Pa
             "{what}: its URI `{uri}` names a scheme; only relative paths and data URIs are read"
         ));
     }
+    let folder_check = match scope {
+        UriScope::EmbeddedOnly => {
+            return Err(format!(
+                "{what}: it names the file `{uri}`, but this model was given as bytes, with no folder to \
+                 read it from; embed its data (a .glb, or data: URIs)"
+            ));
+        }
+        UriScope::ModelFolder => true,
+        UriScope::Anywhere => false,
+    };
     let path = base.join(decoded.as_ref());
     let metadata = std::fs::metadata(&path).map_err(|e| {
         let base_shown = if base.as_os_str().is_empty() { Path::new(".") } else { base };
@@ -93,7 +106,7 @@ pub fn resolve(base: &Path, uri: &str, scope: UriScope, what: &str) -> Result<Pa
     if !metadata.is_file() {
         return Err(format!("{what}: `{uri}` is {}, not a regular file", file_kind(&metadata)));
     }
-    if scope == UriScope::ModelFolder {
+    if folder_check {
         let folder =
             std::fs::canonicalize(if base.as_os_str().is_empty() { Path::new(".") } else { base })
                 .map_err(|e| format!("{what}: cannot resolve the model's folder {}: {e}", base.display()))?;
@@ -236,6 +249,9 @@ mod tests {
         let e = resolve(&model, absolute.to_str().unwrap(), UriScope::ModelFolder, "buffer 0").unwrap_err();
         assert!(e.contains("outside the model's folder"), "{e}");
         let e = resolve(&model, "file:///etc/passwd", UriScope::Anywhere, "buffer 0").unwrap_err();
+        assert!(e.contains("scheme"), "{e}");
+        let e = resolve(&model, "mine.bin", UriScope::EmbeddedOnly, "buffer 0").unwrap_err();
+        assert!(e.contains("given as bytes") && e.contains("`mine.bin`"), "{e}");
         assert!(e.contains("scheme"), "{e}");
         #[cfg(unix)]
         {

@@ -1,0 +1,12 @@
+//! Gnomon in the browser: the lab (a scene, settings from the command line's flags,
+//! frames measured against `raytraced`) on the page's WebGPU device, behind a small
+//! JS API. `flags` turns name and value pairs into checked settings, `lab` holds the
+//! state and renders (plain Rust, tested natively), `api` is the wasm-bindgen class
+//! a page uses. The page itself, its build and its browser test are in `web/`
+//! (docs/web.md).
+
+pub mod flags;
+pub mod lab;
+
+#[cfg(target_arch = "wasm32")]
+mod api;

@@ -1,0 +1,248 @@
+// The lab in a real browser, against the native renderer. Serves web/dist on
+// 127.0.0.1, opens it in headless Chromium (WebGPU on SwiftShader), and for each
+// case renders the same scene and settings natively (`gnomon render
+// --visibility-out`): the two visibility images must agree on at least 99.9 % of
+// pixels, lit or shadowed. Then drops a broken .glb on the page: the page must show
+// the command line's error, naming the file, and render on.
+//
+//   node browser-test.mjs [--gnomon PATH] [--screenshot FILE.png] [--out FILE.json]
+//
+// Chromium comes from Debian (`apt-get install chromium`); playwright-core drives
+// it through the DevTools protocol and downloads no browser of its own.
+import { spawn, spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import net from 'node:net';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const root = path.resolve(here, '../..');
+const args = process.argv.slice(2);
+const option = (name, fallback) => {
+  const i = args.indexOf(name);
+  return i >= 0 ? args[i + 1] : fallback;
+};
+const gnomon = path.resolve(option('--gnomon', path.join(root, 'target/release/gnomon')));
+const screenshot = option('--screenshot', null);
+// The view the screenshot shows: a coarse map without rays, whose errors the heat-map shows.
+const screenshotView = option(
+  '--screenshot-view',
+  'scene=spheres&technique=hard&shadow-res=512&refine=off&sun-elevation=25&width=640&height=360',
+);
+const outJson = option('--out', null);
+const dist = path.join(root, 'web/dist');
+const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+// The least share of pixels on which the browser and the native renderer must agree.
+const AGREEMENT = 0.999;
+// How long one page may take to render (SwiftShader on two cores is slow).
+const RENDER_TIMEOUT_MS = 240_000;
+
+// Each case: the URL's settings, which are also the command line's flags.
+const CASES = [
+  { name: 'pcf2x2, sun', flags: { technique: 'pcf2x2' } },
+  { name: 'PCSS, sun of 3°', flags: { technique: 'pcss', 'sun-angular-diameter': '3' } },
+  { name: 'cascaded sun, pcf', flags: { technique: 'pcf', partition: 'cascades' } },
+  { name: 'point light, pcf2x2', flags: { technique: 'pcf2x2', light: 'point' } },
+];
+const SIZE = { width: '640', height: '360' };
+
+function fail(message) {
+  console.error(`browser test: FAILED: ${message}`);
+  process.exit(1);
+}
+
+function check(condition, message) {
+  if (!condition) fail(message);
+}
+
+function freePort() {
+  return new Promise((resolve, reject) => {
+    const server = net.createServer();
+    server.on('error', reject);
+    server.listen(0, '127.0.0.1', () => {
+      const { port } = server.address();
+      server.close(() => resolve(port));
+    });
+  });
+}
+
+// A float32 .npy (what `--visibility-out x.npy` writes), as a Float32Array.
+function readNpy(file) {
+  const bytes = fs.readFileSync(file);
+  check(bytes.subarray(0, 6).toString('latin1') === '\x93NUMPY', `${file} is not a .npy`);
+  const major = bytes[6];
+  const headerLength = major === 1 ? bytes.readUInt16LE(8) : bytes.readUInt32LE(8);
+  const start = (major === 1 ? 10 : 12) + headerLength;
+  const header = bytes.subarray(major === 1 ? 10 : 12, start).toString('latin1');
+  check(header.includes("'<f4'"), `${file}: not little-endian float32: ${header}`);
+  const data = bytes.subarray(start);
+  return new Float32Array(data.buffer.slice(data.byteOffset, data.byteOffset + data.length));
+}
+
+function native(flags, dir) {
+  const npy = path.join(dir, 'visibility.npy');
+  const argv = ['render', 'spheres', '-o', path.join(dir, 'native.png'), '--visibility-out', npy];
+  for (const [key, value] of Object.entries({ ...SIZE, ...flags })) argv.push(`--${key}`, value);
+  const run = spawnSync(gnomon, argv, { encoding: 'utf8' });
+  check(run.status === 0, `gnomon ${argv.join(' ')}: ${run.stderr}`);
+  return readNpy(npy);
+}
+
+// Pixels lit (> 0.5) in one image and shadowed in the other, or drawn in one only.
+function compare(browser, nativeVisibility) {
+  check(browser.length === nativeVisibility.length, `${browser.length} pixels against ${nativeVisibility.length}`);
+  let agree = 0;
+  let drawn = 0;
+  let lit = 0;
+  let absolute = 0;
+  for (let i = 0; i < browser.length; i++) {
+    const a = browser[i];
+    const b = nativeVisibility[i];
+    const aDrawn = Number.isFinite(a);
+    if (Number.isFinite(b)) {
+      drawn++;
+      if (b > 0.5) lit++;
+    }
+    if (aDrawn !== Number.isFinite(b)) continue;
+    if (!aDrawn || (a > 0.5) === (b > 0.5)) agree++;
+    if (aDrawn) absolute += Math.abs(a - b);
+  }
+  return { agreement: agree / browser.length, lit, shadowed: drawn - lit, meanAbs: absolute / Math.max(drawn, 1) };
+}
+
+async function waitForRender(page) {
+  await page.waitForFunction(
+    () => document.title === 'gnomon: done' || document.title === 'gnomon: error',
+    null,
+    { timeout: RENDER_TIMEOUT_MS, polling: 250 },
+  );
+  const title = await page.title();
+  const status = JSON.parse(await page.textContent('#status'));
+  check(title === 'gnomon: done', `the page ended in "${title}": ${JSON.stringify(status)}`);
+  return status;
+}
+
+// Frames this many times again, without the truth, once pipelines are built: each
+// pass's median, in milliseconds, as `gnomon bench` reports native ones.
+const WARM_FRAMES = 5;
+
+async function warmTimes(page) {
+  const reports = [];
+  for (let i = 0; i < WARM_FRAMES; i++) {
+    reports.push(await page.evaluate(() => window.gnomon.lab.render(false)));
+  }
+  const median = (values) => {
+    const sorted = [...values].sort((a, b) => a - b);
+    return sorted[Math.floor(sorted.length / 2)];
+  };
+  const passes = reports[0].passes.map(({ pass }) => ({
+    pass,
+    ms: median(reports.map((r) => r.passes.find((p) => p.pass === pass)?.ms ?? NaN)),
+  }));
+  return { frame_ms: median(reports.map((r) => r.frame_ms)), passes };
+}
+
+async function main() {
+  check(fs.existsSync(path.join(dist, 'index.html')), 'no web/dist: run sh scripts/build-web.sh');
+  check(fs.existsSync(gnomon), `no native gnomon at ${gnomon}: cargo build --release`);
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'gnomon-browser-'));
+  const port = await freePort();
+  const server = spawn('python3', ['-m', 'http.server', '--bind', '127.0.0.1', String(port)], {
+    cwd: dist,
+    stdio: 'ignore',
+  });
+  const browser = await chromium.launch({
+    executablePath: chromiumPath,
+    ignoreDefaultArgs: ['--headless'],
+    args: [
+      '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--enable-features=Vulkan',
+      '--use-webgpu-adapter=swiftshader', '--disable-background-networking', '--disable-component-update',
+      '--disable-sync', '--no-first-run', '--disable-quic',
+    ],
+  });
+  const results = [];
+  try {
+    const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+    const consoleErrors = [];
+    page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+    page.on('pageerror', (e) => consoleErrors.push(String(e)));
+    // The server may take a moment to listen.
+    for (let tries = 0; ; tries++) {
+      try {
+        await page.goto(`http://127.0.0.1:${port}/`, { waitUntil: 'domcontentloaded' });
+        break;
+      } catch (e) {
+        if (tries > 40) throw e;
+        await new Promise((r) => setTimeout(r, 250));
+      }
+    }
+    for (const c of CASES) {
+      const query = new URLSearchParams({ scene: 'spheres', ...c.flags, ...SIZE, status: '1' });
+      const started = Date.now();
+      await page.goto(`http://127.0.0.1:${port}/?${query}`);
+      const status = await waitForRender(page);
+      const seconds = (Date.now() - started) / 1000;
+      for (const key of ['scene', 'technique', 'width', 'height', 'lit', 'shadowed', 'mismatch_vs_raytraced', 'adapter']) {
+        check(key in status, `${c.name}: the status has no "${key}": ${JSON.stringify(status)}`);
+      }
+      check(status.scene === 'spheres' && status.technique === c.flags.technique, `${c.name}: ${JSON.stringify(status)}`);
+      check(status.width === 640 && status.height === 360, `${c.name}: size ${status.width}x${status.height}`);
+      const m = status.mismatch_vs_raytraced;
+      check(typeof m === 'number' && m >= 0 && m <= 1, `${c.name}: mismatch_vs_raytraced ${m}`);
+      const visibility = await page.evaluate(() => Array.from(window.gnomon.lab.visibility(), (v) => (Number.isNaN(v) ? null : v)));
+      const fromBrowser = Float32Array.from(visibility, (v) => (v === null ? NaN : v));
+      const compared = compare(fromBrowser, native(c.flags, dir));
+      const countsOff = Math.abs(status.lit - compared.lit) + Math.abs(status.shadowed - compared.shadowed);
+      const warm = await warmTimes(page);
+      const line = {
+        case: c.name,
+        agreement: compared.agreement,
+        mean_abs_difference: compared.meanAbs,
+        browser: { lit: status.lit, shadowed: status.shadowed },
+        native: { lit: compared.lit, shadowed: compared.shadowed },
+        mismatch_vs_raytraced: m,
+        first_frame_ms: status.frame_ms,
+        warm_frame_ms: warm.frame_ms,
+        warm_passes: warm.passes,
+        page_seconds: seconds,
+        adapter: status.adapter,
+      };
+      results.push(line);
+      console.log(JSON.stringify(line));
+      check(compared.agreement >= AGREEMENT, `${c.name}: the visibility agrees on ${(100 * compared.agreement).toFixed(3)} % of pixels, below ${100 * AGREEMENT} %`);
+      check(countsOff <= (1 - AGREEMENT) * fromBrowser.length, `${c.name}: lit/shadowed ${status.lit}/${status.shadowed} against native ${compared.lit}/${compared.shadowed}`);
+    }
+    if (screenshot) {
+      await page.goto(`http://127.0.0.1:${port}/?${screenshotView}`);
+      await waitForRender(page);
+      await page.screenshot({ path: screenshot, fullPage: true });
+      console.log(`browser test: screenshot ${screenshot}`);
+    }
+
+    // A broken file: the command line's error, on the page, and the page renders on.
+    const bad = path.join(dir, 'broken.glb');
+    fs.writeFileSync(bad, Buffer.concat([Buffer.from('glTF'), Buffer.from([2, 0, 0, 0, 64, 0, 0, 0]), Buffer.alloc(52, 0x7a)]));
+    const cli = spawnSync(gnomon, ['render', bad, '-o', path.join(dir, 'bad.png')], { encoding: 'utf8' });
+    check(cli.status !== 0, 'the command line rendered a broken file');
+    await page.setInputFiles('#file', bad);
+    await page.waitForFunction(() => document.getElementById('error').textContent.length > 0, null, { timeout: 30_000 });
+    const shown = await page.textContent('#error');
+    const cliMessage = cli.stderr.replace(bad, 'broken.glb');
+    check(shown.startsWith('broken.glb: '), `the page's error does not name the file: ${shown}`);
+    check(cliMessage.includes(shown.trim()), `the page says "${shown}", the command line "${cli.stderr.trim()}"`);
+    await page.evaluate(() => window.gnomon.render());
+    const after = await waitForRender(page);
+    check(after.scene === 'spheres', `after the broken file the page shows ${after.scene}`);
+    console.log(`browser test: broken file refused as the command line refuses it: ${shown.trim()}`);
+    check(consoleErrors.length === 0, `the page logged errors: ${consoleErrors.join(' | ')}`);
+  } finally {
+    await browser.close();
+    server.kill();
+  }
+  if (outJson) fs.writeFileSync(outJson, `${JSON.stringify(results, null, 2)}\n`);
+  console.log(`browser test: passed, ${results.length} cases, each at least ${100 * AGREEMENT} % of pixels as native`);
+}
+
+main().catch((e) => fail(e.stack || String(e)));
