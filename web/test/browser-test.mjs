@@ -189,6 +189,8 @@ async function main() {
       }
       check(status.scene === 'spheres' && status.technique === c.flags.technique, `${c.name}: ${JSON.stringify(status)}`);
       check(status.width === 640 && status.height === 360, `${c.name}: size ${status.width}x${status.height}`);
+      // SwiftShader has timestamp queries: every frame is timed, pass by pass.
+      check(status.frame_ms > 0 && status.passes.length > 0, `${c.name}: no pass times: ${JSON.stringify(status)}`);
       const m = status.mismatch_vs_raytraced;
       check(typeof m === 'number' && m >= 0 && m <= 1, `${c.name}: mismatch_vs_raytraced ${m}`);
       const visibility = await page.evaluate(() => Array.from(window.gnomon.lab.visibility(), (v) => (Number.isNaN(v) ? null : v)));

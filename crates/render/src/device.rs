@@ -249,9 +249,9 @@ impl Gpu {
         }
     }
 
-    /// The first device error [`Gpu::checked`] could not report when it was raised
-    /// (in a browser), taken so that it is reported once; `Ok` where there is none
-    /// (always, on a device Gnomon can wait for).
+    /// The first device error Gnomon's passes raised that could not be reported when
+    /// it was raised (in a browser), taken so that it is reported once; `Ok` where
+    /// there is none (always, on a device Gnomon can wait for).
     pub fn deferred_error(&self) -> Result<(), RenderError> {
         let taken = self.deferred.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
         match taken {

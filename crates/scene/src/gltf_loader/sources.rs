@@ -250,9 +250,9 @@ mod tests {
         assert!(e.contains("outside the model's folder"), "{e}");
         let e = resolve(&model, "file:///etc/passwd", UriScope::Anywhere, "buffer 0").unwrap_err();
         assert!(e.contains("scheme"), "{e}");
+        // A model given as bytes names no file at all, even one beside it.
         let e = resolve(&model, "mine.bin", UriScope::EmbeddedOnly, "buffer 0").unwrap_err();
         assert!(e.contains("given as bytes") && e.contains("`mine.bin`"), "{e}");
-        assert!(e.contains("scheme"), "{e}");
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(dir.path().join("secret.bin"), model.join("link.bin")).unwrap();

@@ -59,6 +59,24 @@ fn hierarchy_transforms_and_materials_from_glb() {
     check_hierarchy(&dir.join("tri.glb"));
 }
 
+/// A model given as bytes loads as the same file does; one that names a file of its
+/// own is refused, naming the file, since bytes have no folder.
+#[test]
+fn a_model_given_as_bytes_loads_as_its_file_does_and_names_no_file() {
+    let temp = temp_dir("bytes");
+    let path = temp.path().join("tri.glb");
+    let bytes = glb(&hierarchy_json(None), &triangle_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let (from_file, _) = gltf_loader::load(&path).unwrap();
+    let (from_bytes, _) = gltf_loader::load_from_bytes(&bytes, "dropped.glb").unwrap();
+    assert_eq!(from_bytes.instances.len(), from_file.instances.len());
+    assert_eq!(from_bytes.instances[0].world_from_object, from_file.instances[0].world_from_object);
+    assert_eq!(from_bytes.meshes[0].positions, from_file.meshes[0].positions);
+    let external = hierarchy_json(Some("tri.bin"));
+    let e = gltf_loader::load_from_bytes(external.as_bytes(), "dropped.gltf").unwrap_err().to_string();
+    assert!(e.starts_with("dropped.gltf: buffer 0") && e.contains("`tri.bin`"), "{e}");
+}
+
 fn broken(name: &str) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/broken").join(name);
     let err = gltf_loader::load(&path).expect_err(name).to_string();
