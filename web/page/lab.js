@@ -224,7 +224,7 @@ function render() {
 
 async function renderNow() {
   try {
-    const report = await lab.render($('truth').checked);
+    const report = await lab.render({ truth: $('truth').checked });
     draw($('image'), lab.color(), report.width, report.height);
     draw($('heatmap'), lab.heatmap(), report.width, report.height);
     figures(report);

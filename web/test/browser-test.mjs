@@ -131,7 +131,7 @@ const WARM_FRAMES = 5;
 async function warmTimes(page) {
   const reports = [];
   for (let i = 0; i < WARM_FRAMES; i++) {
-    reports.push(await page.evaluate(() => window.gnomon.lab.render(false)));
+    reports.push(await page.evaluate(() => window.gnomon.lab.render({ truth: false })));
   }
   const median = (values) => {
     const sorted = [...values].sort((a, b) => a - b);
@@ -238,6 +238,9 @@ async function main() {
     const after = await waitForRender(page);
     check(after.scene === 'spheres', `after the broken file the page shows ${after.scene}`);
     console.log(`browser test: broken file refused as the command line refuses it: ${shown.trim()}`);
+    // A wrong option is refused by name, and refuses nothing else.
+    const refused = await page.evaluate(() => window.gnomon.lab.render({ truth: 'yes' }).then(() => 'rendered', (e) => e.message));
+    check(refused.includes('`truth` is true or false'), `render({truth: 'yes'}): ${refused}`);
     check(consoleErrors.length === 0, `the page logged errors: ${consoleErrors.join(' | ')}`);
   } finally {
     await browser.close();

@@ -9,7 +9,10 @@ use gnomon_render::Gpu;
 use gnomon_scene::builtin;
 use wasm_bindgen::prelude::*;
 
-use crate::{flags::Flag, lab::Lab};
+use crate::{
+    flags::Flag,
+    lab::{Lab, Truth},
+};
 
 /// Gnomon's lab on the page's WebGPU device: a scene, settings, and frames measured
 /// against `raytraced`.
@@ -103,16 +106,20 @@ impl JsLab {
         self.lab_mut()?.set_flags(&flags).map_err(js)
     }
 
-    /// Renders the scene; with `truth`, also the same view with `raytraced`, and
-    /// measures the frame against it. Resolves to the frame's report: `scene`,
-    /// `technique`, `width`, `height`, `lit`, `shadowed`, `mismatch_vs_raytraced`,
-    /// `truth`, `adapter`, `frame_ms` and `passes`.
+    /// Renders the scene and, unless `options` says `{truth: false}`, the same view
+    /// with `raytraced` too, measuring the frame against it. Resolves to the frame's
+    /// report: `scene`, `technique`, `width`, `height`, `lit`, `shadowed`,
+    /// `mismatch_vs_raytraced`, `truth`, `adapter`, `frame_ms` and `passes`.
     // The lab stays borrowed while the frame is read back, on purpose: a call made
     // meanwhile finds it borrowed and throws BUSY, instead of changing the scene
     // under the frame.
     #[allow(clippy::await_holding_refcell_ref)]
-    pub fn render(&self, truth: bool) -> js_sys::Promise {
+    pub fn render(&self, options: &JsValue) -> js_sys::Promise {
         let inner = self.inner.clone();
+        let truth = match render_options(options) {
+            Ok(truth) => truth,
+            Err(e) => return js_sys::Promise::reject(&JsValue::from(e)),
+        };
         wasm_bindgen_futures::future_to_promise(async move {
             let mut lab = inner.try_borrow_mut().map_err(|_| JsValue::from(js(BUSY)))?;
             let report = lab.render(truth).await.map_err(|e| JsValue::from(js(e)))?;
@@ -151,6 +158,19 @@ impl JsLab {
 
 /// The error for a call made while a render is in flight.
 const BUSY: &str = "the lab is still rendering: wait for render()'s promise before the next call";
+
+/// `render`'s options: nothing, or `{truth: true}` or `{truth: false}`.
+fn render_options(options: &JsValue) -> Result<Truth, JsError> {
+    if options.is_undefined() || options.is_null() {
+        return Ok(Truth::Measure);
+    }
+    let truth = js_sys::Reflect::get(options, &"truth".into()).unwrap_or(JsValue::UNDEFINED);
+    match (truth.is_undefined(), truth.as_bool()) {
+        (true, _) | (false, Some(true)) => Ok(Truth::Measure),
+        (false, Some(false)) => Ok(Truth::Skip),
+        (false, None) => Err(js("render: `truth` is true or false, as in render({truth: false})")),
+    }
+}
 
 /// A plain object's entries as flags: strings as they are, numbers and booleans in
 /// words, arrays of numbers joined by commas (`[0, 2, 5]` is `0,2,5`).

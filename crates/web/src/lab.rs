@@ -40,11 +40,11 @@ struct LoadedScene {
 /// The last frame and its truth.
 struct Shown {
     frame: Frame,
-    truth: Option<Truth>,
+    truth: Option<Measured>,
 }
 
 /// The frame against `raytraced`.
-struct Truth {
+struct Measured {
     metrics: DrawnMetrics,
     heatmap: Vec<u8>,
 }
@@ -84,6 +84,15 @@ pub struct PassReport {
     pub pass: &'static str,
     /// Milliseconds.
     pub ms: f64,
+}
+
+/// Whether a render also draws the truth and measures the frame against it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Truth {
+    /// Also render `raytraced` and measure every light-facing pixel against it.
+    Measure,
+    /// The frame alone (for timing, say).
+    Skip,
 }
 
 /// The lab: a device, a renderer, a scene and settings.
@@ -169,13 +178,13 @@ impl Lab {
         &self.settings
     }
 
-    /// Renders the scene with the settings, and with `truth` the same view with
-    /// `raytraced` too, measuring the frame against it.
-    pub async fn render(&mut self, truth: bool) -> Result<Report, LabError> {
+    /// Renders the scene with the settings and, with [`Truth::Measure`], the same
+    /// view with `raytraced` too, measuring the frame against it.
+    pub async fn render(&mut self, truth: Truth) -> Result<Report, LabError> {
         let request = OutputRequest::default();
         let LoadedScene { drawn, uploaded, .. } = &self.scene;
         let frame = self.renderer.render_uploaded_async(uploaded, drawn, &self.settings, &request).await?;
-        let truth = if truth {
+        let truth = if truth == Truth::Measure {
             let mut traced = self.settings.clone();
             traced.shadow.filter.technique = Technique::RAYTRACED;
             let reference = self.renderer.render_uploaded_async(uploaded, drawn, &traced, &request).await?;
@@ -239,7 +248,7 @@ fn upload(renderer: &Renderer, name: String, loaded: Scene, ground: bool) -> Res
 
 /// `frame` against `reference`, the same view drawn by `raytraced`: every
 /// light-facing pixel compared, the truth's answer being the traced one.
-fn measure(frame: &Frame, reference: Frame) -> Truth {
+fn measure(frame: &Frame, reference: Frame) -> Measured {
     let surfaces = DrawnSurfaces {
         width: frame.width,
         position: &frame.position,
@@ -254,7 +263,7 @@ fn measure(frame: &Frame, reference: Frame) -> Truth {
         samples: 1,
         rays: 0,
     };
-    Truth {
+    Measured {
         metrics: measure_drawn(&frame.visibility, &truth),
         heatmap: heatmap::drawn(&frame.visibility, &truth),
     }

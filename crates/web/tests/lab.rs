@@ -5,7 +5,7 @@
 use gnomon_render::{Gpu, OutputRequest, Renderer};
 use gnomon_web::{
     flags::{Flag, settings_from_flags},
-    lab::Lab,
+    lab::{Lab, Truth},
 };
 
 // The shared `figure:` lines that `.ci/run` gathers into its summary.
@@ -30,7 +30,7 @@ fn the_labs_frame_is_the_renderers_and_its_counts_add_up() {
     let mut lab = Lab::new(gpu.clone()).unwrap();
     let given = flags(&[SMALL[0], SMALL[1], ("technique", "pcf2x2")]);
     lab.set_flags(&given).unwrap();
-    let report = pollster::block_on(lab.render(true)).unwrap();
+    let report = pollster::block_on(lab.render(Truth::Measure)).unwrap();
     assert_eq!((report.scene.as_str(), report.technique.as_str()), ("spheres", "pcf2x2"));
     assert_eq!((report.width, report.height), (96, 54));
 
@@ -58,14 +58,14 @@ fn the_labs_frame_is_the_renderers_and_its_counts_add_up() {
 fn the_truth_measures_zero_against_itself_and_sees_a_poor_map() {
     let mut lab = Lab::new(gpu()).unwrap();
     lab.set_flags(&flags(&[SMALL[0], SMALL[1], ("technique", "raytraced")])).unwrap();
-    let traced = pollster::block_on(lab.render(true)).unwrap();
+    let traced = pollster::block_on(lab.render(Truth::Measure)).unwrap();
     assert_eq!(traced.mismatch_vs_raytraced, Some(0.0), "{traced:?}");
     // A negative bias of about 0.12 of the depth range at depth 0.5 (`--depth-bias`'s
     // help) puts each surface behind its own depth in the map: acne, lit surfaces
     // falsely shadowed.
     let poor = [SMALL[0], SMALL[1], ("technique", "hard"), ("shadow-res", "256"), ("refine", "off")];
     lab.set_flags(&flags(&[&poor[..], &[("depth-bias", "-2000000")]].concat())).unwrap();
-    let report = pollster::block_on(lab.render(true)).unwrap();
+    let report = pollster::block_on(lab.render(Truth::Measure)).unwrap();
     let mismatch = report.mismatch_vs_raytraced.unwrap();
     figures::figure(
         "web lab, spheres, hard with acne, against raytraced",
@@ -91,5 +91,5 @@ fn a_bad_file_is_named_and_the_lab_keeps_working() {
     let e = lab.set_flags(&flags(&[("technique", "nope")])).unwrap_err().to_string();
     assert!(e.contains("nope") && e.contains("pcss"), "{e}");
     assert_eq!(lab.settings().image.width, 96, "a refused flag changed the settings");
-    assert!(pollster::block_on(lab.render(false)).is_ok());
+    assert!(pollster::block_on(lab.render(Truth::Skip)).is_ok());
 }
