@@ -22,12 +22,15 @@ if ! wasm-bindgen --version 2>/dev/null | grep -q " $version\$"; then
 fi
 
 cargo build --release --target wasm32-unknown-unknown -p gnomon-web
+# Where cargo put it: `target/`, unless CARGO_TARGET_DIR or a cargo config says otherwise.
+target_dir=$(cargo metadata --format-version 1 --no-deps |
+  python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
 
 staging=web/dist.partial
 rm -rf "$staging"
 mkdir -p "$staging"
 wasm-bindgen --target web --no-typescript --out-dir "$staging" --out-name gnomon \
-  target/wasm32-unknown-unknown/release/gnomon_web.wasm
+  "$target_dir/wasm32-unknown-unknown/release/gnomon_web.wasm"
 cp web/page/index.html web/page/lab.js web/page/lab.css "$staging"/
 rm -rf web/dist
 mv "$staging" web/dist
