@@ -31,7 +31,7 @@ rm -rf "$staging"
 mkdir -p "$staging"
 wasm-bindgen --target web --no-typescript --out-dir "$staging" --out-name gnomon \
   "$target_dir/wasm32-unknown-unknown/release/gnomon_web.wasm"
-cp web/page/index.html web/page/lab.js web/page/lab.css "$staging"/
+cp web/page/index.html web/page/lab.js web/page/lab.css web/page/viewer.html web/page/viewer.js "$staging"/
 rm -rf web/dist
 mv "$staging" web/dist
 echo "build-web: wrote web/dist/ ($(du -sh web/dist | cut -f1)); serve it with: sh scripts/serve-web.sh" >&2

@@ -52,6 +52,9 @@ function updateUrl() {
   const url = `${location.pathname}?${query}`;
   history.replaceState(null, '', url);
   $('link').href = url;
+  // The viewer takes the same keys; a model from a file stays in the lab.
+  $('viewer-link').href = `viewer.html?${query}`;
+  $('viewer-link').hidden = fromFile;
 }
 
 // One control for one flag: a list, a switch or a text field, showing its default.

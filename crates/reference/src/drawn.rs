@@ -132,6 +132,23 @@ pub fn faces_light(light: &Light, surfaces: DrawnSurfaces) -> Vec<bool> {
         .collect()
 }
 
+impl DrawnTruth {
+    /// The truth at a frame's surfaces from the visibility of the same view drawn with
+    /// every pixel traced (the GPU's `raytraced`), without the CPU tracer: how a
+    /// browser, which has no threads for it, measures a frame. Ambiguity is not
+    /// traced, so no pixel is set apart as ambiguous.
+    pub fn from_traced(light: &Light, surfaces: DrawnSurfaces, traced_visibility: Vec<f32>) -> DrawnTruth {
+        let pixels = traced_visibility.len();
+        DrawnTruth {
+            visibility: traced_visibility,
+            faces_light: faces_light(light, surfaces),
+            ambiguous: vec![false; pixels],
+            samples: 1,
+            rays: 0,
+        }
+    }
+}
+
 struct DrawnPixel {
     visibility: f32,
     faces_light: bool,

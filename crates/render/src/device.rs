@@ -165,12 +165,23 @@ impl Gpu {
         let timestamp_period_ns =
             device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| queue.get_timestamp_period());
         let IndirectDraws { indirect_draws, indirect_count } = IndirectDraws::of(adapter, &device);
+        let info = GpuInfo::of(adapter_info.clone());
+        // wgpu names a browser's adapter by its description, which browsers leave
+        // empty; its vendor and architecture say more.
+        #[cfg(target_arch = "wasm32")]
+        let info = GpuInfo {
+            adapter: match info.adapter.is_empty() {
+                true => browser_adapter_name().await.unwrap_or_else(|| "WebGPU adapter".into()),
+                false => info.adapter,
+            },
+            ..info
+        };
         Ok(Self {
             ray_queries: device.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
             device_type: adapter_info.device_type,
             device,
             queue,
-            info: GpuInfo::of(adapter_info),
+            info,
             limits,
             timestamp_period_ns,
             indirect_draws,
@@ -334,4 +345,22 @@ impl IndirectDraws {
             indirect_draws && device.features().contains(wgpu::Features::MULTI_DRAW_INDIRECT_COUNT);
         Self { indirect_draws, indirect_count }
     }
+}
+
+/// The browser's own words for its WebGPU adapter (`google swiftshader`), from
+/// `navigator.gpu.requestAdapter()`'s `info`.
+#[cfg(target_arch = "wasm32")]
+async fn browser_adapter_name() -> Option<String> {
+    use wasm_bindgen::{JsCast, JsValue};
+    let get = |object: &JsValue, key: &str| js_sys::Reflect::get(object, &key.into()).ok();
+    let gpu = get(&get(&js_sys::global(), "navigator")?, "gpu")?;
+    let request: js_sys::Function = get(&gpu, "requestAdapter")?.dyn_into().ok()?;
+    let promise: js_sys::Promise = request.call0(&gpu).ok()?.dyn_into().ok()?;
+    let adapter = wasm_bindgen_futures::JsFuture::from(promise).await.ok()?;
+    let info = get(&adapter, "info")?;
+    let parts: Vec<String> = ["vendor", "architecture", "description"]
+        .iter()
+        .filter_map(|key| get(&info, key)?.as_string().filter(|s| !s.is_empty()))
+        .collect();
+    (!parts.is_empty()).then(|| format!("{} (WebGPU)", parts.join(" ")))
 }

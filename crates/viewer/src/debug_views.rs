@@ -1,6 +1,7 @@
 //! The viewer's measured debug views: the texel-density (Lloyd's m) heat-map of the
 //! current view, and the error heat-map against the ray-traced reference, traced on
-//! a worker thread with its progress reported.
+//! a worker thread with its progress reported (on the desktop), or against the same
+//! view drawn by the GPU's `raytraced` (in a browser, which has no threads for it).
 
 use std::sync::{
     Arc,
@@ -9,14 +10,13 @@ use std::sync::{
 };
 
 use gnomon_reference::{
-    ReferenceOptions, TracedScene, aliasing,
+    aliasing,
     aliasing::{AliasingImage, AliasingInput},
-    heatmap, metrics,
-    metrics::RasterView,
-    reference_visibility,
+    drawn::{DrawnSurfaces, DrawnTruth, measure_drawn},
+    heatmap,
 };
 use gnomon_render::Frame;
-use gnomon_scene::{Scene, Settings, settings::CascadeSelection};
+use gnomon_scene::{Settings, settings::CascadeSelection};
 
 /// Lloyd's m over `frame`, with the cascade selection of `settings`.
 pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
@@ -80,58 +80,32 @@ pub struct ErrorJob {
 }
 
 impl ErrorJob {
-    /// Starts tracing the reference for the view of `frame` (rendered with `settings`).
-    pub fn start(scene: &Scene, frame: Frame, settings: Settings) -> Self {
-        let rows_done = Arc::new(AtomicU64::new(0));
+    /// The heat-map of `frame` against `traced`, the same view drawn by the GPU's
+    /// `raytraced`: every light-facing pixel compared, as the browser's lab measures
+    /// (`gnomon_reference::drawn`). Ready at once.
+    // The desktop compares with the CPU reference, and tests this.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub fn against_raytraced(frame: &Frame, traced: Frame, settings: Settings) -> Self {
+        let surfaces = DrawnSurfaces {
+            width: frame.width,
+            position: &frame.position,
+            geometric_normal: &frame.geometric_normal,
+        };
+        let truth = DrawnTruth::from_traced(&frame.light, surfaces, traced.visibility);
+        let measured = measure_drawn(&frame.visibility, &truth);
+        let summary = format!(
+            "error against `raytraced`, every light-facing pixel: {:.3} % wrong (red wrongly shadowed {:.3} %, \
+             blue wrongly lit {:.3} %)",
+            100.0 * measured.mismatch_rate,
+            100.0 * measured.false_shadow_rate,
+            100.0 * measured.false_lit_rate
+        );
+        let rgba = heatmap::drawn(&frame.visibility, &truth);
         let (sender, result) = mpsc::channel();
+        // The receiver is alive: the send cannot fail.
+        let _ = sender.send(Picture::new(frame.width, frame.height, rgba, summary, settings));
         let rows = frame.height as u64;
-        let scene = scene.clone();
-        let counter = rows_done.clone();
-        std::thread::spawn(move || {
-            let traced = TracedScene::build(&scene);
-            let options = ReferenceOptions {
-                width: frame.width,
-                height: frame.height,
-                samples: settings.reference.samples,
-            };
-            let reference = reference_visibility(&traced, &frame.camera, &frame.light, &options, &|done| {
-                counter.store(done, Ordering::Relaxed)
-            });
-            let raster = RasterView {
-                visibility: &frame.visibility,
-                object_id: &frame.object_id,
-                depth: &frame.depth,
-            };
-            let classes = metrics::classify(raster, &reference);
-            let measured = metrics::measure(raster, &reference, &classes);
-            // An area light's reference is fractional: compare the penumbrae.
-            let (rgba, summary) = if reference.samples > 1 {
-                (
-                    heatmap::soft(&frame.visibility, &reference, &classes),
-                    format!(
-                        "error against a {}-sample reference: MAE {:.4} over all compared pixels, {:.4} over the {} penumbra pixels, p99 {:.3} (|V − R|, black 0 to red 1)",
-                        reference.samples,
-                        measured.mae,
-                        measured.penumbra.error.mae,
-                        measured.penumbra.error.pixels,
-                        measured.p99
-                    ),
-                )
-            } else {
-                (
-                    heatmap::hard(&frame.visibility, &reference, &classes),
-                    format!(
-                        "error against the exact reference: {:.3} % wrong (red wrongly shadowed {:.3} %, \
-                         blue wrongly lit {:.3} %)",
-                        100.0 * measured.mismatch_rate,
-                        100.0 * measured.false_shadow_rate,
-                        100.0 * measured.false_lit_rate
-                    ),
-                )
-            };
-            let _ = sender.send(Picture::new(frame.width, frame.height, rgba, summary, settings));
-        });
-        Self { rows_done, rows, result }
+        Self { rows_done: Arc::new(AtomicU64::new(rows)), rows, result }
     }
 
     /// The fraction of rows traced.
@@ -145,6 +119,74 @@ impl ErrorJob {
             Ok(picture) => Some(Ok(picture)),
             Err(mpsc::TryRecvError::Empty) => None,
             Err(mpsc::TryRecvError::Disconnected) => Some(Err("the reference worker stopped".into())),
+        }
+    }
+}
+
+/// The CPU reference, traced on a thread: the desktop's (a browser has no threads).
+#[cfg(not(target_arch = "wasm32"))]
+mod cpu {
+    use gnomon_reference::{
+        ReferenceOptions, TracedScene, metrics, metrics::RasterView, reference_visibility,
+    };
+    use gnomon_scene::Scene;
+
+    use super::*;
+
+    impl ErrorJob {
+        /// Starts tracing the reference for the view of `frame` (rendered with `settings`).
+        pub fn start(scene: &Scene, frame: Frame, settings: Settings) -> Self {
+            let rows_done = Arc::new(AtomicU64::new(0));
+            let (sender, result) = mpsc::channel();
+            let rows = frame.height as u64;
+            let scene = scene.clone();
+            let counter = rows_done.clone();
+            std::thread::spawn(move || {
+                let traced = TracedScene::build(&scene);
+                let options = ReferenceOptions {
+                    width: frame.width,
+                    height: frame.height,
+                    samples: settings.reference.samples,
+                };
+                let reference =
+                    reference_visibility(&traced, &frame.camera, &frame.light, &options, &|done| {
+                        counter.store(done, Ordering::Relaxed)
+                    });
+                let raster = RasterView {
+                    visibility: &frame.visibility,
+                    object_id: &frame.object_id,
+                    depth: &frame.depth,
+                };
+                let classes = metrics::classify(raster, &reference);
+                let measured = metrics::measure(raster, &reference, &classes);
+                // An area light's reference is fractional: compare the penumbrae.
+                let (rgba, summary) = if reference.samples > 1 {
+                    (
+                        heatmap::soft(&frame.visibility, &reference, &classes),
+                        format!(
+                            "error against a {}-sample reference: MAE {:.4} over all compared pixels, {:.4} over the {} penumbra pixels, p99 {:.3} (|V − R|, black 0 to red 1)",
+                            reference.samples,
+                            measured.mae,
+                            measured.penumbra.error.mae,
+                            measured.penumbra.error.pixels,
+                            measured.p99
+                        ),
+                    )
+                } else {
+                    (
+                        heatmap::hard(&frame.visibility, &reference, &classes),
+                        format!(
+                            "error against the exact reference: {:.3} % wrong (red wrongly shadowed {:.3} %, \
+                             blue wrongly lit {:.3} %)",
+                            100.0 * measured.mismatch_rate,
+                            100.0 * measured.false_shadow_rate,
+                            100.0 * measured.false_lit_rate
+                        ),
+                    )
+                };
+                let _ = sender.send(Picture::new(frame.width, frame.height, rgba, summary, settings));
+            });
+            Self { rows_done, rows, result }
         }
     }
 }
@@ -166,6 +208,36 @@ mod tests {
             assert!(started.elapsed().as_secs() < 300, "the reference took over 5 minutes");
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
+    }
+
+    /// Against the GPU's `raytraced` (the browser's error view), a good render is
+    /// nearly all right and an inverted one nearly all wrong.
+    #[test]
+    fn the_error_view_against_raytraced_marks_where_the_shadows_are_wrong() {
+        let gpu = Gpu::new_headless().unwrap();
+        let mut renderer = Renderer::new(&gpu).unwrap();
+        let scene = builtin::spheres();
+        let mut settings = Settings::default();
+        (settings.image.width, settings.image.height) = (128, 72);
+        let mut traced = settings.clone();
+        traced.shadow.filter.technique = gnomon_scene::settings::Technique::RAYTRACED;
+        let request = OutputRequest::default();
+        let frame = renderer.render(&scene, &settings, &request).unwrap();
+        let truth = renderer.render(&scene, &traced, &request).unwrap();
+        let surface = frame.object_id.iter().filter(|&&id| id != 0).count();
+        let good = finish(ErrorJob::against_raytraced(&frame, truth.clone(), settings.clone()));
+        assert!(good.summary.contains("% wrong"), "{}", good.summary);
+        let mut inverted = frame;
+        for v in inverted.visibility.iter_mut().filter(|v| !v.is_nan()) {
+            *v = 1.0 - *v;
+        }
+        let bad = finish(ErrorJob::against_raytraced(&inverted, truth, settings));
+        let (good, bad) = (wrong(&good), wrong(&bad));
+        assert!(good * 200 < surface, "{good} of {surface} surface pixels marked wrong on a good render");
+        assert!(
+            bad * 10 > surface * 8,
+            "only {bad} of {surface} surface pixels marked on an inverted render"
+        );
     }
 
     /// Pixels painted as wrongly shadowed or wrongly lit.

@@ -8,6 +8,8 @@
 //! frame, instead of drawing every layer it crosses again. Released, it takes back
 //! the motion it had.
 
+use std::sync::Arc;
+
 use glam::{Mat4, Vec3};
 use gnomon_render::{GpuScene, Renderer};
 use gnomon_scene::{Camera, Motion, Scene};
@@ -183,7 +185,7 @@ impl Hand {
         // One object at a time: a new grab lets go of the one held.
         if matches!(action, Action::Grab(_))
             && let Some(held) = self.held.take()
-            && let Err(e) = held.release(&mut model.scene, renderer, uploaded)
+            && let Err(e) = held.release(Arc::make_mut(&mut model.scene), renderer, uploaded)
         {
             model.say(format!("{e:#}"));
         }
@@ -191,7 +193,7 @@ impl Hand {
             (Action::Grab(grip), _) => match grab(&model.scene, &camera, aspect, grip) {
                 Ok(held) => {
                     let name = model.scene.instances[held.instance].name.clone();
-                    match held.take(&mut model.scene, renderer, uploaded) {
+                    match held.take(Arc::make_mut(&mut model.scene), renderer, uploaded) {
                         Ok(()) => {
                             self.held = Some(held);
                             model.say(format!("moving {name}: a moving caster while held"));
@@ -203,14 +205,14 @@ impl Hand {
                 Err(why) => Err(anyhow::anyhow!(why)),
             },
             (Action::DragTo(point), Some(held)) => match held.offset_to(&camera, aspect, *point) {
-                Some(by) => held.move_by(by, &mut model.scene, renderer, uploaded),
+                Some(by) => held.move_by(by, Arc::make_mut(&mut model.scene), renderer, uploaded),
                 None => Ok(()),
             },
             (Action::MoveHeldBy(by), Some(held)) => {
-                held.move_by(Vec3::from_array(*by), &mut model.scene, renderer, uploaded)
+                held.move_by(Vec3::from_array(*by), Arc::make_mut(&mut model.scene), renderer, uploaded)
             }
             (Action::Release, Some(held)) => {
-                let released = held.release(&mut model.scene, renderer, uploaded);
+                let released = held.release(Arc::make_mut(&mut model.scene), renderer, uploaded);
                 let name = model.scene.instances[held.instance].name.clone();
                 self.held = None;
                 model.say(format!("released {name}"));

@@ -126,6 +126,16 @@ pub struct RunReport {
 }
 
 /// Opens the window and runs until it is closed (or `frames` have been drawn).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(options: ViewerOptions) -> anyhow::Result<RunReport> {
     window::run(options)
+}
+
+/// Starts the viewer on a page's `canvas` and returns at once: the browser runs its
+/// event loop from then on, and each frame's GPU work as a task of its own. Status
+/// lines go to the browser's console, prefixed `gnomon view:`; the error view's truth
+/// is the GPU's `raytraced` (a page has no threads for the CPU reference).
+#[cfg(target_arch = "wasm32")]
+pub fn start_on_canvas(options: ViewerOptions, canvas: web_sys::HtmlCanvasElement) -> anyhow::Result<()> {
+    window::start(options, canvas)
 }

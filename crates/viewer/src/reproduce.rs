@@ -102,6 +102,7 @@ fn absolute(path: &Path) -> anyhow::Result<PathBuf> {
 
 /// Writes `contents` to `path` through a temporary file beside it, so that a failure
 /// leaves no half-written file.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn write_whole(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
     let name = path.file_name().with_context(|| format!("{}: not a file name", path.display()))?;
     let temporary = path.with_file_name(format!(".{}.partial", name.to_string_lossy()));
@@ -115,6 +116,7 @@ pub fn write_whole(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>)
 }
 
 /// Saves an RGBA8 image as a PNG, whole or not at all.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn save_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> anyhow::Result<()> {
     write_whole(path, |temporary| {
         image::save_buffer_with_format(

@@ -22,7 +22,7 @@ pub struct JsLab {
     inner: Rc<RefCell<Lab>>,
 }
 
-fn js(error: impl std::fmt::Display) -> JsError {
+pub(crate) fn js(error: impl std::fmt::Display) -> JsError {
     JsError::new(&error.to_string())
 }
 
@@ -41,12 +41,7 @@ impl JsLab {
                  later; Chromium headless with --enable-unsafe-webgpu)"
             ))
         })?;
-        let mut gpu = Gpu::with_adapter_async(&adapter, |_| {}).await.map_err(js)?;
-        if gpu.info.adapter.is_empty() {
-            // wgpu names a browser's adapter by its description, which browsers
-            // leave empty; its vendor and architecture say more.
-            gpu.info.adapter = browser_adapter_name().await.unwrap_or_else(|| "WebGPU adapter".into());
-        }
+        let gpu = Gpu::with_adapter_async(&adapter, |_| {}).await.map_err(js)?;
         let lab = Lab::new(gpu).map_err(js)?;
         Ok(JsLab { inner: Rc::new(RefCell::new(lab)) })
     }
@@ -174,7 +169,7 @@ fn render_options(options: &JsValue) -> Result<Truth, JsError> {
 
 /// A plain object's entries as flags: strings as they are, numbers and booleans in
 /// words, arrays of numbers joined by commas (`[0, 2, 5]` is `0,2,5`).
-fn flags_of(object: &JsValue) -> Result<Vec<Flag>, JsError> {
+pub(crate) fn flags_of(object: &JsValue) -> Result<Vec<Flag>, JsError> {
     if object.is_undefined() || object.is_null() {
         return Ok(Vec::new());
     }
@@ -212,24 +207,8 @@ fn flags_of(object: &JsValue) -> Result<Vec<Flag>, JsError> {
     Ok(flags)
 }
 
-/// The browser's own words for its WebGPU adapter (`google swiftshader`), from
-/// `navigator.gpu.requestAdapter()`'s `info`.
-async fn browser_adapter_name() -> Option<String> {
-    let get = |object: &JsValue, key: &str| js_sys::Reflect::get(object, &key.into()).ok();
-    let gpu = get(&get(&js_sys::global(), "navigator")?, "gpu")?;
-    let request: js_sys::Function = get(&gpu, "requestAdapter")?.dyn_into().ok()?;
-    let promise: js_sys::Promise = request.call0(&gpu).ok()?.dyn_into().ok()?;
-    let adapter = wasm_bindgen_futures::JsFuture::from(promise).await.ok()?;
-    let info = get(&adapter, "info")?;
-    let parts: Vec<String> = ["vendor", "architecture", "description"]
-        .iter()
-        .filter_map(|key| get(&info, key)?.as_string().filter(|s| !s.is_empty()))
-        .collect();
-    (!parts.is_empty()).then(|| format!("{} (WebGPU)", parts.join(" ")))
-}
-
 /// A panic's message in the browser's console, where it would otherwise be only
 /// "unreachable executed".
-fn report_panics_to_the_console() {
+pub(crate) fn report_panics_to_the_console() {
     std::panic::set_hook(Box::new(|info| web_sys::console::error_1(&info.to_string().into())));
 }

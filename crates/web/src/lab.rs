@@ -4,10 +4,12 @@
 //! against it. The JS API (`api.rs`) wraps it; the native tests drive it as it is.
 
 use gnomon_reference::{
-    drawn::{DrawnMetrics, DrawnSurfaces, DrawnTruth, faces_light, measure_drawn},
+    drawn::{DrawnMetrics, DrawnSurfaces, DrawnTruth, measure_drawn},
     heatmap,
 };
-use gnomon_render::{Frame, Gpu, GpuScene, OutputRequest, RenderError, Renderer};
+use gnomon_render::{
+    Frame, Gpu, GpuScene, OutputRequest, RenderError, Renderer, techniques::TechniqueRegistry,
+};
 use gnomon_scene::{Scene, Settings, builtin, gltf_loader, settings::Technique};
 use serde::Serialize;
 
@@ -130,14 +132,7 @@ impl Lab {
 
     /// Shows the built-in scene `name` (`gnomon scenes` lists them).
     pub fn load_builtin(&mut self, name: &str) -> Result<(), LabError> {
-        let scene = builtin::build(name).map_err(|e| match e {
-            builtin::BuiltinError::Unknown(_) => LabError::Scene(format!(
-                "unknown scene `{name}`: give one of the built-in scenes {}",
-                builtin::names().join(", ")
-            )),
-            out_of_range @ (builtin::BuiltinError::InstancesOutOfRange(_)
-            | builtin::BuiltinError::LampsOutOfRange(_)) => LabError::Scene(out_of_range.to_string()),
-        })?;
+        let scene = builtin_scene(name)?;
         self.show(name.to_string(), scene)
     }
 
@@ -160,11 +155,7 @@ impl Lab {
     /// Replaces the settings with the defaults and `flags` over them, checked as the
     /// command line checks them. Wrong flags leave the settings as they were.
     pub fn set_flags(&mut self, flags: &[Flag]) -> Result<(), LabError> {
-        let settings = settings_from_flags(flags)?;
-        self.renderer
-            .techniques()
-            .check(&settings.shadow)
-            .map_err(|e| FlagsError(gnomon_scene::settings::in_flags(&e.to_string())))?;
+        let settings = checked_settings(flags, self.renderer.techniques())?;
         if settings.scene.ground != self.scene.ground {
             let LoadedScene { name, loaded, .. } = &self.scene;
             self.scene = upload(&self.renderer, name.clone(), loaded.clone(), settings.scene.ground)?;
@@ -236,6 +227,28 @@ impl Lab {
     }
 }
 
+/// The built-in scene `name`, or an error that lists them.
+pub fn builtin_scene(name: &str) -> Result<Scene, LabError> {
+    builtin::build(name).map_err(|e| match e {
+        builtin::BuiltinError::Unknown(_) => LabError::Scene(format!(
+            "unknown scene `{name}`: give one of the built-in scenes {}",
+            builtin::names().join(", ")
+        )),
+        out_of_range @ (builtin::BuiltinError::InstancesOutOfRange(_)
+        | builtin::BuiltinError::LampsOutOfRange(_)) => LabError::Scene(out_of_range.to_string()),
+    })
+}
+
+/// `flags` over the defaults, checked as the command line checks them: each value,
+/// and the technique against `techniques`.
+pub fn checked_settings(flags: &[Flag], techniques: &TechniqueRegistry) -> Result<Settings, LabError> {
+    let settings = settings_from_flags(flags)?;
+    techniques
+        .check(&settings.shadow)
+        .map_err(|e| FlagsError(gnomon_scene::settings::in_flags(&e.to_string())))?;
+    Ok(settings)
+}
+
 /// `scene` on the GPU, with a ground plane under it when `ground`.
 fn upload(renderer: &Renderer, name: String, loaded: Scene, ground: bool) -> Result<LoadedScene, LabError> {
     let mut drawn = loaded.clone();
@@ -254,15 +267,7 @@ fn measure(frame: &Frame, reference: Frame) -> Measured {
         position: &frame.position,
         geometric_normal: &frame.geometric_normal,
     };
-    let faces = faces_light(&frame.light, surfaces);
-    let pixels = reference.visibility.len();
-    let truth = DrawnTruth {
-        visibility: reference.visibility,
-        faces_light: faces,
-        ambiguous: vec![false; pixels],
-        samples: 1,
-        rays: 0,
-    };
+    let truth = DrawnTruth::from_traced(&frame.light, surfaces, reference.visibility);
     Measured {
         metrics: measure_drawn(&frame.visibility, &truth),
         heatmap: heatmap::drawn(&frame.visibility, &truth),

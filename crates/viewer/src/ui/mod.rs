@@ -6,7 +6,10 @@
 
 mod inspect;
 
-use std::collections::{BTreeMap, VecDeque};
+use std::{
+    collections::{BTreeMap, VecDeque},
+    sync::Arc,
+};
 
 use egui::{Color32, RichText};
 use glam::Vec3;
@@ -31,7 +34,9 @@ pub(crate) struct Model {
     pub settings: Settings,
     pub baseline: Settings,
     pub source: SceneSource,
-    pub scene: Scene,
+    /// Shared with the frame being rendered (a browser renders while the panels
+    /// run); a change copies it only if that frame still holds it.
+    pub scene: Arc<Scene>,
     pub rig: CameraRig,
     pub view: View,
     pub show_panel: bool,
@@ -90,7 +95,7 @@ impl Model {
             settings,
             baseline,
             source,
-            scene,
+            scene: Arc::new(scene),
             view: View::Lit,
             show_panel,
             show_maps: false,
@@ -123,7 +128,7 @@ impl Model {
 
     pub fn say(&mut self, message: impl Into<String>) {
         let message = message.into();
-        eprintln!("gnomon view: {message}");
+        crate::window::log(&message);
         self.messages.push(message);
     }
 
@@ -378,8 +383,8 @@ impl Model {
             let name = format!(
                 "gnomon-view-{}-{}.png",
                 self.settings.shadow.filter.technique.name(),
-                std::time::SystemTime::now()
-                    .duration_since(std::time::UNIX_EPOCH)
+                web_time::SystemTime::now()
+                    .duration_since(web_time::UNIX_EPOCH)
                     .map(|d| d.as_secs())
                     .unwrap_or_default()
             );
