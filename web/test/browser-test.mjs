@@ -103,7 +103,77 @@ const VIEWER_MISMATCH = 0.001;
 const VIEWER_VIEW = 'scene=spheres&technique=pcf2x2&compare=1';
 const VIEWER_SCREENSHOT_VIEW = 'scene=spheres&technique=hard&shadow-res=512&refine=off&sun-elevation=25&compare=1&maps=1';
 
-async function viewerTest(browser, port, viewerShot) {
+// A small .glb: a 4 m square floor and a 1 m box floating 0.5 m over it, each face
+// its own four vertices with its normal.
+function boxGlb() {
+  const positions = [];
+  const normals = [];
+  const indices = [];
+  const quad = (corners, normal) => {
+    const base = positions.length / 3;
+    for (const c of corners) { positions.push(...c); normals.push(...normal); }
+    indices.push(base, base + 1, base + 2, base, base + 2, base + 3);
+  };
+  quad([[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]], [0, 1, 0]);
+  const [lo, hi] = [-0.5, 0.5];
+  const y = (v) => v + 1.0; // the box spans y from 0.5 to 1.5
+  quad([[lo, y(hi), lo], [lo, y(hi), hi], [hi, y(hi), hi], [hi, y(hi), lo]], [0, 1, 0]);
+  quad([[lo, y(lo), lo], [hi, y(lo), lo], [hi, y(lo), hi], [lo, y(lo), hi]], [0, -1, 0]);
+  quad([[lo, y(lo), hi], [hi, y(lo), hi], [hi, y(hi), hi], [lo, y(hi), hi]], [0, 0, 1]);
+  quad([[lo, y(lo), lo], [lo, y(hi), lo], [hi, y(hi), lo], [hi, y(lo), lo]], [0, 0, -1]);
+  quad([[hi, y(lo), lo], [hi, y(hi), lo], [hi, y(hi), hi], [hi, y(lo), hi]], [1, 0, 0]);
+  quad([[lo, y(lo), lo], [lo, y(lo), hi], [lo, y(hi), hi], [lo, y(hi), lo]], [-1, 0, 0]);
+  const bin = Buffer.concat([
+    Buffer.from(new Float32Array(positions).buffer),
+    Buffer.from(new Float32Array(normals).buffer),
+    Buffer.from(new Uint16Array(indices).buffer),
+  ]);
+  const vertexBytes = positions.length * 4;
+  const count = positions.length / 3;
+  const json = {
+    asset: { version: '2.0' },
+    buffers: [{ byteLength: bin.length }],
+    bufferViews: [
+      { buffer: 0, byteOffset: 0, byteLength: vertexBytes, target: 34962 },
+      { buffer: 0, byteOffset: vertexBytes, byteLength: vertexBytes, target: 34962 },
+      { buffer: 0, byteOffset: 2 * vertexBytes, byteLength: indices.length * 2, target: 34963 },
+    ],
+    accessors: [
+      { bufferView: 0, componentType: 5126, count, type: 'VEC3', min: [-2, 0, -2], max: [2, 1.5, 2] },
+      { bufferView: 1, componentType: 5126, count, type: 'VEC3' },
+      { bufferView: 2, componentType: 5123, count: indices.length, type: 'SCALAR' },
+    ],
+    meshes: [{ primitives: [{ attributes: { POSITION: 0, NORMAL: 1 }, indices: 2 }] }],
+    nodes: [{ mesh: 0, name: 'floor and box' }],
+    scenes: [{ nodes: [0] }],
+    scene: 0,
+  };
+  const pad = (b, fill) => Buffer.concat([b, Buffer.alloc((4 - (b.length % 4)) % 4, fill)]);
+  const jsonChunk = pad(Buffer.from(JSON.stringify(json)), 0x20);
+  const binChunk = pad(bin, 0);
+  const header = Buffer.alloc(12);
+  header.write('glTF', 0, 'latin1');
+  header.writeUInt32LE(2, 4);
+  header.writeUInt32LE(12 + 8 + jsonChunk.length + 8 + binChunk.length, 8);
+  const chunk = (type, data) => {
+    const h = Buffer.alloc(8);
+    h.writeUInt32LE(data.length, 0);
+    h.write(type, 4, 'latin1');
+    return Buffer.concat([h, data]);
+  };
+  return Buffer.concat([header, chunk('JSON', jsonChunk), chunk('BIN\0', binChunk)]);
+}
+
+// Drops `bytes` as a file called `name` on the page, as a user's drag would.
+async function dropFile(page, bytes, name) {
+  await page.evaluate(({ data, name }) => {
+    const transfer = new DataTransfer();
+    transfer.items.add(new File([new Uint8Array(data)], name));
+    document.body.dispatchEvent(new DragEvent('drop', { dataTransfer: transfer, bubbles: true, cancelable: true }));
+  }, { data: Array.from(bytes), name });
+}
+
+async function viewerTest(browser, port, viewerShot, broken) {
   const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
   const lines = [];
   const errors = [];
@@ -141,6 +211,20 @@ async function viewerTest(browser, port, viewerShot) {
   const said = page.waitForEvent('console', { predicate: (m) => m.text().includes('a page cannot write files'), timeout: 30_000 });
   await page.keyboard.press('F12');
   await said;
+  // A model dropped on the page: a broken one is refused as the command line
+  // refuses it, and the viewer keeps its scene; a good one is shown and measured.
+  await dropFile(page, broken.bytes, 'broken.glb');
+  await page.waitForFunction(() => document.getElementById('error').textContent.length > 0, null, { timeout: 30_000 });
+  const droppedError = await page.textContent('#error');
+  check(broken.cliMessage.includes(droppedError.trim()) && droppedError.startsWith('broken.glb: '),
+    `the viewer says "${droppedError}" for a broken file, the command line "${broken.cliMessage.trim()}"`);
+  const showing = page.waitForEvent('console', { predicate: (m) => m.text().includes('gnomon view: showing box'), timeout: RENDER_TIMEOUT_MS });
+  await dropFile(page, boxGlb(), 'box.glb');
+  await showing;
+  const boxMeasured = page.waitForEvent('console', { predicate: (m) => m.text().includes('% wrong'), timeout: RENDER_TIMEOUT_MS });
+  await page.evaluate(() => window.gnomon.viewer.compareWithReference());
+  const boxWrong = (await boxMeasured).text().match(/([0-9.]+) % wrong/);
+  check(boxWrong && Number(boxWrong[1]) / 100 <= VIEWER_MISMATCH, `the dropped box's view: ${boxWrong && boxWrong[0]}, above ${100 * VIEWER_MISMATCH} %`);
   check(errors.length === 0, `the viewer page logged errors: ${errors.join(' | ')}`);
   // A wrong flag is refused as the command line refuses it.
   await page.goto(`http://127.0.0.1:${port}/viewer.html?scene=spheres&technique=nope`);
@@ -157,9 +241,15 @@ async function viewerTest(browser, port, viewerShot) {
     console.log(`browser test: viewer screenshot ${viewerShot}`);
   }
   await page.close();
-  const line = { case: 'viewer, pcf2x2', mismatch_vs_raytraced: mismatch, page_seconds: seconds, status };
+  const line = {
+    case: 'viewer, pcf2x2',
+    mismatch_vs_raytraced: mismatch,
+    dropped_box_mismatch_vs_raytraced: Number(boxWrong[1]) / 100,
+    page_seconds: seconds,
+    status,
+  };
   console.log(JSON.stringify(line));
-  console.log(`browser test: the viewer drew, measured ${wrong[1]} % wrong, answered F1, and refused a wrong flag: ${refused.split('\n')[0]}`);
+  console.log(`browser test: the viewer drew, measured ${wrong[1]} % wrong, answered F1 and F12, refused a broken file, showed a dropped box (${boxWrong[1]} % wrong), and refused a wrong flag: ${refused.split('\n')[0]}`);
   return line;
 }
 
@@ -318,7 +408,7 @@ async function main() {
     const refused = await page.evaluate(() => window.gnomon.lab.render({ truth: 'yes' }).then(() => 'rendered', (e) => e.message));
     check(refused.includes('`truth` is true or false'), `render({truth: 'yes'}): ${refused}`);
     check(consoleErrors.length === 0, `the page logged errors: ${consoleErrors.join(' | ')}`);
-    results.push(await viewerTest(browser, port, viewerShot));
+    results.push(await viewerTest(browser, port, viewerShot, { bytes: fs.readFileSync(bad), cliMessage }));
   } finally {
     await browser.close();
     server.kill();

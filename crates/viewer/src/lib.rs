@@ -131,11 +131,40 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<RunReport> {
     window::run(options)
 }
 
-/// Starts the viewer on a page's `canvas` and returns at once: the browser runs its
-/// event loop from then on, and each frame's GPU work as a task of its own. Status
-/// lines go to the browser's console, prefixed `gnomon view:`; the error view's truth
-/// is the GPU's `raytraced` (a page has no threads for the CPU reference).
+/// Starts the viewer on a page's `canvas` and returns at once, with the way to reach
+/// it: the browser runs its event loop from then on, and each frame's GPU work as a
+/// task of its own. Status lines go to the browser's console, prefixed
+/// `gnomon view:`; the error view's truth is the GPU's `raytraced` (a page has no
+/// threads for the CPU reference).
 #[cfg(target_arch = "wasm32")]
-pub fn start_on_canvas(options: ViewerOptions, canvas: web_sys::HtmlCanvasElement) -> anyhow::Result<()> {
-    window::start(options, canvas)
+pub fn start_on_canvas(
+    options: ViewerOptions,
+    canvas: web_sys::HtmlCanvasElement,
+) -> anyhow::Result<CanvasViewer> {
+    Ok(CanvasViewer { proxy: window::start(options, canvas)? })
+}
+
+/// A viewer running on a page's canvas, for the page to talk to.
+#[cfg(target_arch = "wasm32")]
+pub struct CanvasViewer {
+    proxy: winit::event_loop::EventLoopProxy<window::Arrived>,
+}
+
+#[cfg(target_arch = "wasm32")]
+impl CanvasViewer {
+    /// Shows `scene` in place of the one shown, once the frame in flight is done, as
+    /// if opened from `source`.
+    pub fn show_scene(&self, scene: Scene, source: SceneSource) -> anyhow::Result<()> {
+        let new = Box::new(window::NewScene { scene, source });
+        self.send(window::Arrived::Scene(new))
+    }
+
+    /// Carries out `action`, as if the panels had sent it.
+    pub fn act(&self, action: Action) -> anyhow::Result<()> {
+        self.send(window::Arrived::Act(action))
+    }
+
+    fn send(&self, event: window::Arrived) -> anyhow::Result<()> {
+        self.proxy.send_event(event).map_err(|_| anyhow::anyhow!("the viewer has stopped"))
+    }
 }

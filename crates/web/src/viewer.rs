@@ -1,10 +1,12 @@
 //! The viewer (winit and egui, as `gnomon view` opens it on the desktop) on a page's
-//! canvas, started from JS with a built-in scene and settings flags. Its status lines
-//! go to the browser's console (`gnomon view: …`); its error view measures against
-//! the GPU's `raytraced`.
+//! canvas, started from JS with a built-in scene and settings flags, and then given
+//! models and asked for comparisons through the `Viewer` it returns. Its status
+//! lines go to the browser's console (`gnomon view: …`); its error view measures
+//! against the GPU's `raytraced`.
 
 use gnomon_render::techniques::TechniqueRegistry;
-use gnomon_viewer::{Action, SceneSource, ViewerOptions};
+use gnomon_scene::gltf_loader;
+use gnomon_viewer::{Action, CanvasViewer, SceneSource, ViewerOptions};
 use wasm_bindgen::prelude::*;
 
 use crate::{
@@ -17,8 +19,8 @@ use crate::{
 const COMPARE_AT_FRAME: u32 = 3;
 
 /// Starts the viewer on `canvas` with the built-in scene `scene` and `flags` (as
-/// `Lab.setSettings` takes them), and returns at once: the browser runs it from
-/// then on. `options`: `{compare: true}` compares the view with `raytraced` once
+/// `Lab.setSettings` takes them), and returns a `Viewer` at once: the browser runs
+/// it from then on. `options`: `{compare: true}` compares the view with `raytraced` once
 /// the first frames are drawn; `{showMaps: true}` opens the shadow-map preview;
 /// `{hidePanels: true}` starts with the panels hidden (F1 shows them). Wrong flags,
 /// an unknown scene or an unknown option throw, naming it.
@@ -28,7 +30,7 @@ pub fn start_viewer(
     scene: &str,
     flags: &JsValue,
     options: &JsValue,
-) -> Result<(), JsError> {
+) -> Result<JsViewer, JsError> {
     report_panics_to_the_console();
     let settings = checked_settings(&flags_of(flags)?, &TechniqueRegistry::builtin()).map_err(js)?;
     let mut loaded = builtin_scene(scene).map_err(js)?;
@@ -43,7 +45,35 @@ pub fn start_viewer(
     if switches.compare {
         viewer.script.push((COMPARE_AT_FRAME, Action::CompareWithReference));
     }
-    gnomon_viewer::start_on_canvas(viewer, canvas).map_err(|e| js(format!("{e:#}")))
+    let running = gnomon_viewer::start_on_canvas(viewer, canvas).map_err(|e| js(format!("{e:#}")))?;
+    Ok(JsViewer { running })
+}
+
+/// The viewer running on a canvas.
+#[wasm_bindgen(js_name = Viewer)]
+pub struct JsViewer {
+    running: CanvasViewer,
+}
+
+#[wasm_bindgen(js_class = Viewer)]
+impl JsViewer {
+    /// Shows the glTF model `bytes` (a `.glb`, or a `.gltf` with its data
+    /// embedded), called `name`, once the frame in flight is done; returns the
+    /// loader's warnings. A model that cannot be loaded throws the command line's
+    /// error, naming it, and the viewer keeps its scene.
+    #[wasm_bindgen(js_name = loadGltf)]
+    pub fn load_gltf(&self, bytes: &[u8], name: &str) -> Result<Vec<String>, JsError> {
+        let (scene, extras) = gltf_loader::load_from_bytes(bytes, name).map_err(js)?;
+        self.running.show_scene(scene, SceneSource::Gltf(name.into())).map_err(js)?;
+        Ok(extras.warnings)
+    }
+
+    /// Measures the view against `raytraced`, as the panel's "Compare with the
+    /// reference" does; the figures arrive in the status line and the console.
+    #[wasm_bindgen(js_name = compareWithReference)]
+    pub fn compare_with_reference(&self) -> Result<(), JsError> {
+        self.running.act(Action::CompareWithReference).map_err(js)
+    }
 }
 
 /// `startViewer`'s options.

@@ -151,6 +151,29 @@ impl Model {
         }
     }
 
+    /// Shows `scene` from its own camera, as if opened from `source`; the debug
+    /// pictures of the old one are dropped.
+    pub fn show_scene(&mut self, scene: Scene, source: SceneSource) {
+        self.settings.camera.eye = None;
+        self.settings.camera.target = None;
+        match self.settings.resolve_camera(&scene) {
+            Ok(camera) => {
+                let mode = self.rig.mode;
+                self.rig = CameraRig::looking(camera.eye, camera.target);
+                self.rig.mode = mode;
+            }
+            Err(e) => self.say(e.to_string()),
+        }
+        let name = scene.name.clone();
+        self.scene = Arc::new(scene);
+        self.source = source;
+        self.density = None;
+        self.error = None;
+        self.error_job = None;
+        self.view = View::Lit;
+        self.say(format!("showing {name}"));
+    }
+
     /// Turns or moves the light by a drag of (dx, dy) pixels: the sun's azimuth and
     /// elevation, or a spot or point light across the view.
     pub fn drag_light(&mut self, dx: f32, dy: f32) {

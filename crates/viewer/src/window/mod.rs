@@ -61,21 +61,37 @@ pub(crate) fn run(options: ViewerOptions) -> anyhow::Result<RunReport> {
     Ok(app.report)
 }
 
-/// Starts the viewer on `canvas` and returns; the browser runs it from then on.
+/// Starts the viewer on `canvas` and returns the way to reach it; the browser runs
+/// it from then on.
 #[cfg(target_arch = "wasm32")]
-pub(crate) fn start(options: ViewerOptions, canvas: web_sys::HtmlCanvasElement) -> anyhow::Result<()> {
+pub(crate) fn start(
+    options: ViewerOptions,
+    canvas: web_sys::HtmlCanvasElement,
+) -> anyhow::Result<winit::event_loop::EventLoopProxy<Arrived>> {
     let event_loop = event_loop()?;
     let app = App::new(options, platform::Host { canvas, proxy: None })?;
-    platform::run_loop(event_loop, app);
-    Ok(())
+    Ok(platform::run_loop(event_loop, app))
 }
 
-/// What comes back to the event loop from work that ran on its own.
+/// What comes to the event loop from outside it: work that ran on its own, and
+/// what the page asks.
 pub(crate) enum Arrived {
     /// The GPU device, the surface and the renderer, for the window just made.
     Opened(anyhow::Result<Box<Live>>),
     /// A frame's work, done.
     Frame(Box<FrameDone>),
+    /// A scene to show in place of the one shown (from a page: `CanvasViewer`).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Scene(Box<NewScene>),
+    /// An action, as if the panels had sent it (from a page: `CanvasViewer`).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Act(Action),
+}
+
+/// A scene to show, and where it came from (to name it in commands and scene files).
+pub(crate) struct NewScene {
+    pub scene: Scene,
+    pub source: crate::SceneSource,
 }
 
 /// What exists once the window is open.
@@ -113,6 +129,8 @@ pub(crate) struct App {
     waiting: Vec<Action>,
     /// What the next frame reads back for a comparison the panels asked for.
     compare_asked: bool,
+    /// A scene to show once the renderer is back from the frame in flight.
+    next_scene: Option<NewScene>,
     window_size: [u32; 2],
     report: RunReport,
     failure: Option<anyhow::Error>,
@@ -147,6 +165,7 @@ impl App {
             script,
             waiting: Vec::new(),
             compare_asked: false,
+            next_scene: None,
             window_size,
             report: RunReport::default(),
             failure: None,
@@ -178,6 +197,26 @@ impl App {
             }
             Arrived::Opened(Err(e)) => self.fail(event_loop, e),
             Arrived::Frame(done) => self.finish_frame(*done),
+            Arrived::Scene(new) => self.next_scene = Some(*new),
+            Arrived::Act(action) => self.model.pending.push(action),
+        }
+    }
+
+    /// Shows `new` in place of the scene shown, uploaded by `workshop`'s renderer;
+    /// a scene that cannot be uploaded is reported, and the old one stays.
+    fn switch_scene(&mut self, workshop: &mut Workshop, new: NewScene) {
+        let NewScene { mut scene, source } = new;
+        if self.model.settings.scene.ground {
+            scene.add_ground_plane();
+        }
+        match workshop.renderer.upload(&scene) {
+            Ok(uploaded) => {
+                workshop.uploaded = uploaded;
+                // What the hand held was an instance of the old scene.
+                self.hand = Hand::default();
+                self.model.show_scene(scene, source);
+            }
+            Err(e) => self.model.say(format!("{}: {e}", scene.name)),
         }
     }
 
@@ -194,7 +233,10 @@ impl App {
         self.model.settings.camera.target = Some(self.model.rig.target);
         let settings = self.model.frame_settings();
         let Some(live) = self.live.as_mut() else { return Ok(()) };
-        if let Some(workshop) = live.workshop.take() {
+        if let Some(mut workshop) = live.workshop.take() {
+            if let Some(new) = self.next_scene.take() {
+                self.switch_scene(&mut workshop, new);
+            }
             let compare = std::mem::take(&mut self.compare_asked);
             let read_back = ReadBack {
                 density: self.model.view == View::TexelDensity

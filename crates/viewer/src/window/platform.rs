@@ -161,11 +161,13 @@ mod web {
         attributes.with_canvas(Some(host.canvas.clone())).with_prevent_default(true).with_focusable(true)
     }
 
-    /// Starts the event loop and returns: the browser runs it.
-    pub(crate) fn run_loop(event_loop: EventLoop<Arrived>, mut app: App) {
+    /// Starts the event loop and returns the way into it: the browser runs it.
+    pub(crate) fn run_loop(event_loop: EventLoop<Arrived>, mut app: App) -> EventLoopProxy<Arrived> {
         use winit::platform::web::EventLoopExtWebSys;
-        app.host.proxy = Some(event_loop.create_proxy());
+        let proxy = event_loop.create_proxy();
+        app.host.proxy = Some(proxy.clone());
         event_loop.spawn_app(app);
+        proxy
     }
 
     /// A status line, in the browser's console.
