@@ -8,17 +8,21 @@
 #   a folder of its own for the ray-query tests (fetch-lavapipe-ray-query.sh: the
 #   system's Mesa is left as it is);
 # - with --browser, Debian's Chromium and Node.js with npm, for the lab's browser
-#   test (web/test/browser-test.mjs; docs/web.md).
+#   test (web/test/browser-test.mjs; docs/web.md);
+# - with --python, Python's venv module (Debian ships it apart, in python3-venv),
+#   for `pip install ./python` in a fresh virtual environment (docs/python.md).
 # Does nothing when everything is already there.
 set -eu
 
 want_tests=no
 want_browser=no
+want_python=no
 for arg in "$@"; do
     case "$arg" in
         --tests) want_tests=yes ;;
         --browser) want_browser=yes ;;
-        *) echo "install-system-deps: unknown option $arg (give --tests, --browser or nothing)" >&2; exit 2 ;;
+        --python) want_python=yes ;;
+        *) echo "install-system-deps: unknown option $arg (give --tests, --browser, --python or nothing)" >&2; exit 2 ;;
     esac
 done
 
@@ -51,6 +55,10 @@ fi
 if [ "$want_browser" = yes ] && ! command -v npm >/dev/null 2>&1; then
     echo "install-system-deps: no npm; installing Node.js for the browser test's driver" >&2
     packages="$packages nodejs npm"
+fi
+if [ "$want_python" = yes ] && ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
+    echo "install-system-deps: no Python venv module; installing python3-venv for the Python package" >&2
+    packages="$packages python3-venv"
 fi
 # The ray-query tests skip, saying so, without it: a failed fetch is no failure here.
 fetch_ray_query() {

@@ -1,6 +1,6 @@
 #!/bin/sh
-# Prints the README's Nth `sh` code block (1 or 2: the two commands the README opens
-# with), exactly as the README writes it, so that `.ci/run` runs what a newcomer
+# Prints the README's Nth `sh` code block (1 and 2: the two commands the README opens
+# with; 4: the Python package's install), exactly as the README writes it, so that `.ci/run` runs what a newcomer
 # copies and the two can never drift apart.
 #
 #   sh scripts/readme-command.sh N [README]

@@ -219,11 +219,28 @@ impl Staged {
         let npy = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"));
         self.write_with(path, |temp| {
             if npy {
-                write_npy(temp, width, height, values)
+                write_npy(temp, &[height as usize, width as usize], values)
             } else {
                 write_exr_y(temp, width, height, values)
             }
         })
+    }
+
+    /// Three float channels, by the path's extension: `.exr` (channels `R`, `G`, `B`)
+    /// or `.npy` (shape height × width × 3).
+    pub fn vec3_image(
+        &mut self,
+        path: &Path,
+        width: u32,
+        height: u32,
+        values: &[Vec3],
+    ) -> anyhow::Result<()> {
+        let npy = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+        if !npy {
+            return self.exr_rgb(path, width, height, values);
+        }
+        let flat: Vec<f32> = values.iter().flat_map(|v| v.to_array()).collect();
+        self.write_with(path, |temp| write_npy(temp, &[height as usize, width as usize, 3], &flat))
     }
 
     pub fn exr_rgb(&mut self, path: &Path, width: u32, height: u32, values: &[Vec3]) -> anyhow::Result<()> {
@@ -297,10 +314,14 @@ fn write_exr_y(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::
     Ok(())
 }
 
-/// A NumPy `.npy` file (format version 1.0): little-endian float32, C order, shape
-/// (height, width).
-fn write_npy(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::Result<()> {
-    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({height}, {width}), }}");
+/// A NumPy `.npy` file (format version 1.0): little-endian float32, C order, of
+/// `shape` (height, width, and channels where there are several).
+fn write_npy(path: &Path, shape: &[usize], values: &[f32]) -> anyhow::Result<()> {
+    let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+    let mut header = format!(
+        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}), }}",
+        dims.join(", ") + if shape.len() == 1 { "," } else { "" }
+    );
     // Magic (6) + version (2) + header length (2) + header + '\n' must be a multiple of 64.
     let unpadded = 10 + header.len() + 1;
     header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
@@ -375,7 +396,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("gnomon-npy-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("v.npy");
-        write_npy(&path, 3, 2, &[0.0, 0.5, 1.0, f32::NAN, 0.25, 0.75]).unwrap();
+        write_npy(&path, &[2, 3], &[0.0, 0.5, 1.0, f32::NAN, 0.25, 0.75]).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
         let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;

@@ -37,6 +37,10 @@ pub struct RenderArgs {
     /// Background pixels are NaN in the first three.
     #[arg(long, value_name = "DIR", help_heading = "Outputs")]
     pub aov_out: Option<PathBuf>,
+    /// The format of `--aov-out`'s images: OpenEXR, or NumPy `.npy` (float32; position
+    /// and normal height × width × 3, the others height × width).
+    #[arg(long, value_enum, default_value = "exr", help_heading = "Outputs")]
+    pub aov_format: AovFormat,
     /// Print the adapter, driver and backend used, and timings.
     #[arg(long, short)]
     pub verbose: bool,
@@ -54,8 +58,32 @@ impl RenderArgs {
     }
 }
 
-/// The files `--aov-out` writes into its directory.
-const AOV_FILES: [&str; 5] = ["position.exr", "normal.exr", "depth.exr", "object_id.exr", "visibility.exr"];
+/// The images `--aov-out` writes into its directory, by name (the format's
+/// extension follows).
+const AOV_NAMES: [&str; 5] = ["position", "normal", "depth", "object_id", "visibility"];
+
+/// The file format of `--aov-out`'s images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AovFormat {
+    /// OpenEXR: position and normal in channels R, G, B; the others in Y.
+    Exr,
+    /// NumPy `.npy`, little-endian float32 (what Python's `gnomon.Frame` holds).
+    Npy,
+}
+
+impl AovFormat {
+    fn extension(self) -> &'static str {
+        match self {
+            AovFormat::Exr => "exr",
+            AovFormat::Npy => "npy",
+        }
+    }
+}
+
+/// The files `--aov-out` writes, in the order of [`AOV_NAMES`].
+fn aov_files(dir: &std::path::Path, format: AovFormat) -> [PathBuf; 5] {
+    AOV_NAMES.map(|name| dir.join(format!("{name}.{}", format.extension())))
+}
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
@@ -108,7 +136,7 @@ fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.aov_out {
         output::check_dir(dir, "--aov-out")?;
     }
-    let aov_files: Vec<PathBuf> = args.aov_out.iter().flat_map(|d| AOV_FILES.map(|f| d.join(f))).collect();
+    let aov_files: Vec<PathBuf> = args.aov_out.iter().flat_map(|d| aov_files(d, args.aov_format)).collect();
     let planned: Vec<output::Planned> =
         [("--out", Some(&args.out)), ("--shadow-map-out", args.shadow_map_out.as_ref())]
             .into_iter()
@@ -199,9 +227,9 @@ fn stage_outputs(args: &RenderArgs, frame: &Frame) -> anyhow::Result<Staged> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--aov-out: cannot create directory {}", dir.display()))?;
         let (w, h) = (frame.width, frame.height);
-        let [position, normal, depth, object_id, visibility] = AOV_FILES.map(|f| dir.join(f));
-        staged.exr_rgb(&position, w, h, &frame.position)?;
-        staged.exr_rgb(&normal, w, h, &frame.normal)?;
+        let [position, normal, depth, object_id, visibility] = aov_files(dir, args.aov_format);
+        staged.vec3_image(&position, w, h, &frame.position)?;
+        staged.vec3_image(&normal, w, h, &frame.normal)?;
         staged.float_image(&depth, w, h, &frame.depth)?;
         let ids: Vec<f32> = frame.object_id.iter().map(|&i| i as f32).collect();
         staged.float_image(&object_id, w, h, &ids)?;

@@ -6,6 +6,8 @@
 pub mod builtin;
 pub mod camera_path;
 mod casters;
+#[cfg(feature = "cli")]
+pub mod flags;
 pub mod framing;
 pub mod geometry;
 pub mod gltf_loader;

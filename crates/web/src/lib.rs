@@ -6,7 +6,8 @@
 //! The pages themselves, their build and their browser test are in `web/`
 //! (docs/web.md).
 
-pub mod flags;
+/// Settings from flags: shared with the Python package, so in `gnomon-scene`.
+pub use gnomon_scene::flags;
 pub mod lab;
 
 #[cfg(target_arch = "wasm32")]

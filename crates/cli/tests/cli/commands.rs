@@ -74,6 +74,38 @@ fn float_outputs_are_written_with_their_documented_layout() {
     );
 }
 
+/// `--aov-format npy`: the AOVs as NumPy files, vectors height × width × 3, and the
+/// same values as the `.npy` visibility output.
+#[test]
+fn aovs_as_npy_have_their_documented_shapes() {
+    let temp = temp_dir("aov-npy");
+    let dir = temp.path();
+    let size = ["--width", "64", "--height", "36"];
+    let args = ["render", "contact", "--out", "c.png", "--visibility-out", "v.npy", "--aov-out", "aov"];
+    let out = gnomon(dir, &[&args[..], &size[..], &["--aov-format", "npy"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let aov = dir.join("aov");
+    assert_eq!(
+        files_in(&aov),
+        ["depth.npy", "normal.npy", "object_id.npy", "position.npy", "visibility.npy"]
+    );
+    let header = |path: &std::path::Path| {
+        let bytes = std::fs::read(path).unwrap();
+        let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        let header = String::from_utf8(bytes[10..10 + len].to_vec()).unwrap();
+        assert_eq!((10 + len) % 64, 0, "{header}");
+        (header, bytes[10 + len..].to_vec())
+    };
+    for (name, shape, values) in [("position", "(36, 64, 3)", 36 * 64 * 3), ("depth", "(36, 64)", 36 * 64)] {
+        let (text, data) = header(&aov.join(format!("{name}.npy")));
+        assert!(text.contains(&format!("'shape': {shape}")) && text.contains("'<f4'"), "{name}: {text}");
+        assert_eq!(data.len(), 4 * values, "{name}");
+    }
+    assert_eq!(header(&aov.join("visibility.npy")), header(&dir.join("v.npy")));
+    let bad = gnomon(dir, &["render", "--aov-out", "aov2", "--aov-format", "tiff"]);
+    assert!(!bad.status.success() && stderr(&bad).contains("--aov-format"), "{}", stderr(&bad));
+}
+
 #[test]
 fn an_unknown_scene_names_the_valid_ones() {
     let temp = temp_dir("unknown");

@@ -1,11 +1,11 @@
-//! Settings from the command line's flags, given as name and value pairs: the page's
-//! URL (`?technique=pcss&width=640`) and the JS API's plain objects
-//! (`{technique: "pcss", width: 640}`) both come here, so that each is parsed and
+//! Settings from the command line's flags, given as name and value pairs: a web
+//! page's URL (`?technique=pcss&width=640`), the JS API's plain objects
+//! (`{technique: "pcss", width: 640}`) and Python's keyword arguments all come here, so that each is parsed and
 //! checked by the very definition the command line uses (clap's, derived on
 //! [`Settings`]), and a wrong value gets the command line's error, word for word.
 
+use crate::{Settings, settings};
 use clap::{Args as _, FromArgMatches as _};
-use gnomon_scene::{Settings, settings};
 
 /// A flag and its value, as a page or a host gives it: the flag's long name without
 /// its dashes (`technique`, `sun-elevation`) and its value in words (`pcss`, `30`,
@@ -32,7 +32,7 @@ fn command() -> clap::Command {
 /// The settings `flags` give over the defaults, checked as the command line checks
 /// them: parsed by clap, then [`Settings::validate`], whose message names the flag.
 /// Whether a technique is registered is the renderer's to say
-/// (`TechniqueRegistry::check`, which [`crate::lab::Lab::set_flags`] asks).
+/// (`TechniqueRegistry::check`, which the front ends ask).
 pub fn settings_from_flags(flags: &[Flag]) -> Result<Settings, FlagsError> {
     let command = command();
     let mut argv = vec!["gnomon".to_string()];
