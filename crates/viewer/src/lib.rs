@@ -12,6 +12,7 @@ mod debug_views;
 mod drag;
 mod reproduce;
 pub mod settings_form;
+mod status_line;
 mod ui;
 mod window;
 

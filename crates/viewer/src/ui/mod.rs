@@ -128,7 +128,7 @@ impl Model {
 
     pub fn say(&mut self, message: impl Into<String>) {
         let message = message.into();
-        crate::window::log(&message);
+        crate::status_line::say(&message);
         self.messages.push(message);
     }
 

@@ -5,6 +5,7 @@
 //! work, which a browser runs while its page goes on.
 
 mod job;
+mod live;
 mod paint;
 mod platform;
 
@@ -23,6 +24,7 @@ use winit::{
 
 use self::{
     job::{FrameDone, FrameJob, ReadBack, Workshop},
+    live::Live,
     paint::{paint, refresh_picture, show_live_frame},
 };
 use crate::{
@@ -32,11 +34,6 @@ use crate::{
     reproduce,
     ui::{Images, Model},
 };
-
-pub(crate) use platform::log;
-
-/// Side of each shadow-map layer in the preview, in pixels.
-const MAP_PREVIEW_TILE: u32 = 256;
 
 fn event_loop() -> anyhow::Result<EventLoop<Arrived>> {
     let event_loop = EventLoop::with_user_event().build().context(
@@ -92,26 +89,6 @@ pub(crate) enum Arrived {
 pub(crate) struct NewScene {
     pub scene: Scene,
     pub source: crate::SceneSource,
-}
-
-/// What exists once the window is open.
-pub(crate) struct Live {
-    window: Arc<Window>,
-    /// Kept for as long as its device: a browser loses the device (and each
-    /// readback fails) once the instance it came from is collected.
-    _instance: wgpu::Instance,
-    /// The window's device, which the renderer shares.
-    gpu: gnomon_render::Gpu,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
-    /// The renderer and the scene's upload; `None` while a frame's work has them.
-    workshop: Option<Workshop>,
-    egui: egui_winit::State,
-    painter: egui_wgpu::Renderer,
-    /// The live frame's image as egui knows it.
-    view_texture: Option<egui::TextureId>,
-    maps_texture: Option<egui::TextureId>,
-    images: Images,
 }
 
 pub(crate) struct App {
@@ -388,7 +365,7 @@ async fn connect(window: Arc<Window>, scene: Arc<Scene>) -> anyhow::Result<Box<L
         .await
         .map_err(|_| RenderError::no_adapter())?;
     let gpu = gnomon_render::Gpu::with_adapter_async(&adapter, |_| {}).await?;
-    platform::log(&gpu.info.to_string());
+    crate::status_line::say(&gpu.info.to_string());
     let size = window.inner_size();
     let mut config = surface
         .get_default_config(&adapter, size.width.max(1), size.height.max(1))

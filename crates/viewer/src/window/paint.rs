@@ -3,8 +3,11 @@
 
 use gnomon_render::{LiveFrame, wgpu};
 
-use super::{Live, MAP_PREVIEW_TILE};
-use crate::debug_views;
+use super::live::Live;
+use crate::{debug_views, status_line};
+
+/// Side of each shadow-map layer in the preview, in pixels.
+const MAP_PREVIEW_TILE: u32 = 256;
 
 /// Hands a live frame's textures to egui.
 pub(super) fn show_live_frame(live: &mut Live, frame: &LiveFrame, show_maps: bool) {
@@ -40,7 +43,7 @@ pub(super) fn show_live_frame(live: &mut Live, frame: &LiveFrame, show_maps: boo
             });
             live.images.maps = live.maps_texture.map(|id| (id, [maps.width(), maps.height()]));
         }
-        Err(e) => super::platform::log(&e.to_string()),
+        Err(e) => status_line::say(&e.to_string()),
     }
 }
 

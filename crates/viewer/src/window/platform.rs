@@ -1,6 +1,6 @@
 //! What differs between a desktop window and a browser's canvas, in one place: how
 //! the event loop runs, which window is drawn into, how work that waits for the GPU
-//! runs, where status lines go, where the error view's truth comes from, and whether
+//! runs, where the error view's truth comes from, and whether
 //! a screenshot can be written to a file.
 
 use std::future::Future;
@@ -62,11 +62,6 @@ mod desktop {
     pub(crate) fn run_loop(event_loop: EventLoop<Arrived>, app: &mut App) -> anyhow::Result<()> {
         use anyhow::Context;
         event_loop.run_app(app).context("the window's event loop failed")
-    }
-
-    /// A status line, on standard error.
-    pub(crate) fn log(message: &str) {
-        eprintln!("gnomon view: {message}");
     }
 
     /// Puts `text` on the clipboard (egui-winit's, the system's).
@@ -168,11 +163,6 @@ mod web {
         app.host.proxy = Some(proxy.clone());
         event_loop.spawn_app(app);
         proxy
-    }
-
-    /// A status line, in the browser's console.
-    pub(crate) fn log(message: &str) {
-        web_sys::console::log_1(&format!("gnomon view: {message}").into());
     }
 
     /// Puts `text` on the system's clipboard, through the page (egui-winit's own
