@@ -22,7 +22,10 @@
 #      depth-only baseline;
 #   5. Sponza from the Bevy comparison's view: instances against clusters, kept maps
 #      against none, and Florence's submission paths;
-#   6. `lamps:N`: lighting per light with the light list.
+#   6. a moving sun (`bench --sun-path day`, nothing kept) against a still one, kept
+#      maps and none, on Sponza from the Bevy view: the shadow passes' time and the
+#      texels they rasterize per frame (issue 53's baseline for virtual maps);
+#   7. `lamps:N`: lighting per light with the light list.
 set -u
 gnomon=${1:-target/release/gnomon}
 shared=${2:-../shared/scenes}
@@ -171,7 +174,19 @@ step florence-submission "$gnomon" bench "$florence" --partition cascades --tech
   --out "$out/florence-submission"
 bench_md florence-submission
 
-echo "## 6. lamps:N, the light list" >> "$md"
+echo "## 6. A moving sun against a still one (Sponza, the Bevy view)" >> "$md"
+# The sun moves every frame along a day's arc: no kept map is valid, every layer is
+# drawn, whatever --map-cache says. Still sun: kept maps draw nothing.
+# shellcheck disable=SC2086
+step sun-day "$gnomon" bench "$sponza" $bevy_view --techniques pcf2x2 --frames 60 --warmup 10 \
+  --sun-path day --sweep map-cache=still-casters,off --out "$out/sun-day"
+bench_md sun-day
+# shellcheck disable=SC2086
+step sun-still "$gnomon" bench "$sponza" $bevy_view --techniques pcf2x2 --frames 60 --warmup 10 \
+  --sweep map-cache=still-casters,off --out "$out/sun-still"
+bench_md sun-still
+
+echo "## 7. lamps:N, the light list" >> "$md"
 for n in 1 8 32 64; do
   step "lamps-$n" "$gnomon" bench "lamps:$n" --light all --frames 30 --warmup 5 \
     --sweep lighting=light-list,per-light --out "$out/lamps-$n"

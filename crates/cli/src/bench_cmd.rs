@@ -17,8 +17,9 @@ use gnomon_render::{
 use gnomon_scene::{
     Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
-    settings::Technique,
+    settings::{LightKind, Technique},
 };
+use gnomon_math::solar::DayArc;
 use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -70,6 +71,12 @@ pub struct BenchArgs {
     /// the target (an orbit's arc: that angle in radians); in (0, 1].
     #[arg(long, value_name = "FRACTION", default_value_t = 0.05, help_heading = "Benchmark")]
     pub path_travel: f32,
+    /// Move the sun every frame along this path over the warm-up and timed frames
+    /// (overriding --sun-elevation and --sun-azimuth), so that no kept map is valid:
+    /// `day` runs from 7 h to 17 h of an equinox at 45° N, the sun 10.5° to 45° high.
+    /// Needs the sun (`--light sun`).
+    #[arg(long, value_enum, help_heading = "Benchmark")]
+    pub sun_path: Option<SunPathKind>,
     /// How to time passes: GPU timestamps where the adapter has them (else the CPU
     /// wall clock), or the CPU wall clock always.
     #[arg(long, value_enum, default_value_t = ClockArg::Auto, help_heading = "Benchmark")]
@@ -82,6 +89,21 @@ pub struct BenchArgs {
     pub verbose: bool,
     #[command(flatten)]
     pub settings: Settings,
+}
+
+/// How `--sun-path` moves the sun.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SunPathKind {
+    /// A day's arc ([`DayArc::EQUINOX_45_NORTH`]).
+    Day,
+}
+
+impl SunPathKind {
+    fn arc(self) -> DayArc {
+        match self {
+            SunPathKind::Day => DayArc::EQUINOX_45_NORTH,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -117,6 +139,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.path_travel
     );
     args.settings.validate()?;
+    anyhow::ensure!(
+        args.sun_path.is_none() || args.settings.light.kind == LightKind::Sun,
+        "--sun-path moves the sun, and --light is {:?}: give --light sun with --sun-path",
+        args.settings.light.kind
+    );
     output::check_dir(&args.out, "--out")?;
     let (mut scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
     let mover = args.moving.map(|count| crate::bench_moving::Mover::new(&scene, count)).transpose()?;
@@ -249,12 +276,19 @@ impl Bench<'_> {
         let frames = self.args.warmup + self.args.frames;
         let path = self.args.camera_path;
         let travel = self.args.path_travel;
-        // The camera of frame `i` of the warm-up and timed frames together.
+        let sun_arc = self.args.sun_path.map(SunPathKind::arc);
+        // The camera and the sun of frame `i` of the warm-up and timed frames together.
         let place = |settings: &mut Settings, i: u32| {
+            let fraction = i as f32 / (frames - 1).max(1) as f32;
             if let Some(kind) = path {
-                let camera = camera_on_path(&start, kind, travel, i as f32 / (frames - 1).max(1) as f32);
+                let camera = camera_on_path(&start, kind, travel, fraction);
                 settings.camera.eye = Some(camera.eye);
                 settings.camera.target = Some(camera.target);
+            }
+            if let Some(arc) = sun_arc {
+                let sun = arc.at(fraction);
+                settings.light.sun_elevation = Some(sun.elevation);
+                settings.light.sun_azimuth = Some(sun.azimuth);
             }
         };
         let settings = &mut settings;
@@ -322,6 +356,10 @@ impl Bench<'_> {
         series.push("CPU cull", cost.cpu.cull_ms);
         series.push("CPU record", cost.cpu.record_ms);
         series.push("wall frame", wall_ms);
+        // What a fill-bound GPU pays for: the texels the shadow passes cleared or
+        // drew into, in millions.
+        let texels: u64 = cost.lights.iter().flat_map(|l| l.layer_texels.iter()).sum();
+        series.push("shadow Mtexels", texels as f64 / 1e6);
         // What the frame costs beyond its GPU work and the CPU's submission: resource
         // creation, stalls and readback waits. 1 means nothing is wasted.
         series.push("wall ÷ (GPU + CPU)", wall_ms / (timings.frame_ms + cost.cpu.submit_ms));

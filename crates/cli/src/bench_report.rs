@@ -121,7 +121,7 @@ fn header(md: &mut String, report: &Report, info: &GpuInfo) {
     let _ = writeln!(
         md,
         "- adapter: {} ({}, {}), driver: {} {}\n- timing: {}\n- {} instances{}, {} triangles; image {}×{}; \
-         {} warm-up and {} timed frames per row; times in ms (the layer counts of kept maps in layers), median (p95)\n- command: `{}`\n",
+         {} warm-up and {} timed frames per row; times in ms (the layer counts of kept maps in layers, `shadow Mtexels` in millions of texels the shadow passes cleared or drew), median (p95)\n- command: `{}`\n",
         info.adapter,
         info.device_type,
         info.backend,

@@ -36,6 +36,34 @@ pub fn sun_position(hour: f32, latitude: f32, declination: f32) -> SunPosition {
     SunPosition { elevation, azimuth: azimuth.rem_euclid(360.0) }
 }
 
+/// A day's arc of the sun, for what must follow a sun that moves every frame (`gnomon
+/// bench --sun-path day`): at 45° N on an equinox, from 7 h to 17 h of solar time.
+/// The sun stays 10.5° or more above the horizon, so every shadow stays in the scene,
+/// and each step of a bench's frames turns it by a fraction of a degree, so that no
+/// kept map is ever valid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DayArc {
+    /// Degrees north (positive) or south.
+    pub latitude: f32,
+    /// The sun's declination in degrees (0 on an equinox).
+    pub declination: f32,
+    /// Local solar hours at the start and the end of the arc.
+    pub first_hour: f32,
+    pub last_hour: f32,
+}
+
+impl DayArc {
+    /// The arc `bench --sun-path day` follows.
+    pub const EQUINOX_45_NORTH: DayArc =
+        DayArc { latitude: 45.0, declination: 0.0, first_hour: 7.0, last_hour: 17.0 };
+
+    /// The sun `fraction` of the way along the arc (0 its start, 1 its end).
+    pub fn at(&self, fraction: f32) -> SunPosition {
+        let hour = self.first_hour + fraction.clamp(0.0, 1.0) * (self.last_hour - self.first_hour);
+        sun_position(hour, self.latitude, self.declination)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -69,5 +97,22 @@ mod tests {
         let (am, pm) = (sun_position(9.0, 45.0, june), sun_position(15.0, 45.0, june));
         assert!((am.elevation - pm.elevation).abs() < 1e-3);
         assert!((am.azimuth + pm.azimuth - 360.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_day_arc_stays_up_and_turns_from_east_to_west() {
+        let arc = DayArc::EQUINOX_45_NORTH;
+        let steps = 200;
+        let mut previous = arc.at(0.0);
+        assert!((previous.elevation - 10.5).abs() < 0.1, "{previous:?}");
+        for k in 1..=steps {
+            let sun = arc.at(k as f32 / steps as f32);
+            assert!(sun.elevation >= 10.4, "{sun:?}");
+            // Azimuth grows through south (180°) all day; every step moves the sun.
+            assert!(sun.azimuth > previous.azimuth, "{previous:?} then {sun:?}");
+            previous = sun;
+        }
+        let noon = arc.at(0.5);
+        assert!((noon.elevation - 45.0).abs() < 1e-3 && (noon.azimuth - 180.0).abs() < 1e-3);
     }
 }

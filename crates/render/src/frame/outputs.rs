@@ -158,6 +158,11 @@ pub struct LightStats {
     /// per bucket of shadow items whose count the GPU wrote (`GpuCulled`); 0 for a
     /// kept layer.
     pub layer_commands: Vec<u32>,
+    /// Texels each layer's passes rasterized this frame: the area of every pass that
+    /// cleared the layer or drew into it (the whole layer, the strips a scrolled
+    /// layer newly covers); 0 for a kept layer with no moving caster. What a
+    /// fill-bound GPU pays for, whatever the casters cover.
+    pub layer_texels: Vec<u64>,
     /// Instances drawn into each layer: those whose bounds reach into its frustum.
     pub layer_instances: Vec<u32>,
     /// Triangles drawn into each layer: every triangle of those instances, less the
@@ -488,7 +493,8 @@ impl TimedLights {
                 technique: light.technique.technique(),
                 resolution: light.map_resolution(),
                 layer_draws: layers.iter().map(|v| v.runs.len() as u32).collect(),
-                layer_commands: commands.of(index, layers.len()),
+                layer_commands: commands.of(index, layers.len()).iter().map(|w| w.commands).collect(),
+                layer_texels: commands.of(index, layers.len()).iter().map(|w| w.texels).collect(),
                 layer_instances: layers.iter().map(Visible::instances).collect(),
                 layer_triangles: layers.iter().map(Visible::triangles).collect(),
                 layer_cache: cache.clone(),

@@ -61,29 +61,41 @@ pub(super) struct Recording<'e> {
     pub layer_commands: LayerCommands,
 }
 
-/// The draw commands recorded into each layer of each light, every pass of a layer
-/// together (its still casters, its strips, its moving casters).
+/// What was recorded into each layer of each light, every pass of a layer together
+/// (its still casters, its strips, its moving casters): draw commands, and texels
+/// rasterized.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct LayerCommands(Vec<Vec<u32>>);
+pub(super) struct LayerCommands(Vec<Vec<LayerWork>>);
+
+/// One layer's recorded work.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct LayerWork {
+    /// Draw commands recorded into it.
+    pub commands: u32,
+    /// Texels its passes covered: the area of each pass that cleared its target or
+    /// drew into it (the whole layer, or the strips a scrolled layer newly covers).
+    pub texels: u64,
+}
 
 impl LayerCommands {
-    /// Counts `commands` more for layer `layer` of light `light`.
-    pub fn add(&mut self, light: usize, layer: usize, commands: u32) {
+    /// Counts `work` more for layer `layer` of light `light`.
+    pub fn add(&mut self, light: usize, layer: usize, work: LayerWork) {
         if self.0.len() <= light {
             self.0.resize(light + 1, Vec::new());
         }
         let layers = &mut self.0[light];
         if layers.len() <= layer {
-            layers.resize(layer + 1, 0);
+            layers.resize(layer + 1, LayerWork::default());
         }
-        layers[layer] += commands;
+        layers[layer].commands += work.commands;
+        layers[layer].texels += work.texels;
     }
 
-    /// Light `light`'s count per layer, for its `layers` layers (0 for a layer that
-    /// recorded nothing).
-    pub fn of(&self, light: usize, layers: usize) -> Vec<u32> {
+    /// Light `light`'s work per layer, for its `layers` layers (nothing for a layer
+    /// that recorded nothing).
+    pub fn of(&self, light: usize, layers: usize) -> Vec<LayerWork> {
         let recorded = self.0.get(light).map(Vec::as_slice).unwrap_or(&[]);
-        (0..layers).map(|l| recorded.get(l).copied().unwrap_or(0)).collect()
+        (0..layers).map(|l| recorded.get(l).copied().unwrap_or_default()).collect()
     }
 }
 

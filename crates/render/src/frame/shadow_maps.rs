@@ -15,7 +15,7 @@ use super::{
     depth_pass::{Casters, DepthArea, DepthPass, DepthStart, LayerCulling, ScissorRect},
     map_cache::{LayerKey, LayerPlan},
     plan::LightPlan,
-    recording::Recording,
+    recording::{LayerWork, Recording},
 };
 use crate::{
     GpuScene,
@@ -236,7 +236,15 @@ impl Renderer {
         let writes = timed.and_then(|t| rec.clock.render_part(t.slot, t.part));
         let drawn = self.record_depth_pass(rec.encoder, uploaded, &pass, writes);
         rec.stats.add(&drawn);
-        rec.layer_commands.add(layer.light_index, layer.layer, drawn.shadow_commands);
+        let resolution = u64::from(layer.light.map_resolution());
+        let area = match &layer.area {
+            DepthArea::Whole => resolution * resolution,
+            DepthArea::Strips(strips) => strips.iter().map(|s| u64::from(s.width) * u64::from(s.height)).sum(),
+        };
+        // A pass that neither clears nor draws leaves its texels alone.
+        let touched = drawn.shadow_commands > 0 || layer.start == DepthStart::Clear;
+        let work = LayerWork { commands: drawn.shadow_commands, texels: if touched { area } else { 0 } };
+        rec.layer_commands.add(layer.light_index, layer.layer, work);
     }
 }
 
