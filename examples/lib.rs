@@ -4,6 +4,8 @@
 //! - `window.rs`: a winit application with its own mesh, camera and WGSL shader,
 //!   which asks Gnomon for its light's shadows and calls `shadow_visibility` from its
 //!   own fragment shader ([`host`]).
+//! - `virtual_pages.rs`: the pages a virtual shadow map would draw for one view,
+//!   from the library's page-request pass on the surfaces the renderer saw.
 //!
 //! Run one with `cargo run --release -p gnomon-examples --example headless -- FILE.gltf OUT.png`
 //! or `cargo run --release -p gnomon-examples --example window`.

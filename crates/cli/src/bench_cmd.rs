@@ -10,6 +10,7 @@ use std::{collections::BTreeMap, path::PathBuf, time::Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use gnomon_math::solar::DayArc;
 use gnomon_render::{
     DepthBaselineScene, FrameCost, Gpu, GpuScene, LayerCache, Renderer,
     timing::{ClockChoice, TimingSource},
@@ -19,7 +20,6 @@ use gnomon_scene::{
     camera_path::{CameraPathKind, camera_on_path},
     settings::{LightKind, Technique},
 };
-use gnomon_math::solar::DayArc;
 use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -123,14 +123,9 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// One configuration to time: a technique, and the swept setting's value.
-struct Config {
-    technique: Technique,
-    sweep_value: Option<String>,
-    settings: Settings,
-}
-
-pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+/// Refuses values of the bench's own flags out of their ranges, naming the flag and
+/// what is valid.
+fn check_args(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!((1..=100_000).contains(&args.frames), "--frames {}: give 1 to 100000", args.frames);
     anyhow::ensure!(args.warmup <= 10_000, "--warmup {}: give 0 to 10000", args.warmup);
     anyhow::ensure!(
@@ -141,9 +136,20 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
     anyhow::ensure!(
         args.sun_path.is_none() || args.settings.light.kind == LightKind::Sun,
-        "--sun-path moves the sun, and --light is {:?}: give --light sun with --sun-path",
-        args.settings.light.kind
+        "--sun-path moves the sun: give it with --light sun (the default), not another light"
     );
+    Ok(())
+}
+
+/// One configuration to time: a technique, and the swept setting's value.
+struct Config {
+    technique: Technique,
+    sweep_value: Option<String>,
+    settings: Settings,
+}
+
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    check_args(args)?;
     output::check_dir(&args.out, "--out")?;
     let (mut scene, mut base) = crate::lab::load(&args.scene, &args.settings)?;
     let mover = args.moving.map(|count| crate::bench_moving::Mover::new(&scene, count)).transpose()?;

@@ -5,7 +5,8 @@
 //! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]);
 //! whether a mesh is closed, for face culling in the shadow pass ([`topology`]); and
 //! which way a projection winds a triangle or a cluster of them ([`facing`]); and the
-//! pixels a light's range can reach on screen ([`screen_bounds`]).
+//! pixels a light's range can reach on screen ([`screen_bounds`]); and a virtual shadow
+//! map's clipmap, its page requests and its page pool ([`virtual_map`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -32,6 +33,7 @@ pub mod solar;
 #[cfg(test)]
 mod test_rng;
 pub mod topology;
+pub mod virtual_map;
 pub mod warping;
 
 pub use aabb::Aabb;

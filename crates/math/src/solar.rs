@@ -47,8 +47,9 @@ pub struct DayArc {
     pub latitude: f32,
     /// The sun's declination in degrees (0 on an equinox).
     pub declination: f32,
-    /// Local solar hours at the start and the end of the arc.
+    /// Local solar hour at the start of the arc.
     pub first_hour: f32,
+    /// Local solar hour at its end.
     pub last_hour: f32,
 }
 

@@ -28,6 +28,7 @@ mod readback;
 pub mod techniques;
 pub mod timing;
 pub mod uniforms;
+pub mod virtual_map;
 
 pub use clusters::CLUSTERS_BUILT;
 pub use device::{DeferredErrors, Gpu, GpuInfo};

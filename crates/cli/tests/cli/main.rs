@@ -3,6 +3,7 @@
 
 mod support;
 
+mod bench_sun;
 mod calibrate;
 mod commands;
 mod hardening;

@@ -239,7 +239,9 @@ impl Renderer {
         let resolution = u64::from(layer.light.map_resolution());
         let area = match &layer.area {
             DepthArea::Whole => resolution * resolution,
-            DepthArea::Strips(strips) => strips.iter().map(|s| u64::from(s.width) * u64::from(s.height)).sum(),
+            DepthArea::Strips(strips) => {
+                strips.iter().map(|s| u64::from(s.width) * u64::from(s.height)).sum()
+            }
         };
         // A pass that neither clears nor draws leaves its texels alone.
         let touched = drawn.shadow_commands > 0 || layer.start == DepthStart::Clear;

@@ -90,6 +90,10 @@ fn struct_layouts() -> Vec<StructLayout> {
             world_from_clip, light_from_world, splits, near, far, cascade_count, blend,
         }),
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
+        struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
+            light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
+            page_texels, width, height,
+        }),
         struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
         struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
         struct_layout!(crate::gpu_scene::shadow_items::ItemGpu as "ShadowItem" {
@@ -198,6 +202,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("blit".into(), blit::blit_wgsl()));
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
     out.push(("depth baseline".into(), super::depth_baseline::baseline_wgsl()));
+    out.push(("page requests".into(), crate::virtual_map::page_requests_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);

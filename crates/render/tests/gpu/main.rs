@@ -20,3 +20,4 @@ mod map_cache;
 mod persistence;
 mod submission;
 mod techniques;
+mod virtual_pages;

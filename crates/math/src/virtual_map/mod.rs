@@ -1,0 +1,254 @@
+//! Virtual shadow maps for a sun: the clipmap's geometry and the pages a pixel needs.
+//!
+//! A virtual map replaces the few large textures of cascades with a clipmap of
+//! *virtual* levels around the camera, each [`ClipmapShape::virtual_resolution`]²
+//! texels cut into pages of [`ClipmapShape::page_size`]², of which only the pages that
+//! visible pixels read are given memory and drawn: resolution matched to the pixels'
+//! footprint, as in Lefohn, Sengupta and Owens, "Resolution-Matched Shadow Maps" (ACM
+//! TOG 26(4), 2007), laid out as a clipmap (Tanner, Migdal and Jones, "The Clipmap",
+//! SIGGRAPH 1998) the way Unreal Engine 5's virtual shadow maps are.
+//!
+//! The geometry here is what the GPU passes and the page pool ([`pages`]) share:
+//! - Every level looks along the light with the same rigid `light_from_world`, so a
+//!   distance in light space is a distance in the world.
+//! - Level `l`'s texels are `2^l` times level 0's, and level 0's are a power of two in
+//!   world units. Pages are anchored at the light-space origin, not at the camera, so a
+//!   page keeps its place in the world as the camera moves: a kept page stays valid,
+//!   and the page of level `l + 1` over a point is the page of level `l` over it with
+//!   its coordinates halved ([`PageKey::coarser`]).
+//! - Each level's window of `pages_per_side`² pages is centred on the camera, snapped
+//!   to whole pages.
+//! - A pixel asks for the finest level whose texels are no smaller than its footprint
+//!   (about one texel per pixel), and for every page its filter and normal offset may
+//!   reach ([`Clipmap::request`]).
+
+pub mod pages;
+
+use glam::{IVec2, Mat4, Vec2, Vec3};
+
+use crate::{Aabb, projection::view_from_world_look_at};
+
+/// The size of a virtual map: how many texels each level has and how they are paged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClipmapShape {
+    /// Texels per side of each virtual level (a multiple of `page_size`).
+    pub virtual_resolution: u32,
+    /// Texels per side of a page.
+    pub page_size: u32,
+    /// Virtual levels, each covering twice the width of the one before.
+    pub levels: u32,
+}
+
+/// The most levels a clipmap may have (the GPU passes hold every level's origin in
+/// one uniform).
+pub const MAX_LEVELS: u32 = 16;
+
+impl ClipmapShape {
+    /// Unreal's shape: 16384² virtual texels per level in 128² pages, and 16 levels,
+    /// from texels 2^15 times finer than the coarsest level's.
+    pub const DEFAULT: ClipmapShape = ClipmapShape { virtual_resolution: 16384, page_size: 128, levels: 16 };
+
+    /// Pages per side of a level.
+    pub fn pages_per_side(&self) -> u32 {
+        self.virtual_resolution / self.page_size
+    }
+}
+
+/// One virtual page: its level and its place in that level's grid of pages, in
+/// whole pages from the light-space origin (x right, y up in light space).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PageKey {
+    /// Its level, 0 the finest.
+    pub level: u32,
+    /// Its column, in pages from the light-space origin (x right).
+    pub x: i32,
+    /// Its row, in pages from the light-space origin (y up).
+    pub y: i32,
+}
+
+impl PageKey {
+    /// The page of the next coarser level that covers this one.
+    pub fn coarser(self) -> PageKey {
+        PageKey { level: self.level + 1, x: self.x.div_euclid(2), y: self.y.div_euclid(2) }
+    }
+}
+
+/// A rectangle of pages of one level, both ends included.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PageRect {
+    /// The level of its pages.
+    pub level: u32,
+    /// Its first column and row.
+    pub min: IVec2,
+    /// Its last column and row (included).
+    pub max: IVec2,
+}
+
+impl PageRect {
+    /// Whether `page` lies in the rectangle.
+    pub fn contains(&self, page: PageKey) -> bool {
+        page.level == self.level
+            && (self.min.x..=self.max.x).contains(&page.x)
+            && (self.min.y..=self.max.y).contains(&page.y)
+    }
+
+    /// Every page of the rectangle.
+    pub fn pages(&self) -> impl Iterator<Item = PageKey> + '_ {
+        (self.min.y..=self.max.y)
+            .flat_map(move |y| (self.min.x..=self.max.x).map(move |x| PageKey { level: self.level, x, y }))
+    }
+}
+
+/// One frame's clipmap for a sun: where each level lies, and its depth range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clipmap {
+    /// Its levels' size and paging.
+    pub shape: ClipmapShape,
+    /// World to the light's view space: a rotation only, looking along the light's
+    /// travel (−z), so that light-space x and y are world units.
+    pub light_from_world: Mat4,
+    /// World size of one texel of level 0, a power of two; level `l`'s is `2^l` times it.
+    pub finest_texel: f32,
+    /// Each level's first page: the level covers pages `origin .. origin +
+    /// pages_per_side` in x and y.
+    pub origins: Vec<IVec2>,
+    /// Distance along the light's view axis of the depth-0 plane: in front of the
+    /// whole scene, so that every caster of a page is drawn.
+    pub near: f32,
+    /// Distance along the light's view axis of the depth-1 plane: behind the scene.
+    pub far: f32,
+}
+
+impl Clipmap {
+    /// The clipmap of a sun travelling along `travel`, around `camera` (the eye's
+    /// world position), for a scene within `bounds` whose farthest visible pixel has
+    /// a footprint of `farthest_footprint` world units. The coarsest level's texels
+    /// are no finer than that footprint, so that every pixel finds its level without
+    /// being clamped to one finer than it needs, and its window covers the scene
+    /// twice over; each finer level halves the texel. The levels change only when the
+    /// farthest footprint crosses a power of two (a turn of the light or a change of
+    /// levels re-draws every page: [`pages::PagePool::invalidate_all`]).
+    pub fn new(
+        shape: ClipmapShape,
+        travel: Vec3,
+        camera: Vec3,
+        bounds: &Aabb,
+        farthest_footprint: f32,
+    ) -> Clipmap {
+        let light_from_world = view_from_world_look_at(Vec3::ZERO, travel.normalize(), Vec3::Y);
+        let in_light = bounds.transformed(light_from_world);
+        let width = in_light.extent().truncate().max_element().max(1e-6);
+        let coarsest = (2.0 * width / shape.virtual_resolution as f32).max(farthest_footprint);
+        let coarsest_exponent = coarsest.log2().ceil() as i32;
+        let finest_texel = 2f32.powi(coarsest_exponent - (shape.levels as i32 - 1));
+        let centre = light_from_world.transform_point3(camera).truncate();
+        let half = (shape.pages_per_side() / 2) as i32;
+        let origins = (0..shape.levels)
+            .map(|level| {
+                let page = page_world_size(shape, finest_texel, level);
+                (centre / page).floor().as_ivec2() - IVec2::splat(half)
+            })
+            .collect();
+        // Light space looks down −z: the nearest point has the largest z.
+        let margin = 1e-3 * in_light.extent().z.max(1e-6);
+        let (near, far) = (-in_light.max.z - margin, -in_light.min.z + margin);
+        Clipmap { shape, light_from_world, finest_texel, origins, near, far }
+    }
+
+    /// World size of a texel of `level`.
+    pub fn texel_size(&self, level: u32) -> f32 {
+        self.finest_texel * 2f32.powi(level as i32)
+    }
+
+    /// World size of a page of `level`.
+    pub fn page_size(&self, level: u32) -> f32 {
+        page_world_size(self.shape, self.finest_texel, level)
+    }
+
+    /// The level a pixel whose footprint is `footprint` world units reads: the
+    /// coarsest whose texels are no larger than the footprint (level 0 where even
+    /// its texels are larger, the coarsest level where every level's are smaller).
+    pub fn level_for_footprint(&self, footprint: f32) -> u32 {
+        let ratio = footprint / self.finest_texel;
+        if ratio.is_nan() || ratio < 1.0 {
+            return 0;
+        }
+        (ratio.log2().floor() as u32).min(self.shape.levels - 1)
+    }
+
+    /// A world point's place in light space, x and y.
+    pub fn light_xy(&self, world: Vec3) -> Vec2 {
+        self.light_from_world.transform_point3(world).truncate()
+    }
+
+    /// The page of `level` over the light-space point `xy`, if it lies in the level's
+    /// window.
+    pub fn page_at(&self, level: u32, xy: Vec2) -> Option<PageKey> {
+        let page = (xy / self.page_size(level)).floor().as_ivec2();
+        self.in_window(level, page).then_some(PageKey { level, x: page.x, y: page.y })
+    }
+
+    /// Whether page `page` of `level` lies in the level's window.
+    fn in_window(&self, level: u32, page: IVec2) -> bool {
+        let rel = page - self.origins[level as usize];
+        let side = self.shape.pages_per_side() as i32;
+        rel.x >= 0 && rel.y >= 0 && rel.x < side && rel.y < side
+    }
+
+    /// The pages of `level` over the light-space rectangle `low..=high`, clipped to
+    /// the level's window; None where it lies outside it.
+    pub fn pages_over(&self, level: u32, low: Vec2, high: Vec2) -> Option<PageRect> {
+        let size = self.page_size(level);
+        let origin = self.origins[level as usize];
+        let last = origin + IVec2::splat(self.shape.pages_per_side() as i32 - 1);
+        let min = (low / size).floor().as_ivec2().max(origin);
+        let max = (high / size).floor().as_ivec2().min(last);
+        (min.x <= max.x && min.y <= max.y).then_some(PageRect { level, min, max })
+    }
+
+    /// The pages of `level` that a caster within `bounds` can write: those over its
+    /// light-space shadow, the rectangle its corners cover seen from the light. A
+    /// caster that moves dirties these pages where it was and where it is.
+    pub fn pages_under(&self, level: u32, bounds: &Aabb) -> Option<PageRect> {
+        let in_light = bounds.transformed(self.light_from_world);
+        self.pages_over(level, in_light.min.truncate(), in_light.max.truncate())
+    }
+
+    /// Every page a pixel at world point `point` whose footprint is `footprint`
+    /// world units reads, through a filter that reaches `reach_texels` texels of its
+    /// level from the point (the kernel's radius, the normal offset's, a texel for
+    /// bilinear taps): the rectangle of pages of its level over that square. Nothing
+    /// for a point outside the level's window.
+    pub fn request(&self, point: Vec3, footprint: f32, reach_texels: f32) -> Option<PageRect> {
+        let level = self.level_for_footprint(footprint);
+        let xy = self.light_xy(point);
+        let reach = reach_texels * self.texel_size(level);
+        self.page_at(level, xy)?;
+        self.pages_over(level, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
+    }
+
+    /// World to the clip space of page `page` alone: the orthographic projection of
+    /// its light-space window over the clipmap's depth range, which a page's depth
+    /// pass draws with into its physical page.
+    pub fn page_clip_from_world(&self, page: PageKey) -> Mat4 {
+        let size = self.page_size(page.level);
+        let (left, bottom) = (page.x as f32 * size, page.y as f32 * size);
+        let clip_from_light = glam::camera::rh::proj::directx::orthographic(
+            left,
+            left + size,
+            bottom,
+            bottom + size,
+            self.near,
+            self.far,
+        );
+        clip_from_light * self.light_from_world
+    }
+}
+
+/// World size of a page of `level` for texels of `finest_texel` at level 0.
+fn page_world_size(shape: ClipmapShape, finest_texel: f32, level: u32) -> f32 {
+    finest_texel * 2f32.powi(level as i32) * shape.page_size as f32
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,315 @@
+//! The physical page pool of a virtual shadow map: which virtual pages hold memory
+//! this frame, which of them must be drawn, and which were refused.
+//!
+//! **Invariant** (checked after every step by `tests::check_invariant`):
+//! - `resident` and `slots` describe one bijection: page `k` is resident in slot `s`
+//!   exactly when `slots[s].page == Some(k)` and `resident[k] == s`;
+//! - a page requested in a frame is never evicted in that frame, so every page
+//!   granted in a frame holds memory until the frame's end;
+//! - a page is refused only when every slot holds a page requested in the same frame.
+//!
+//! Allocation grants the coarse levels first, so that when the pool is too small the
+//! pages refused are the finest, and a pixel whose page was refused falls back to a
+//! coarser page over the same point that is resident ([`PagePool::resolve`]). Slots
+//! are reused least recently used first.
+
+use std::collections::HashMap;
+
+use super::PageKey;
+
+/// What a frame does with a granted page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PageState {
+    /// Newly given memory: drawn this frame.
+    New,
+    /// Resident, but something in it changed (the light turned, a caster moved over
+    /// it): drawn again this frame.
+    Dirty,
+    /// Resident and unchanged: kept as it is, drawn not at all.
+    Kept,
+}
+
+/// A page granted memory for this frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PageGrant {
+    /// The virtual page.
+    pub page: PageKey,
+    /// Its slot in the pool's texture.
+    pub physical: u32,
+    /// Whether it is drawn this frame, and why.
+    pub state: PageState,
+}
+
+/// One frame's allocation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameAllocation {
+    /// Every page requested that holds memory, coarse levels first.
+    pub granted: Vec<PageGrant>,
+    /// Pages requested that the pool had no room for: their pixels read a coarser
+    /// page ([`PagePool::resolve`]).
+    pub refused: Vec<PageKey>,
+    /// Resident pages of earlier frames whose slots this frame took.
+    pub evicted: u32,
+}
+
+impl FrameAllocation {
+    /// The pages to draw this frame: the new and the dirty.
+    pub fn to_draw(&self) -> impl Iterator<Item = &PageGrant> {
+        self.granted.iter().filter(|g| g.state != PageState::Kept)
+    }
+}
+
+/// One slot of the pool.
+#[derive(Clone, Copy, Debug, Default)]
+struct Slot {
+    page: Option<PageKey>,
+    /// The frame that last requested it (0: never).
+    last_used: u64,
+    /// Its content no longer matches the scene.
+    stale: bool,
+}
+
+/// The pool: a fixed number of physical pages, kept across frames.
+#[derive(Clone, Debug)]
+pub struct PagePool {
+    slots: Vec<Slot>,
+    resident: HashMap<PageKey, u32>,
+    frame: u64,
+}
+
+impl PagePool {
+    /// A pool of `capacity` physical pages, all free.
+    pub fn new(capacity: u32) -> PagePool {
+        PagePool { slots: vec![Slot::default(); capacity as usize], resident: HashMap::new(), frame: 0 }
+    }
+
+    /// Physical pages in the pool.
+    pub fn capacity(&self) -> u32 {
+        self.slots.len() as u32
+    }
+
+    /// Pages holding memory now.
+    pub fn resident(&self) -> usize {
+        self.resident.len()
+    }
+
+    /// Marks every resident page stale: the light turned, and every depth in the pool
+    /// is of the old direction.
+    pub fn invalidate_all(&mut self) {
+        for slot in self.slots.iter_mut().filter(|s| s.page.is_some()) {
+            slot.stale = true;
+        }
+    }
+
+    /// Marks stale every resident page for which `overlaps` holds (the pages a moved
+    /// caster covered or covers); returns how many it marked.
+    pub fn invalidate(&mut self, overlaps: impl Fn(PageKey) -> bool) -> u32 {
+        let mut marked = 0;
+        for slot in &mut self.slots {
+            if let Some(page) = slot.page
+                && overlaps(page)
+                && !slot.stale
+            {
+                slot.stale = true;
+                marked += 1;
+            }
+        }
+        marked
+    }
+
+    /// Grants memory to this frame's requested pages (duplicates allowed), coarse
+    /// levels first: a resident page keeps its slot, drawn again only if stale; a new
+    /// one takes a free slot, else the least recently used slot no page of this frame
+    /// holds; when none is left, it is refused.
+    pub fn allocate(&mut self, requests: &[PageKey]) -> FrameAllocation {
+        self.frame += 1;
+        let frame = self.frame;
+        let mut wanted: Vec<PageKey> = requests.to_vec();
+        // Coarse levels first, then a fixed order, so that the result does not depend
+        // on the order the requests arrived in.
+        wanted.sort_unstable_by(|a, b| b.level.cmp(&a.level).then(a.cmp(b)));
+        wanted.dedup();
+        // Every requested resident page first: none of them may be evicted.
+        for page in &wanted {
+            if let Some(&slot) = self.resident.get(page) {
+                self.slots[slot as usize].last_used = frame;
+            }
+        }
+        // The slots a new page may take, free ones first, then least recently used.
+        let mut free: Vec<u32> =
+            (0..self.capacity()).filter(|&s| self.slots[s as usize].last_used != frame).collect();
+        free.sort_by_key(|&s| {
+            let slot = &self.slots[s as usize];
+            (slot.page.is_some(), slot.last_used)
+        });
+        let mut free = free.into_iter();
+        let mut allocation = FrameAllocation::default();
+        for page in wanted {
+            if let Some(&physical) = self.resident.get(&page) {
+                let slot = &mut self.slots[physical as usize];
+                let state = if slot.stale { PageState::Dirty } else { PageState::Kept };
+                slot.stale = false;
+                allocation.granted.push(PageGrant { page, physical, state });
+                continue;
+            }
+            let Some(physical) = free.next() else {
+                allocation.refused.push(page);
+                continue;
+            };
+            let slot = &mut self.slots[physical as usize];
+            if let Some(old) = slot.page.replace(page) {
+                self.resident.remove(&old);
+                allocation.evicted += 1;
+            }
+            *slot = Slot { page: Some(page), last_used: frame, stale: false };
+            self.resident.insert(page, physical);
+            allocation.granted.push(PageGrant { page, physical, state: PageState::New });
+        }
+        allocation
+    }
+
+    /// The page a pixel that asked for `page` reads: the page itself if resident,
+    /// else the finest coarser page over the same point that is, up to level
+    /// `levels − 1`; None when none is.
+    pub fn resolve(&self, page: PageKey, levels: u32) -> Option<(PageKey, u32)> {
+        let mut key = page;
+        loop {
+            if let Some(&physical) = self.resident.get(&key) {
+                return Some((key, physical));
+            }
+            if key.level + 1 >= levels {
+                return None;
+            }
+            key = key.coarser();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Lcg;
+
+    /// The invariant stated at the top of this module.
+    fn check_invariant(pool: &PagePool, allocation: &FrameAllocation) {
+        for (s, slot) in pool.slots.iter().enumerate() {
+            if let Some(page) = slot.page {
+                assert_eq!(pool.resident.get(&page), Some(&(s as u32)), "slot {s} holds {page:?}");
+            }
+        }
+        for (page, &s) in &pool.resident {
+            assert_eq!(pool.slots[s as usize].page, Some(*page), "{page:?} is resident in slot {s}");
+        }
+        for grant in &allocation.granted {
+            assert_eq!(pool.resident.get(&grant.page), Some(&grant.physical), "{grant:?} was evicted");
+        }
+        let slots: std::collections::HashSet<u32> = allocation.granted.iter().map(|g| g.physical).collect();
+        assert_eq!(slots.len(), allocation.granted.len(), "two grants share a slot");
+        if !allocation.refused.is_empty() {
+            assert_eq!(allocation.granted.len() as u32, pool.capacity(), "refused with room left");
+        }
+    }
+
+    fn page(level: u32, x: i32, y: i32) -> PageKey {
+        PageKey { level, x, y }
+    }
+
+    #[test]
+    fn a_still_scene_draws_no_page_after_the_first_frame() {
+        let mut pool = PagePool::new(16);
+        let requests = [page(0, 0, 0), page(0, 1, 0), page(1, 0, 0), page(0, 0, 0)];
+        let first = pool.allocate(&requests);
+        check_invariant(&pool, &first);
+        assert_eq!(first.to_draw().count(), 3);
+        let second = pool.allocate(&requests);
+        check_invariant(&pool, &second);
+        assert_eq!(second.to_draw().count(), 0, "{second:?}");
+        assert_eq!(second.granted.len(), 3);
+    }
+
+    #[test]
+    fn a_turned_light_draws_every_page_again_in_the_same_slots() {
+        let mut pool = PagePool::new(8);
+        let requests = [page(0, 0, 0), page(2, -1, 3)];
+        let first = pool.allocate(&requests);
+        pool.invalidate_all();
+        let second = pool.allocate(&requests);
+        check_invariant(&pool, &second);
+        assert!(second.granted.iter().all(|g| g.state == PageState::Dirty), "{second:?}");
+        let slots = |a: &FrameAllocation| a.granted.iter().map(|g| g.physical).collect::<Vec<_>>();
+        assert_eq!(slots(&first), slots(&second));
+        assert_eq!(pool.allocate(&requests).to_draw().count(), 0);
+    }
+
+    #[test]
+    fn an_overfull_pool_refuses_the_finest_pages_and_they_fall_back() {
+        let mut pool = PagePool::new(3);
+        let coarse = page(3, 0, 0);
+        let fine: Vec<PageKey> = (0..4).map(|i| page(0, i, 0)).collect();
+        let mut requests = fine.clone();
+        requests.push(coarse);
+        let allocation = pool.allocate(&requests);
+        check_invariant(&pool, &allocation);
+        assert_eq!(allocation.refused.len(), 2, "{allocation:?}");
+        assert!(allocation.granted.iter().any(|g| g.page == coarse), "the coarse page goes first");
+        for refused in &allocation.refused {
+            let (read, _) = pool.resolve(*refused, 4).expect("a coarser page is resident");
+            assert_eq!(read, coarse, "{refused:?} reads the resident level-3 page over it");
+        }
+        // Nothing coarser is resident over a point elsewhere.
+        assert_eq!(pool.resolve(page(0, 100, 0), 4), None);
+    }
+
+    #[test]
+    fn pages_requested_this_frame_are_never_evicted_and_the_least_recently_used_go_first() {
+        let mut pool = PagePool::new(4);
+        pool.allocate(&[page(0, 0, 0), page(0, 1, 0)]);
+        pool.allocate(&[page(0, 2, 0), page(0, 3, 0)]);
+        // Touch (0, 0) again, so (0, 1) is the least recently used.
+        pool.allocate(&[page(0, 0, 0)]);
+        let allocation = pool.allocate(&[page(0, 0, 0), page(0, 9, 0)]);
+        check_invariant(&pool, &allocation);
+        assert_eq!(allocation.evicted, 1);
+        assert!(pool.resolve(page(0, 1, 0), 1).is_none(), "the least recently used page left");
+        assert!(pool.resolve(page(0, 2, 0), 1).is_some());
+    }
+
+    #[test]
+    fn invalidating_a_region_dirties_only_the_resident_pages_in_it() {
+        let mut pool = PagePool::new(8);
+        let requests: Vec<PageKey> = (0..6).map(|i| page(0, i, 0)).collect();
+        pool.allocate(&requests);
+        let marked = pool.invalidate(|p| (2..=3).contains(&p.x));
+        assert_eq!(marked, 2);
+        let allocation = pool.allocate(&requests);
+        let drawn: Vec<i32> = allocation.to_draw().map(|g| g.page.x).collect();
+        assert_eq!(drawn, vec![2, 3]);
+        assert!(allocation.to_draw().all(|g| g.state == PageState::Dirty));
+    }
+
+    #[test]
+    fn the_invariant_holds_over_random_frames() {
+        let mut rng = Lcg(7);
+        let mut pool = PagePool::new(24);
+        for _ in 0..300 {
+            let count = (rng.next() * 40.0) as usize;
+            let requests: Vec<PageKey> = (0..count)
+                .map(|_| {
+                    page((rng.next() * 4.0) as u32, (rng.next() * 12.0) as i32 - 6, (rng.next() * 3.0) as i32)
+                })
+                .collect();
+            if rng.next() < 0.1 {
+                pool.invalidate_all();
+            }
+            let allocation = pool.allocate(&requests);
+            check_invariant(&pool, &allocation);
+            let distinct: std::collections::HashSet<PageKey> = requests.iter().copied().collect();
+            assert_eq!(allocation.granted.len() + allocation.refused.len(), distinct.len());
+            // Refused pages are never coarser than a granted new one.
+            if let Some(coarsest_refused) = allocation.refused.iter().map(|p| p.level).max() {
+                let new = allocation.granted.iter().filter(|g| g.state == PageState::New);
+                assert!(new.into_iter().all(|g| g.page.level >= coarsest_refused));
+            }
+        }
+    }
+}

@@ -1,0 +1,177 @@
+//! The clipmap's geometry: levels nest, windows follow the camera by whole pages,
+//! requests cover every texel a filter reads, and a caster dirties exactly the pages
+//! under its shadow.
+
+use glam::{Vec2, Vec3};
+
+use super::*;
+use crate::test_rng::Lcg;
+
+fn scene() -> Aabb {
+    Aabb::new(Vec3::new(-40.0, 0.0, -25.0), Vec3::new(40.0, 20.0, 25.0))
+}
+
+/// The clipmap of a sun over [`scene`], around `camera`, for a camera whose farthest
+/// pixel spans 0.05 world units.
+fn clipmap(camera: Vec3) -> Clipmap {
+    Clipmap::new(ClipmapShape::DEFAULT, Vec3::new(0.3, -1.0, 0.2), camera, &scene(), 0.05)
+}
+
+#[test]
+fn the_coarsest_level_serves_the_farthest_pixel_unclamped() {
+    for farthest in [1e-4f32, 0.05, 3.0, 700.0] {
+        let map = Clipmap::new(ClipmapShape::DEFAULT, Vec3::NEG_Y, Vec3::ZERO, &scene(), farthest);
+        let coarsest = map.shape.levels - 1;
+        assert!(map.texel_size(coarsest) >= farthest, "{farthest}: {}", map.texel_size(coarsest));
+        // The farthest pixel's level matches its footprint: not clamped to a level
+        // whose texels are more than twice finer.
+        let level = map.level_for_footprint(farthest);
+        assert!(map.texel_size(level) <= farthest && 2.0 * map.texel_size(level) > farthest, "{farthest}");
+    }
+}
+
+#[test]
+fn the_coarsest_level_covers_the_scene_and_each_level_halves_the_texel() {
+    let map = clipmap(Vec3::new(5.0, 2.0, 3.0));
+    let shape = map.shape;
+    assert_eq!(map.finest_texel.log2().fract(), 0.0, "a power of two: {}", map.finest_texel);
+    for level in 1..shape.levels {
+        assert_eq!(map.texel_size(level), 2.0 * map.texel_size(level - 1));
+    }
+    // Every corner of the scene lies in the coarsest level's window.
+    let coarsest = shape.levels - 1;
+    for corner in scene().corners() {
+        assert!(map.page_at(coarsest, map.light_xy(corner)).is_some(), "{corner}");
+    }
+    // The depth range holds the whole scene.
+    for corner in scene().corners() {
+        let depth = -map.light_from_world.transform_point3(corner).z;
+        assert!(depth > map.near && depth < map.far, "{depth} outside {}..{}", map.near, map.far);
+    }
+}
+
+#[test]
+fn light_space_is_rigid() {
+    let map = clipmap(Vec3::ZERO);
+    let (a, b) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(-4.0, 0.5, 7.0));
+    let light = |p| map.light_from_world.transform_point3(p);
+    assert!((light(a).distance(light(b)) - a.distance(b)).abs() < 1e-4);
+}
+
+#[test]
+fn pages_nest_across_levels() {
+    let map = clipmap(Vec3::ZERO);
+    let mut rng = Lcg(3);
+    for _ in 0..500 {
+        let xy = Vec2::new(rng.range(-30.0, 30.0), rng.range(-30.0, 30.0));
+        let level = (rng.next() * 10.0) as u32;
+        let (Some(fine), Some(coarse)) = (map.page_at(level, xy), map.page_at(level + 1, xy)) else {
+            continue;
+        };
+        assert_eq!(fine.coarser(), coarse, "{xy} at level {level}");
+    }
+}
+
+#[test]
+fn the_window_follows_the_camera_by_whole_pages_and_stays_centred() {
+    let before = clipmap(Vec3::ZERO);
+    let after = clipmap(Vec3::new(3.0, 0.0, 1.0));
+    let half = (before.shape.pages_per_side() / 2) as i32;
+    for level in 0..before.shape.levels {
+        let size = after.page_size(level);
+        // The camera's page is the window's centre page.
+        let centre = (after.light_xy(Vec3::new(3.0, 0.0, 1.0)) / size).floor().as_ivec2();
+        assert_eq!(centre - after.origins[level as usize], IVec2::splat(half), "level {level}");
+        // A page keeps its world place: its projection depends on its key alone.
+        let key = PageKey { level, x: 2, y: -1 };
+        assert_eq!(before.page_clip_from_world(key), after.page_clip_from_world(key));
+    }
+}
+
+#[test]
+fn a_pixel_reads_the_coarsest_level_whose_texels_fit_its_footprint() {
+    let map = clipmap(Vec3::ZERO);
+    let mut rng = Lcg(11);
+    for _ in 0..200 {
+        let footprint = map.finest_texel * 2f32.powf(rng.range(0.0, 14.0));
+        let level = map.level_for_footprint(footprint);
+        assert!(map.texel_size(level) <= footprint * (1.0 + 1e-6), "{footprint}: level {level}");
+        assert!(map.texel_size(level) * 2.0 > footprint, "{footprint}: level {level} is too fine");
+    }
+    assert_eq!(map.level_for_footprint(0.0), 0);
+    assert_eq!(map.level_for_footprint(f32::NAN), 0);
+    assert_eq!(map.level_for_footprint(1e9), map.shape.levels - 1);
+}
+
+#[test]
+fn a_request_covers_every_texel_the_filter_reaches() {
+    let map = clipmap(Vec3::new(1.0, 1.0, 1.0));
+    let mut rng = Lcg(5);
+    for _ in 0..300 {
+        // Near the camera, where every level's window holds the point and its taps.
+        let point = Vec3::ONE + rng.vec(-0.5, 0.5);
+        let footprint = rng.range(0.001, 0.5);
+        let reach = rng.range(0.5, 8.0);
+        let rect = map.request(point, footprint, reach).expect("the point lies in its level's window");
+        let level = map.level_for_footprint(footprint);
+        assert_eq!(rect.level, level);
+        let xy = map.light_xy(point);
+        let step = map.texel_size(level) * reach;
+        for (dx, dy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (0.0, 0.0)] {
+            let tap = xy + Vec2::new(dx, dy) * step;
+            let page = map.page_at(level, tap).expect("a tap near the camera lies in the window");
+            assert!(rect.contains(page), "{page:?} outside {rect:?}");
+        }
+        // And no more than the square's pages: at most one page beyond each side.
+        let pages = (2.0 * step / map.page_size(level)).ceil() as i32 + 1;
+        assert!(rect.max.x - rect.min.x < pages && rect.max.y - rect.min.y < pages, "{rect:?}");
+    }
+}
+
+#[test]
+fn a_caster_dirties_exactly_the_pages_under_its_shadow() {
+    let map = clipmap(Vec3::ZERO);
+    let mut rng = Lcg(9);
+    for _ in 0..50 {
+        let centre = rng.vec(-5.0, 5.0);
+        let caster = Aabb::new(centre - rng.vec(0.05, 1.0), centre + rng.vec(0.05, 1.0));
+        // Levels whose windows (32 world units and more) hold every caster whole.
+        let level = 12 + (rng.next() * 4.0) as u32;
+        let rect = map.pages_under(level, &caster).expect("the caster is near the camera");
+        let in_light = caster.transformed(map.light_from_world);
+        let size = map.page_size(level);
+        // Every page near the caster: dirtied exactly when its window meets the
+        // caster's light-space rectangle.
+        for y in rect.min.y - 2..=rect.max.y + 2 {
+            for x in rect.min.x - 2..=rect.max.x + 2 {
+                let page = PageKey { level, x, y };
+                let (low, high) =
+                    (Vec2::new(x as f32, y as f32) * size, Vec2::new(x as f32 + 1.0, y as f32 + 1.0) * size);
+                let meets = low.x <= in_light.max.x
+                    && high.x > in_light.min.x
+                    && low.y <= in_light.max.y
+                    && high.y > in_light.min.y;
+                assert_eq!(rect.contains(page), meets, "{page:?} against {rect:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_page_projection_maps_its_window_onto_clip_space() {
+    let map = clipmap(Vec3::ZERO);
+    let key = PageKey { level: 6, x: -3, y: 2 };
+    let size = map.page_size(key.level);
+    let clip_from_world = map.page_clip_from_world(key);
+    let world_from_light = map.light_from_world.inverse();
+    let depth = 0.5 * (map.near + map.far);
+    let corner = |u: f32, v: f32| {
+        let light = Vec3::new((key.x as f32 + u) * size, (key.y as f32 + v) * size, -depth);
+        clip_from_world.project_point3(world_from_light.transform_point3(light))
+    };
+    let low = corner(0.0, 0.0);
+    let high = corner(1.0, 1.0);
+    assert!((low.x + 1.0).abs() < 1e-3 && (low.y + 1.0).abs() < 1e-3, "{low}");
+    assert!((high.x - 1.0).abs() < 1e-3 && (high.y - 1.0).abs() < 1e-3, "{high}");
+    assert!((low.z - 0.5).abs() < 1e-3, "{low}");
+}

@@ -1,0 +1,71 @@
+// Page requests of a virtual shadow map (`virtual_map/mod.rs`): every pixel the
+// prepass saw marks the pages of the clipmap level that matches its footprint, over
+// the square its filter and normal offset reach, as bits of one mask per level.
+// Many pixels share a page; atomicOr keeps one bit for all of them. The same
+// arithmetic as `Clipmap::request` in gnomon-math, which the tests hold it to.
+
+import package::constants::VIRTUAL_ORIGIN_VECTORS;
+
+struct PageRequestParams {
+    light_from_world: mat4x4<f32>,
+    // Each level's first page, two levels to a vector: level 2k in xy, 2k + 1 in zw.
+    origins: array<vec4<i32>, VIRTUAL_ORIGIN_VECTORS>,
+    // World size of a texel of level 0; level l's is 2^l times it.
+    finest_texel: f32,
+    // A pixel's footprint in world units per unit of view depth.
+    footprint_per_depth: f32,
+    // Texels of its level that a pixel's filter reaches from its point.
+    reach_texels: f32,
+    levels: u32,
+    pages_per_side: u32,
+    page_texels: u32,
+    width: u32,
+    height: u32,
+}
+
+// The prepass's surface: the world point in xyz, its view depth in w (0: no surface).
+@group(0) @binding(0) var request_surface: texture_2d<f32>;
+// One bit per page: level · pages_per_side² + row · pages_per_side + column, rows
+// and columns counted from the level's first page.
+@group(0) @binding(1) var<storage, read_write> page_bits: array<atomic<u32>>;
+@group(0) @binding(2) var<uniform> request_params: PageRequestParams;
+
+fn level_origin(level: u32) -> vec2<i32> {
+    let pair = request_params.origins[level / 2u];
+    return select(pair.zw, pair.xy, level % 2u == 0u);
+}
+
+@compute @workgroup_size(8, 8)
+fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= request_params.width || id.y >= request_params.height) {
+        return;
+    }
+    let surface = textureLoad(request_surface, vec2<i32>(id.xy), 0);
+    if (surface.w <= 0.0) {
+        return;
+    }
+    // The coarsest level whose texels are no larger than the pixel's footprint.
+    let ratio = surface.w * request_params.footprint_per_depth / request_params.finest_texel;
+    var level = 0u;
+    if (ratio >= 1.0) {
+        level = min(u32(floor(log2(ratio))), request_params.levels - 1u);
+    }
+    let texel = request_params.finest_texel * exp2(f32(level));
+    let page_world = texel * f32(request_params.page_texels);
+    let xy = (request_params.light_from_world * vec4<f32>(surface.xyz, 1.0)).xy;
+    let origin = level_origin(level);
+    let side = i32(request_params.pages_per_side);
+    let centre = vec2<i32>(floor(xy / page_world)) - origin;
+    if (any(centre < vec2<i32>(0)) || any(centre >= vec2<i32>(side))) {
+        return;
+    }
+    let reach = request_params.reach_texels * texel;
+    let low = max(vec2<i32>(floor((xy - reach) / page_world)) - origin, vec2<i32>(0));
+    let high = min(vec2<i32>(floor((xy + reach) / page_world)) - origin, vec2<i32>(side - 1));
+    for (var y = low.y; y <= high.y; y++) {
+        for (var x = low.x; x <= high.x; x++) {
+            let bit = level * u32(side * side) + u32(y * side + x);
+            atomicOr(&page_bits[bit / 32u], 1u << (bit % 32u));
+        }
+    }
+}

@@ -1,0 +1,105 @@
+//! Virtual shadow maps' page requests on the GPU (`virtual_map/page_requests.wgsl`)
+//! against the clipmap's own arithmetic (`gnomon_math::virtual_map`): the pass must
+//! ask for exactly the pages that `Clipmap::request` names for every pixel.
+
+use std::collections::BTreeSet;
+
+use glam::{Vec2, Vec3, Vec4};
+use gnomon_math::{
+    Aabb,
+    virtual_map::{Clipmap, ClipmapShape, PageKey},
+};
+use gnomon_render::virtual_map::{PageRequests, PixelReach};
+
+use crate::support::gpu;
+
+/// A small deterministic generator (an LCG), the same on every platform.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Whether `x`, in units of a grid step, lies within `margin` of a grid line, where
+/// the GPU's rounding and the CPU's may fall on different sides.
+fn near_grid(x: f32, margin: f32) -> bool {
+    let f = x - x.floor();
+    f < margin || f > 1.0 - margin
+}
+
+#[test]
+fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
+    let gpu = gpu();
+    let camera = Vec3::new(2.0, 6.0, 9.0);
+    let bounds = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 12.0, 30.0));
+    // A 60° camera 240 pixels high, seeing up to 40 units away; the filter reaches
+    // 2.5 texels.
+    let reach =
+        PixelReach { footprint_per_depth: 2.0 * (30f32.to_radians()).tan() / 240.0, reach_texels: 2.5 };
+    let travel = Vec3::new(-0.4, -1.0, 0.3);
+    let clipmap =
+        Clipmap::new(ClipmapShape::DEFAULT, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
+    let (width, height) = (96u32, 64u32);
+    let mut rng = Lcg(17);
+    let mut texels = Vec::with_capacity((width * height) as usize);
+    let mut expected = BTreeSet::new();
+    for _ in 0..width * height {
+        // Surfaces from 0.5 to 40 units away, in every direction round the camera.
+        let direction =
+            Vec3::new(rng.next() - 0.5, rng.next() - 0.8, rng.next() - 0.5).normalize_or(Vec3::NEG_Y);
+        let depth = 0.5 + 39.5 * rng.next() * rng.next();
+        let point = camera + direction * depth;
+        let footprint = depth * reach.footprint_per_depth;
+        let level = clipmap.level_for_footprint(footprint);
+        let xy = clipmap.light_xy(point);
+        let page = clipmap.page_size(level);
+        let spread = reach.reach_texels * clipmap.texel_size(level);
+        // Pixels on a boundary of levels or pages are left out (as background): the
+        // two sides' rounding may differ there by an ulp.
+        let ambiguous = near_grid((footprint / clipmap.finest_texel).log2(), 1e-3)
+            || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
+                .iter()
+                .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3));
+        if ambiguous || rng.next() < 0.1 {
+            texels.push(Vec4::ZERO);
+            continue;
+        }
+        texels.push(point.extend(depth));
+        if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
+            expected.extend(rect.pages());
+        }
+    }
+    let surface = gpu.device.create_texture(&gnomon_render::wgpu::TextureDescriptor {
+        label: Some("test surface"),
+        size: gnomon_render::wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: gnomon_render::wgpu::TextureDimension::D2,
+        format: gnomon_render::wgpu::TextureFormat::Rgba32Float,
+        usage: gnomon_render::wgpu::TextureUsages::TEXTURE_BINDING
+            | gnomon_render::wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    gpu.queue.write_texture(
+        surface.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        gnomon_render::wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(16 * width),
+            rows_per_image: Some(height),
+        },
+        surface.size(),
+    );
+    let requests = PageRequests::new(gpu).expect("the pass builds");
+    let asked: Vec<PageKey> =
+        pollster::block_on(requests.request(gpu, &surface, &clipmap, reach)).expect("requested");
+    let asked: BTreeSet<PageKey> = asked.into_iter().collect();
+    let levels: BTreeSet<u32> = expected.iter().map(|p| p.level).collect();
+    assert!(expected.len() > 100 && levels.len() >= 4, "{} pages over levels {levels:?}", expected.len());
+    let missing: Vec<_> = expected.difference(&asked).take(5).collect();
+    let extra: Vec<_> = asked.difference(&expected).take(5).collect();
+    assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
+}
