@@ -185,6 +185,57 @@ impl PagePool {
     }
 }
 
+/// A page-table entry: where a virtual page's texels are, for the sampling shaders.
+/// Bit 31 says the entry holds a page; bits 24 to 27 how many levels coarser that
+/// page is than the one asked for (0: the page itself; more: a fallback); bits 0 to
+/// 23 its slot in the pool.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct TableEntry(pub u32);
+
+impl TableEntry {
+    /// No resident page over this one, itself or coarser.
+    pub const EMPTY: TableEntry = TableEntry(0);
+    const VALID: u32 = 1 << 31;
+    const SLOT_BITS: u32 = 24;
+
+    /// The entry for a page read from `slot`, `coarser` levels up.
+    pub fn new(slot: u32, coarser: u32) -> TableEntry {
+        debug_assert!(slot < 1 << Self::SLOT_BITS && coarser < 16);
+        TableEntry(Self::VALID | (coarser << Self::SLOT_BITS) | slot)
+    }
+
+    /// The slot and how many levels coarser, if the entry holds a page.
+    pub fn get(self) -> Option<(u32, u32)> {
+        (self.0 & Self::VALID != 0)
+            .then_some((self.0 & ((1 << Self::SLOT_BITS) - 1), (self.0 >> Self::SLOT_BITS) & 0xf))
+    }
+}
+
+impl PagePool {
+    /// The page table of `clipmap`: for every page of every level's window, level
+    /// after level and row after row from each level's first page, where its texels
+    /// are, resolved to a coarser resident page where it is not resident itself
+    /// ([`PagePool::resolve`]). What the sampling shaders read.
+    pub fn page_table(&self, clipmap: &super::Clipmap) -> Vec<TableEntry> {
+        let shape = clipmap.shape;
+        let side = shape.pages_per_side() as i32;
+        let mut table = Vec::with_capacity((shape.levels as usize) * (side * side) as usize);
+        for (level, origin) in clipmap.origins.iter().enumerate() {
+            for y in 0..side {
+                for x in 0..side {
+                    let page = PageKey { level: level as u32, x: origin.x + x, y: origin.y + y };
+                    let entry = match self.resolve(page, shape.levels) {
+                        Some((found, slot)) => TableEntry::new(slot, found.level - page.level),
+                        None => TableEntry::EMPTY,
+                    };
+                    table.push(entry);
+                }
+            }
+        }
+        table
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,5 +362,48 @@ mod tests {
                 assert!(new.into_iter().all(|g| g.page.level >= coarsest_refused));
             }
         }
+    }
+
+    #[test]
+    fn the_page_table_points_every_page_at_itself_or_its_fallback() {
+        use glam::Vec3;
+        let shape = super::super::ClipmapShape { virtual_resolution: 1024, page_size: 128, levels: 4 };
+        let bounds = crate::Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
+        let clipmap = super::super::Clipmap::new(shape, Vec3::NEG_Y, Vec3::ZERO, &bounds, 0.5);
+        let origin = clipmap.origins[0];
+        let fine = page(0, origin.x + 2, origin.y + 3);
+        let coarse = fine.coarser().coarser();
+        let mut pool = PagePool::new(2);
+        pool.allocate(&[fine, coarse]);
+        let table = pool.page_table(&clipmap);
+        let side = shape.pages_per_side() as usize;
+        assert_eq!(table.len(), 4 * side * side);
+        let index = |p: PageKey| {
+            let o = clipmap.origins[p.level as usize];
+            p.level as usize * side * side + (p.y - o.y) as usize * side + (p.x - o.x) as usize
+        };
+        let slot = |p: PageKey| pool.resident[&p];
+        // Every page of every window: itself where resident, else the coarse page two
+        // levels up from level 0 (one from level 1) where it lies under it, else none.
+        for level in 0..4u32 {
+            let o = clipmap.origins[level as usize];
+            for y in 0..side as i32 {
+                for x in 0..side as i32 {
+                    let p = page(level, o.x + x, o.y + y);
+                    let ancestor = (level..2).fold(p, |k, _| k.coarser());
+                    let expected = if p == fine {
+                        Some((slot(fine), 0))
+                    } else if level <= 2 && ancestor == coarse {
+                        Some((slot(coarse), 2 - level))
+                    } else {
+                        None
+                    };
+                    assert_eq!(table[index(p)].get(), expected, "{p:?}");
+                }
+            }
+        }
+        let valid = table.iter().filter(|e| e.get().is_some()).count();
+        // The coarse page (level 2) covers 4×4 pages of level 0 and 2×2 of level 1.
+        assert_eq!(valid, 16 + 4 + 1);
     }
 }
