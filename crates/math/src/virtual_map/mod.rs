@@ -245,6 +245,27 @@ impl Clipmap {
     }
 }
 
+impl Clipmap {
+    /// World to the clip space of `level`'s whole window: what a full-resolution
+    /// (`virtual_resolution`²) map of the level would be drawn with. Page `(x, y)` of
+    /// the window covers its columns `(x − origin.x) · page_size …` and, v down, its
+    /// rows `(origin.y + pages_per_side − 1 − y) · page_size …`.
+    pub fn level_clip_from_world(&self, level: u32) -> Mat4 {
+        let size = self.page_size(level);
+        let origin = self.origins[level as usize].as_vec2() * size;
+        let width = size * self.shape.pages_per_side() as f32;
+        let clip_from_light = glam::camera::rh::proj::directx::orthographic(
+            origin.x,
+            origin.x + width,
+            origin.y,
+            origin.y + width,
+            self.near,
+            self.far,
+        );
+        clip_from_light * self.light_from_world
+    }
+}
+
 /// World size of a page of `level` for texels of `finest_texel` at level 0.
 fn page_world_size(shape: ClipmapShape, finest_texel: f32, level: u32) -> f32 {
     finest_texel * 2f32.powi(level as i32) * shape.page_size as f32

@@ -178,6 +178,40 @@ impl DepthBaselinePass {
         })
     }
 
+    /// Builds the pipelines that `scene` needs under `raster`, before a pass
+    /// borrows them.
+    pub fn prepare(&mut self, device: &wgpu::Device, scene: &DepthBaselineScene, raster: BaselineRaster<'_>) {
+        for (sides, _) in &scene.ranges {
+            self.pipeline(device, raster.key(*sides));
+        }
+    }
+
+    /// The bind group of one matrix, from `pool`.
+    pub fn matrix_group(&self, gpu: &Gpu, pool: &mut Pool, clip_from_world: Mat4) -> wgpu::BindGroup {
+        let matrix = pool.uniform(&gpu.queue, "baseline clip_from_world", &clip_from_world);
+        pool.bind_group("depth-only baseline", &self.group_layout, &[Binding::Buffer(matrix)])
+    }
+
+    /// Draws `scene` into the open `pass` through `group`'s matrix, with the
+    /// pipelines [`DepthBaselinePass::prepare`] built for `raster`.
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &DepthBaselineScene,
+        raster: BaselineRaster<'_>,
+        group: &wgpu::BindGroup,
+    ) {
+        pass.set_bind_group(0, group, &[]);
+        pass.set_vertex_buffer(0, scene.positions.slice(..));
+        pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (sides, range) in &scene.ranges {
+            if !range.is_empty() {
+                pass.set_pipeline(&self.pipelines[&raster.key(*sides)]);
+                pass.draw_indexed(range.clone(), 0, 0..1);
+            }
+        }
+    }
+
     /// Records the baseline's depth pass into `layer.target` through
     /// `layer.clip_from_world`, rasterized as `layer.raster` says the shadow pass would.
     pub fn record(
@@ -190,13 +224,8 @@ impl DepthBaselinePass {
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let BaselineLayer { clip_from_world, raster, target } = layer;
-        let device = &gpu.device;
-        let matrix = pool.uniform(&gpu.queue, "baseline clip_from_world", &clip_from_world);
-        let group = pool.bind_group("depth-only baseline", &self.group_layout, &[Binding::Buffer(matrix)]);
-        // Every pipeline exists before the pass borrows them.
-        for (sides, _) in &scene.ranges {
-            self.pipeline(device, raster.key(*sides));
-        }
+        let group = self.matrix_group(gpu, pool, clip_from_world);
+        self.prepare(&gpu.device, scene, raster);
         // The same pass set-up (attachment, load and store) as the shadow pass's.
         let mut pass = super::begin_depth_pass(
             encoder,
@@ -205,14 +234,6 @@ impl DepthBaselinePass {
             wgpu::LoadOp::Clear(1.0),
             timestamp_writes,
         );
-        pass.set_bind_group(0, &group, &[]);
-        pass.set_vertex_buffer(0, scene.positions.slice(..));
-        pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (sides, range) in &scene.ranges {
-            if !range.is_empty() {
-                pass.set_pipeline(&self.pipelines[&raster.key(*sides)]);
-                pass.draw_indexed(range.clone(), 0, 0..1);
-            }
-        }
+        self.draw(&mut pass, scene, raster, &group);
     }
 }

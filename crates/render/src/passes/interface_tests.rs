@@ -94,6 +94,10 @@ fn struct_layouts() -> Vec<StructLayout> {
             light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
             page_texels, width, height,
         }),
+        struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
+            light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,
+            pool_pages_per_side, _pad0,
+        }),
         struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
         struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
         struct_layout!(crate::gpu_scene::shadow_items::ItemGpu as "ShadowItem" {
@@ -203,6 +207,8 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
     out.push(("depth baseline".into(), super::depth_baseline::baseline_wgsl()));
     out.push(("page requests".into(), crate::virtual_map::page_requests_wgsl()));
+    out.push(("page clear".into(), crate::virtual_map::draw::page_clear_wgsl()));
+    out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);

@@ -5,8 +5,16 @@
 //! (`page_requests.wgsl`). The clipmap's geometry and the page pool that the marked
 //! pages are then granted from are CPU-side, in [`gnomon_math::virtual_map`].
 //!
-//! Not yet built: drawing the granted pages into a physical pool, sampling through
-//! the page table, and `--partition virtual` (see `docs/virtual-maps.md`).
+//! The granted pages are drawn into a physical pool of page tiles ([`VirtualPages`],
+//! `draw.rs`), and sampled through the page table by `page_lookup.wgsl`
+//! ([`VirtualPages::visibility`], `probe.rs`). Not yet built: culling casters per page, the lighting passes' sampling
+//! through the page table, and `--partition virtual` (see `docs/virtual-maps.md`).
+
+pub(crate) mod draw;
+mod probe;
+
+pub use draw::{PoolSize, VirtualPages};
+pub use probe::VirtualProbe;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
@@ -32,6 +40,53 @@ pub(crate) struct PageRequestParams {
     pub page_texels: u32,
     pub width: u32,
     pub height: u32,
+}
+
+/// A virtual map as the sampling shaders read it (`VirtualMap` in
+/// `page_lookup.wgsl`): the clipmap's levels and the pool's layout.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct VirtualMapGpu {
+    pub light_from_world: Mat4,
+    /// Each level's first page, two levels to a vector.
+    pub origins: [[i32; 4]; ORIGIN_VECTORS],
+    pub finest_texel: f32,
+    pub near: f32,
+    pub far: f32,
+    pub levels: u32,
+    pub pages_per_side: u32,
+    pub page_texels: u32,
+    pub pool_pages_per_side: u32,
+    pub _pad0: u32,
+}
+
+impl VirtualMapGpu {
+    /// `clipmap`'s levels, sampled from a pool of `pool_pages_per_side`² tiles.
+    pub fn new(clipmap: &Clipmap, pool_pages_per_side: u32) -> Self {
+        VirtualMapGpu {
+            light_from_world: clipmap.light_from_world,
+            origins: packed_origins(clipmap),
+            finest_texel: clipmap.finest_texel,
+            near: clipmap.near,
+            far: clipmap.far,
+            levels: clipmap.shape.levels,
+            pages_per_side: clipmap.shape.pages_per_side(),
+            page_texels: clipmap.shape.page_size,
+            pool_pages_per_side,
+            _pad0: 0,
+        }
+    }
+}
+
+/// Each level's first page, two levels to a vector (level 2k in xy, 2k + 1 in zw).
+fn packed_origins(clipmap: &Clipmap) -> [[i32; 4]; ORIGIN_VECTORS] {
+    let mut origins = [[0i32; 4]; ORIGIN_VECTORS];
+    for (level, origin) in clipmap.origins.iter().enumerate().take(MAX_LEVELS as usize) {
+        let pair = &mut origins[level / 2];
+        pair[2 * (level % 2)] = origin.x;
+        pair[2 * (level % 2) + 1] = origin.y;
+    }
+    origins
 }
 
 /// What a pixel's footprint and filter are, for the pages it asks for.
@@ -133,15 +188,9 @@ impl PageRequests {
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
-        let mut origins = [[0i32; 4]; ORIGIN_VECTORS];
-        for (level, origin) in clipmap.origins.iter().enumerate() {
-            let pair = &mut origins[level / 2];
-            pair[2 * (level % 2)] = origin.x;
-            pair[2 * (level % 2) + 1] = origin.y;
-        }
         let params = PageRequestParams {
             light_from_world: clipmap.light_from_world,
-            origins,
+            origins: packed_origins(clipmap),
             finest_texel: clipmap.finest_texel,
             footprint_per_depth: reach.footprint_per_depth,
             reach_texels: reach.reach_texels,
@@ -246,6 +295,11 @@ fn decode(words: &[u32], clipmap: &Clipmap) -> Vec<PageKey> {
     }
     pages.sort_unstable();
     pages
+}
+
+/// `lookup_probe.wgsl` (with `page_lookup.wgsl`), composed.
+pub(crate) fn lookup_probe_wgsl() -> String {
+    crate::passes::compose_wgsl(&[include_str!("lookup_probe.wgsl")])
 }
 
 /// `page_requests.wgsl`, composed.

@@ -1,0 +1,208 @@
+//! Drawing a virtual shadow map's pages: one depth texture of `pages_per_side`² page
+//! tiles (the physical pool), the [`PagePool`] that says which virtual page each tile
+//! holds, and a frame that draws only the pages new or dirty this frame, each through
+//! its own projection ([`Clipmap::page_clip_from_world`]) into its tile. Casters are
+//! drawn as the depth-only baseline draws them (`passes/depth_baseline.rs`: every
+//! caster pre-transformed, one draw per cull state), each page drawing every caster:
+//! culling per page, or per run of pages, is not built yet.
+
+use gnomon_math::virtual_map::{
+    Clipmap, PageKey,
+    pages::{FrameAllocation, PagePool, TableEntry},
+};
+use gnomon_scene::settings::BiasSettings;
+
+use crate::{
+    DepthBaselineScene, Gpu, RenderError,
+    passes::{
+        SHADOW_FORMAT, begin_depth_pass,
+        depth_baseline::{BaselineRaster, DepthBaselinePass},
+        shadow::{DepthRange, DepthTarget},
+    },
+    pool::Pool,
+};
+
+/// How large a virtual map's physical pool is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PoolSize {
+    /// Texels per side of a page (the clipmap's page size).
+    pub page_size: u32,
+    /// Page tiles per side of the pool's texture: `pages_per_side`² physical pages.
+    pub pages_per_side: u32,
+}
+
+impl PoolSize {
+    /// Texels per side of the pool's texture.
+    pub fn texels_per_side(&self) -> u64 {
+        u64::from(self.page_size) * u64::from(self.pages_per_side)
+    }
+}
+
+/// A virtual map's physical pages and what they hold, kept across frames.
+pub struct VirtualPages {
+    size: PoolSize,
+    texture: wgpu::Texture,
+    pages: PagePool,
+    clear: wgpu::RenderPipeline,
+    baseline: DepthBaselinePass,
+    pool: Pool,
+    bias: BiasSettings,
+}
+
+impl VirtualPages {
+    /// A pool of `size` on `gpu`, every page free. Refuses a pool larger than the
+    /// device's largest 2D texture, before allocating it.
+    pub fn new(gpu: &Gpu, size: PoolSize) -> Result<VirtualPages, RenderError> {
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        let side = size.texels_per_side();
+        if side == 0 || side > u64::from(max) {
+            return Err(RenderError::ShadowMapTooLarge {
+                requested: side.min(u64::from(u32::MAX)) as u32,
+                max,
+                adapter: gpu.info.adapter.clone(),
+            });
+        }
+        let device = &gpu.device;
+        gpu.checked("creating a virtual map's page pool", || {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("virtual page pool"),
+                size: wgpu::Extent3d { width: side as u32, height: side as u32, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: SHADOW_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            VirtualPages {
+                size,
+                texture,
+                pages: PagePool::new(size.pages_per_side * size.pages_per_side),
+                clear: clear_pipeline(device),
+                baseline: DepthBaselinePass::new(device),
+                pool: Pool::new(device),
+                bias: BiasSettings::default(),
+            }
+        })
+    }
+
+    /// The pool's size.
+    pub fn size(&self) -> PoolSize {
+        self.size
+    }
+
+    /// The pool's depth texture: page tile `slot` at texels
+    /// [`VirtualPages::tile_origin`].
+    pub fn texture(&self) -> &wgpu::Texture {
+        &self.texture
+    }
+
+    /// The top-left texel of slot `slot`'s tile: slots run along rows.
+    pub fn tile_origin(&self, slot: u32) -> (u32, u32) {
+        let PoolSize { page_size, pages_per_side } = self.size;
+        ((slot % pages_per_side) * page_size, (slot / pages_per_side) * page_size)
+    }
+
+    /// Every page drawn so far is stale: the light turned, or the clipmap's levels
+    /// changed.
+    pub fn invalidate_all(&mut self) {
+        self.pages.invalidate_all();
+    }
+
+    /// Marks stale the resident pages for which `overlaps` holds (under a moved
+    /// caster's shadow, where it was and where it is); returns how many.
+    pub fn invalidate(&mut self, overlaps: impl Fn(PageKey) -> bool) -> u32 {
+        self.pages.invalidate(overlaps)
+    }
+
+    /// The page table for `clipmap` as the pool now stands.
+    pub fn page_table(&self, clipmap: &Clipmap) -> Vec<TableEntry> {
+        self.pages.page_table(clipmap)
+    }
+
+    /// Grants this frame's `requests` their pages and draws, into their tiles, the
+    /// casters of `casters` over every page new or dirty this frame; submits the
+    /// draws and returns the allocation (what was drawn, kept and refused).
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        casters: &DepthBaselineScene,
+        clipmap: &Clipmap,
+        requests: &[PageKey],
+    ) -> FrameAllocation {
+        self.pool.end_frame();
+        let allocation = self.pages.allocate(requests);
+        let raster = BaselineRaster {
+            bias: &self.bias,
+            depth_range: DepthRange::Clipped,
+            target: DepthTarget::Projected,
+        };
+        self.baseline.prepare(&gpu.device, casters, raster);
+        let drawn: Vec<_> = allocation.to_draw().copied().collect();
+        if drawn.is_empty() {
+            return allocation;
+        }
+        let groups: Vec<wgpu::BindGroup> = drawn
+            .iter()
+            .map(|grant| {
+                self.baseline.matrix_group(gpu, &mut self.pool, clipmap.page_clip_from_world(grant.page))
+            })
+            .collect();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let view = self.texture.create_view(&Default::default());
+        {
+            let mut pass = begin_depth_pass(&mut encoder, "virtual pages", &view, wgpu::LoadOp::Load, None);
+            let size = self.size.page_size;
+            for (grant, group) in drawn.iter().zip(&groups) {
+                let (x, y) = self.tile_origin(grant.physical);
+                pass.set_viewport(x as f32, y as f32, size as f32, size as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, size, size);
+                pass.set_pipeline(&self.clear);
+                pass.draw(0..3, 0..1);
+                self.baseline.draw(&mut pass, casters, raster, group);
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+        allocation
+    }
+}
+
+/// The pipeline that clears a page's tile to the far plane (`page_clear.wgsl`).
+fn clear_pipeline(device: &wgpu::Device) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("page_clear.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(page_clear_wgsl().into()),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("virtual page clear"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_page_clear"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: SHADOW_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// `page_clear.wgsl`, composed.
+pub(crate) fn page_clear_wgsl() -> String {
+    crate::passes::compose_wgsl(&[include_str!("page_clear.wgsl")])
+}
+
+#[cfg(test)]
+mod tests;

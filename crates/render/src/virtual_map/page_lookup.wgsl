@@ -1,0 +1,89 @@
+// Sampling a virtual shadow map through its page table: a texel of a clipmap level
+// is found in the page pool through the table's entry for its page (the page
+// itself, or a coarser page standing in for it), so that a filter's taps may fall
+// in different pages, resident or not. `gnomon_math::virtual_map` holds the same
+// arithmetic; `draw/lookup_tests.rs` holds this file to it.
+
+import package::constants::VIRTUAL_ORIGIN_VECTORS;
+
+struct VirtualMap {
+    light_from_world: mat4x4<f32>,
+    // Each level's first page, two levels to a vector: level 2k in xy, 2k + 1 in zw.
+    origins: array<vec4<i32>, VIRTUAL_ORIGIN_VECTORS>,
+    // World size of a texel of level 0; level l's is 2^l times it.
+    finest_texel: f32,
+    // Distances along the light's axis of the depth-0 and depth-1 planes.
+    near: f32,
+    far: f32,
+    levels: u32,
+    pages_per_side: u32,
+    page_texels: u32,
+    // Page tiles per side of the pool's texture; slots run along rows.
+    pool_pages_per_side: u32,
+    _pad0: u32,
+}
+
+@group(0) @binding(0) var<uniform> virtual_map: VirtualMap;
+// One entry per page of every level's window (`TableEntry`): bit 31 valid, bits 24
+// to 27 how many levels coarser the page read is, bits 0 to 23 its slot.
+@group(0) @binding(1) var<storage, read> page_table: array<u32>;
+@group(0) @binding(2) var page_pool: texture_depth_2d;
+
+fn virtual_origin(level: u32) -> vec2<i32> {
+    let pair = virtual_map.origins[level / 2u];
+    return select(pair.zw, pair.xy, level % 2u == 0u);
+}
+
+// The stored depth of texel `texel` of `level` (in texels from the light-space
+// origin, y up), through the page table; 1 (the far plane: lit) where no page holds
+// it, itself or coarser.
+fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
+    let size = i32(virtual_map.page_texels);
+    let side = i32(virtual_map.pages_per_side);
+    let page = vec2<i32>(floor(vec2<f32>(texel) / f32(size)));
+    let relative = page - virtual_origin(level);
+    if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
+        return 1.0;
+    }
+    let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
+    if ((entry & 0x80000000u) == 0u) {
+        return 1.0;
+    }
+    let slot = entry & 0xffffffu;
+    let coarser = (entry >> 24u) & 0xfu;
+    // The texel of the page read, at its own level: coordinates halved per level up.
+    let scale = f32(1u << coarser);
+    let read = vec2<i32>(floor(vec2<f32>(texel) / scale));
+    let within = read - vec2<i32>(floor(vec2<f32>(read) / f32(size))) * size;
+    let pool = i32(virtual_map.pool_pages_per_side);
+    let tile = vec2<i32>(i32(slot) % pool, i32(slot) / pool) * size;
+    // Texture rows run down, light-space y up.
+    return textureLoad(page_pool, tile + vec2<i32>(within.x, size - 1 - within.y), 0);
+}
+
+// The light's view of a world point: light-space x and y, and the depth the map
+// stores for it (0 at the near plane, 1 at the far one).
+fn virtual_light_point(world: vec3<f32>) -> vec3<f32> {
+    let light = (virtual_map.light_from_world * vec4<f32>(world, 1.0)).xyz;
+    return vec3<f32>(light.xy, (-light.z - virtual_map.near) / (virtual_map.far - virtual_map.near));
+}
+
+// The fraction of a 2×2 bilinear footprint of `level` round the world point that
+// sees the light: each of the four texels compared with the receiver's depth, and
+// the results weighted bilinearly (percentage-closer filtering, Reeves, Salesin and
+// Cook 1987), whatever pages the taps fall in.
+fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
+    let point = virtual_light_point(world);
+    let texel_size = virtual_map.finest_texel * exp2(f32(level));
+    let continuous = point.xy / texel_size - vec2<f32>(0.5);
+    let base = vec2<i32>(floor(continuous));
+    let weight = continuous - floor(continuous);
+    var lit = vec4<f32>(0.0);
+    lit.x = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base));
+    lit.y = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(1, 0)));
+    lit.z = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(0, 1)));
+    lit.w = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(1, 1)));
+    let bottom = mix(lit.x, lit.y, weight.x);
+    let top = mix(lit.z, lit.w, weight.x);
+    return mix(bottom, top, weight.y);
+}

@@ -1,0 +1,100 @@
+//! Sampling a virtual map at given world points, through its page table, with the
+//! shaders' own lookup (`page_lookup.wgsl`, `lookup_probe.wgsl`): a 2×2
+//! percentage-closer filter at a chosen level. What the tests hold the lookup to, and
+//! a way for a host to ask what the map says at a point.
+
+use bytemuck::{Pod, Zeroable};
+use gnomon_math::virtual_map::Clipmap;
+use wgpu::util::DeviceExt;
+
+use super::{VirtualMapGpu, VirtualPages};
+use crate::{Gpu, RenderError};
+
+/// A world point to sample a virtual map at, and the level to read there.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct VirtualProbe {
+    /// The receiver, in world space.
+    pub world: [f32; 3],
+    /// The clipmap level its filter reads (its pixel's, `Clipmap::level_for_footprint`).
+    pub level: u32,
+}
+
+impl VirtualPages {
+    /// The fraction of a 2×2 bilinear footprint that sees the light at each probe,
+    /// read through the page table of `clipmap` as the pool now stands: a tap whose
+    /// page is not resident reads the coarser page standing in for it, and a tap
+    /// under no page reads the far plane (lit). Submits and waits.
+    pub async fn visibility(
+        &self,
+        gpu: &Gpu,
+        clipmap: &Clipmap,
+        probes: &[VirtualProbe],
+    ) -> Result<Vec<f32>, RenderError> {
+        if probes.is_empty() {
+            return Ok(Vec::new());
+        }
+        let device = &gpu.device;
+        let words: Vec<u32> = self.page_table(clipmap).iter().map(|e| e.0).collect();
+        let uniform = VirtualMapGpu::new(clipmap, self.size().pages_per_side);
+        let bytes = 4 * probes.len() as u64;
+        let (pipeline, read) = gpu.checked("sampling a virtual map", || {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("lookup_probe.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(super::lookup_probe_wgsl().into()),
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("virtual lookup probe"),
+                layout: None,
+                module: &module,
+                entry_point: Some("probe_virtual_map"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let read = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("probe readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            (pipeline, read)
+        })?;
+        let init = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let uniform = init("virtual map", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+        let table = init("page table", bytemuck::cast_slice(&words), wgpu::BufferUsages::STORAGE);
+        let probes_buffer = init("probes", bytemuck::cast_slice(probes), wgpu::BufferUsages::STORAGE);
+        let out = init(
+            "probe visibility",
+            &vec![0u8; bytes as usize],
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        );
+        let view = self.texture().create_view(&Default::default());
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("virtual lookup probe"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: table.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 3, resource: probes_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: out.as_entire_binding() },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups((probes.len() as u32).div_ceil(64), 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&out, 0, &read, 0, bytes);
+        gpu.queue.submit([encoder.finish()]);
+        crate::readback::read_buffer(gpu, &read).await
+    }
+}
