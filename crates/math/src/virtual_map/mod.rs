@@ -35,7 +35,8 @@ pub struct ClipmapShape {
     pub virtual_resolution: u32,
     /// Texels per side of a page.
     pub page_size: u32,
-    /// Virtual levels, each covering twice the width of the one before.
+    /// Virtual levels, each covering twice the width of the one before: 1 to
+    /// [`MAX_LEVELS`].
     pub levels: u32,
 }
 
@@ -173,7 +174,7 @@ impl Clipmap {
         if ratio.is_nan() || ratio < 1.0 {
             return 0;
         }
-        (ratio.log2().floor() as u32).min(self.shape.levels - 1)
+        (ratio.log2().floor() as u32).min(self.shape.levels.saturating_sub(1))
     }
 
     /// A world point's place in light space, x and y.
