@@ -404,6 +404,11 @@ mod tests {
             "rays/accel.rs",
             "rays/mod.rs",
             "rays/query.rs",
+            // A virtual map's pool of page tiles: one texture kept across frames,
+            // as the kept shadow maps are.
+            "virtual_map/draw.rs",
+            // Its tests' full-resolution reference maps.
+            "virtual_map/draw/tests.rs",
         ];
         let creations =
             ["create_texture", "create_buffer", "create_bind_group(", "create_query_set", "create_view("];

@@ -19,7 +19,7 @@ use crate::{
         depth_baseline::{BaselineRaster, DepthBaselinePass},
         shadow::{DepthRange, DepthTarget},
     },
-    pool::Pool,
+    pool::{Pool, ViewKey},
 };
 
 /// How large a virtual map's physical pool is.
@@ -93,6 +93,12 @@ impl VirtualPages {
         self.size
     }
 
+    /// The pool of transient resources, its frame begun, for sampling the map.
+    pub(super) fn frame_pool(&mut self) -> &mut Pool {
+        self.pool.end_frame();
+        &mut self.pool
+    }
+
     /// The pool's depth texture: page tile `slot` at texels
     /// [`VirtualPages::tile_origin`].
     pub fn texture(&self) -> &wgpu::Texture {
@@ -151,7 +157,7 @@ impl VirtualPages {
             })
             .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let view = self.texture.create_view(&Default::default());
+        let view = self.pool.view(&self.texture, ViewKey::default());
         {
             let mut pass = begin_depth_pass(&mut encoder, "virtual pages", &view, wgpu::LoadOp::Load, None);
             let size = self.size.page_size;

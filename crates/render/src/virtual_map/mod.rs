@@ -1,14 +1,17 @@
-//! Virtual shadow maps on the GPU (issue 53), the part built so far: the page
-//! requests. A compute pass reads the prepass's surface (each pixel's world point and
-//! view depth) and marks, in one bit per page, the pages of the clipmap level that
-//! matches each pixel's footprint that its filter may read
-//! (`page_requests.wgsl`). The clipmap's geometry and the page pool that the marked
-//! pages are then granted from are CPU-side, in [`gnomon_math::virtual_map`].
+//! Virtual shadow maps on the GPU (issue 53), the parts built so far:
+//! - the page requests: a compute pass reads the prepass's surface (each pixel's
+//!   world point and view depth) and marks, one bit per page, the pages of the
+//!   clipmap level matching each pixel's footprint that its filter may read
+//!   (`page_requests.wgsl`);
+//! - the pool of page tiles that draws only the pages new or dirty this frame
+//!   ([`VirtualPages`], `draw.rs`);
+//! - sampling through the page table (`page_lookup.wgsl`; [`VirtualPages::visibility`]
+//!   in `probe.rs`).
 //!
-//! The granted pages are drawn into a physical pool of page tiles ([`VirtualPages`],
-//! `draw.rs`), and sampled through the page table by `page_lookup.wgsl`
-//! ([`VirtualPages::visibility`], `probe.rs`). Not yet built: culling casters per page, the lighting passes' sampling
-//! through the page table, and `--partition virtual` (see `docs/virtual-maps.md`).
+//! The clipmap's geometry and the page pool's bookkeeping are CPU-side, in
+//! [`gnomon_math::virtual_map`]. Not yet built: culling casters per page, the
+//! lighting passes' sampling through the page table, and `--partition virtual` (see
+//! `docs/virtual-maps.md`).
 
 pub(crate) mod draw;
 mod probe;
@@ -20,7 +23,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 use gnomon_math::virtual_map::{Clipmap, MAX_LEVELS, PageKey};
 
-use crate::{Frame, Gpu, RenderError};
+use crate::{
+    Frame, Gpu, RenderError,
+    pool::{Binding, Pool, ViewKey},
+};
 
 /// Vectors of two levels' origins in [`PageRequestParams::origins`].
 pub(crate) const ORIGIN_VECTORS: usize = (MAX_LEVELS as usize).div_ceil(2);
@@ -104,6 +110,8 @@ pub struct PixelReach {
 pub struct PageRequests {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    /// Its buffers and bind groups, kept from one request to the next.
+    pool: Pool,
 }
 
 impl PageRequests {
@@ -151,7 +159,7 @@ impl PageRequests {
                 compilation_options: Default::default(),
                 cache: None,
             });
-            PageRequests { layout, pipeline }
+            PageRequests { layout, pipeline, pool: Pool::new(device) }
         })
     }
 
@@ -159,7 +167,7 @@ impl PageRequests {
     /// xyz, view depth in w, 0 where no surface is seen) ask for, each once, in
     /// [`PageKey`] order. Submits the pass and waits for it.
     pub async fn request(
-        &self,
+        &mut self,
         gpu: &Gpu,
         surface: &wgpu::Texture,
         clipmap: &Clipmap,
@@ -175,19 +183,11 @@ impl PageRequests {
         let side = shape.pages_per_side();
         let words = (shape.levels as u64 * u64::from(side) * u64::from(side)).div_ceil(32);
         let device = &gpu.device;
+        self.pool.end_frame();
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let bits = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("page request bits"),
-            size: 4 * words,
-            usage,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("page request readback"),
-            size: 4 * words,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+        let bits = self.pool.buffer("page request bits", 4 * words, usage);
+        let readback_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
+        let readback = self.pool.buffer("page request readback", 4 * words, readback_usage);
         let params = PageRequestParams {
             light_from_world: clipmap.light_from_world,
             origins: packed_origins(clipmap),
@@ -200,23 +200,10 @@ impl PageRequests {
             width: surface.width(),
             height: surface.height(),
         };
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("page request parameters"),
-            size: std::mem::size_of::<PageRequestParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
-        let view = surface.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("page requests"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: bits.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: uniform.as_entire_binding() },
-            ],
-        });
+        let uniform = self.pool.uniform(&gpu.queue, "page request parameters", &params);
+        let view = self.pool.view(surface, ViewKey::default());
+        let bindings = [Binding::View(view), Binding::Buffer(bits.clone()), Binding::Buffer(uniform)];
+        let group = self.pool.bind_group("page requests", &self.layout, &bindings);
         let mut encoder = device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&bits, 0, None);
         {
@@ -239,7 +226,7 @@ impl PageRequests {
     /// [`PageRequests::request`] for the surfaces a rendered `frame` saw: its world
     /// positions and view depths (background pixels ask for nothing).
     pub async fn request_for_frame(
-        &self,
+        &mut self,
         gpu: &Gpu,
         frame: &Frame,
         clipmap: &Clipmap,
@@ -252,16 +239,13 @@ impl PageRequests {
             .map(|(p, &d)| if d.is_finite() && p.is_finite() { [p.x, p.y, p.z, d] } else { [0.0; 4] })
             .collect();
         let size = wgpu::Extent3d { width: frame.width, height: frame.height, depth_or_array_layers: 1 };
-        let surface = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("frame surface for page requests"),
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let surface = self.pool.texture(
+            "frame surface for page requests",
             size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            wgpu::TextureFormat::Rgba32Float,
+            usage,
+        );
         let layout = wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(16 * frame.width),

@@ -5,10 +5,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use gnomon_math::virtual_map::Clipmap;
-use wgpu::util::DeviceExt;
 
 use super::{VirtualMapGpu, VirtualPages};
-use crate::{Gpu, RenderError};
+use crate::{
+    Gpu, RenderError,
+    pool::{Binding, ViewKey},
+};
 
 /// A world point to sample a virtual map at, and the level to read there.
 #[repr(C)]
@@ -26,7 +28,7 @@ impl VirtualPages {
     /// page is not resident reads the coarser page standing in for it, and a tap
     /// under no page reads the far plane (lit). Submits and waits.
     pub async fn visibility(
-        &self,
+        &mut self,
         gpu: &Gpu,
         clipmap: &Clipmap,
         probes: &[VirtualProbe],
@@ -38,54 +40,41 @@ impl VirtualPages {
         let words: Vec<u32> = self.page_table(clipmap).iter().map(|e| e.0).collect();
         let uniform = VirtualMapGpu::new(clipmap, self.size().pages_per_side);
         let bytes = 4 * probes.len() as u64;
-        let (pipeline, read) = gpu.checked("sampling a virtual map", || {
+        let pipeline = gpu.checked("sampling a virtual map", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("lookup_probe.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(super::lookup_probe_wgsl().into()),
             });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("virtual lookup probe"),
                 layout: None,
                 module: &module,
                 entry_point: Some("probe_virtual_map"),
                 compilation_options: Default::default(),
                 cache: None,
-            });
-            let read = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("probe readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            (pipeline, read)
-        })?;
-        let init = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
             })
-        };
-        let uniform = init("virtual map", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
-        let table = init("page table", bytemuck::cast_slice(&words), wgpu::BufferUsages::STORAGE);
-        let probes_buffer = init("probes", bytemuck::cast_slice(probes), wgpu::BufferUsages::STORAGE);
-        let out = init(
+        })?;
+        let texture = self.texture().clone();
+        let pool = self.frame_pool();
+        let uniform = pool.uniform(&gpu.queue, "virtual map", &uniform);
+        let table = pool.storage(&gpu.queue, "page table", &words, wgpu::BufferUsages::empty());
+        let probes_buffer = pool.storage(&gpu.queue, "probes", probes, wgpu::BufferUsages::empty());
+        let out = pool.buffer(
             "probe visibility",
-            &vec![0u8; bytes as usize],
+            bytes,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         );
-        let view = self.texture().create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("virtual lookup probe"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: table.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 3, resource: probes_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: out.as_entire_binding() },
-            ],
-        });
+        let read =
+            pool.buffer("probe readback", bytes, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
+        let view = pool.view(&texture, ViewKey::default());
+        let bindings = [
+            Binding::Buffer(uniform),
+            Binding::Buffer(table),
+            Binding::View(view),
+            Binding::Buffer(probes_buffer),
+            Binding::Buffer(out.clone()),
+        ];
+        let group = pool.bind_group("virtual lookup probe", &pipeline.get_bind_group_layout(0), &bindings);
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -93,7 +93,7 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
         },
         surface.size(),
     );
-    let requests = PageRequests::new(gpu).expect("the pass builds");
+    let mut requests = PageRequests::new(gpu).expect("the pass builds");
     let asked: Vec<PageKey> =
         pollster::block_on(requests.request(gpu, &surface, &clipmap, reach)).expect("requested");
     let asked: BTreeSet<PageKey> = asked.into_iter().collect();
