@@ -198,6 +198,9 @@ fn report_frame(gpu: &Gpu, scene: &Scene, frame: &Frame, render_time: std::time:
     }
     for (i, light) in frame.lights.iter().enumerate() {
         eprintln!("gnomon: {}", light_line(i, light));
+        if let Some(pages) = &light.pages {
+            eprintln!("gnomon: {}", pages_line(i, pages));
+        }
         if light.traced_pixels.is_some() {
             eprintln!("gnomon: {}", traced_line(i, light, frame.pixel_count()));
         } else if light.refine != gnomon_scene::settings::Refine::Off {
@@ -332,5 +335,24 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         ms("mask", light.mask_ms),
         ms("trace", light.trace_ms),
         ms("lighting", light.lighting_ms),
+    )
+}
+
+/// `--verbose`'s line on a virtual map's pages: drawn, kept and refused (whose pixels
+/// fell back to a coarser page), and the pool.
+pub(crate) fn pages_line(index: usize, pages: &gnomon_render::PageStats) -> String {
+    let texels = u64::from(pages.drawn) * u64::from(pages.page_size).pow(2);
+    let fallback = match pages.refused {
+        0 => String::new(),
+        n => format!("; {n} refused, the pool full: their pixels read a coarser page"),
+    };
+    format!(
+        "light {index}: virtual map: {} pages requested, {} drawn ({:.2} M texels), {} kept{fallback}; {} of {} tiles resident",
+        pages.requested,
+        pages.drawn,
+        texels as f64 / 1e6,
+        pages.kept,
+        pages.resident,
+        pages.capacity,
     )
 }

@@ -1,10 +1,14 @@
 //! Which kind of shadow map a light draws and how its receivers look it up, decided in
 //! one place from the view the light's kind takes (`Light::shadow_view`) and
-//! `shadow.map.omni`: the frame's depth targets,
+//! the shadow settings (`shadow.map.omni`, `shadow.partition`): the frame's depth targets,
 //! the registry's checks, the light uniform and the lighting passes' WGSL all ask
 //! [`MapLookup::of`]. A leaf: it depends on nothing of the renderer.
 
-use gnomon_scene::{Light, lights::ShadowView, settings::OmniMap};
+use gnomon_scene::{
+    Light,
+    lights::ShadowView,
+    settings::{OmniMap, Partition, ShadowSettings},
+};
 
 /// How a receiver is found in its light's own map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -15,18 +19,26 @@ pub(crate) enum MapLookup {
     Cube,
     /// Through a point light's dual paraboloids, into two 2D layers.
     Paraboloid,
+    /// Through a sun's virtual map: the clipmap level of the receiver's footprint,
+    /// its page found in the page table (`virtual_map/page_lookup.wgsl`).
+    Virtual,
 }
 
 impl MapLookup {
-    /// The map `light` draws under `omni` (which only an omnidirectional view reads).
-    pub fn of(light: &Light, omni: OmniMap) -> MapLookup {
-        match (light.shadow_view(), omni) {
-            (ShadowView::Omni { .. }, OmniMap::Cube) => MapLookup::Cube,
-            (ShadowView::Omni { .. }, OmniMap::Paraboloid) => MapLookup::Paraboloid,
+    /// The map `light` draws under `shadow`: `shadow.map.omni` for an
+    /// omnidirectional view, `shadow.partition` for a sun's (a virtual partition of
+    /// any other light is refused by the technique registry's `check_light`).
+    pub fn of(light: &Light, shadow: &ShadowSettings) -> MapLookup {
+        match (light.shadow_view(), shadow.map.omni, shadow.partition) {
+            (ShadowView::Omni { .. }, OmniMap::Cube, _) => MapLookup::Cube,
+            (ShadowView::Omni { .. }, OmniMap::Paraboloid, _) => MapLookup::Paraboloid,
+            (ShadowView::Parallel { .. }, _, Partition::Virtual) => MapLookup::Virtual,
             (
-                ShadowView::Parallel { .. } | ShadowView::Frustum { .. },
+                ShadowView::Parallel { .. },
                 OmniMap::Cube | OmniMap::Paraboloid,
-            ) => MapLookup::Map,
+                Partition::Single | Partition::Cascades,
+            )
+            | (ShadowView::Frustum { .. }, OmniMap::Cube | OmniMap::Paraboloid, _) => MapLookup::Map,
         }
     }
 }

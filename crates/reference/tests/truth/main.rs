@@ -23,3 +23,4 @@ mod refine_forward;
 mod refine_soft;
 mod screen_space;
 mod soft_shadows;
+mod virtual_maps;

@@ -1,7 +1,7 @@
 //! The bind groups a frame builds from its resources: the camera, each light's scene
 //! group (instances and uniform), and the shadow group of the lighting and mask
 //! passes, with the samplers and the placeholders bound where a light has no moment
-//! map, cube map or mask. Made once with the renderer; the groups come from the pool.
+//! map, cube map, virtual map or mask. Made once with the renderer; the groups come from the pool.
 
 use crate::{
     gpu_scene::GpuScene,
@@ -21,6 +21,16 @@ pub(crate) struct FixedBindings {
     placeholder_cube: wgpu::TextureView,
     /// Bound in place of the shadow mask on the forward path and in the mask pass.
     pub placeholder_mask: wgpu::TextureView,
+    /// Bound in place of a virtual map's uniform and page table for the lights
+    /// without one.
+    placeholder_virtual: VirtualBuffers,
+}
+
+/// A virtual map's uniform and page table, as a light's shadow group binds them.
+#[derive(Clone)]
+pub(crate) struct VirtualBuffers {
+    pub uniform: wgpu::Buffer,
+    pub page_table: wgpu::Buffer,
 }
 
 /// The textures of a light's shadow group.
@@ -32,6 +42,8 @@ pub(crate) struct ShadowViews<'a> {
     pub cube: Option<&'a wgpu::TextureView>,
     /// The light's layer of the shadow mask, on the mask path's lighting pass.
     pub mask: Option<&'a wgpu::TextureView>,
+    /// A sun's virtual map (whose page pool is `map`).
+    pub virtual_map: Option<&'a VirtualBuffers>,
 }
 
 fn placeholder(
@@ -49,6 +61,21 @@ fn placeholder(
         format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING,
         view_formats: &[],
+    })
+}
+
+/// A zeroed buffer of `size` bytes, bound where a light has no virtual map.
+fn placeholder_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage,
+        mapped_at_creation: false,
     })
 }
 
@@ -100,12 +127,22 @@ impl FixedBindings {
                 placeholder(device, "no shadow mask", screen_space::MASK_FORMAT, 1),
                 wgpu::TextureViewDimension::D2,
             ),
+            placeholder_virtual: VirtualBuffers {
+                uniform: placeholder_buffer(
+                    device,
+                    "no virtual map",
+                    size_of::<crate::virtual_map::VirtualMapGpu>() as u64,
+                    wgpu::BufferUsages::UNIFORM,
+                ),
+                page_table: placeholder_buffer(device, "no page table", 4, wgpu::BufferUsages::STORAGE),
+            },
         }
     }
 
     /// Group 2 of the lighting and mask passes: a light's maps and their samplers.
     pub fn shadow_group(&self, pool: &mut Pool, layouts: &Layouts, views: ShadowViews) -> wgpu::BindGroup {
         let mask = Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone());
+        // The mask after the shadow resources (`passes::Layouts::shadow`).
         let bindings = [self.map_bindings(&views), vec![mask]].concat();
         pool.bind_group("shadow map", &layouts.shadow, &bindings)
     }
@@ -135,6 +172,8 @@ impl FixedBindings {
             Binding::View(views.cube.unwrap_or(&self.placeholder_cube).clone()),
             Binding::Sampler(self.compare_nearest_sampler.clone()),
             Binding::Sampler(self.gather_sampler.clone()),
+            Binding::Buffer(views.virtual_map.unwrap_or(&self.placeholder_virtual).uniform.clone()),
+            Binding::Buffer(views.virtual_map.unwrap_or(&self.placeholder_virtual).page_table.clone()),
         ]
     }
 }

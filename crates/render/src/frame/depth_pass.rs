@@ -94,11 +94,14 @@ pub(super) enum DepthArea {
     Whole,
     /// These rectangles of it only: every run is drawn once into each.
     Strips(Vec<ScissorRect>),
+    /// This rectangle as if it were the whole target: the viewport and the scissor
+    /// (a virtual map's page in its tile of the pool).
+    Tile(ScissorRect),
 }
 
 /// A rectangle of a target, in texels from its top-left corner.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct ScissorRect {
+pub(crate) struct ScissorRect {
     pub x: u32,
     pub y: u32,
     pub width: u32,
@@ -178,6 +181,7 @@ impl DepthArea {
         match self {
             DepthArea::Whole => vec![None],
             DepthArea::Strips(strips) => strips.iter().copied().map(Some).collect(),
+            DepthArea::Tile(tile) => vec![Some(*tile)],
         }
     }
 }
@@ -251,6 +255,10 @@ fn open_depth_pass<'e>(
 ) -> wgpu::RenderPass<'e> {
     let mut pass =
         begin_depth_pass(encoder, "shadow", depth.target_view, depth.start.load(), timestamp_writes);
+    if let DepthArea::Tile(tile) = depth.area {
+        let (x, y, size) = (tile.x as f32, tile.y as f32, (tile.width as f32, tile.height as f32));
+        pass.set_viewport(x, y, size.0, size.1, 0.0, 1.0);
+    }
     pass.set_bind_group(0, group, &[]);
     stats.bind_group_changes += 1;
     pass

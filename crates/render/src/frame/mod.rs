@@ -21,16 +21,20 @@ mod recording;
 mod refine;
 mod screen;
 mod shadow_maps;
+mod virtual_pages;
+mod virtual_record;
 
 use gnomon_scene::{Scene, Settings, settings::MomentFormat};
 
 pub use crate::pool::Creations;
+pub(crate) use depth_pass::ScissorRect;
 pub use map_cache::LayerCache;
 pub use outputs::{
     CpuTimings, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, ShadowMapImage,
 };
 pub use receiver::{LightShadows, ReceiverVariant, Shadows};
 pub use recording::DrawStats;
+pub use virtual_pages::PageStats;
 
 use crate::{
     Gpu, GpuScene, RenderError,
@@ -80,6 +84,8 @@ pub struct Renderer {
     techniques: TechniqueRegistry,
     /// Each light's map as its still casters drew it, kept across frames.
     map_cache: map_cache::MapCache,
+    /// Each virtual light's pool of pages, kept across frames.
+    virtual_lights: virtual_pages::VirtualLights,
 }
 
 impl Renderer {
@@ -115,6 +121,7 @@ impl Renderer {
                 pool: Pool::new(device),
                 late_times: LateTimes::default(),
                 map_cache: map_cache::MapCache::default(),
+                virtual_lights: virtual_pages::VirtualLights::default(),
                 techniques,
                 layouts,
                 passes,

@@ -207,6 +207,8 @@ pub struct LightStats {
     /// Why its rays traversed the shader's BVH where `screen.tracer` asked for ray
     /// queries: the device has none, or cannot take the scene in its structures.
     pub tracer_fallback: Option<crate::rays::RayQueriesUnavailable>,
+    /// A virtual map's pages this frame (`--partition virtual`).
+    pub pages: Option<super::virtual_pages::PageStats>,
 }
 
 impl LightStats {
@@ -514,6 +516,7 @@ impl TimedLights {
                     .filter(|_| light.settings.shadow.map.draw_submission == DrawSubmission::GpuCulled),
                 traversal: None,
                 tracer_fallback: None,
+                pages: light.virtual_map.as_ref().map(|v| v.stats),
             })
             .collect();
         TimedLights { lights, passes: Vec::new(), timings: None }

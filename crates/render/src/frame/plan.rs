@@ -27,6 +27,51 @@ use crate::{
     uniforms::{LightGpu, LightInputs},
 };
 
+impl Renderer {
+    /// Records a depth prepass from the camera (`clip_from_world`) of everything it
+    /// sees, receivers that cast no shadow included, with the shadow pass's
+    /// pipelines and no bias: what SDSM reduces and a virtual map's pages are
+    /// requested from. Returns its depth, `settings.image`'s size.
+    pub(super) fn camera_depth_prepass(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        uploaded: &GpuScene,
+        settings: &Settings,
+        clip_from_world: glam::Mat4,
+    ) -> wgpu::Texture {
+        let (width, height) = (settings.image.width, settings.image.height);
+        let depth = self.pool.texture(
+            "camera depth prepass",
+            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            SHADOW_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let camera_as_light = LightGpu { clip_from_world, ..Default::default() };
+        let mut prepass = settings.clone();
+        prepass.shadow.bias = BiasSettings::none();
+        let seen = uploaded.cull(&[CullView {
+            frustum: Frustum::from_clip_from_world(clip_from_world),
+            near: true,
+            casters_only: false,
+            granularity: Granularity::Instances,
+        }]);
+        let view = self.pool.view(&depth, ViewKey::default());
+        let pass = super::depth_pass::DepthPass {
+            settings: &prepass,
+            light: &camera_as_light,
+            target_view: &view,
+            visible: &seen[0],
+            target: DepthTarget::Projected,
+            unclipped: false,
+            start: super::depth_pass::DepthStart::Clear,
+            area: super::depth_pass::DepthArea::Whole,
+            culling: None,
+        };
+        self.record_depth_pass(encoder, uploaded, &pass, None);
+        depth
+    }
+}
+
 /// A frame, as decided before recording.
 pub(super) struct FramePlan {
     pub camera: Camera,
@@ -58,6 +103,8 @@ pub(super) struct LightPlan {
     /// Which of its pixels trace a shadow ray (on the mask path; off for a light with
     /// an area).
     pub refine: Refine,
+    /// A sun's virtual map's pages this frame (`--partition virtual`).
+    pub virtual_map: Option<super::virtual_pages::VirtualPlan>,
 }
 
 impl LightPlan {
@@ -66,13 +113,13 @@ impl LightPlan {
         match self.lookup() {
             MapLookup::Cube => DepthTarget::CubeFace,
             MapLookup::Paraboloid => DepthTarget::Paraboloid,
-            MapLookup::Map => DepthTarget::Projected,
+            MapLookup::Map | MapLookup::Virtual => DepthTarget::Projected,
         }
     }
 
     /// How the lighting pass looks its map up.
     pub fn lookup(&self) -> MapLookup {
-        MapLookup::of(&self.light, self.settings.shadow.map.omni)
+        MapLookup::of(&self.light, &self.settings.shadow)
     }
 
     /// Layers of its map.
@@ -146,7 +193,14 @@ impl Renderer {
             } else {
                 rays::forward_light_refine(settings.light_refine(&r))
             };
+            let virtual_map = match MapLookup::of(&r.light, shadow) {
+                MapLookup::Virtual => {
+                    Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, index).await?)
+                }
+                MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid => None,
+            };
             lights.push(LightPlan {
+                virtual_map,
                 refine,
                 name: r.name,
                 light: r.light,
@@ -158,6 +212,8 @@ impl Renderer {
                 light_gpu,
             });
         }
+        let virtual_lights: Vec<bool> = lights.iter().map(|l| l.virtual_map.is_some()).collect();
+        self.virtual_lights.keep_only(&virtual_lights);
         // One light's own pass is its list: the list's walk would only add to it.
         let lighting =
             if mask_path && lights.len() > 1 { settings.screen.lighting } else { Lighting::PerLight };
@@ -206,38 +262,8 @@ impl Renderer {
         let gpu = self.gpu.clone();
         let clip_from_world = camera.clip_from_world(aspect);
         let (depth, pending) = gpu.checked("reducing the camera's depth (SDSM)", || {
-            let (width, height) = (settings.image.width, settings.image.height);
-            let depth = self.pool.texture(
-                "camera depth prepass",
-                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                SHADOW_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            );
-            // The shadow pass's pipelines draw it, with the camera's projection and no
-            // bias, receivers that cast no shadow included.
-            let camera_as_light = LightGpu { clip_from_world, ..Default::default() };
-            let mut prepass = settings.clone();
-            prepass.shadow.bias = BiasSettings::none();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let seen = uploaded.cull(&[CullView {
-                frustum: Frustum::from_clip_from_world(clip_from_world),
-                near: true,
-                casters_only: false,
-                granularity: Granularity::Instances,
-            }]);
-            let view = self.pool.view(&depth, ViewKey::default());
-            let pass = super::depth_pass::DepthPass {
-                settings: &prepass,
-                light: &camera_as_light,
-                target_view: &view,
-                visible: &seen[0],
-                target: DepthTarget::Projected,
-                unclipped: false,
-                start: super::depth_pass::DepthStart::Clear,
-                area: super::depth_pass::DepthArea::Whole,
-                culling: None,
-            };
-            self.record_depth_pass(&mut encoder, uploaded, &pass, None);
+            let depth = self.camera_depth_prepass(&mut encoder, uploaded, settings, clip_from_world);
             let planes = Planes::new(camera.near, camera.far);
             let pending =
                 self.passes.depth_reduce.record(&mut self.pool, &gpu.queue, &mut encoder, &depth, planes);

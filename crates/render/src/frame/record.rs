@@ -325,7 +325,9 @@ impl Renderer {
         let lookup = light.lookup();
         let cube = (lookup == MapLookup::Cube)
             .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
-        LightMaps { light_buffer, map: map_view, moments, cube, lookup }
+        let virtual_map =
+            light.virtual_map.as_ref().map(|plan| Self::virtual_buffers(&mut self.pool, &gpu.queue, plan));
+        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, lookup }
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes

@@ -7,7 +7,7 @@
 
 use web_time::Instant;
 
-use super::bindings::ShadowViews;
+use super::bindings::{ShadowViews, VirtualBuffers};
 use crate::{
     passes::lighting::MapLookup,
     readback::PendingReadback,
@@ -119,13 +119,21 @@ pub(super) struct LightMaps {
     pub moments: Option<wgpu::TextureView>,
     /// A point light's map as a cube.
     pub cube: Option<wgpu::TextureView>,
+    /// A sun's virtual map's uniform and page table (its pool is `map`).
+    pub virtual_map: Option<VirtualBuffers>,
     pub lookup: MapLookup,
 }
 
 impl LightMaps {
     /// The views of a shadow group, with the light's layer of the mask where it has one.
     pub fn views<'a>(&'a self, mask: Option<&'a wgpu::TextureView>) -> ShadowViews<'a> {
-        ShadowViews { map: &self.map, moments: self.moments.as_ref(), cube: self.cube.as_ref(), mask }
+        ShadowViews {
+            map: &self.map,
+            moments: self.moments.as_ref(),
+            cube: self.cube.as_ref(),
+            mask,
+            virtual_map: self.virtual_map.as_ref(),
+        }
     }
 }
 

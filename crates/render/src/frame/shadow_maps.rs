@@ -60,6 +60,11 @@ impl Renderer {
         light_index: u32,
     ) -> wgpu::Texture {
         debug_assert_eq!(layers.len() as u32, light.layers(), "one culled set per layer");
+        if let Some(plan) = &light.virtual_map {
+            // Its pool of pages, kept by `virtual_pages.rs`, is its map.
+            self.map_cache.bypass(light_index as usize, layers.len());
+            return self.record_virtual_pages(rec, uploaded, light, plan, light_index);
+        }
         // A technique that reads no map (`techniques/raytraced.rs`): no pass clears it.
         let reads_map = light.technique.rays() == RayUse::AsSettingsSay;
         if reads_map && light.settings.shadow.map.cache == MapCacheSetting::StillCasters {
@@ -242,6 +247,7 @@ impl Renderer {
             DepthArea::Strips(strips) => {
                 strips.iter().map(|s| u64::from(s.width) * u64::from(s.height)).sum()
             }
+            DepthArea::Tile(tile) => u64::from(tile.width) * u64::from(tile.height),
         };
         // A pass that neither clears nor draws leaves its texels alone.
         let touched = drawn.shadow_commands > 0 || layer.start == DepthStart::Clear;
@@ -258,7 +264,7 @@ fn whole_layer(light: &LightPlan, layer: usize) -> CullView {
 
 /// An empty pass that writes `part` of `slot`'s timestamps: it brackets a layer's
 /// commands, copies included, so that the clock times them together.
-fn bracket(rec: &mut Recording, slot: Slot, part: SlotPart) {
+pub(super) fn bracket(rec: &mut Recording, slot: Slot, part: SlotPart) {
     rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some("shadow layer timing"),
         timestamp_writes: rec.clock.compute_part(slot, part),

@@ -331,6 +331,16 @@ impl GpuScene {
         self.batches.iter().map(|b| b.tree.len()).sum()
     }
 
+    /// The world bounds of each batch of moving casters (`Motion::Dynamic`): where
+    /// their shadows fall in a light's map this frame.
+    pub(crate) fn moving_caster_bounds(&self) -> Vec<Aabb> {
+        self.batches
+            .iter()
+            .filter(|b| b.casts_shadow && b.motion == gnomon_scene::Motion::Dynamic && !b.tree.is_empty())
+            .map(|b| b.tree.bounds())
+            .collect()
+    }
+
     /// Culls every view, in parallel: the runs each one draws.
     pub(crate) fn cull(&self, views: &[CullView]) -> Vec<Visible> {
         views.par_iter().map(|view| self.cull_one(view)).collect()

@@ -96,7 +96,10 @@ fn struct_layouts() -> Vec<StructLayout> {
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
             light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,
-            pool_pages_per_side, _pad0,
+            pool_pages_per_side, footprint_per_depth,
+        }),
+        struct_layout!(crate::virtual_map::SurfaceParams as "SurfaceParams" {
+            world_from_clip, view_z_from_world, width, height, _pad0, _pad1,
         }),
         struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
         struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
@@ -123,6 +126,10 @@ fn lookups(technique: TechniqueRef) -> Vec<Lookup> {
     }
     if technique.maps().paraboloid {
         all.push(Lookup::Own(MapLookup::Paraboloid));
+    }
+    // A virtual map's lookup is pcf2x2's (the registry's `check_light`).
+    if technique.technique() == gnomon_scene::settings::Technique::PCF2X2 {
+        all.push(Lookup::Own(MapLookup::Virtual));
     }
     all
 }
@@ -208,6 +215,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("depth baseline".into(), super::depth_baseline::baseline_wgsl()));
     out.push(("page requests".into(), crate::virtual_map::page_requests_wgsl()));
     out.push(("page clear".into(), crate::virtual_map::draw::page_clear_wgsl()));
+    out.push(("surface from depth".into(), crate::virtual_map::surface_from_depth_wgsl()));
     out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {

@@ -120,6 +120,12 @@ pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -
             parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
             (include_str!("paraboloid_visibility.wgsl"), "paraboloid_lookup_visibility")
         }
+        MapLookup::Virtual => {
+            // Its filter is page_lookup.wgsl's pcf2x2, across pages: the registry
+            // refuses any other technique for a virtual map (`check_light`).
+            parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+            (include_str!("../virtual_map/virtual_visibility.wgsl"), "virtual_lookup_visibility")
+        }
     };
     parts.push(visibility.to_owned());
     parts.push(LOOKUP_VISIBILITY.bind(implementation));

@@ -3,7 +3,7 @@
 
 // This light's layer of the mask: visibility + 2 × the shadow-map layer that shaded it
 // (+ TRACED_LAYER_FLAG where rays decided the pixel, under the traced debug view).
-@group(2) @binding(7) var shadow_mask: texture_2d<f32>;
+@group(2) @binding(9) var shadow_mask: texture_2d<f32>;
 
 // `pixel_visibility` on the mask path (passes/wgsl_interfaces.rs).
 fn mask_pixel_visibility(

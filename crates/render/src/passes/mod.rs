@@ -222,7 +222,7 @@ impl Layouts {
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
             forward_rays: crate::rays::forward_layouts(device),
-            shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(7)]].concat()),
+            shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(9)]].concat()),
             receiver: layout(
                 "shadow receiver",
                 &[vec![uniform_entry(0, fragment), uniform_entry(1, fragment)], shadow_entries(2)].concat(),
@@ -248,11 +248,13 @@ impl Layouts {
 /// The shadow resources a light's lookup reads, from binding `first` on: its depth
 /// map and comparison sampler, the moment map and its sampler, the cube with its
 /// nearest comparison and gathering samplers (the declarations of
-/// techniques/bindings.wgsl and receiver.wgsl).
+/// techniques/bindings.wgsl and receiver.wgsl), then a virtual map's uniform and
+/// page table (virtual_map/page_lookup.wgsl), whose pool is the depth map.
 fn shadow_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
     use wgpu::{SamplerBindingType as S, TextureViewDimension as D};
     let depth = |dimension| texture(wgpu::TextureSampleType::Depth, dimension);
     let filterable = texture(wgpu::TextureSampleType::Float { filterable: true }, D::D2Array);
+    let buffer = |ty| wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None };
     [
         depth(D::D2Array),
         wgpu::BindingType::Sampler(S::Comparison),
@@ -261,6 +263,8 @@ fn shadow_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
         depth(D::Cube),
         wgpu::BindingType::Sampler(S::Comparison),
         wgpu::BindingType::Sampler(S::NonFiltering),
+        buffer(wgpu::BufferBindingType::Uniform),
+        buffer(wgpu::BufferBindingType::Storage { read_only: true }),
     ]
     .into_iter()
     .zip(first..)

@@ -99,6 +99,15 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
         MapLookup::Paraboloid => {
             vec![include_str!("refine_omni.wgsl").to_owned(), MAP_UNSURE.bind("paraboloid_map_unsure")]
         }
+        MapLookup::Virtual => vec![
+            include_str!("refine_footprint.wgsl").to_owned(),
+            include_str!("refine_virtual.wgsl").to_owned(),
+            // refine_footprint.wgsl's own test, which a virtual map does not call, reads
+            // a 2D map's plane.
+            include_str!("refine_map.wgsl").to_owned(),
+            FOOTPRINT_RECEIVER.bind("projected_footprint_receiver"),
+            MAP_UNSURE.bind("virtual_map_unsure"),
+        ],
     };
     let penumbrae = size == LightSize::Area;
     let mut parts = vec![

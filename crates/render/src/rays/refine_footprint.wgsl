@@ -116,27 +116,36 @@ fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool 
             let corner = vec2<f32>(f32(x + 1), f32(y + 1)) / size;
             let stored = textureGather(shadow_map, shadow_gather, corner, layer);
             let receiver = footprint_receiver(x, y);
-            var lit_from = receiver - vec4<f32>(bounds.tolerance);
-            if all(vec2<i32>(x, y) == base) {
-                lit_from += vec4<f32>(bounds.own_bias);
-                if bounds.grazing {
-                    // The receiver's own surface, as the map stored it.
-                    let own = receiver + vec4<f32>(bounds.surface + bounds.own_bias);
-                    lit_from = own - vec4<f32>(bounds.tolerance);
-                    let behind_own = stored > own + vec4<f32>(bounds.tolerance);
-                    if any(behind_own & (stored < vec4<f32>(1.0))) {
-                        return true;
-                    }
-                }
-            }
-            let is_lit = stored >= lit_from;
-            let is_shadowed = stored <= receiver - vec4<f32>(bounds.margin);
-            if !all(is_lit | is_shadowed) {
+            let evidence = block_evidence(stored, receiver, all(vec2<i32>(x, y) == base), bounds);
+            if evidence.x {
                 return true;
             }
-            lit = lit || any(is_lit);
-            shadowed = shadowed || any(is_shadowed);
+            lit = lit || evidence.y;
+            shadowed = shadowed || evidence.z;
         }
     }
     return lit && shadowed;
+}
+
+// What a 2×2 block of stored depths says against the receiver's depths at the same
+// texels (`footprint_unsure`; `bilinear` for the block the lookup reads): whether
+// it makes the pixel unsure (x), and whether it holds evidence of light (y) and of
+// a caster (z).
+fn block_evidence(stored: vec4<f32>, receiver: vec4<f32>, bilinear: bool, bounds: FootprintBounds) -> vec3<bool> {
+    var lit_from = receiver - vec4<f32>(bounds.tolerance);
+    if bilinear {
+        lit_from += vec4<f32>(bounds.own_bias);
+        if bounds.grazing {
+            // The receiver's own surface, as the map stored it.
+            let own = receiver + vec4<f32>(bounds.surface + bounds.own_bias);
+            lit_from = own - vec4<f32>(bounds.tolerance);
+            let behind_own = stored > own + vec4<f32>(bounds.tolerance);
+            if any(behind_own & (stored < vec4<f32>(1.0))) {
+                return vec3<bool>(true, false, false);
+            }
+        }
+    }
+    let is_lit = stored >= lit_from;
+    let is_shadowed = stored <= receiver - vec4<f32>(bounds.margin);
+    return vec3<bool>(!all(is_lit | is_shadowed), any(is_lit), any(is_shadowed));
 }

@@ -8,7 +8,8 @@ use std::hash::{Hash, Hasher};
 
 use gnomon_scene::{
     Light, Scene, Settings,
-    settings::{ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
+    lights::ShadowView,
+    settings::{Partition, ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
 };
 
 use super::{BUILTIN, ShadowTechnique};
@@ -185,14 +186,36 @@ impl TechniqueRegistry {
             value: technique.technique().to_string(),
             valid: format!("for point light `{name}` {map}: {}", self.names(fits)),
         };
-        match MapLookup::of(light, shadow.map.omni) {
+        let virtual_for = |kind: &str| SettingsError {
+            setting: "shadow.partition",
+            value: "virtual".into(),
+            valid: format!("single or cascades for {kind} `{name}`: a virtual map is a sun's so far"),
+        };
+        match (light.shadow_view(), shadow.partition) {
+            (ShadowView::Frustum { .. }, Partition::Virtual) => return Err(virtual_for("spot light")),
+            (ShadowView::Omni { .. }, Partition::Virtual) => return Err(virtual_for("point light")),
+            (ShadowView::Parallel { .. }, _)
+            | (
+                ShadowView::Frustum { .. } | ShadowView::Omni { .. },
+                Partition::Single | Partition::Cascades,
+            ) => {}
+        }
+        match MapLookup::of(light, shadow) {
             MapLookup::Cube if technique.cube_wgsl().is_none() => {
                 Err(refuse("(a cube map)", &|t| t.cube_wgsl().is_some()))
             }
             MapLookup::Paraboloid if !technique.maps().paraboloid => {
                 Err(refuse("with `shadow.map.omni` paraboloid", &|t| t.maps().paraboloid))
             }
-            MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid => Ok(technique),
+            // The page table's lookup is pcf2x2's (`virtual_map/page_lookup.wgsl`).
+            MapLookup::Virtual if technique.technique() != Technique::PCF2X2 => Err(SettingsError {
+                setting: "shadow.filter.technique",
+                value: technique.technique().to_string(),
+                valid: format!(
+                    "pcf2x2 for sun `{name}` with `shadow.partition` virtual (its only filter so far)"
+                ),
+            }),
+            MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid | MapLookup::Virtual => Ok(technique),
         }
     }
 

@@ -337,7 +337,7 @@ impl LightGpu {
             };
         }
         uniform.set_layers(layout, resolution);
-        if MapLookup::of(light, shadow.map.omni) == MapLookup::Paraboloid {
+        if MapLookup::of(light, shadow) == MapLookup::Paraboloid {
             uniform.set_paraboloids(layout, resolution);
         }
         uniform

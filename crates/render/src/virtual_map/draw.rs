@@ -1,10 +1,11 @@
 //! Drawing a virtual shadow map's pages: one depth texture of `pages_per_side`² page
 //! tiles (the physical pool), the [`PagePool`] that says which virtual page each tile
 //! holds, and a frame that draws only the pages new or dirty this frame, each through
-//! its own projection ([`Clipmap::page_clip_from_world`]) into its tile. Casters are
-//! drawn as the depth-only baseline draws them (`passes/depth_baseline.rs`: every
-//! caster pre-transformed, one draw per cull state), each page drawing every caster:
-//! culling per page, or per run of pages, is not built yet.
+//! its own projection ([`Clipmap::page_clip_from_world`]) into its tile. Here casters
+//! are drawn as the depth-only baseline draws them (`passes/depth_baseline.rs`: every
+//! caster pre-transformed, one draw per cull state), each page drawing every caster;
+//! the frame draws its pages with the shadow pass instead, culled per page
+//! (`frame/virtual_record.rs`).
 
 use gnomon_math::virtual_map::{
     Clipmap, PageKey,
@@ -88,6 +89,11 @@ impl VirtualPages {
         })
     }
 
+    /// Pages resident in the pool.
+    pub fn resident(&self) -> usize {
+        self.pages.resident()
+    }
+
     /// The pool's size.
     pub fn size(&self) -> PoolSize {
         self.size
@@ -126,6 +132,29 @@ impl VirtualPages {
     /// The page table for `clipmap` as the pool now stands.
     pub fn page_table(&self, clipmap: &Clipmap) -> Vec<TableEntry> {
         self.pages.page_table(clipmap)
+    }
+
+    /// Grants this frame's `requests` their tiles (the frame draws those new or
+    /// stale itself: `frame/virtual_pages.rs`).
+    pub(crate) fn allocate(&mut self, requests: &[PageKey]) -> FrameAllocation {
+        self.pages.allocate(requests)
+    }
+
+    /// Records one pass that clears each of `tiles` of the pool (seen through
+    /// `view`) to the far plane.
+    pub(crate) fn record_tile_clears(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        tiles: &[crate::frame::ScissorRect],
+    ) {
+        let mut pass = begin_depth_pass(encoder, "virtual page clears", view, wgpu::LoadOp::Load, None);
+        pass.set_pipeline(&self.clear);
+        for tile in tiles {
+            pass.set_viewport(tile.x as f32, tile.y as f32, tile.width as f32, tile.height as f32, 0.0, 1.0);
+            pass.set_scissor_rect(tile.x, tile.y, tile.width, tile.height);
+            pass.draw(0..3, 0..1);
+        }
     }
 
     /// Grants this frame's `requests` their pages and draws, into their tiles, the

@@ -9,8 +9,9 @@ struct Probe {
     level: u32,
 }
 
-@group(0) @binding(3) var<storage, read> probes: array<Probe>;
-@group(0) @binding(4) var<storage, read_write> probe_visibility: array<f32>;
+// After the shadow resources (group 0, from binding 0 here) and the virtual map's.
+@group(0) @binding(10) var<storage, read> probes: array<Probe>;
+@group(0) @binding(11) var<storage, read_write> probe_visibility: array<f32>;
 
 @compute @workgroup_size(64)
 fn probe_virtual_map(@builtin(global_invocation_id) id: vec3<u32>) {

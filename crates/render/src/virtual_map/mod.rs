@@ -9,9 +9,9 @@
 //!   in `probe.rs`).
 //!
 //! The clipmap's geometry and the page pool's bookkeeping are CPU-side, in
-//! [`gnomon_math::virtual_map`]. Not yet built: culling casters per page, the
-//! lighting passes' sampling through the page table, and `--partition virtual` (see
-//! `docs/virtual-maps.md`).
+//! [`gnomon_math::virtual_map`]. The frame's use of them (`--partition virtual`) is
+//! in `frame/virtual_pages.rs` and `frame/virtual_record.rs`; the lighting passes'
+//! lookup in `virtual_visibility.wgsl` (see `docs/virtual-maps.md`).
 
 pub(crate) mod draw;
 mod probe;
@@ -63,12 +63,15 @@ pub(crate) struct VirtualMapGpu {
     pub pages_per_side: u32,
     pub page_texels: u32,
     pub pool_pages_per_side: u32,
-    pub _pad0: u32,
+    /// A pixel's footprint in world units per unit of view depth (which level it
+    /// reads: [`PixelReach::footprint_per_depth`]).
+    pub footprint_per_depth: f32,
 }
 
 impl VirtualMapGpu {
-    /// `clipmap`'s levels, sampled from a pool of `pool_pages_per_side`² tiles.
-    pub fn new(clipmap: &Clipmap, pool_pages_per_side: u32) -> Self {
+    /// `clipmap`'s levels, sampled from a pool of `pool_pages_per_side`² tiles by
+    /// pixels whose footprint is `footprint_per_depth` per unit of view depth.
+    pub fn new(clipmap: &Clipmap, pool_pages_per_side: u32, footprint_per_depth: f32) -> Self {
         VirtualMapGpu {
             light_from_world: clipmap.light_from_world,
             origins: packed_origins(clipmap),
@@ -79,7 +82,7 @@ impl VirtualMapGpu {
             pages_per_side: clipmap.shape.pages_per_side(),
             page_texels: clipmap.shape.page_size,
             pool_pages_per_side,
-            _pad0: 0,
+            footprint_per_depth,
         }
     }
 }
@@ -106,67 +109,195 @@ pub struct PixelReach {
     pub reach_texels: f32,
 }
 
-/// The page-request pipeline.
+/// The page-request pipeline, and the pass that unprojects a camera depth prepass
+/// into the surface it reads.
 pub struct PageRequests {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    surface_layout: wgpu::BindGroupLayout,
+    surface_pipeline: wgpu::ComputePipeline,
     /// Its buffers and bind groups, kept from one request to the next.
     pool: Pool,
 }
 
+/// The surface pass's uniform: see `surface_from_depth.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct SurfaceParams {
+    pub world_from_clip: Mat4,
+    pub view_z_from_world: glam::Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// A camera's depth prepass, for [`PageRequests::request_from_depth`].
+pub struct CameraDepth<'a> {
+    /// Its depth, `Depth32Float`, 1 where nothing was seen.
+    pub depth: &'a wgpu::Texture,
+    /// The camera's projection.
+    pub clip_from_world: Mat4,
+    /// The camera's view.
+    pub view_from_world: Mat4,
+}
+
+/// A compute entry of `binding` and type `ty`.
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+/// A buffer binding of type `ty`.
+fn buffer_binding(ty: wgpu::BufferBindingType) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None }
+}
+
+/// A compute pipeline of one bind group `layout`, running `entry` of `wgsl`.
+fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    wgsl: String,
+    entry: &str,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::ComputePipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
 impl PageRequests {
-    /// Builds the pipeline on `gpu`.
+    /// Builds the pipelines on `gpu`.
     pub fn new(gpu: &Gpu) -> Result<PageRequests, RenderError> {
         gpu.checked("building the page-request pass", || {
             let device = &gpu.device;
-            let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty,
-                count: None,
+            let float_texture = wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
             };
-            let buffer =
-                |ty| wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None };
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("page requests"),
                 entries: &[
-                    entry(
+                    compute_entry(0, float_texture),
+                    compute_entry(1, buffer_binding(wgpu::BufferBindingType::Storage { read_only: false })),
+                    compute_entry(2, buffer_binding(wgpu::BufferBindingType::Uniform)),
+                ],
+            });
+            let surface_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("surface from depth"),
+                entries: &[
+                    compute_entry(
                         0,
                         wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            sample_type: wgpu::TextureSampleType::Depth,
                             view_dimension: wgpu::TextureViewDimension::D2,
                             multisampled: false,
                         },
                     ),
-                    entry(1, buffer(wgpu::BufferBindingType::Storage { read_only: false })),
-                    entry(2, buffer(wgpu::BufferBindingType::Uniform)),
+                    compute_entry(
+                        1,
+                        wgpu::BindingType::StorageTexture {
+                            access: wgpu::StorageTextureAccess::WriteOnly,
+                            format: wgpu::TextureFormat::Rgba32Float,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                        },
+                    ),
+                    compute_entry(2, buffer_binding(wgpu::BufferBindingType::Uniform)),
                 ],
             });
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("page_requests.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(page_requests_wgsl().into()),
-            });
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("page requests"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("page requests"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("request_pages"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            PageRequests { layout, pipeline, pool: Pool::new(device) }
+            PageRequests {
+                pipeline: compute_pipeline(
+                    device,
+                    "page requests",
+                    page_requests_wgsl(),
+                    "request_pages",
+                    &layout,
+                ),
+                surface_pipeline: compute_pipeline(
+                    device,
+                    "surface from depth",
+                    surface_from_depth_wgsl(),
+                    "surface_from_depth",
+                    &surface_layout,
+                ),
+                layout,
+                surface_layout,
+                pool: Pool::new(device),
+            }
         })
+    }
+
+    /// [`PageRequests::request`] for the surface a camera's depth prepass saw, each
+    /// pixel unprojected into its world point and view depth on the GPU first.
+    pub async fn request_from_depth(
+        &mut self,
+        gpu: &Gpu,
+        camera: CameraDepth<'_>,
+        clipmap: &Clipmap,
+        reach: PixelReach,
+    ) -> Result<Vec<PageKey>, RenderError> {
+        self.pool.end_frame();
+        let size = camera.depth.size();
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING;
+        let surface = self.pool.texture("camera surface", size, wgpu::TextureFormat::Rgba32Float, usage);
+        let params = SurfaceParams {
+            // In f64: an f32 inverse of a perspective matrix bends rays by parts in 10⁵.
+            world_from_clip: camera.clip_from_world.as_dmat4().inverse().as_mat4(),
+            view_z_from_world: camera.view_from_world.row(2),
+            width: size.width,
+            height: size.height,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        let uniform = self.pool.uniform(&gpu.queue, "surface parameters", &params);
+        let depth = self.pool.view(camera.depth, ViewKey::default());
+        let out = self.pool.view(&surface, ViewKey::default());
+        let bindings = [Binding::View(depth), Binding::View(out), Binding::Buffer(uniform)];
+        let group = self.pool.bind_group("surface from depth", &self.surface_layout, &bindings);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("surface from depth"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.surface_pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(size.width.div_ceil(8), size.height.div_ceil(8), 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        self.requests_of(gpu, &surface, clipmap, reach).await
     }
 
     /// The pages the pixels of `surface` (an `Rgba32Float` texture: world point in
     /// xyz, view depth in w, 0 where no surface is seen) ask for, each once, in
     /// [`PageKey`] order. Submits the pass and waits for it.
     pub async fn request(
+        &mut self,
+        gpu: &Gpu,
+        surface: &wgpu::Texture,
+        clipmap: &Clipmap,
+        reach: PixelReach,
+    ) -> Result<Vec<PageKey>, RenderError> {
+        self.pool.end_frame();
+        self.requests_of(gpu, surface, clipmap, reach).await
+    }
+
+    /// [`PageRequests::request`], in the pool's current frame.
+    async fn requests_of(
         &mut self,
         gpu: &Gpu,
         surface: &wgpu::Texture,
@@ -183,7 +314,6 @@ impl PageRequests {
         let side = shape.pages_per_side();
         let words = (shape.levels as u64 * u64::from(side) * u64::from(side)).div_ceil(32);
         let device = &gpu.device;
-        self.pool.end_frame();
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let bits = self.pool.buffer("page request bits", 4 * words, usage);
         let readback_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
@@ -281,9 +411,17 @@ fn decode(words: &[u32], clipmap: &Clipmap) -> Vec<PageKey> {
     pages
 }
 
-/// `lookup_probe.wgsl` (with `page_lookup.wgsl`), composed.
+/// `lookup_probe.wgsl` (with `page_lookup.wgsl`), composed, with the shadow
+/// resources in group 0 from binding 0.
 pub(crate) fn lookup_probe_wgsl() -> String {
-    crate::passes::compose_wgsl(&[include_str!("lookup_probe.wgsl")])
+    let place = crate::passes::BindingPlace { group: 0, binding: 0 };
+    let bindings = crate::techniques::shadow_bindings_wgsl(place);
+    crate::passes::compose_wgsl(&[&bindings, include_str!("lookup_probe.wgsl")])
+}
+
+/// `surface_from_depth.wgsl`, composed.
+pub(crate) fn surface_from_depth_wgsl() -> String {
+    crate::passes::compose_wgsl(&[include_str!("surface_from_depth.wgsl")])
 }
 
 /// `page_requests.wgsl`, composed.

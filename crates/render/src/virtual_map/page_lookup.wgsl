@@ -2,9 +2,15 @@
 // is found in the page pool through the table's entry for its page (the page
 // itself, or a coarser page standing in for it), so that a filter's taps may fall
 // in different pages, resident or not. `gnomon_math::virtual_map` holds the same
-// arithmetic; `draw/lookup_tests.rs` holds this file to it.
+// arithmetic; `draw/tests.rs` holds this file to it.
+//
+// The pool is the light's `shadow_map` (one layer); the clipmap's uniform and the
+// page table follow the other shadow resources, at the place the pass's generated
+// constants name (`shadow_entries` in passes/mod.rs).
 
 import package::constants::VIRTUAL_ORIGIN_VECTORS;
+import package::techniques::bindings::shadow_map;
+import package::variant::{SHADOW_BINDING, SHADOW_GROUP};
 
 struct VirtualMap {
     light_from_world: mat4x4<f32>,
@@ -20,34 +26,55 @@ struct VirtualMap {
     page_texels: u32,
     // Page tiles per side of the pool's texture; slots run along rows.
     pool_pages_per_side: u32,
-    _pad0: u32,
+    // A pixel's footprint in world units per unit of view depth: which level it reads.
+    footprint_per_depth: f32,
 }
 
-@group(0) @binding(0) var<uniform> virtual_map: VirtualMap;
+@group(SHADOW_GROUP) @binding(SHADOW_BINDING + 7u) var<uniform> virtual_map: VirtualMap;
 // One entry per page of every level's window (`TableEntry`): bit 31 valid, bits 24
 // to 27 how many levels coarser the page read is, bits 0 to 23 its slot.
-@group(0) @binding(1) var<storage, read> page_table: array<u32>;
-@group(0) @binding(2) var page_pool: texture_depth_2d;
+@group(SHADOW_GROUP) @binding(SHADOW_BINDING + 8u) var<storage, read> page_table: array<u32>;
+
+// A texel as the table resolves it: its stored depth, and whether its own level's
+// page held it (not a coarser page standing in, nor no page at all).
+struct VirtualTexel {
+    depth: f32,
+    exact: bool,
+}
+
+// The level a pixel at view depth `view_depth` reads: the coarsest whose texels are
+// no larger than its footprint, as the page requests chose (`page_requests.wgsl`).
+fn virtual_level(view_depth: f32) -> u32 {
+    let ratio = view_depth * virtual_map.footprint_per_depth / virtual_map.finest_texel;
+    if (ratio < 1.0) {
+        return 0u;
+    }
+    return min(u32(floor(log2(ratio))), virtual_map.levels - 1u);
+}
+
+// World size of a texel of `level`.
+fn virtual_texel_size(level: u32) -> f32 {
+    return virtual_map.finest_texel * exp2(f32(level));
+}
 
 fn virtual_origin(level: u32) -> vec2<i32> {
     let pair = virtual_map.origins[level / 2u];
     return select(pair.zw, pair.xy, level % 2u == 0u);
 }
 
-// The stored depth of texel `texel` of `level` (in texels from the light-space
-// origin, y up), through the page table; 1 (the far plane: lit) where no page holds
-// it, itself or coarser.
-fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
+// Texel `texel` of `level` (in texels from the light-space origin, y up) through
+// the page table; the far plane (lit) where no page holds it, itself or coarser.
+fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     let size = i32(virtual_map.page_texels);
     let side = i32(virtual_map.pages_per_side);
     let page = vec2<i32>(floor(vec2<f32>(texel) / f32(size)));
     let relative = page - virtual_origin(level);
     if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
-        return 1.0;
+        return VirtualTexel(1.0, false);
     }
     let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
     if ((entry & 0x80000000u) == 0u) {
-        return 1.0;
+        return VirtualTexel(1.0, false);
     }
     let slot = entry & 0xffffffu;
     let coarser = (entry >> 24u) & 0xfu;
@@ -58,7 +85,13 @@ fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
     let pool = i32(virtual_map.pool_pages_per_side);
     let tile = vec2<i32>(i32(slot) % pool, i32(slot) / pool) * size;
     // Texture rows run down, light-space y up.
-    return textureLoad(page_pool, tile + vec2<i32>(within.x, size - 1 - within.y), 0);
+    let depth = textureLoad(shadow_map, tile + vec2<i32>(within.x, size - 1 - within.y), 0, 0);
+    return VirtualTexel(depth, coarser == 0u);
+}
+
+// The stored depth of texel `texel` of `level` ([`virtual_texel`]'s).
+fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
+    return virtual_texel(level, texel).depth;
 }
 
 // The light's view of a world point: light-space x and y, and the depth the map

@@ -38,7 +38,7 @@ impl VirtualPages {
         }
         let device = &gpu.device;
         let words: Vec<u32> = self.page_table(clipmap).iter().map(|e| e.0).collect();
-        let uniform = VirtualMapGpu::new(clipmap, self.size().pages_per_side);
+        let uniform = VirtualMapGpu::new(clipmap, self.size().pages_per_side, 0.0);
         let bytes = 4 * probes.len() as u64;
         let pipeline = gpu.checked("sampling a virtual map", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -66,15 +66,17 @@ impl VirtualPages {
         );
         let read =
             pool.buffer("probe readback", bytes, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
-        let view = pool.view(&texture, ViewKey::default());
-        let bindings = [
-            Binding::Buffer(uniform),
-            Binding::Buffer(table),
-            Binding::View(view),
-            Binding::Buffer(probes_buffer),
-            Binding::Buffer(out.clone()),
+        let view = pool.view(&texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
+        // The places `lookup_probe.wgsl` declares: the shadow resources' from 0.
+        let bindings = vec![
+            (0, Binding::View(view)),
+            (7, Binding::Buffer(uniform)),
+            (8, Binding::Buffer(table)),
+            (10, Binding::Buffer(probes_buffer)),
+            (11, Binding::Buffer(out.clone())),
         ];
-        let group = pool.bind_group("virtual lookup probe", &pipeline.get_bind_group_layout(0), &bindings);
+        let layout = pipeline.get_bind_group_layout(0);
+        let group = pool.bind_group_numbered("virtual lookup probe", &layout, bindings);
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

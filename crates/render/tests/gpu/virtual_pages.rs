@@ -103,3 +103,75 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
     let extra: Vec<_> = asked.difference(&expected).take(5).collect();
     assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
 }
+
+/// A frame's virtual pages: a renderer kept across frames draws only pages new or
+/// stale, a still sun none, a turned one every page it reads; a pool too small for
+/// the view refuses pages, counts them, and their pixels read coarser pages.
+mod in_the_frame {
+    use gnomon_render::{Frame, OutputRequest, PageStats, Renderer};
+    use gnomon_scene::{
+        Settings, builtin,
+        settings::{Partition, Refine},
+    };
+
+    use crate::support;
+
+    fn virtual_sun(pool_side: u32) -> Settings {
+        let mut s = support::settings(320, 180, 1024);
+        s.shadow.partition = Partition::Virtual;
+        s.shadow.virtual_map.pool_side = pool_side;
+        s.screen.refine = Refine::Off;
+        s
+    }
+
+    fn pages(frame: &Frame) -> PageStats {
+        frame.lights[0].pages.expect("a virtual light reports its pages")
+    }
+
+    /// The share of light-facing pixels in shadow (visibility below a half).
+    fn shadowed(frame: &Frame) -> f64 {
+        let seen: Vec<f32> = frame.visibility.iter().copied().filter(|v| v.is_finite()).collect();
+        seen.iter().filter(|&&v| v < 0.5).count() as f64 / seen.len().max(1) as f64
+    }
+
+    #[test]
+    fn a_still_sun_draws_no_page_and_a_turned_one_draws_every_page_it_reads() {
+        let scene = builtin::spheres();
+        let s = virtual_sun(24);
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let uploaded = renderer.upload(&scene).unwrap();
+        let request = OutputRequest::default();
+        let first = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let p = pages(&first);
+        assert!(p.requested > 10 && p.drawn == p.requested && p.refused == 0, "{p:?}");
+        assert_eq!(first.lights[0].layer_texels, vec![u64::from(p.drawn) * 128 * 128]);
+        let still = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let p = pages(&still);
+        assert_eq!((p.drawn, p.kept), (0, p.requested), "{p:?}");
+        assert_eq!(still.lights[0].layer_texels.iter().sum::<u64>(), 0);
+        // The kept pages shade as the drawn ones did.
+        assert_eq!(first.visibility.len(), still.visibility.len());
+        let differ = first.visibility.iter().zip(&still.visibility).filter(|(a, b)| (*a - *b).abs() > 1e-6);
+        assert_eq!(differ.count(), 0);
+        let mut turned = s.clone();
+        turned.light.sun_azimuth = Some(turned.light.sun_azimuth.unwrap_or(0.0) + 10.0);
+        let p = pages(&renderer.render_uploaded(&uploaded, &scene, &turned, &request).unwrap());
+        assert_eq!((p.drawn, p.kept), (p.requested - p.refused, 0), "{p:?}");
+    }
+
+    #[test]
+    fn an_overfull_pool_refuses_pages_counts_them_and_falls_back_to_coarser_ones() {
+        let scene = builtin::spheres();
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let ample = renderer.render(&scene, &virtual_sun(24), &OutputRequest::default()).unwrap();
+        let full = renderer.render(&scene, &virtual_sun(2), &OutputRequest::default()).unwrap();
+        let (a, f) = (pages(&ample), pages(&full));
+        assert_eq!(a.refused, 0, "{a:?}");
+        assert_eq!((f.capacity, f.resident), (4, 4), "{f:?}");
+        assert_eq!(f.refused, f.requested - 4, "{f:?}");
+        // The refused pages' pixels read the coarse resident pages: the spheres'
+        // shadows are still there, blurrier, not lost to lit pixels.
+        let (sa, sf) = (shadowed(&ample), shadowed(&full));
+        assert!(sa > 0.02 && sf > 0.5 * sa, "shadowed: {sa} with room, {sf} with 4 tiles");
+    }
+}

@@ -18,6 +18,7 @@ pub mod ranges;
 mod screen;
 mod shadow;
 mod unused;
+mod virtual_map;
 // The tests parse flags: they need the `cli` feature, which `cargo test --workspace`
 // turns on (the `gnomon` binary asks for it).
 #[cfg(all(test, feature = "cli"))]
@@ -32,6 +33,7 @@ pub use light::*;
 pub use screen::*;
 pub use shadow::*;
 pub use unused::UnusedSetting;
+pub use virtual_map::*;
 
 /// Everything that configures one render besides the scene itself.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]

@@ -146,6 +146,7 @@ pub static ALL: &[&SettingRange] = &[
     &super::CSM_SCALE_RANGE,
     &super::CSM_OFFSET_RANGE,
     &super::RESOLUTION_RANGE,
+    &super::POOL_SIDE_RANGE,
     &super::CASCADE_COUNT_RANGE,
     &super::SPLIT_LAMBDA_RANGE,
     &super::CASCADE_BLEND_RANGE,

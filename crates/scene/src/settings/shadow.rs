@@ -313,6 +313,12 @@ pub enum Partition {
     /// Cascaded shadow maps for a sun: the view frustum split along its depth, one
     /// --shadow-res map per slice, in a depth texture array (a spot keeps one map).
     Cascades,
+    /// A virtual shadow map for a sun (issue 53): a clipmap of 16384² levels in 128²
+    /// pages around the camera, each level twice the area of the one before. Only the
+    /// pages that visible pixels read, at their own footprint, are drawn, into a pool
+    /// of tiles (--page-pool), and kept until the light or a caster over them moves.
+    /// Filtered with pcf2x2 so far.
+    Virtual,
 }
 
 /// How the view depth range is divided among cascades.
@@ -465,6 +471,10 @@ pub struct ShadowSettings {
     #[cfg_attr(feature = "cli", command(flatten))]
     #[patch(nesting)]
     pub contact: ContactSettings,
+    /// The virtual map, used with `--partition virtual`.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    #[patch(nesting)]
+    pub virtual_map: VirtualMapSettings,
 }
 
 impl ShadowSettings {
@@ -488,7 +498,7 @@ impl ShadowSettings {
                 s.partition == Partition::Single,
                 "shadow.map.warp",
                 &warp,
-                "a warp of a single map: with `shadow.partition` cascades use `shadow.map.warp` none",
+                "a warp of a single map: with `shadow.partition` cascades or virtual use `shadow.map.warp` none",
             )?;
             check(
                 s.filter.kernel_unit == KernelUnit::Texels,
@@ -501,6 +511,7 @@ impl ShadowSettings {
         s.bias.validate()?;
         RESOLUTION_RANGE.check(s.map.resolution)?;
         s.contact.validate()?;
+        s.virtual_map.validate()?;
         Ok(())
     }
 }

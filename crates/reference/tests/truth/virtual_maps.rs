@@ -1,0 +1,62 @@
+//! A sun's virtual shadow map (`--partition virtual`, issue 53) against the
+//! reference: the map alone, and refined by rays where the page table's footprint
+//! test is unsure (`rays/refine_virtual.wgsl`), exact as a single map refined is.
+
+use crate::common;
+
+use common::{
+    compare,
+    figures::{figure, percent},
+    reference, render,
+};
+use gnomon_scene::{
+    Settings, builtin,
+    settings::{Partition, Refine, Technique},
+};
+
+/// Issue 25's bound for `--refine rays` over `pcf2x2`, which a virtual map refined
+/// must meet too: 0.02 % of light-facing pixels wrong.
+const REFINED_MISMATCH: f64 = 0.0002;
+
+/// The map alone, unrefined: its texels no larger than a pixel's footprint, it is
+/// wrong only along shadow edges and terminators.
+const UNREFINED_MISMATCH: f64 = 0.005;
+
+fn settings(refine: Refine) -> Settings {
+    let mut s = Settings::default();
+    s.image.width = 640;
+    s.image.height = 360;
+    s.shadow.filter.technique = Technique::PCF2X2;
+    s.shadow.partition = Partition::Virtual;
+    s.screen.refine = refine;
+    s
+}
+
+#[test]
+fn a_virtual_map_refined_by_rays_matches_the_reference_tracing_few_pixels() {
+    for scene in [builtin::spheres(), builtin::columns(), builtin::grazing()] {
+        let truth = reference(&scene, &settings(Refine::Off));
+        let map_frame = render(&scene, &settings(Refine::Off));
+        let map = compare(&map_frame, &truth);
+        let refined_frame = render(&scene, &settings(Refine::Rays));
+        let refined = compare(&refined_frame, &truth);
+        let pages = refined_frame.lights[0].pages.expect("a virtual light reports its pages");
+        let rays = refined_frame.lights[0].traced_pixels.expect("a refined frame reports its rays");
+        figure(
+            &format!("{}, virtual map, pcf2x2 alone: mismatch", scene.name),
+            percent(map.mismatch_rate),
+            percent(UNREFINED_MISMATCH),
+        );
+        figure(
+            &format!("{}, virtual map refined by rays: mismatch ({rays} pixels traced)", scene.name),
+            percent(refined.mismatch_rate),
+            percent(REFINED_MISMATCH),
+        );
+        assert!(pages.requested > 0 && pages.refused == 0, "{}: {pages:?}", scene.name);
+        assert!(map.mismatch_rate <= UNREFINED_MISMATCH, "{}: {map:?}", scene.name);
+        assert!(refined.mismatch_rate <= REFINED_MISMATCH, "{}: {refined:?}", scene.name);
+        assert!(refined.compared > 50_000, "{}: {refined:?}", scene.name);
+        // Rays decide a small share of the light-facing pixels, not all of them.
+        assert!((rays as usize) < refined.compared / 5, "{}: {rays} traced", scene.name);
+    }
+}

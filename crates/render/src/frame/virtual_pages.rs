@@ -1,0 +1,238 @@
+//! A sun's virtual shadow map in the frame (`--partition virtual`, issue 53).
+//!
+//! Before recording, [`Renderer::plan_virtual`] draws a depth prepass from the
+//! camera, asks the GPU which pages of the clipmap its pixels read
+//! (`virtual_map/page_requests.wgsl`), waits for the answer, marks stale the pages
+//! that the light's turn or a moving caster changed, and grants the requests their
+//! tiles in the light's kept pool ([`VirtualPages`]), coarse levels first. Recording
+//! ([`Renderer::record_virtual_pages`]) clears and draws only the pages new or stale
+//! this frame, each through its own projection into its tile, its casters culled
+//! against the page alone (on the GPU where the frame culls there), with the
+//! shadow pass's pipelines: alpha-tested casters, clusters and bias as any layer.
+//! The lighting, mask and refinement passes then read the pool through the page
+//! table (`virtual_map/virtual_visibility.wgsl`, `rays/refine_virtual.wgsl`).
+
+use glam::Mat4;
+use gnomon_math::{
+    Aabb,
+    virtual_map::{Clipmap, ClipmapShape, pages::FrameAllocation},
+};
+use gnomon_scene::{Camera, Light, Settings, lights::ShadowView, settings::BiasSettings};
+
+use super::Renderer;
+use crate::{
+    GpuScene, RenderError,
+    virtual_map::{CameraDepth, PageRequests, PixelReach, PoolSize, VirtualMapGpu, VirtualPages},
+};
+
+/// Texels a pcf2x2 lookup reaches from its point besides its normal offset: its
+/// bilinear footprint's, and half a texel for the level chosen at a pixel's edge.
+const BILINEAR_REACH_TEXELS: f32 = 1.5;
+
+/// Levels above each requested page of the coarser page asked for with it, so that a
+/// pool too small for the view still holds a page over every pixel: the pool grants
+/// coarse levels first, and a refused page's pixels read the nearest coarser
+/// resident page (`virtual_texel` in page_lookup.wgsl). One such page stands for
+/// 4³ = 64 pages below it, so they add little when the pool has room.
+const FALLBACK_LEVELS: u32 = 3;
+
+/// Each light's kept pool of pages, and the request pass they share.
+#[derive(Default)]
+pub(super) struct VirtualLights {
+    kept: Vec<Option<KeptPages>>,
+    requests: Option<PageRequests>,
+}
+
+/// A light's pool of page tiles, and what its resident pages were drawn under.
+struct KeptPages {
+    pages: VirtualPages,
+    drawn_under: Option<DrawnUnder>,
+    /// The moving casters' bounds when the pages were last drawn: where their
+    /// shadows were.
+    moving_before: Vec<Aabb>,
+}
+
+/// What every resident page's depths depend on besides its casters: any change
+/// draws every page again.
+#[derive(Clone, Debug, PartialEq)]
+struct DrawnUnder {
+    light_from_world: Mat4,
+    finest_texel: f32,
+    levels: u32,
+    near: f32,
+    far: f32,
+    bias: BiasSettings,
+    still_generation: u64,
+}
+
+/// A virtual map's pages in one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PageStats {
+    /// Pages asked for: those the pixels read, and a coarser page over each of
+    /// them for their fallback.
+    pub requested: u32,
+    /// Pages drawn: new this frame, or stale (the light turned, a caster over them
+    /// moved).
+    pub drawn: u32,
+    /// Pages asked for and kept from an earlier frame, drawn nothing.
+    pub kept: u32,
+    /// Pages asked for that the full pool had no tile for: their pixels read a
+    /// coarser resident page (a fallback, blurrier).
+    pub refused: u32,
+    /// Pages resident in the pool after the frame.
+    pub resident: u32,
+    /// Tiles in the pool.
+    pub capacity: u32,
+    /// Texels per side of a page.
+    pub page_size: u32,
+}
+
+/// A virtual light's frame, as decided before recording.
+pub(crate) struct VirtualPlan {
+    pub clipmap: Clipmap,
+    /// The pages granted (those to draw among them) and refused.
+    pub allocation: FrameAllocation,
+    /// The sampling passes' uniform.
+    pub uniform: VirtualMapGpu,
+    /// The page table's words (`TableEntry`).
+    pub table: Vec<u32>,
+    pub stats: PageStats,
+}
+
+impl Renderer {
+    /// A virtual light's pages for this frame: requested by the pixels of a camera
+    /// prepass, granted in the light's pool. Waits for the requests.
+    pub(super) async fn plan_virtual(
+        &mut self,
+        uploaded: &GpuScene,
+        light: &Light,
+        settings: &Settings,
+        camera: &Camera,
+        index: usize,
+    ) -> Result<VirtualPlan, RenderError> {
+        let ShadowView::Parallel { travel } = light.shadow_view() else {
+            unreachable!("the technique registry refuses a virtual map for a light other than a sun")
+        };
+        let gpu = self.gpu.clone();
+        let (width, height) = (settings.image.width, settings.image.height);
+        let aspect = width as f32 / height as f32;
+        let footprint_per_depth = 2.0 * (0.5 * camera.fov_y_degrees.to_radians()).tan() / height as f32;
+        // The farthest pixel the camera can see: at the scene's farthest corner.
+        let farthest = uploaded.bounds.corners().iter().map(|c| c.distance(camera.eye)).fold(0.0, f32::max);
+        let shape = ClipmapShape::DEFAULT;
+        let clipmap =
+            Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
+        let reach = PixelReach {
+            footprint_per_depth,
+            reach_texels: BILINEAR_REACH_TEXELS + settings.shadow.bias.normal_offset,
+        };
+        let clip_from_world = camera.clip_from_world(aspect);
+        let depth = gpu.checked("drawing the camera's depth for a virtual map's pages", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let depth = self.camera_depth_prepass(&mut encoder, uploaded, settings, clip_from_world);
+            gpu.queue.submit([encoder.finish()]);
+            depth
+        })?;
+        if self.virtual_lights.requests.is_none() {
+            self.virtual_lights.requests = Some(PageRequests::new(&gpu)?);
+        }
+        let requests = self.virtual_lights.requests.as_mut().expect("made above");
+        let camera_depth =
+            CameraDepth { depth: &depth, clip_from_world, view_from_world: camera.view_from_world() };
+        let mut requested = requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?;
+        let fallbacks: Vec<_> = requested
+            .iter()
+            .map(|&page| {
+                let mut coarse = page;
+                while coarse.level < (page.level + FALLBACK_LEVELS).min(shape.levels - 1) {
+                    coarse = coarse.coarser();
+                }
+                coarse
+            })
+            .collect();
+        requested.extend(fallbacks);
+        requested.sort_unstable();
+        requested.dedup();
+        let size =
+            PoolSize { page_size: shape.page_size, pages_per_side: settings.shadow.virtual_map.pool_side };
+        let kept = self.virtual_lights.kept_for(&gpu, index, size)?;
+        let under = DrawnUnder {
+            light_from_world: clipmap.light_from_world,
+            finest_texel: clipmap.finest_texel,
+            levels: shape.levels,
+            near: clipmap.near,
+            far: clipmap.far,
+            bias: settings.shadow.bias.clone(),
+            still_generation: uploaded.still_generation,
+        };
+        if kept.drawn_under.as_ref() != Some(&under) {
+            kept.pages.invalidate_all();
+        }
+        kept.drawn_under = Some(under);
+        // A moving caster's shadow changes the pages under it, where it was and
+        // where it is.
+        let moving = uploaded.moving_caster_bounds();
+        let stale: Vec<_> = moving
+            .iter()
+            .chain(&kept.moving_before)
+            .flat_map(|bounds| (0..shape.levels).filter_map(|level| clipmap.pages_under(level, bounds)))
+            .collect();
+        if !stale.is_empty() {
+            kept.pages.invalidate(|page| stale.iter().any(|rect| rect.contains(page)));
+        }
+        kept.moving_before = moving;
+        let allocation = kept.pages.allocate(&requested);
+        let table = kept.pages.page_table(&clipmap).iter().map(|entry| entry.0).collect();
+        let uniform = VirtualMapGpu::new(&clipmap, size.pages_per_side, footprint_per_depth);
+        let drawn = allocation.to_draw().count() as u32;
+        let stats = PageStats {
+            requested: requested.len() as u32,
+            drawn,
+            kept: allocation.granted.len() as u32 - drawn,
+            refused: allocation.refused.len() as u32,
+            resident: kept.pages.resident() as u32,
+            capacity: size.pages_per_side * size.pages_per_side,
+            page_size: size.page_size,
+        };
+        Ok(VirtualPlan { clipmap, allocation, uniform, table, stats })
+    }
+}
+
+impl VirtualLights {
+    /// Light `index`'s pool, made (or made again) at `size`.
+    fn kept_for(
+        &mut self,
+        gpu: &crate::Gpu,
+        index: usize,
+        size: PoolSize,
+    ) -> Result<&mut KeptPages, RenderError> {
+        if self.kept.len() <= index {
+            self.kept.resize_with(index + 1, || None);
+        }
+        let slot = &mut self.kept[index];
+        if slot.as_ref().is_none_or(|k| k.pages.size() != size) {
+            *slot = Some(KeptPages {
+                pages: VirtualPages::new(gpu, size)?,
+                drawn_under: None,
+                moving_before: vec![],
+            });
+        }
+        Ok(slot.as_mut().expect("made above"))
+    }
+
+    /// Light `index`'s pool, planned this frame.
+    pub fn pages(&mut self, index: usize) -> &mut VirtualPages {
+        &mut self.kept[index].as_mut().expect("planned this frame").pages
+    }
+
+    /// Forgets the pools of the lights past the first `lights`, and of those not
+    /// virtual this frame (`virtual_lights[i]` false).
+    pub fn keep_only(&mut self, virtual_lights: &[bool]) {
+        self.kept.truncate(virtual_lights.len());
+        for (kept, &is_virtual) in self.kept.iter_mut().zip(virtual_lights) {
+            if !is_virtual {
+                *kept = None;
+            }
+        }
+    }
+}

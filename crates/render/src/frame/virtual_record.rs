@@ -1,0 +1,95 @@
+//! Recording a sun's virtual map (`--partition virtual`): clearing and drawing the
+//! pages [`super::virtual_pages`] planned, and the buffers its sampling passes bind.
+
+use super::{
+    Renderer,
+    bindings::VirtualBuffers,
+    cull::layer_view,
+    depth_pass::{Casters, DepthArea, DepthPass, DepthStart, LayerCulling, ScissorRect},
+    plan::LightPlan,
+    recording::{LayerWork, Recording},
+    shadow_maps::bracket,
+    virtual_pages::VirtualPlan,
+};
+use crate::{
+    GpuScene,
+    pool::{Pool, ViewKey},
+    timing::{PassKind, SlotPart},
+};
+
+impl Renderer {
+    /// Clears and draws the pages of a virtual light's pool that are new or stale
+    /// this frame, timed as its one layer; returns the pool's texture, its map.
+    pub(super) fn record_virtual_pages(
+        &mut self,
+        rec: &mut Recording,
+        uploaded: &GpuScene,
+        light: &LightPlan,
+        plan: &VirtualPlan,
+        light_index: u32,
+    ) -> wgpu::Texture {
+        let gpu = self.gpu.clone();
+        let pages = self.virtual_lights.pages(light_index as usize);
+        let texture = pages.texture().clone();
+        let drawn: Vec<_> = plan.allocation.to_draw().copied().collect();
+        if drawn.is_empty() {
+            return texture;
+        }
+        let page_size = pages.size().page_size;
+        let tiles: Vec<ScissorRect> = drawn
+            .iter()
+            .map(|grant| {
+                let (x, y) = pages.tile_origin(grant.physical);
+                ScissorRect { x, y, width: page_size, height: page_size }
+            })
+            .collect();
+        let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Shadow, Some(light_index), Some(0));
+        bracket(rec, slot, SlotPart::Opening);
+        let view = self.pool.view(&texture, ViewKey::default());
+        let pages = self.virtual_lights.pages(light_index as usize);
+        pages.record_tile_clears(rec.encoder, &view, &tiles);
+        let views: Vec<_> = drawn
+            .iter()
+            .map(|grant| layer_view(light, plan.clipmap.page_clip_from_world(grant.page)))
+            .collect();
+        let seen = uploaded.cull(&views);
+        let mut work = LayerWork::default();
+        for ((grant, tile), (view_culled, visible)) in drawn.iter().zip(&tiles).zip(views.iter().zip(&seen)) {
+            let page_light = crate::uniforms::LightGpu {
+                clip_from_world: plan.clipmap.page_clip_from_world(grant.page),
+                ..light.light_gpu
+            };
+            let pass = DepthPass {
+                settings: &light.settings,
+                light: &page_light,
+                target_view: &view,
+                visible,
+                target: light.depth_target(),
+                unclipped: light.layout.depth_clamp,
+                start: DepthStart::Keep,
+                area: DepthArea::Tile(*tile),
+                culling: Some(LayerCulling { view: *view_culled, casters: Casters::All }),
+            };
+            let stats = self.record_depth_pass(rec.encoder, uploaded, &pass, None);
+            rec.stats.add(&stats);
+            work.commands += stats.shadow_commands;
+            work.texels += u64::from(page_size) * u64::from(page_size);
+        }
+        rec.layer_commands.add(light_index as usize, 0, work);
+        bracket(rec, slot, SlotPart::Closing);
+        rec.clock.end(&gpu, rec.encoder, slot);
+        texture
+    }
+
+    /// A virtual light's uniform and page table for the sampling passes.
+    pub(super) fn virtual_buffers(
+        pool: &mut Pool,
+        queue: &wgpu::Queue,
+        plan: &VirtualPlan,
+    ) -> VirtualBuffers {
+        VirtualBuffers {
+            uniform: pool.uniform(queue, "virtual map", &plan.uniform),
+            page_table: pool.storage(queue, "page table", &plan.table, wgpu::BufferUsages::empty()),
+        }
+    }
+}

@@ -1,0 +1,81 @@
+// Whether a sun's virtual map is unsure of a pixel: the footprint test of
+// refine_footprint.wgsl (the bilinear 2×2 and a ring of UNSURE_RING_TEXELS texels,
+// each stored depth against the receiver's plane there) on the level the pixel read,
+// each texel found through the page table. The map is orthographic, so the plane's
+// depth is affine in texels, with the slope the receiver's normal gives it in light
+// space.
+//
+// A texel that its own level's page does not hold (the pool was full and a coarser
+// page stands in, or no page holds it) says nothing exact: the pixel is unsure and
+// a ray decides, as past a 2D map's edge. Under a light with an area, the penumbrae
+// are not bounded here yet: every pixel is unsure, and rays decide them all.
+import package::passes::light_binding::light;
+import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, UNSURE_RING_TEXELS, block_evidence, receiver_bias};
+import package::variant::REFINE_PENUMBRAE;
+import package::virtual_map::page_lookup::{virtual_light_point, virtual_map, virtual_texel, virtual_texel_size};
+import package::virtual_map::virtual_visibility::virtual_offset_point;
+
+// The receiver's depth at the four texels of the block from texel (x, y), in
+// refine_footprint.wgsl's order ((x, y+1), (x+1, y+1), (x+1, y), (x, y)): its plane
+// through depth `depth` at continuous texel position `p`, `gradient` per texel.
+fn virtual_block_receiver(x: i32, y: i32, p: vec2<f32>, depth: f32, gradient: vec2<f32>) -> vec4<f32> {
+    let r = depth + dot(gradient, vec2<f32>(f32(x), f32(y)) - p);
+    return vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
+}
+
+// `layer` is the level the lookup read; `n` the normal it was offset along;
+// `geometric_n` gives the receiver's plane.
+fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
+    if REFINE_PENUMBRAE {
+        return true;
+    }
+    let level = layer;
+    let texel = virtual_texel_size(level);
+    let depth_range = virtual_map.far - virtual_map.near;
+    let point = virtual_light_point(virtual_offset_point(world, n, l, level));
+    // The plane a·x + b·y + c·z = const in light space (looking down −z, depth
+    // (−z − near) / range): depth changes by (a, b) / c / range per world unit.
+    let plane = (virtual_map.light_from_world * vec4<f32>(geometric_n, 0.0)).xyz;
+    if abs(plane.z) < 1e-6 {
+        // The receiver is seen edge-on from the light.
+        return true;
+    }
+    let gradient = plane.xy / plane.z * texel / depth_range;
+    let slope = abs(gradient.x) + abs(gradient.y);
+    // A texel's length along the light's ray, in depth.
+    let along_ray = texel / depth_range;
+    let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.bias.slope + 1.0) * slope;
+    let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), point.z);
+    // Texel (i, j) holds the depth at its centre, continuous position (i, j).
+    let p = point.xy / texel - vec2<f32>(0.5);
+    let base = vec2<i32>(floor(p));
+    // The surface itself, as far behind the lookup's plane as the offset moved it.
+    let surface_point = virtual_light_point(world);
+    let surface = surface_point.z + dot(gradient, surface_point.xy / texel - vec2<f32>(0.5) - p) - point.z;
+    let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
+    let bounds = FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing);
+    let first = base - vec2<i32>(UNSURE_RING_TEXELS);
+    let end = base + vec2<i32>(2 + UNSURE_RING_TEXELS);
+    var lit = false;
+    var shadowed = false;
+    for (var y = first.y; y < end.y; y += 2) {
+        for (var x = first.x; x < end.x; x += 2) {
+            let a = virtual_texel(level, vec2<i32>(x, y + 1));
+            let b = virtual_texel(level, vec2<i32>(x + 1, y + 1));
+            let c = virtual_texel(level, vec2<i32>(x + 1, y));
+            let d = virtual_texel(level, vec2<i32>(x, y));
+            if !(a.exact && b.exact && c.exact && d.exact) {
+                return true;
+            }
+            let stored = vec4<f32>(a.depth, b.depth, c.depth, d.depth);
+            let receiver = virtual_block_receiver(x, y, p, point.z, gradient);
+            let evidence = block_evidence(stored, receiver, all(vec2<i32>(x, y) == base), bounds);
+            if evidence.x {
+                return true;
+            }
+            lit = lit || evidence.y;
+            shadowed = shadowed || evidence.z;
+        }
+    }
+    return lit && shadowed;
+}

@@ -1,0 +1,47 @@
+//! A virtual shadow map's settings (`--partition virtual`, issue 53): the pool of
+//! page tiles the pages a frame reads are drawn into. The clipmap's shape (16384²
+//! levels in 128² pages) is `gnomon_math::virtual_map::ClipmapShape::DEFAULT`.
+
+use serde::{Deserialize, Serialize};
+
+use super::{SettingsError, ranges::SettingRange};
+
+/// The most page tiles per side of the pool: 64² tiles of 128² texels are one
+/// 8192² depth texture, 256 MiB.
+pub const MAX_POOL_SIDE: u32 = 64;
+
+/// `shadow.virtual_map.pool_side`'s range.
+pub const POOL_SIDE_RANGE: SettingRange =
+    SettingRange::closed("shadow.virtual_map.pool_side", 2.0, MAX_POOL_SIDE as f64, "tiles");
+
+/// A virtual shadow map (--partition virtual).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(struct_patch::Patch)]
+#[patch(attribute(derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)))]
+#[patch(attribute(serde(default, deny_unknown_fields)))]
+#[patch(attribute(allow(missing_docs)))]
+#[patch(attribute(
+    doc = "Overrides of [`VirtualMapSettings`], as a light's own shadow settings write them: each field as documented there, `None` to keep the value it is laid over."
+))]
+#[serde(default, deny_unknown_fields)]
+pub struct VirtualMapSettings {
+    /// Page tiles per side of the physical pool, one depth texture of (side · 128)²
+    /// texels. The default, 24² tiles of 128², holds 576 pages: 9.4 M texels, 0.56×
+    /// four 2048² cascades. When a frame asks for more pages than it holds, pixels
+    /// read a coarser resident page instead.
+    #[cfg_attr(feature = "cli", arg(long = "page-pool", value_name = "TILES", default_value_t = VirtualMapSettings::default().pool_side, help_heading = "Virtual map"))]
+    pub pool_side: u32,
+}
+
+impl Default for VirtualMapSettings {
+    fn default() -> Self {
+        Self { pool_side: 24 }
+    }
+}
+
+impl VirtualMapSettings {
+    pub(super) fn validate(&self) -> Result<(), SettingsError> {
+        POOL_SIDE_RANGE.check(self.pool_side)
+    }
+}
