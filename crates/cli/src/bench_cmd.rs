@@ -366,6 +366,14 @@ impl Bench<'_> {
         // drew into, in millions.
         let texels: u64 = cost.lights.iter().flat_map(|l| l.layer_texels.iter()).sum();
         series.push("shadow Mtexels", texels as f64 / 1e6);
+        // A virtual map's pages drawn, and what asking for them cost before the
+        // shadow passes (a camera prepass, the request pass, the wait).
+        let pages: Vec<_> = cost.lights.iter().filter_map(|l| l.pages).collect();
+        if !pages.is_empty() {
+            series.push("pages drawn", pages.iter().map(|p| f64::from(p.drawn)).sum());
+            series.push("pages refused", pages.iter().map(|p| f64::from(p.refused)).sum());
+            series.push("page requests (wall)", pages.iter().map(|p| p.request_ms).sum());
+        }
         // What the frame costs beyond its GPU work and the CPU's submission: resource
         // creation, stalls and readback waits. 1 means nothing is wasted.
         series.push("wall ÷ (GPU + CPU)", wall_ms / (timings.frame_ms + cost.cpu.submit_ms));

@@ -25,9 +25,11 @@ use crate::{
     virtual_map::{CameraDepth, PageRequests, PixelReach, PoolSize, VirtualMapGpu, VirtualPages},
 };
 
-/// Texels a pcf2x2 lookup reaches from its point besides its normal offset: its
-/// bilinear footprint's, and half a texel for the level chosen at a pixel's edge.
-const BILINEAR_REACH_TEXELS: f32 = 1.5;
+/// Texels a pcf2x2 lookup and its refinement's footprint test reach from the lookup's
+/// point: the bilinear 2×2 (texels from ⌊p − ½⌋ to one past it) and the test's ring
+/// around it, so up to 1.5 + ring texels, and half a texel more for a level chosen
+/// at a pixel's edge. (The normal offset's reach is added to it.)
+const LOOKUP_REACH_TEXELS: f32 = 2.0 + crate::rays::refine::UNSURE_RING_TEXELS as f32;
 
 /// Levels above each requested page of the coarser page asked for with it, so that a
 /// pool too small for the view still holds a page over every pixel: the pool grants
@@ -66,7 +68,7 @@ struct DrawnUnder {
 }
 
 /// A virtual map's pages in one frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PageStats {
     /// Pages asked for: those the pixels read, and a coarser page over each of
     /// them for their fallback.
@@ -85,6 +87,10 @@ pub struct PageStats {
     pub capacity: u32,
     /// Texels per side of a page.
     pub page_size: u32,
+    /// Wall-clock milliseconds from the camera prepass's recording to the requests'
+    /// arrival on the CPU: the prepass, the request pass and the wait for them, a
+    /// cost the shadow passes' time leaves out.
+    pub request_ms: f64,
 }
 
 /// A virtual light's frame, as decided before recording.
@@ -113,10 +119,15 @@ impl Renderer {
         let ShadowView::Parallel { travel } = light.shadow_view() else {
             unreachable!("the technique registry refuses a virtual map for a light other than a sun")
         };
+        let started = web_time::Instant::now();
         let gpu = self.gpu.clone();
         let (width, height) = (settings.image.width, settings.image.height);
         let aspect = width as f32 / height as f32;
-        let footprint_per_depth = 2.0 * (0.5 * camera.fov_y_degrees.to_radians()).tan() / height as f32;
+        // A pixel's footprint per unit of view depth, each level of bias halving the
+        // texels it reads (and so the level its footprint picks).
+        let lod_bias = settings.shadow.virtual_map.lod_bias;
+        let footprint_per_depth =
+            2.0 * (0.5 * camera.fov_y_degrees.to_radians()).tan() / height as f32 / (1u32 << lod_bias) as f32;
         // The farthest pixel the camera can see: at the scene's farthest corner.
         let farthest = uploaded.bounds.corners().iter().map(|c| c.distance(camera.eye)).fold(0.0, f32::max);
         let shape = ClipmapShape::DEFAULT;
@@ -124,7 +135,7 @@ impl Renderer {
             Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
         let reach = PixelReach {
             footprint_per_depth,
-            reach_texels: BILINEAR_REACH_TEXELS + settings.shadow.bias.normal_offset,
+            reach_texels: LOOKUP_REACH_TEXELS + settings.shadow.bias.normal_offset,
         };
         let clip_from_world = camera.clip_from_world(aspect);
         let depth = gpu.checked("drawing the camera's depth for a virtual map's pages", || {
@@ -140,6 +151,7 @@ impl Renderer {
         let camera_depth =
             CameraDepth { depth: &depth, clip_from_world, view_from_world: camera.view_from_world() };
         let mut requested = requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?;
+        let request_ms = started.elapsed().as_secs_f64() * 1e3;
         let fallbacks: Vec<_> = requested
             .iter()
             .map(|&page| {
@@ -193,6 +205,7 @@ impl Renderer {
             resident: kept.pages.resident() as u32,
             capacity: size.pages_per_side * size.pages_per_side,
             page_size: size.page_size,
+            request_ms,
         };
         Ok(VirtualPlan { clipmap, allocation, uniform, table, stats })
     }

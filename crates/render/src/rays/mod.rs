@@ -10,7 +10,7 @@ mod accel;
 mod bvh;
 mod forward;
 pub(crate) mod query;
-mod refine;
+pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};

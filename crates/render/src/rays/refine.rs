@@ -29,6 +29,9 @@ pub(crate) const COUNTER_STRIDE: u64 = 256;
 /// Bytes of one light's counters (`RefineCounters` in refine_list.wgsl): the three
 /// workgroup counts of the indirect dispatch, then the pixels listed.
 const COUNTER_BYTES: u64 = 16;
+/// Texels of the ring around a lookup's bilinear 2×2 that the footprint test reads
+/// (`refine_footprint.wgsl`): a virtual map's pixels ask for the pages it reaches.
+pub(crate) const UNSURE_RING_TEXELS: i32 = 2;
 /// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
 pub(crate) const PIXEL_BYTES: u64 = 8;
 

@@ -5,8 +5,7 @@ import package::passes::light_binding::light;
 import package::techniques::bindings::{shadow_gather, shadow_map};
 import package::variant::footprint_receiver;
 
-// Texels of ring around the bilinear footprint.
-const UNSURE_RING_TEXELS: i32 = 2;
+import package::constants::UNSURE_RING_TEXELS;
 // The depth band, in texel world sizes along the light's ray, inside which a stored
 // depth is too close to the receiver's to trust.
 const UNSURE_DEPTH_TEXELS: f32 = 2.0;

@@ -10,7 +10,8 @@
 // a ray decides, as past a 2D map's edge. Under a light with an area, the penumbrae
 // are not bounded here yet: every pixel is unsure, and rays decide them all.
 import package::passes::light_binding::light;
-import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, UNSURE_RING_TEXELS, block_evidence, receiver_bias};
+import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
+import package::constants::UNSURE_RING_TEXELS;
 import package::variant::REFINE_PENUMBRAE;
 import package::virtual_map::page_lookup::{virtual_light_point, virtual_map, virtual_texel, virtual_texel_size};
 import package::virtual_map::virtual_visibility::virtual_offset_point;

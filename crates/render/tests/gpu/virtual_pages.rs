@@ -108,9 +108,10 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
 /// stale, a still sun none, a turned one every page it reads; a pool too small for
 /// the view refuses pages, counts them, and their pixels read coarser pages.
 mod in_the_frame {
+    use glam::{Mat4, Vec3};
     use gnomon_render::{Frame, OutputRequest, PageStats, Renderer};
     use gnomon_scene::{
-        Settings, builtin,
+        Motion, Settings, builtin,
         settings::{Partition, Refine},
     };
 
@@ -173,5 +174,46 @@ mod in_the_frame {
         // shadows are still there, blurrier, not lost to lit pixels.
         let (sa, sf) = (shadowed(&ample), shadowed(&full));
         assert!(sa > 0.02 && sf > 0.5 * sa, "shadowed: {sa} with room, {sf} with 4 tiles");
+    }
+
+    /// Pixels whose visibility differs between two frames of one view.
+    fn differing(a: &Frame, b: &Frame) -> usize {
+        assert_eq!(a.visibility.len(), b.visibility.len());
+        a.visibility
+            .iter()
+            .zip(&b.visibility)
+            .filter(|(x, y)| (x.is_finite() || y.is_finite()) && x != y)
+            .count()
+    }
+
+    #[test]
+    fn a_moving_caster_redraws_only_the_pages_under_it_and_the_frame_matches_one_from_scratch() {
+        let mut scene = builtin::spheres();
+        let ball = scene.instances.iter().position(|i| i.name == "sphere 1,1").expect("a sphere");
+        scene.instances[ball].motion = Motion::Dynamic;
+        let s = virtual_sun(24);
+        let request = OutputRequest::default();
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let mut uploaded = renderer.upload(&scene).unwrap();
+        let first = pages(&renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap());
+        assert_eq!(first.drawn, first.requested, "{first:?}");
+
+        scene.instances[ball].world_from_object *= Mat4::from_translation(Vec3::new(0.7, 0.3, -0.4));
+        renderer.move_instances(&mut uploaded, &scene, &[ball]).unwrap();
+        let moved = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let p = pages(&moved);
+        // The pages under the ball, where it was and where it is, and no others.
+        assert!(p.drawn > 0 && p.drawn < p.requested / 2, "{p:?}");
+        assert_eq!(p.drawn + p.kept, p.requested, "{p:?}");
+        let scratch = Renderer::new(support::gpu()).unwrap().render(&scene, &s, &request).unwrap();
+        assert_eq!(differing(&moved, &scratch), 0, "the kept and redrawn pages shade as pages drawn afresh");
+        // Without the redraw the ball's old shadow would stay: the frame before the
+        // move differs from this one.
+        let before = {
+            let mut still = builtin::spheres();
+            still.instances[ball].motion = Motion::Dynamic;
+            Renderer::new(support::gpu()).unwrap().render(&still, &s, &request).unwrap()
+        };
+        assert!(differing(&before, &moved) > 50, "the move should change the shadows");
     }
 }

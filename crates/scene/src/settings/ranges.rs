@@ -147,6 +147,7 @@ pub static ALL: &[&SettingRange] = &[
     &super::CSM_OFFSET_RANGE,
     &super::RESOLUTION_RANGE,
     &super::POOL_SIDE_RANGE,
+    &super::LOD_BIAS_RANGE,
     &super::CASCADE_COUNT_RANGE,
     &super::SPLIT_LAMBDA_RANGE,
     &super::CASCADE_BLEND_RANGE,

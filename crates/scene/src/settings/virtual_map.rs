@@ -10,6 +10,14 @@ use super::{SettingsError, ranges::SettingRange};
 /// 8192² depth texture, 256 MiB.
 pub const MAX_POOL_SIDE: u32 = 64;
 
+/// The most levels finer than a pixel's footprint a virtual map may read: 2 draws
+/// texels a quarter of a pixel wide, 16× the pages.
+pub const MAX_LOD_BIAS: u32 = 2;
+
+/// `shadow.virtual_map.lod_bias`'s range.
+pub const LOD_BIAS_RANGE: SettingRange =
+    SettingRange::closed("shadow.virtual_map.lod_bias", 0.0, MAX_LOD_BIAS as f64, "levels");
+
 /// `shadow.virtual_map.pool_side`'s range.
 pub const POOL_SIDE_RANGE: SettingRange =
     SettingRange::closed("shadow.virtual_map.pool_side", 2.0, MAX_POOL_SIDE as f64, "tiles");
@@ -32,16 +40,23 @@ pub struct VirtualMapSettings {
     /// read a coarser resident page instead.
     #[cfg_attr(feature = "cli", arg(long = "page-pool", value_name = "TILES", default_value_t = VirtualMapSettings::default().pool_side, help_heading = "Virtual map"))]
     pub pool_side: u32,
+    /// Levels finer than a pixel's footprint that its lookup reads: 0 reads texels
+    /// as large as the footprint (half to one pixel), 1 texels half as large, for 4×
+    /// the pages. Finer texels narrow the bands along shadow edges where the map is
+    /// unsure, so rays decide fewer pixels.
+    #[cfg_attr(feature = "cli", arg(long = "page-lod-bias", value_name = "LEVELS", default_value_t = VirtualMapSettings::default().lod_bias, help_heading = "Virtual map"))]
+    pub lod_bias: u32,
 }
 
 impl Default for VirtualMapSettings {
     fn default() -> Self {
-        Self { pool_side: 24 }
+        Self { pool_side: 24, lod_bias: 0 }
     }
 }
 
 impl VirtualMapSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
-        POOL_SIDE_RANGE.check(self.pool_side)
+        POOL_SIDE_RANGE.check(self.pool_side)?;
+        LOD_BIAS_RANGE.check(self.lod_bias)
     }
 }
