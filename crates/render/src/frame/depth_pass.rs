@@ -29,6 +29,7 @@ use crate::{
 };
 
 /// One depth-only pass: a shadow-map layer, or SDSM's camera prepass.
+#[derive(Clone)]
 pub(super) struct DepthPass<'a> {
     pub settings: &'a Settings,
     /// The uniform whose `clip_from_world` projects the geometry.
@@ -153,7 +154,7 @@ impl DepthStart {
 /// What a run of draws in a depth pass shares: the scissor, the pipeline and, for
 /// alpha-masked casters, the material texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct DrawState {
+pub(super) struct DrawState {
     rect: Option<ScissorRect>,
     key: ShadowPipelineKey,
     /// The material group an alpha-masked caster samples; None for opaque ones.
@@ -189,14 +190,14 @@ impl DepthArea {
 /// Sets what each draw of a depth pass needs as it changes: the scissor, the
 /// pipeline with its vertex stream, and an alpha-masked caster's material.
 #[derive(Default)]
-struct StateChanges {
+pub(super) struct StateChanges {
     current: Option<DrawState>,
     stream: Option<VertexStream>,
 }
 
 impl StateChanges {
     /// Moves `pass` to `state`, counting the changes in `stats`.
-    fn apply(
+    pub(super) fn apply(
         &mut self,
         pass: &mut wgpu::RenderPass<'_>,
         pipelines: (&mut ShadowPass, &wgpu::Device),
@@ -230,7 +231,7 @@ impl StateChanges {
 
 /// A pass's draws bucketed by their state, buckets in order of first appearance
 /// (within each scissor rectangle, in the order of the rectangles).
-fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec<&'a Run>)> {
+pub(super) fn buckets<'a>(uploaded: &GpuScene, depth: &'a DepthPass) -> Vec<(DrawState, Vec<&'a Run>)> {
     let mut buckets: Vec<(DrawState, Vec<&Run>)> = Vec::new();
     for rect in depth.area.rects() {
         for run in &depth.visible.runs {

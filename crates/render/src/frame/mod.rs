@@ -21,6 +21,7 @@ mod recording;
 mod refine;
 mod screen;
 mod shadow_maps;
+mod tile_pass;
 mod virtual_pages;
 mod virtual_record;
 

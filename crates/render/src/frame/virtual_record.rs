@@ -5,16 +5,18 @@ use super::{
     Renderer,
     bindings::VirtualBuffers,
     cull::layer_view,
-    depth_pass::{Casters, DepthArea, DepthPass, DepthStart, LayerCulling, ScissorRect},
+    depth_pass::{DepthArea, DepthPass, DepthStart, ScissorRect},
     plan::LightPlan,
     recording::{LayerWork, Recording},
     shadow_maps::bracket,
+    tile_pass::{Tile, TilePass},
     virtual_pages::VirtualPlan,
 };
 use crate::{
     GpuScene,
     pool::{Pool, ViewKey},
     timing::{PassKind, SlotPart},
+    uniforms::LightGpu,
 };
 
 impl Renderer {
@@ -52,29 +54,39 @@ impl Renderer {
             .iter()
             .map(|grant| layer_view(light, plan.clipmap.page_clip_from_world(grant.page)))
             .collect();
+        // Culled on the CPU, cluster by cluster where the settings say so, against
+        // each page alone: one pass for every page needs every page's draws before it.
         let seen = uploaded.cull(&views);
-        let mut work = LayerWork::default();
-        for ((grant, tile), (view_culled, visible)) in drawn.iter().zip(&tiles).zip(views.iter().zip(&seen)) {
-            let page_light = crate::uniforms::LightGpu {
-                clip_from_world: plan.clipmap.page_clip_from_world(grant.page),
-                ..light.light_gpu
-            };
-            let pass = DepthPass {
-                settings: &light.settings,
-                light: &page_light,
-                target_view: &view,
+        let like = DepthPass {
+            settings: &light.settings,
+            light: &light.light_gpu,
+            target_view: &view,
+            visible: &seen[0],
+            target: light.depth_target(),
+            unclipped: light.layout.depth_clamp,
+            start: DepthStart::Keep,
+            area: DepthArea::Whole,
+            culling: None,
+        };
+        let page_tiles = drawn
+            .iter()
+            .zip(&tiles)
+            .zip(&seen)
+            .map(|((grant, rect), visible)| Tile {
+                rect: *rect,
+                light: LightGpu {
+                    clip_from_world: plan.clipmap.page_clip_from_world(grant.page),
+                    ..light.light_gpu
+                },
                 visible,
-                target: light.depth_target(),
-                unclipped: light.layout.depth_clamp,
-                start: DepthStart::Keep,
-                area: DepthArea::Tile(*tile),
-                culling: Some(LayerCulling { view: *view_culled, casters: Casters::All }),
-            };
-            let stats = self.record_depth_pass(rec.encoder, uploaded, &pass, None);
-            rec.stats.add(&stats);
-            work.commands += stats.shadow_commands;
-            work.texels += u64::from(page_size) * u64::from(page_size);
-        }
+            })
+            .collect();
+        let stats = self.record_tile_pass(rec.encoder, uploaded, &TilePass { like, tiles: page_tiles });
+        rec.stats.add(&stats);
+        let work = LayerWork {
+            commands: stats.shadow_commands,
+            texels: drawn.len() as u64 * u64::from(page_size) * u64::from(page_size),
+        };
         rec.layer_commands.add(light_index as usize, 0, work);
         bracket(rec, slot, SlotPart::Closing);
         rec.clock.end(&gpu, rec.encoder, slot);
