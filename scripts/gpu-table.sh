@@ -25,7 +25,10 @@
 #   6. a moving sun (`bench --sun-path day`, nothing kept) against a still one, kept
 #      maps and none, on Sponza from the Bevy view: the shadow passes' time and the
 #      texels they rasterize per frame (issue 53's baseline for virtual maps);
-#   7. `lamps:N`: lighting per light with the light list.
+#   7. `lamps:N`: lighting per light with the light list;
+#   8. virtual maps against cascades (`scripts/virtual-vs-cascades.sh`, its own
+#      limit of VIRTUAL_SECONDS, default 240): error, traced share, moving and
+#      still sun at the three views of issue 53.
 set -u
 gnomon=${1:-target/release/gnomon}
 shared=${2:-../shared/scenes}
@@ -192,4 +195,14 @@ for n in 1 8 32 64; do
     --sweep lighting=light-list,per-light --out "$out/lamps-$n"
   bench_md "lamps-$n"
 done
+
+echo "## 8. Virtual map against cascades" >> "$md"
+if [ "$(date +%s)" -lt "$deadline" ]; then
+  timeout "${VIRTUAL_SECONDS:-240}" sh "$(dirname "$0")/virtual-vs-cascades.sh" "$gnomon" "$shared" "$out/virtual" \
+    > "$out/virtual.log" 2>&1
+  echo "exit $?" >> "$md"
+  cat "$out/virtual/virtual-vs-cascades.md" >> "$md" 2>/dev/null
+else
+  printf 'skipped: the run is out of time.\n\n' >> "$md"
+fi
 echo "done: $md"

@@ -216,19 +216,41 @@ impl PagePool {
     /// after level and row after row from each level's first page, where its texels
     /// are, resolved to a coarser resident page where it is not resident itself
     /// ([`PagePool::resolve`]). What the sampling shaders read.
+    ///
+    /// Built in one sweep from the coarsest level down, each entry that holds no page
+    /// taking its parent's one level further up (each level's window lies inside the
+    /// next one's, so a page's parent is in the table): linear in the table's size,
+    /// where resolving each entry alone walked up the levels through the pool's map.
     pub fn page_table(&self, clipmap: &super::Clipmap) -> Vec<TableEntry> {
         let shape = clipmap.shape;
         let side = shape.pages_per_side() as i32;
-        let mut table = Vec::with_capacity((shape.levels as usize) * (side * side) as usize);
-        for (level, origin) in clipmap.origins.iter().enumerate() {
+        let per_level = (side * side) as usize;
+        let levels = clipmap.origins.len();
+        let mut table = vec![TableEntry::EMPTY; levels * per_level];
+        let index = |page: PageKey| -> Option<usize> {
+            let origin = clipmap.origins.get(page.level as usize)?;
+            let (x, y) = (page.x - origin.x, page.y - origin.y);
+            ((0..side).contains(&x) && (0..side).contains(&y))
+                .then(|| page.level as usize * per_level + (y * side + x) as usize)
+        };
+        for (&page, &slot) in &self.resident {
+            if let Some(i) = index(page) {
+                table[i] = TableEntry::new(slot, 0);
+            }
+        }
+        for level in (0..levels.saturating_sub(1)).rev() {
+            let origin = clipmap.origins[level];
             for y in 0..side {
                 for x in 0..side {
+                    let i = level * per_level + (y * side + x) as usize;
+                    if table[i] != TableEntry::EMPTY {
+                        continue;
+                    }
                     let page = PageKey { level: level as u32, x: origin.x + x, y: origin.y + y };
-                    let entry = match self.resolve(page, shape.levels) {
-                        Some((found, slot)) => TableEntry::new(slot, found.level - page.level),
-                        None => TableEntry::EMPTY,
-                    };
-                    table.push(entry);
+                    let parent = index(page.coarser()).and_then(|p| table[p].get());
+                    if let Some((slot, coarser)) = parent {
+                        table[i] = TableEntry::new(slot, coarser + 1);
+                    }
                 }
             }
         }
@@ -405,5 +427,43 @@ mod tests {
         let valid = table.iter().filter(|e| e.get().is_some()).count();
         // The coarse page (level 2) covers 4×4 pages of level 0 and 2×2 of level 1.
         assert_eq!(valid, 16 + 4 + 1);
+    }
+
+    /// The sweep that builds the table gives every entry what resolving it alone
+    /// gives, for pools filled at random over a moving window.
+    #[test]
+    fn the_page_table_resolves_each_entry_as_resolve_does() {
+        use glam::Vec3;
+        let shape = super::super::ClipmapShape { virtual_resolution: 2048, page_size: 128, levels: 5 };
+        let bounds = crate::Aabb::new(Vec3::splat(-40.0), Vec3::splat(40.0));
+        let mut rng = Lcg(11);
+        let mut pool = PagePool::new(40);
+        for step in 0..6 {
+            let camera = Vec3::new(3.0 * step as f32, 0.0, -2.0 * step as f32);
+            let clipmap = super::super::Clipmap::new(shape, Vec3::new(0.3, -1.0, 0.2), camera, &bounds, 0.4);
+            let side = shape.pages_per_side() as i32;
+            let requests: Vec<PageKey> = (0..60)
+                .map(|_| {
+                    let level = (rng.next() * shape.levels as f32) as u32 % shape.levels;
+                    let o = clipmap.origins[level as usize];
+                    let (x, y) = ((rng.next() * side as f32) as i32, (rng.next() * side as f32) as i32);
+                    page(level, o.x + x.min(side - 1), o.y + y.min(side - 1))
+                })
+                .collect();
+            pool.allocate(&requests);
+            let table = pool.page_table(&clipmap);
+            let mut i = 0;
+            for (level, o) in clipmap.origins.iter().enumerate() {
+                for y in 0..side {
+                    for x in 0..side {
+                        let p = page(level as u32, o.x + x, o.y + y);
+                        let resolved =
+                            pool.resolve(p, shape.levels).map(|(found, slot)| (slot, found.level - p.level));
+                        assert_eq!(table[i].get(), resolved, "step {step}, {p:?}");
+                        i += 1;
+                    }
+                }
+            }
+        }
     }
 }

@@ -13,7 +13,7 @@ import package::passes::light_binding::light;
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
 import package::constants::UNSURE_RING_TEXELS;
 import package::variant::REFINE_PENUMBRAE;
-import package::virtual_map::page_lookup::{virtual_light_point, virtual_map, virtual_texel, virtual_texel_size};
+import package::virtual_map::page_lookup::{VirtualTexel, virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel, virtual_texel_size, virtual_tile_depth};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
 // The receiver's depth at the four texels of the block from texel (x, y), in
@@ -22,6 +22,16 @@ import package::virtual_map::virtual_visibility::virtual_offset_point;
 fn virtual_block_receiver(x: i32, y: i32, p: vec2<f32>, depth: f32, gradient: vec2<f32>) -> vec4<f32> {
     let r = depth + dot(gradient, vec2<f32>(f32(x), f32(y)) - p);
     return vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
+}
+
+// Texel `texel` of `level`: from `tile` where its z is 1 (the footprint lies in one
+// page, resident at its own level: no table read per texel), through the table
+// otherwise.
+fn footprint_texel(level: u32, texel: vec2<i32>, tile: vec3<i32>) -> VirtualTexel {
+    if tile.z == 1 {
+        return VirtualTexel(virtual_tile_depth(tile.xy, texel), true);
+    }
+    return virtual_texel(level, texel);
 }
 
 // `layer` is the level the lookup read; `n` the normal it was offset along;
@@ -57,14 +67,25 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     let bounds = FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing);
     let first = base - vec2<i32>(UNSURE_RING_TEXELS);
     let end = base + vec2<i32>(2 + UNSURE_RING_TEXELS);
+    // Most footprints lie in one page: its tile, read from the table once.
+    let size = f32(virtual_map.page_texels);
+    let first_page = vec2<i32>(floor(vec2<f32>(first) / size));
+    let last_page = vec2<i32>(floor(vec2<f32>(end - vec2<i32>(1)) / size));
+    var tile = vec3<i32>(0);
+    if all(first_page == last_page) {
+        tile = virtual_exact_tile(level, first_page);
+        if tile.z == 0 {
+            return true;
+        }
+    }
     var lit = false;
     var shadowed = false;
     for (var y = first.y; y < end.y; y += 2) {
         for (var x = first.x; x < end.x; x += 2) {
-            let a = virtual_texel(level, vec2<i32>(x, y + 1));
-            let b = virtual_texel(level, vec2<i32>(x + 1, y + 1));
-            let c = virtual_texel(level, vec2<i32>(x + 1, y));
-            let d = virtual_texel(level, vec2<i32>(x, y));
+            let a = footprint_texel(level, vec2<i32>(x, y + 1), tile);
+            let b = footprint_texel(level, vec2<i32>(x + 1, y + 1), tile);
+            let c = footprint_texel(level, vec2<i32>(x + 1, y), tile);
+            let d = footprint_texel(level, vec2<i32>(x, y), tile);
             if !(a.exact && b.exact && c.exact && d.exact) {
                 return true;
             }

@@ -89,6 +89,33 @@ fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     return VirtualTexel(depth, coarser == 0u);
 }
 
+// Where page `page` of `level` (in pages from the light-space origin) lies in the
+// pool when its own level's page is resident: its tile's first texel in xy and 1 in
+// z; z is 0 where a coarser page stands in for it, or none.
+fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec3<i32> {
+    let side = i32(virtual_map.pages_per_side);
+    let relative = page - virtual_origin(level);
+    if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
+        return vec3<i32>(0);
+    }
+    let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
+    if ((entry & 0x80000000u) == 0u || ((entry >> 24u) & 0xfu) != 0u) {
+        return vec3<i32>(0);
+    }
+    let slot = i32(entry & 0xffffffu);
+    let pool = i32(virtual_map.pool_pages_per_side);
+    let size = i32(virtual_map.page_texels);
+    return vec3<i32>(vec2<i32>(slot % pool, slot / pool) * size, 1);
+}
+
+// The depth of texel `texel` (of a level, y up) from its page's tile at `tile` (the
+// xy of [`virtual_exact_tile`]), without the table.
+fn virtual_tile_depth(tile: vec2<i32>, texel: vec2<i32>) -> f32 {
+    let size = i32(virtual_map.page_texels);
+    let within = texel - vec2<i32>(floor(vec2<f32>(texel) / f32(size))) * size;
+    return textureLoad(shadow_map, tile + vec2<i32>(within.x, size - 1 - within.y), 0, 0);
+}
+
 // The stored depth of texel `texel` of `level` ([`virtual_texel`]'s).
 fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
     return virtual_texel(level, texel).depth;
