@@ -129,8 +129,12 @@ impl LightPlan {
 
     /// Its map's resolution: the settings', or one texel where the technique is rays
     /// and reads no map (`techniques/raytraced.rs`), which keeps its bindings valid
-    /// without holding `resolution`² texels per layer for nothing.
+    /// without holding `resolution`² texels per layer for nothing; a virtual map's
+    /// pool of page tiles, which is what its map texture is.
     pub fn map_resolution(&self) -> u32 {
+        if let Some(pages) = &self.virtual_map {
+            return pages.uniform.pool_pages_per_side * pages.uniform.page_texels;
+        }
         match self.technique.rays() {
             RayUse::AsSettingsSay => self.settings.shadow.map.resolution,
             RayUse::EveryPixel => 1,

@@ -15,7 +15,7 @@
 use glam::Mat4;
 use gnomon_math::{
     Aabb,
-    virtual_map::{Clipmap, ClipmapShape, pages::FrameAllocation},
+    virtual_map::{Clipmap, ClipmapShape, PageKey, pages::FrameAllocation},
 };
 use gnomon_scene::{Camera, Light, Settings, lights::ShadowView, settings::BiasSettings};
 
@@ -150,21 +150,11 @@ impl Renderer {
         let requests = self.virtual_lights.requests.as_mut().expect("made above");
         let camera_depth =
             CameraDepth { depth: &depth, clip_from_world, view_from_world: camera.view_from_world() };
-        let mut requested = requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?;
+        let requested = with_fallbacks(
+            requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?,
+            shape.levels,
+        );
         let request_ms = started.elapsed().as_secs_f64() * 1e3;
-        let fallbacks: Vec<_> = requested
-            .iter()
-            .map(|&page| {
-                let mut coarse = page;
-                while coarse.level < (page.level + FALLBACK_LEVELS).min(shape.levels - 1) {
-                    coarse = coarse.coarser();
-                }
-                coarse
-            })
-            .collect();
-        requested.extend(fallbacks);
-        requested.sort_unstable();
-        requested.dedup();
         let size =
             PoolSize { page_size: shape.page_size, pages_per_side: settings.shadow.virtual_map.pool_side };
         let kept = self.virtual_lights.kept_for(&gpu, index, size)?;
@@ -177,22 +167,7 @@ impl Renderer {
             bias: settings.shadow.bias.clone(),
             still_generation: uploaded.still_generation,
         };
-        if kept.drawn_under.as_ref() != Some(&under) {
-            kept.pages.invalidate_all();
-        }
-        kept.drawn_under = Some(under);
-        // A moving caster's shadow changes the pages under it, where it was and
-        // where it is.
-        let moving = uploaded.moving_caster_bounds();
-        let stale: Vec<_> = moving
-            .iter()
-            .chain(&kept.moving_before)
-            .flat_map(|bounds| (0..shape.levels).filter_map(|level| clipmap.pages_under(level, bounds)))
-            .collect();
-        if !stale.is_empty() {
-            kept.pages.invalidate(|page| stale.iter().any(|rect| rect.contains(page)));
-        }
-        kept.moving_before = moving;
+        kept.mark_stale(under, &clipmap, uploaded.moving_caster_bounds());
         let allocation = kept.pages.allocate(&requested);
         let table = kept.pages.page_table(&clipmap).iter().map(|entry| entry.0).collect();
         let uniform = VirtualMapGpu::new(&clipmap, size.pages_per_side, footprint_per_depth);
@@ -208,6 +183,47 @@ impl Renderer {
             request_ms,
         };
         Ok(VirtualPlan { clipmap, allocation, uniform, table, stats })
+    }
+}
+
+/// `requested` with each page's ancestor [`FALLBACK_LEVELS`] levels up (or at the
+/// coarsest of `levels`), each page once, in order.
+fn with_fallbacks(mut requested: Vec<PageKey>, levels: u32) -> Vec<PageKey> {
+    let fallbacks: Vec<_> = requested
+        .iter()
+        .map(|&page| {
+            let mut coarse = page;
+            while coarse.level < (page.level + FALLBACK_LEVELS).min(levels - 1) {
+                coarse = coarse.coarser();
+            }
+            coarse
+        })
+        .collect();
+    requested.extend(fallbacks);
+    requested.sort_unstable();
+    requested.dedup();
+    requested
+}
+
+impl KeptPages {
+    /// Marks stale every resident page when what they were drawn under changed
+    /// (`under`), and those under a moving caster (bounds `moving`), where it was
+    /// and where it is.
+    fn mark_stale(&mut self, under: DrawnUnder, clipmap: &Clipmap, moving: Vec<Aabb>) {
+        if self.drawn_under.as_ref() != Some(&under) {
+            self.pages.invalidate_all();
+        }
+        self.drawn_under = Some(under);
+        let levels = clipmap.shape.levels;
+        let stale: Vec<_> = moving
+            .iter()
+            .chain(&self.moving_before)
+            .flat_map(|bounds| (0..levels).filter_map(|level| clipmap.pages_under(level, bounds)))
+            .collect();
+        if !stale.is_empty() {
+            self.pages.invalidate(|page| stale.iter().any(|rect| rect.contains(page)));
+        }
+        self.moving_before = moving;
     }
 }
 
