@@ -168,6 +168,14 @@ impl PagePool {
         allocation
     }
 
+    /// Whether, after `allocation` (this frame's), every resident page is drawn this
+    /// frame or stale: then nothing in the pool is worth keeping, and its whole
+    /// texture may be cleared before the frame's draws (a turned light's frames).
+    pub fn keeps_nothing(&self, allocation: &FrameAllocation) -> bool {
+        allocation.granted.iter().all(|g| g.state != PageState::Kept)
+            && self.slots.iter().all(|s| s.page.is_none() || s.stale || s.last_used == self.frame)
+    }
+
     /// The page a pixel that asked for `page` reads: the page itself if resident,
     /// else the finest coarser page over the same point that is, up to level
     /// `levels − 1`; None when none is.
@@ -465,5 +473,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_pool_keeps_nothing_only_when_every_resident_page_is_drawn_or_stale() {
+        let mut pool = PagePool::new(4);
+        let (a, b, c) = (page(0, 0, 0), page(0, 1, 0), page(1, 0, 0));
+        assert!(pool.keeps_nothing(&pool.clone().allocate(&[a, b])), "a first frame draws every page");
+        pool.allocate(&[a, b]);
+        // A still frame keeps both.
+        let still = pool.allocate(&[a, b]);
+        assert!(!pool.keeps_nothing(&still));
+        // A page not asked for, still valid, must survive: nothing may be cleared.
+        let other = pool.allocate(&[c]);
+        assert!(!pool.keeps_nothing(&other), "a and b are resident, valid, and not drawn");
+        // The light turns: every page is stale, those asked for drawn again.
+        pool.invalidate_all();
+        let turned = pool.allocate(&[a]);
+        assert!(turned.granted.iter().all(|g| g.state == PageState::Dirty));
+        assert!(pool.keeps_nothing(&turned), "b and c are stale");
     }
 }

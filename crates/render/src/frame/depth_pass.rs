@@ -143,7 +143,7 @@ pub(super) enum DepthStart {
 }
 
 impl DepthStart {
-    fn load(self) -> wgpu::LoadOp<f32> {
+    pub(super) fn load(self) -> wgpu::LoadOp<f32> {
         match self {
             DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
             DepthStart::Keep => wgpu::LoadOp::Load,

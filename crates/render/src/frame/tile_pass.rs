@@ -28,7 +28,8 @@ pub(super) struct Tile<'a> {
     pub visible: &'a Visible,
 }
 
-/// Tiles of one target drawn in one pass, over what the target holds.
+/// Tiles of one target drawn in one pass, over what the target holds or over the
+/// far plane (`like.start`).
 pub(super) struct TilePass<'a> {
     /// Each tile's draws are those of this pass with the tile's light, casters and
     /// area (`DepthArea::Tile`).
@@ -83,7 +84,7 @@ impl Renderer {
         });
         let mut stats = DrawStats::default();
         let mut pass =
-            begin_depth_pass(encoder, "shadow tiles", tiles.like.target_view, wgpu::LoadOp::Load, None);
+            begin_depth_pass(encoder, "shadow tiles", tiles.like.target_view, tiles.like.start.load(), None);
         let mut changes = StateChanges::default();
         let mut first_argument = 0u64;
         for ((tile, group), buckets) in tiles.tiles.iter().zip(&groups).zip(&tile_buckets) {

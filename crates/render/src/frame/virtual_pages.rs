@@ -102,6 +102,10 @@ pub(crate) struct VirtualPlan {
     pub uniform: VirtualMapGpu,
     /// The page table's words (`TableEntry`).
     pub table: Vec<u32>,
+    /// Whether the pool keeps nothing this frame (every resident page drawn or
+    /// stale): its draws may start from a cleared texture instead of tiles cleared
+    /// one by one ([`gnomon_math::virtual_map::pages::PagePool::keeps_nothing`]).
+    pub clear_whole: bool,
     pub stats: PageStats,
 }
 
@@ -169,6 +173,7 @@ impl Renderer {
         };
         kept.mark_stale(under, &clipmap, uploaded.moving_caster_bounds());
         let allocation = kept.pages.allocate(&requested);
+        let clear_whole = kept.pages.keeps_nothing(&allocation);
         let table = kept.pages.page_table(&clipmap).iter().map(|entry| entry.0).collect();
         let uniform = VirtualMapGpu::new(&clipmap, size.pages_per_side, footprint_per_depth);
         let drawn = allocation.to_draw().count() as u32;
@@ -182,7 +187,7 @@ impl Renderer {
             page_size: size.page_size,
             request_ms,
         };
-        Ok(VirtualPlan { clipmap, allocation, uniform, table, stats })
+        Ok(VirtualPlan { clipmap, allocation, uniform, table, clear_whole, stats })
     }
 }
 

@@ -48,8 +48,15 @@ impl Renderer {
         let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Shadow, Some(light_index), Some(0));
         bracket(rec, slot, SlotPart::Opening);
         let view = self.pool.view(&texture, ViewKey::default());
-        let pages = self.virtual_lights.pages(light_index as usize);
-        pages.record_tile_clears(rec.encoder, &view, &tiles);
+        // A frame that keeps no page (the light turned) clears the pool whole, by its
+        // pass's load: a texture cleared so lets the GPU reject hidden fragments
+        // early, where one cleared tile by tile by a draw may not.
+        let start = if plan.clear_whole {
+            DepthStart::Clear
+        } else {
+            self.virtual_lights.pages(light_index as usize).record_tile_clears(rec.encoder, &view, &tiles);
+            DepthStart::Keep
+        };
         let views: Vec<_> = drawn
             .iter()
             .map(|grant| layer_view(light, plan.clipmap.page_clip_from_world(grant.page)))
@@ -64,7 +71,7 @@ impl Renderer {
             visible: &seen[0],
             target: light.depth_target(),
             unclipped: light.layout.depth_clamp,
-            start: DepthStart::Keep,
+            start,
             area: DepthArea::Whole,
             culling: None,
         };
@@ -83,10 +90,12 @@ impl Renderer {
             .collect();
         let stats = self.record_tile_pass(rec.encoder, uploaded, &TilePass { like, tiles: page_tiles });
         rec.stats.add(&stats);
-        let work = LayerWork {
-            commands: stats.shadow_commands,
-            texels: drawn.len() as u64 * u64::from(page_size) * u64::from(page_size),
+        // The texels cleared or drawn: the whole pool where it was cleared whole.
+        let texels = match start {
+            DepthStart::Clear => u64::from(texture.width()) * u64::from(texture.height()),
+            DepthStart::Keep => drawn.len() as u64 * u64::from(page_size) * u64::from(page_size),
         };
+        let work = LayerWork { commands: stats.shadow_commands, texels };
         rec.layer_commands.add(light_index as usize, 0, work);
         bracket(rec, slot, SlotPart::Closing);
         rec.clock.end(&gpu, rec.encoder, slot);

@@ -140,6 +140,12 @@ impl VirtualPages {
         self.pages.allocate(requests)
     }
 
+    /// Whether, after `allocation`, every resident page is drawn this frame or stale
+    /// ([`PagePool::keeps_nothing`]).
+    pub(crate) fn keeps_nothing(&self, allocation: &FrameAllocation) -> bool {
+        self.pages.keeps_nothing(allocation)
+    }
+
     /// Records one pass that clears each of `tiles` of the pool (seen through
     /// `view`) to the far plane.
     pub(crate) fn record_tile_clears(

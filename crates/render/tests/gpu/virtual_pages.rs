@@ -145,7 +145,8 @@ mod in_the_frame {
         let first = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
         let p = pages(&first);
         assert!(p.requested > 10 && p.drawn == p.requested && p.refused == 0, "{p:?}");
-        assert_eq!(first.lights[0].layer_texels, vec![u64::from(p.drawn) * 128 * 128]);
+        // A first frame keeps nothing: the pool is cleared whole, and its texels counted.
+        assert_eq!(first.lights[0].layer_texels, vec![(24 * 128u64).pow(2)]);
         let still = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
         let p = pages(&still);
         assert_eq!((p.drawn, p.kept), (0, p.requested), "{p:?}");
@@ -202,8 +203,10 @@ mod in_the_frame {
         renderer.move_instances(&mut uploaded, &scene, &[ball]).unwrap();
         let moved = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
         let p = pages(&moved);
-        // The pages under the ball, where it was and where it is, and no others.
+        // The pages under the ball, where it was and where it is, and no others,
+        // each cleared and drawn alone: the kept pages must stay.
         assert!(p.drawn > 0 && p.drawn < p.requested / 2, "{p:?}");
+        assert_eq!(moved.lights[0].layer_texels, vec![u64::from(p.drawn) * 128 * 128]);
         assert_eq!(p.drawn + p.kept, p.requested, "{p:?}");
         let scratch = Renderer::new(support::gpu()).unwrap().render(&scene, &s, &request).unwrap();
         assert_eq!(differing(&moved, &scratch), 0, "the kept and redrawn pages shade as pages drawn afresh");
