@@ -371,6 +371,7 @@ impl Bench<'_> {
         let pages: Vec<_> = cost.lights.iter().filter_map(|l| l.pages).collect();
         if !pages.is_empty() {
             series.push("pages drawn", pages.iter().map(|p| f64::from(p.drawn)).sum());
+            series.push("page runs drawn", pages.iter().map(|p| f64::from(p.runs)).sum());
             series.push("pages refused", pages.iter().map(|p| f64::from(p.refused)).sum());
             series.push("page requests (wall)", pages.iter().map(|p| p.request_ms).sum());
         }

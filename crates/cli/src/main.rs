@@ -129,6 +129,9 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
     let render = e.chain().find_map(|cause| cause.downcast_ref::<RenderError>())?;
     match render {
         RenderError::ShadowMapTooLarge { requested, .. } => Some(format!("--shadow-res = {requested}: ")),
+        RenderError::PagePoolTooLarge { pages_per_side, .. } => {
+            Some(format!("--page-pool {pages_per_side}: "))
+        }
         RenderError::MomentFormatUnsupported { .. } => Some("--moment-format rgba32float: ".into()),
         RenderError::RaysUnavailable(_) => Some("--refine: ".into()),
         RenderError::RayQueriesUnavailable(_) => Some("--tracer ray-query: ".into()),

@@ -338,8 +338,9 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
     )
 }
 
-/// `--verbose`'s line on a virtual map's pages: drawn, kept and refused (whose pixels
-/// fell back to a coarser page), and the pool.
+/// `--verbose`'s line on a virtual map's pages: drawn (and in how many runs of
+/// neighbours), kept and refused (whose pixels fell back to a coarser page), and the
+/// pool.
 pub(crate) fn pages_line(index: usize, pages: &gnomon_render::PageStats) -> String {
     let texels = u64::from(pages.drawn) * u64::from(pages.page_size).pow(2);
     let fallback = match pages.refused {
@@ -347,10 +348,11 @@ pub(crate) fn pages_line(index: usize, pages: &gnomon_render::PageStats) -> Stri
         n => format!("; {n} refused, the pool full: their pixels read a coarser page"),
     };
     format!(
-        "light {index}: virtual map: {} pages requested, {} drawn ({:.2} M texels), {} kept{fallback}; {} of {} tiles resident",
+        "light {index}: virtual map: {} pages requested, {} drawn ({:.2} M texels, in {} runs), {} kept{fallback}; {} of {} tiles resident",
         pages.requested,
         pages.drawn,
         texels as f64 / 1e6,
+        pages.runs,
         pages.kept,
         pages.resident,
         pages.capacity,

@@ -84,6 +84,21 @@ pub enum RenderError {
         /// Name of the adapter, as wgpu reports it.
         adapter: String,
     },
+    /// A virtual map's page pool is wider than the device's largest 2D texture.
+    #[error(
+        "a virtual map's page pool of {pages_per_side} pages a row (`shadow.virtual_map.pool_side`) is \
+         {texels} texels wide, more than adapter `{adapter}` allows: 2D textures up to {max} texels a side"
+    )]
+    PagePoolTooLarge {
+        /// The pool's pages per row.
+        pages_per_side: u32,
+        /// Its texels per row.
+        texels: u64,
+        /// The device's largest 2D texture, in texels a side.
+        max: u32,
+        /// Name of the adapter, as wgpu reports it.
+        adapter: String,
+    },
     /// The image width or height exceeds the device's largest 2D texture.
     #[error(
         "an image of {width}×{height} is larger than adapter `{adapter}` allows: at most {max} pixels a side"

@@ -23,6 +23,7 @@
 //!   reach ([`Clipmap::request`]).
 
 pub mod pages;
+pub mod runs;
 
 use glam::{IVec2, Mat4, Vec2, Vec3};
 
@@ -232,11 +233,19 @@ impl Clipmap {
     /// its light-space window over the clipmap's depth range, which a page's depth
     /// pass draws with into its physical page.
     pub fn page_clip_from_world(&self, page: PageKey) -> Mat4 {
-        let size = self.page_size(page.level);
-        let (left, bottom) = (page.x as f32 * size, page.y as f32 * size);
+        self.run_clip_from_world(page, 1)
+    }
+
+    /// World to the clip space of the `columns` pages of a level's row from `first`
+    /// rightwards: a run of pages drawn as one ([`runs::PageRun`]). Each page's texels
+    /// are where [`Clipmap::page_clip_from_world`] puts them, its projection scaled by
+    /// `columns` across.
+    pub fn run_clip_from_world(&self, first: PageKey, columns: u32) -> Mat4 {
+        let size = self.page_size(first.level);
+        let (left, bottom) = (first.x as f32 * size, first.y as f32 * size);
         let clip_from_light = glam::camera::rh::proj::directx::orthographic(
             left,
-            left + size,
+            left + size * columns as f32,
             bottom,
             bottom + size,
             self.near,

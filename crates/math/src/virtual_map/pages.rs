@@ -176,6 +176,32 @@ impl PagePool {
             && self.slots.iter().all(|s| s.page.is_none() || s.stale || s.last_used == self.frame)
     }
 
+    /// Lays a frame that keeps nothing ([`PagePool::keeps_nothing`]) out anew: its
+    /// granted pages take slots 0, 1, 2… in the order of their level, row and column,
+    /// so that neighbouring pages of a level's row hold neighbouring slots and may be
+    /// drawn as one ([`super::runs::runs`]); every one of them is then drawn as new,
+    /// and the resident pages not granted (all stale) are evicted. Returns whether it
+    /// did: a frame that keeps a page is left as it is, since moving a kept page
+    /// without drawing it would lose it.
+    pub fn pack(&mut self, allocation: &mut FrameAllocation) -> bool {
+        if !self.keeps_nothing(allocation) {
+            return false;
+        }
+        allocation.evicted += (self.resident.len() - allocation.granted.len()) as u32;
+        self.resident.clear();
+        self.slots.fill(Slot::default());
+        let mut order: Vec<&mut PageGrant> = allocation.granted.iter_mut().collect();
+        order.sort_unstable_by_key(|g| (g.page.level, g.page.y, g.page.x));
+        for (physical, grant) in (0u32..).zip(order) {
+            grant.physical = physical;
+            grant.state = PageState::New;
+            self.slots[physical as usize] =
+                Slot { page: Some(grant.page), last_used: self.frame, stale: false };
+            self.resident.insert(grant.page, physical);
+        }
+        true
+    }
+
     /// The page a pixel that asked for `page` reads: the page itself if resident,
     /// else the finest coarser page over the same point that is, up to level
     /// `levels − 1`; None when none is.
@@ -267,12 +293,12 @@ impl PagePool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::test_rng::Lcg;
 
     /// The invariant stated at the top of this module.
-    fn check_invariant(pool: &PagePool, allocation: &FrameAllocation) {
+    pub(crate) fn check_invariant(pool: &PagePool, allocation: &FrameAllocation) {
         for (s, slot) in pool.slots.iter().enumerate() {
             if let Some(page) = slot.page {
                 assert_eq!(pool.resident.get(&page), Some(&(s as u32)), "slot {s} holds {page:?}");

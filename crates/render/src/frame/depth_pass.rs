@@ -196,6 +196,13 @@ pub(super) struct StateChanges {
 }
 
 impl StateChanges {
+    /// Forgets the pipeline, scissor and material set, as after a draw with another
+    /// pipeline: the next [`StateChanges::apply`] sets them all. (Vertex buffers stay
+    /// bound across pipelines.)
+    pub(super) fn forget_state(&mut self) {
+        self.current = None;
+    }
+
     /// Moves `pass` to `state`, counting the changes in `stats`.
     pub(super) fn apply(
         &mut self,

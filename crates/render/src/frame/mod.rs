@@ -28,7 +28,6 @@ mod virtual_record;
 use gnomon_scene::{Scene, Settings, settings::MomentFormat};
 
 pub use crate::pool::Creations;
-pub(crate) use depth_pass::ScissorRect;
 pub use map_cache::LayerCache;
 pub use outputs::{
     CpuTimings, Frame, FrameCost, LightStats, LiveFrame, OutputRequest, PassTimings, ShadowMapImage,

@@ -1,9 +1,9 @@
-//! Many tiles of one depth target drawn in one render pass (a virtual map's pages
-//! in its pool): each tile its own projection (its own scene group), viewport and
-//! scissor, and the casters the CPU culled against it, each bucket of them one
-//! multi-draw from one buffer of arguments for every tile. One pass instead of one
-//! per tile: a pass and a culling dispatch per page cost a GPU tens of
-//! microseconds each, more than a page's draws.
+//! Many tiles of one depth target drawn in one render pass (a virtual map's runs of
+//! pages in one layer of its pool): each tile its own projection (its own scene
+//! group), viewport and scissor, and the casters the CPU culled against it, each
+//! bucket of them one multi-draw from one buffer of arguments for every tile. One
+//! pass instead of one per tile: a pass and a culling dispatch per page cost a GPU
+//! tens of microseconds each, more than a page's draws.
 
 use gnomon_scene::settings::DrawSubmission;
 
@@ -35,6 +35,10 @@ pub(super) struct TilePass<'a> {
     /// area (`DepthArea::Tile`).
     pub like: DepthPass<'a>,
     pub tiles: Vec<Tile<'a>>,
+    /// Where set, each tile is first cleared to the far plane by one draw of this
+    /// pipeline (a triangle over its viewport at depth 1, `page_clear.wgsl`): a pass
+    /// can clear only its whole target, and the rest of the target is kept.
+    pub clear_tiles: Option<&'a wgpu::RenderPipeline>,
 }
 
 impl Renderer {
@@ -90,6 +94,14 @@ impl Renderer {
         for ((tile, group), buckets) in tiles.tiles.iter().zip(&groups).zip(&tile_buckets) {
             let r = tile.rect;
             pass.set_viewport(r.x as f32, r.y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
+            if let Some(clear) = tiles.clear_tiles {
+                pass.set_scissor_rect(r.x, r.y, r.width, r.height);
+                pass.set_pipeline(clear);
+                pass.draw(0..3, 0..1);
+                stats.pipeline_changes += 1;
+                // The casters' pipeline (and scissor) must be set again.
+                changes.forget_state();
+            }
             pass.set_bind_group(0, group, &[]);
             stats.bind_group_changes += 1;
             for (state, runs) in buckets {

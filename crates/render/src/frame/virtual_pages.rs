@@ -6,16 +6,19 @@
 //! that the light's turn or a moving caster changed, and grants the requests their
 //! tiles in the light's kept pool ([`VirtualPages`]), coarse levels first. Recording
 //! ([`Renderer::record_virtual_pages`]) clears and draws only the pages new or stale
-//! this frame, each through its own projection into its tile, its casters culled
-//! against the page alone (on the GPU where the frame culls there), with the
-//! shadow pass's pipelines: alpha-tested casters, clusters and bias as any layer.
+//! this frame, neighbouring pages in neighbouring tiles as one run through one
+//! projection, its casters culled against the run alone, with the shadow pass's
+//! pipelines: alpha-tested casters, clusters and bias as any layer.
 //! The lighting, mask and refinement passes then read the pool through the page
 //! table (`virtual_map/virtual_visibility.wgsl`, `rays/refine_virtual.wgsl`).
 
 use glam::Mat4;
 use gnomon_math::{
     Aabb,
-    virtual_map::{Clipmap, ClipmapShape, PageKey, pages::FrameAllocation},
+    virtual_map::{
+        Clipmap, ClipmapShape, PageKey,
+        runs::{PageRun, runs},
+    },
 };
 use gnomon_scene::{Camera, Light, Settings, lights::ShadowView, settings::BiasSettings};
 
@@ -35,7 +38,9 @@ const LOOKUP_REACH_TEXELS: f32 = 2.0 + crate::rays::refine::UNSURE_RING_TEXELS a
 /// pool too small for the view still holds a page over every pixel: the pool grants
 /// coarse levels first, and a refused page's pixels read the nearest coarser
 /// resident page (`virtual_texel` in page_lookup.wgsl). One such page stands for
-/// 4³ = 64 pages below it, so they add little when the pool has room.
+/// 4³ = 64 pages below it. Asked for only when the pool has no room for every page
+/// the pixels read: each covers much of the scene, so drawing it costs as much as
+/// many pages.
 const FALLBACK_LEVELS: u32 = 3;
 
 /// Each light's kept pool of pages, and the request pass they share.
@@ -76,6 +81,9 @@ pub struct PageStats {
     /// Pages drawn: new this frame, or stale (the light turned, a caster over them
     /// moved).
     pub drawn: u32,
+    /// The runs the pages drawn were drawn in: neighbouring pages in neighbouring
+    /// tiles drawn as one ([`gnomon_math::virtual_map::runs`]).
+    pub runs: u32,
     /// Pages asked for and kept from an earlier frame, drawn nothing.
     pub kept: u32,
     /// Pages asked for that the full pool had no tile for: their pixels read a
@@ -96,16 +104,17 @@ pub struct PageStats {
 /// A virtual light's frame, as decided before recording.
 pub(crate) struct VirtualPlan {
     pub clipmap: Clipmap,
-    /// The pages granted (those to draw among them) and refused.
-    pub allocation: FrameAllocation,
+    /// The pages to draw (new or stale), in runs drawn as one.
+    pub runs: Vec<PageRun>,
     /// The sampling passes' uniform.
     pub uniform: VirtualMapGpu,
     /// The page table's words (`TableEntry`).
     pub table: Vec<u32>,
     /// Whether the pool keeps nothing this frame (every resident page drawn or
-    /// stale): its draws may start from a cleared texture instead of tiles cleared
-    /// one by one ([`gnomon_math::virtual_map::pages::PagePool::keeps_nothing`]).
-    pub clear_whole: bool,
+    /// stale): its pages were laid out anew for drawing in runs
+    /// ([`gnomon_math::virtual_map::pages::PagePool::pack`]), and the layers they
+    /// are drawn into are cleared by their passes' loads, not tile by tile.
+    pub clear_layers: bool,
     pub stats: PageStats,
 }
 
@@ -154,13 +163,18 @@ impl Renderer {
         let requests = self.virtual_lights.requests.as_mut().expect("made above");
         let camera_depth =
             CameraDepth { depth: &depth, clip_from_world, view_from_world: camera.view_from_world() };
-        let requested = with_fallbacks(
-            requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?,
-            shape.levels,
-        );
+        let requested = requests.request_from_depth(&gpu, camera_depth, &clipmap, reach).await?;
         let request_ms = started.elapsed().as_secs_f64() * 1e3;
-        let size =
-            PoolSize { page_size: shape.page_size, pages_per_side: settings.shadow.virtual_map.pool_side };
+        let size = PoolSize::new(shape.page_size, settings.shadow.virtual_map.pool_side);
+        // A pool with room for every page asked for needs no fallback; one without
+        // grants the coarse fallbacks first. (A coarse page covers much of the scene:
+        // drawing fallbacks nobody reads would cost as much as the pages read.)
+        let capacity = size.pages_per_side * size.pages_per_side;
+        let requested = if requested.len() > capacity as usize {
+            with_fallbacks(requested, shape.levels)
+        } else {
+            requested
+        };
         let kept = self.virtual_lights.kept_for(&gpu, index, size)?;
         let under = DrawnUnder {
             light_from_world: clipmap.light_from_world,
@@ -172,22 +186,25 @@ impl Renderer {
             still_generation: uploaded.still_generation,
         };
         kept.mark_stale(under, &clipmap, uploaded.moving_caster_bounds());
-        let allocation = kept.pages.allocate(&requested);
-        let clear_whole = kept.pages.keeps_nothing(&allocation);
+        let mut allocation = kept.pages.allocate(&requested);
+        let clear_layers = kept.pages.pack(&mut allocation);
         let table = kept.pages.page_table(&clipmap).iter().map(|entry| entry.0).collect();
-        let uniform = VirtualMapGpu::new(&clipmap, size.pages_per_side, footprint_per_depth);
-        let drawn = allocation.to_draw().count() as u32;
+        let uniform = VirtualMapGpu::new(&clipmap, size, footprint_per_depth);
+        let to_draw: Vec<_> = allocation.to_draw().copied().collect();
+        let runs = runs(&to_draw, size.pages_per_side);
+        let drawn = to_draw.len() as u32;
         let stats = PageStats {
             requested: requested.len() as u32,
             drawn,
+            runs: runs.len() as u32,
             kept: allocation.granted.len() as u32 - drawn,
             refused: allocation.refused.len() as u32,
             resident: kept.pages.resident() as u32,
-            capacity: size.pages_per_side * size.pages_per_side,
+            capacity,
             page_size: size.page_size,
             request_ms,
         };
-        Ok(VirtualPlan { clipmap, allocation, uniform, table, clear_whole, stats })
+        Ok(VirtualPlan { clipmap, runs, uniform, table, clear_layers, stats })
     }
 }
 

@@ -1,5 +1,6 @@
 //! Recording a sun's virtual map (`--partition virtual`): clearing and drawing the
-//! pages [`super::virtual_pages`] planned, and the buffers its sampling passes bind.
+//! pages [`super::virtual_pages`] planned, neighbours in runs drawn as one
+//! ([`gnomon_math::virtual_map::runs`]), and the buffers its sampling passes bind.
 
 use super::{
     Renderer,
@@ -22,6 +23,12 @@ use crate::{
 impl Renderer {
     /// Clears and draws the pages of a virtual light's pool that are new or stale
     /// this frame, timed as its one layer; returns the pool's texture, its map.
+    ///
+    /// Neighbouring pages in neighbouring tiles are drawn as one run (a frame laid
+    /// out anew, `PagePool::pack`, is mostly long runs), one render pass for each
+    /// layer of the pool that holds a run. A frame that keeps no page clears those
+    /// layers by their passes' loads; one that keeps some clears each run's tiles
+    /// by a draw before its casters.
     pub(super) fn record_virtual_pages(
         &mut self,
         rec: &mut Recording,
@@ -32,70 +39,66 @@ impl Renderer {
     ) -> wgpu::Texture {
         let gpu = self.gpu.clone();
         let pages = self.virtual_lights.pages(light_index as usize);
-        let texture = pages.texture().clone();
-        let drawn: Vec<_> = plan.allocation.to_draw().copied().collect();
-        if drawn.is_empty() {
+        let (texture, size, clear) = (pages.texture().clone(), pages.size(), pages.clear_pipeline().clone());
+        if plan.runs.is_empty() {
             return texture;
         }
-        let page_size = pages.size().page_size;
-        let tiles: Vec<ScissorRect> = drawn
-            .iter()
-            .map(|grant| {
-                let (x, y) = pages.tile_origin(grant.physical);
-                ScissorRect { x, y, width: page_size, height: page_size }
-            })
-            .collect();
         let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Shadow, Some(light_index), Some(0));
         bracket(rec, slot, SlotPart::Opening);
-        let view = self.pool.view(&texture, ViewKey::default());
-        // A frame that keeps no page (the light turned) clears the pool whole, by its
-        // pass's load: a texture cleared so lets the GPU reject hidden fragments
-        // early, where one cleared tile by tile by a draw may not.
-        let start = if plan.clear_whole {
-            DepthStart::Clear
-        } else {
-            self.virtual_lights.pages(light_index as usize).record_tile_clears(rec.encoder, &view, &tiles);
-            DepthStart::Keep
-        };
-        let views: Vec<_> = drawn
-            .iter()
-            .map(|grant| layer_view(light, plan.clipmap.page_clip_from_world(grant.page)))
-            .collect();
+        let projections: Vec<_> =
+            plan.runs.iter().map(|run| plan.clipmap.run_clip_from_world(run.first.page, run.len)).collect();
+        let views: Vec<_> =
+            projections.iter().map(|&clip_from_world| layer_view(light, clip_from_world)).collect();
         // Culled on the CPU, cluster by cluster where the settings say so, against
-        // each page alone: one pass for every page needs every page's draws before it.
+        // each run alone: one pass for every run needs every run's draws before it.
         let seen = uploaded.cull(&views);
-        let like = DepthPass {
-            settings: &light.settings,
-            light: &light.light_gpu,
-            target_view: &view,
-            visible: &seen[0],
-            target: light.depth_target(),
-            unclipped: light.layout.depth_clamp,
-            start,
-            area: DepthArea::Whole,
-            culling: None,
-        };
-        let page_tiles = drawn
-            .iter()
-            .zip(&tiles)
-            .zip(&seen)
-            .map(|((grant, rect), visible)| Tile {
-                rect: *rect,
-                light: LightGpu {
-                    clip_from_world: plan.clipmap.page_clip_from_world(grant.page),
-                    ..light.light_gpu
-                },
-                visible,
-            })
-            .collect();
-        let stats = self.record_tile_pass(rec.encoder, uploaded, &TilePass { like, tiles: page_tiles });
-        rec.stats.add(&stats);
-        // The texels cleared or drawn: the whole pool where it was cleared whole.
-        let texels = match start {
-            DepthStart::Clear => u64::from(texture.width()) * u64::from(texture.height()),
-            DepthStart::Keep => drawn.len() as u64 * u64::from(page_size) * u64::from(page_size),
-        };
-        let work = LayerWork { commands: stats.shadow_commands, texels };
+        let start = if plan.clear_layers { DepthStart::Clear } else { DepthStart::Keep };
+        let mut work = LayerWork::default();
+        for layer in 0..size.layers() {
+            let in_layer: Vec<usize> = (0..plan.runs.len())
+                .filter(|&r| size.tile(plan.runs[r].first.physical).layer == layer)
+                .collect();
+            let Some(&first) = in_layer.first() else { continue };
+            let view = self.pool.view(&texture, ViewKey::layer(layer));
+            let like = DepthPass {
+                settings: &light.settings,
+                light: &light.light_gpu,
+                target_view: &view,
+                visible: &seen[first],
+                target: light.depth_target(),
+                unclipped: light.layout.depth_clamp,
+                start,
+                area: DepthArea::Whole,
+                culling: None,
+            };
+            let tiles = in_layer
+                .iter()
+                .map(|&r| {
+                    let (run, tile) = (&plan.runs[r], size.tile(plan.runs[r].first.physical));
+                    let (width, height) = (size.page_size * run.len, size.page_size);
+                    Tile {
+                        rect: ScissorRect { x: tile.x, y: tile.y, width, height },
+                        light: LightGpu { clip_from_world: projections[r], ..light.light_gpu },
+                        visible: &seen[r],
+                    }
+                })
+                .collect();
+            let clear_tiles = match start {
+                DepthStart::Clear => None,
+                DepthStart::Keep => Some(&clear),
+            };
+            let stats = self.record_tile_pass(rec.encoder, uploaded, &TilePass { like, tiles, clear_tiles });
+            rec.stats.add(&stats);
+            work.commands += stats.shadow_commands;
+            // The texels cleared or drawn: a whole layer where it was cleared whole.
+            work.texels += match start {
+                DepthStart::Clear => size.layer_texels(),
+                DepthStart::Keep => in_layer
+                    .iter()
+                    .map(|&r| u64::from(plan.runs[r].len) * u64::from(size.page_size).pow(2))
+                    .sum(),
+            };
+        }
         rec.layer_commands.add(light_index as usize, 0, work);
         bracket(rec, slot, SlotPart::Closing);
         rec.clock.end(&gpu, rec.encoder, slot);

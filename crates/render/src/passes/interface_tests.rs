@@ -96,7 +96,7 @@ fn struct_layouts() -> Vec<StructLayout> {
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
             light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,
-            pool_pages_per_side, footprint_per_depth,
+            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, _pad0, _pad1, _pad2,
         }),
         struct_layout!(crate::virtual_map::SurfaceParams as "SurfaceParams" {
             world_from_clip, view_z_from_world, width, height, _pad0, _pad1,

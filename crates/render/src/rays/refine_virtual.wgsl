@@ -24,12 +24,12 @@ fn virtual_block_receiver(x: i32, y: i32, p: vec2<f32>, depth: f32, gradient: ve
     return vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
 }
 
-// Texel `texel` of `level`: from `tile` where its z is 1 (the footprint lies in one
+// Texel `texel` of `level`: from `tile` where its w is 1 (the footprint lies in one
 // page, resident at its own level: no table read per texel), through the table
 // otherwise.
-fn footprint_texel(level: u32, texel: vec2<i32>, tile: vec3<i32>) -> VirtualTexel {
-    if tile.z == 1 {
-        return VirtualTexel(virtual_tile_depth(tile.xy, texel), true);
+fn footprint_texel(level: u32, texel: vec2<i32>, tile: vec4<i32>) -> VirtualTexel {
+    if tile.w == 1 {
+        return VirtualTexel(virtual_tile_depth(tile.xyz, texel), true);
     }
     return virtual_texel(level, texel);
 }
@@ -71,10 +71,10 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     let size = f32(virtual_map.page_texels);
     let first_page = vec2<i32>(floor(vec2<f32>(first) / size));
     let last_page = vec2<i32>(floor(vec2<f32>(end - vec2<i32>(1)) / size));
-    var tile = vec3<i32>(0);
+    var tile = vec4<i32>(0);
     if all(first_page == last_page) {
         tile = virtual_exact_tile(level, first_page);
-        if tile.z == 0 {
+        if tile.w == 0 {
             return true;
         }
     }

@@ -16,7 +16,7 @@
 pub(crate) mod draw;
 mod probe;
 
-pub use draw::{PoolSize, VirtualPages};
+pub use draw::{POOL_LAYER_ROWS, PoolSize, PoolTile, VirtualPages};
 pub use probe::VirtualProbe;
 
 use bytemuck::{Pod, Zeroable};
@@ -66,12 +66,17 @@ pub(crate) struct VirtualMapGpu {
     /// A pixel's footprint in world units per unit of view depth (which level it
     /// reads: [`PixelReach::footprint_per_depth`]).
     pub footprint_per_depth: f32,
+    /// Rows of tiles in each layer of the pool ([`PoolSize::rows_per_layer`]).
+    pub pool_rows_per_layer: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 impl VirtualMapGpu {
-    /// `clipmap`'s levels, sampled from a pool of `pool_pages_per_side`² tiles by
-    /// pixels whose footprint is `footprint_per_depth` per unit of view depth.
-    pub fn new(clipmap: &Clipmap, pool_pages_per_side: u32, footprint_per_depth: f32) -> Self {
+    /// `clipmap`'s levels, sampled from a pool of `pool` by pixels whose footprint is
+    /// `footprint_per_depth` per unit of view depth.
+    pub fn new(clipmap: &Clipmap, pool: PoolSize, footprint_per_depth: f32) -> Self {
         VirtualMapGpu {
             light_from_world: clipmap.light_from_world,
             origins: packed_origins(clipmap),
@@ -81,8 +86,12 @@ impl VirtualMapGpu {
             levels: clipmap.shape.levels,
             pages_per_side: clipmap.shape.pages_per_side(),
             page_texels: clipmap.shape.page_size,
-            pool_pages_per_side,
+            pool_pages_per_side: pool.pages_per_side,
             footprint_per_depth,
+            pool_rows_per_layer: pool.rows_per_layer,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 }

@@ -4,7 +4,8 @@
 // in different pages, resident or not. `gnomon_math::virtual_map` holds the same
 // arithmetic; `draw/tests.rs` holds this file to it.
 //
-// The pool is the light's `shadow_map` (one layer); the clipmap's uniform and the
+// The pool is the light's `shadow_map`, its tiles in layers of a few rows; the
+// clipmap's uniform and the
 // page table follow the other shadow resources, at the place the pass's generated
 // constants name (`shadow_entries` in passes/mod.rs).
 
@@ -28,6 +29,11 @@ struct VirtualMap {
     pool_pages_per_side: u32,
     // A pixel's footprint in world units per unit of view depth: which level it reads.
     footprint_per_depth: f32,
+    // Rows of tiles in each layer of the pool; rows run down the layers.
+    pool_rows_per_layer: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(SHADOW_GROUP) @binding(SHADOW_BINDING + 7u) var<uniform> virtual_map: VirtualMap;
@@ -82,38 +88,44 @@ fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     let scale = f32(1u << coarser);
     let read = vec2<i32>(floor(vec2<f32>(texel) / scale));
     let within = read - vec2<i32>(floor(vec2<f32>(read) / f32(size))) * size;
-    let pool = i32(virtual_map.pool_pages_per_side);
-    let tile = vec2<i32>(i32(slot) % pool, i32(slot) / pool) * size;
+    let tile = virtual_slot_tile(slot);
     // Texture rows run down, light-space y up.
-    let depth = textureLoad(shadow_map, tile + vec2<i32>(within.x, size - 1 - within.y), 0, 0);
+    let depth = textureLoad(shadow_map, tile.xy + vec2<i32>(within.x, size - 1 - within.y), tile.z, 0);
     return VirtualTexel(depth, coarser == 0u);
 }
 
+// Where slot `slot`'s tile lies in the pool: its first texel in xy, its layer in z.
+// Slots run along rows, rows down the layers (`PoolSize::tile`).
+fn virtual_slot_tile(slot: u32) -> vec3<i32> {
+    let pool = virtual_map.pool_pages_per_side;
+    let row = slot / pool;
+    let rows = virtual_map.pool_rows_per_layer;
+    let first = vec2<u32>(slot % pool, row % rows) * virtual_map.page_texels;
+    return vec3<i32>(vec2<i32>(first), i32(row / rows));
+}
+
 // Where page `page` of `level` (in pages from the light-space origin) lies in the
-// pool when its own level's page is resident: its tile's first texel in xy and 1 in
-// z; z is 0 where a coarser page stands in for it, or none.
-fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec3<i32> {
+// pool when its own level's page is resident: its tile's first texel in xy, its
+// layer in z, and 1 in w; w is 0 where a coarser page stands in for it, or none.
+fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec4<i32> {
     let side = i32(virtual_map.pages_per_side);
     let relative = page - virtual_origin(level);
     if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
-        return vec3<i32>(0);
+        return vec4<i32>(0);
     }
     let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
     if ((entry & 0x80000000u) == 0u || ((entry >> 24u) & 0xfu) != 0u) {
-        return vec3<i32>(0);
+        return vec4<i32>(0);
     }
-    let slot = i32(entry & 0xffffffu);
-    let pool = i32(virtual_map.pool_pages_per_side);
-    let size = i32(virtual_map.page_texels);
-    return vec3<i32>(vec2<i32>(slot % pool, slot / pool) * size, 1);
+    return vec4<i32>(virtual_slot_tile(entry & 0xffffffu), 1);
 }
 
 // The depth of texel `texel` (of a level, y up) from its page's tile at `tile` (the
-// xy of [`virtual_exact_tile`]), without the table.
-fn virtual_tile_depth(tile: vec2<i32>, texel: vec2<i32>) -> f32 {
+// xyz of [`virtual_exact_tile`]), without the table.
+fn virtual_tile_depth(tile: vec3<i32>, texel: vec2<i32>) -> f32 {
     let size = i32(virtual_map.page_texels);
     let within = texel - vec2<i32>(floor(vec2<f32>(texel) / f32(size))) * size;
-    return textureLoad(shadow_map, tile + vec2<i32>(within.x, size - 1 - within.y), 0, 0);
+    return textureLoad(shadow_map, tile.xy + vec2<i32>(within.x, size - 1 - within.y), tile.z, 0);
 }
 
 // The stored depth of texel `texel` of `level` ([`virtual_texel`]'s).

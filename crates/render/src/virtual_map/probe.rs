@@ -38,7 +38,7 @@ impl VirtualPages {
         }
         let device = &gpu.device;
         let words: Vec<u32> = self.page_table(clipmap).iter().map(|e| e.0).collect();
-        let uniform = VirtualMapGpu::new(clipmap, self.size().pages_per_side, 0.0);
+        let uniform = VirtualMapGpu::new(clipmap, self.size(), 0.0);
         let bytes = 4 * probes.len() as u64;
         let pipeline = gpu.checked("sampling a virtual map", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -145,8 +145,14 @@ mod in_the_frame {
         let first = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
         let p = pages(&first);
         assert!(p.requested > 10 && p.drawn == p.requested && p.refused == 0, "{p:?}");
-        // A first frame keeps nothing: the pool is cleared whole, and its texels counted.
-        assert_eq!(first.lights[0].layer_texels, vec![(24 * 128u64).pow(2)]);
+        // A first frame keeps nothing: its pages take the first slots, and only the
+        // layers of the pool they lie in (4 rows of 24 tiles each) are cleared whole,
+        // their texels counted.
+        let layers = u64::from(p.drawn.div_ceil(24 * gnomon_render::virtual_map::POOL_LAYER_ROWS));
+        assert!(layers < 6, "{p:?}");
+        assert_eq!(first.lights[0].layer_texels, vec![layers * 24 * 128 * 4 * 128]);
+        // It is laid out anew, neighbouring pages in neighbouring tiles, drawn in runs.
+        assert!(p.runs > 0 && p.runs * 2 <= p.drawn, "{p:?}");
         let still = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
         let p = pages(&still);
         assert_eq!((p.drawn, p.kept), (0, p.requested), "{p:?}");
@@ -192,12 +198,17 @@ mod in_the_frame {
         let mut scene = builtin::spheres();
         let ball = scene.instances.iter().position(|i| i.name == "sphere 1,1").expect("a sphere");
         scene.instances[ball].motion = Motion::Dynamic;
-        let s = virtual_sun(24);
+        // A pool of 5² tiles in layers of 4 rows, for the 24 pages the view asks for:
+        // the pages lie in both layers.
+        let s = virtual_sun(5);
         let request = OutputRequest::default();
         let mut renderer = Renderer::new(support::gpu()).unwrap();
         let mut uploaded = renderer.upload(&scene).unwrap();
-        let first = pages(&renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap());
-        assert_eq!(first.drawn, first.requested, "{first:?}");
+        let frame = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let first = pages(&frame);
+        assert!((21..=25).contains(&first.requested), "{first:?}");
+        assert_eq!((first.drawn, first.refused), (first.requested, 0), "{first:?}");
+        assert_eq!(frame.lights[0].layer_texels, vec![2 * (5 * 128) * (4 * 128)], "both layers cleared");
 
         scene.instances[ball].world_from_object *= Mat4::from_translation(Vec3::new(0.7, 0.3, -0.4));
         renderer.move_instances(&mut uploaded, &scene, &[ball]).unwrap();

@@ -73,11 +73,15 @@ fn setup() -> Setup {
 fn pages_hold_the_full_resolution_depth_and_a_still_scene_draws_none() {
     let Setup { gpu, clipmap, requests, casters, .. } = setup();
     let shape = clipmap.shape;
-    let mut pages = VirtualPages::new(&gpu, PoolSize { page_size: 128, pages_per_side: 8 }).unwrap();
+    // 8 rows of tiles in layers of 4: pages in both layers.
+    let size = PoolSize::new(128, 8);
+    assert_eq!(size.layers(), 2);
+    let mut pages = VirtualPages::new(&gpu, size).unwrap();
     let first = pages.draw(&gpu, &casters, &clipmap, &requests);
     assert!(first.refused.is_empty() && first.granted.iter().all(|g| g.state == PageState::New), "{first:?}");
     let pool = depth_of(&gpu, pages.texture());
     let pool_side = 8 * 128;
+    let layer_texels = size.layer_texels() as usize;
 
     // Each level's full-resolution map, drawn as the pages are.
     let mut baseline = DepthBaselinePass::new(&gpu.device);
@@ -114,12 +118,13 @@ fn pages_hold_the_full_resolution_depth_and_a_still_scene_draws_none() {
         for grant in granted {
             let PageKey { x, y, .. } = grant.page;
             let (column, row) = ((x - origin.x) as usize * 128, (origin.y + 7 - y) as usize * 128);
-            let (tx, ty) = pages.tile_origin(grant.physical);
+            let tile = size.tile(grant.physical);
+            let (tx, ty, first) = (tile.x, tile.y, tile.layer as usize * layer_texels);
             for j in 0..128 {
                 for i in 0..128 {
                     let (r, c) = (row + j, column + i);
                     let want = reference[r * 1024 + c];
-                    let got = pool[(ty as usize + j) * pool_side + tx as usize + i];
+                    let got = pool[first + (ty as usize + j) * pool_side + tx as usize + i];
                     // The depth's change to the neighbouring texels: the two projections
                     // round a vertex differently before the rasterizer snaps it to its
                     // sub-texel grid, which moves a sloped surface's depth by a
@@ -173,10 +178,10 @@ fn texel_depth(map: &Lookup, level: u32, texel: glam::IVec2) -> f32 {
     let Some((slot, coarser)) = entry.get() else { return 1.0 };
     let read = glam::IVec2::new(texel.x.div_euclid(1 << coarser), texel.y.div_euclid(1 << coarser));
     let within = glam::IVec2::new(read.x.rem_euclid(size), read.y.rem_euclid(size));
-    let pool = map.pool_pages_per_side as i32;
-    let tile = glam::IVec2::new(slot as i32 % pool, slot as i32 / pool) * size;
-    let (x, y) = (tile.x + within.x, tile.y + size - 1 - within.y);
-    map.pool[(y * pool * size + x) as usize]
+    let tile = map.size.tile(slot);
+    let (x, y) = (tile.x as i32 + within.x, tile.y as i32 + size - 1 - within.y);
+    let row = map.size.texels_per_side() as i32;
+    map.pool[tile.layer as usize * map.size.layer_texels() as usize + (y * row + x) as usize]
 }
 
 /// What the CPU's lookup reads.
@@ -184,7 +189,7 @@ struct Lookup<'a> {
     clipmap: &'a Clipmap,
     table: Vec<TableEntry>,
     pool: Vec<f32>,
-    pool_pages_per_side: u32,
+    size: PoolSize,
 }
 
 /// `virtual_pcf2x2` on the CPU; None where a tap's depth is within 10⁻⁵ of the
@@ -213,15 +218,17 @@ fn pcf2x2(map: &Lookup, world: Vec3, level: u32) -> Option<f32> {
 fn lookups_through_the_page_table_read_every_tap_from_its_own_page_or_its_fallback() {
     let Setup { gpu, clipmap, requests, casters, surfaces } = setup();
     // A pool of 9 pages for more requests: the finest are refused, and their pixels
-    // read the coarser pages over them.
-    let mut pages = VirtualPages::new(&gpu, PoolSize { page_size: 128, pages_per_side: 3 }).unwrap();
+    // read the coarser pages over them. One row of tiles to a layer: the lookups
+    // find each tile's layer.
+    let size = PoolSize { rows_per_layer: 1, ..PoolSize::new(128, 3) };
+    let mut pages = VirtualPages::new(&gpu, size).unwrap();
     let allocation = pages.draw(&gpu, &casters, &clipmap, &requests);
     assert!(!allocation.refused.is_empty(), "the pool must overflow: {allocation:?}");
     let lookup = Lookup {
         clipmap: &clipmap,
         table: pages.page_table(&clipmap),
         pool: depth_of(&gpu, pages.texture()),
-        pool_pages_per_side: 3,
+        size,
     };
     // Receivers a little toward the light from the surfaces the frame saw, each at
     // its pixel's level, every 7th pixel.
