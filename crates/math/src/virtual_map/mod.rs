@@ -241,13 +241,26 @@ impl Clipmap {
     /// are where [`Clipmap::page_clip_from_world`] puts them, its projection scaled by
     /// `columns` across.
     pub fn run_clip_from_world(&self, first: PageKey, columns: u32) -> Mat4 {
-        let size = self.page_size(first.level);
-        let (left, bottom) = (first.x as f32 * size, first.y as f32 * size);
+        let end = first.x + columns as i32 - 1;
+        self.rect_clip_from_world(&PageRect {
+            level: first.level,
+            min: IVec2::new(first.x, first.y),
+            max: IVec2::new(end, first.y),
+        })
+    }
+
+    /// World to the clip space of the pages of `rect`: a map of its level over them
+    /// at full resolution, each page's texels where [`Clipmap::page_clip_from_world`]
+    /// puts them.
+    pub fn rect_clip_from_world(&self, rect: &PageRect) -> Mat4 {
+        let size = self.page_size(rect.level);
+        let (left, bottom) = (rect.min.x as f32 * size, rect.min.y as f32 * size);
+        let pages = (rect.max - rect.min + IVec2::ONE).as_vec2();
         let clip_from_light = glam::camera::rh::proj::directx::orthographic(
             left,
-            left + size * columns as f32,
+            left + size * pages.x,
             bottom,
-            bottom + size,
+            bottom + size * pages.y,
             self.near,
             self.far,
         );

@@ -93,6 +93,11 @@ impl PagePool {
         self.resident.len()
     }
 
+    /// Every resident page and its slot, in no order.
+    pub fn resident_pages(&self) -> impl Iterator<Item = (PageKey, u32)> + '_ {
+        self.resident.iter().map(|(&page, &slot)| (page, slot))
+    }
+
     /// Marks every resident page stale: the light turned, and every depth in the pool
     /// is of the old direction.
     pub fn invalidate_all(&mut self) {

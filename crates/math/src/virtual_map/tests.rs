@@ -175,3 +175,36 @@ fn a_page_projection_maps_its_window_onto_clip_space() {
     assert!((high.x - 1.0).abs() < 1e-3 && (high.y - 1.0).abs() < 1e-3, "{high}");
     assert!((low.z - 0.5).abs() < 1e-3, "{low}");
 }
+
+#[test]
+fn a_rect_projection_puts_each_page_texel_where_the_page_projection_does() {
+    let map = clipmap(Vec3::ZERO);
+    let rect = PageRect { level: 4, min: glam::IVec2::new(-2, 5), max: glam::IVec2::new(0, 6) };
+    let (columns, rows) = (3.0, 2.0);
+    let texels = map.shape.page_size as f32;
+    let rect_clip = map.rect_clip_from_world(&rect);
+    let world_from_light = map.light_from_world.inverse();
+    let size = map.page_size(rect.level);
+    let depth = 0.3 * map.near + 0.7 * map.far;
+    let mut rng = Lcg(3);
+    for page in rect.pages() {
+        let page_clip = map.page_clip_from_world(page);
+        for _ in 0..20 {
+            let (u, v) = (rng.next(), rng.next());
+            let light = Vec3::new((page.x as f32 + u) * size, (page.y as f32 + v) * size, -depth);
+            let world = world_from_light.transform_point3(light);
+            // Viewport texels, v down: the page's own tile, and the rect's.
+            let own = page_clip.project_point3(world);
+            let own = Vec2::new(own.x + 1.0, 1.0 - own.y) * 0.5 * texels;
+            let whole = rect_clip.project_point3(world);
+            let whole = Vec2::new((whole.x + 1.0) * columns, (1.0 - whole.y) * rows) * 0.5 * texels;
+            let offset = Vec2::new((page.x - rect.min.x) as f32, (rect.max.y - page.y) as f32) * texels;
+            assert!((whole - offset - own).length() < 1e-2, "{page:?}: {whole} − {offset} against {own}");
+            assert!((rect_clip.project_point3(world).z - page_clip.project_point3(world).z).abs() < 1e-6);
+        }
+    }
+    // A run is a rect of one row.
+    let first = PageKey { level: 4, x: -2, y: 5 };
+    let run = PageRect { level: 4, min: glam::IVec2::new(-2, 5), max: glam::IVec2::new(0, 5) };
+    assert_eq!(map.run_clip_from_world(first, 3), map.rect_clip_from_world(&run));
+}

@@ -22,6 +22,8 @@ mod refine;
 mod screen;
 mod shadow_maps;
 mod tile_pass;
+#[cfg(test)]
+mod virtual_depth_tests;
 mod virtual_pages;
 mod virtual_record;
 

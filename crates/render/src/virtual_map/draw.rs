@@ -149,6 +149,11 @@ impl VirtualPages {
         self.pages.resident()
     }
 
+    /// The pool's pages: which page each slot holds.
+    pub fn pages(&self) -> &PagePool {
+        &self.pages
+    }
+
     /// The pool's size.
     pub fn size(&self) -> PoolSize {
         self.size
@@ -287,4 +292,4 @@ pub(crate) fn page_clear_wgsl() -> String {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
