@@ -167,11 +167,14 @@ pub fn debug_view_code(view: DebugView) -> u32 {
         DebugView::None => 0,
         DebugView::Cascades => 1,
         DebugView::Traced => 2,
+        DebugView::Pages => 3,
     }
 }
 
 /// Added to the map layer a pixel's mask stores (visibility + 2 × layer) when rays
 /// decided it and the traced view is on, for the lighting pass to tint it: above
-/// every layer index (cascades, cube faces).
+/// every layer index (cascades, cube faces, a virtual map's levels). Under the pages
+/// view, the multiples of it above the level carry the page's flags instead
+/// (`virtual_page_flags` in page_lookup.wgsl).
 pub const TRACED_LAYER_FLAG: u32 = 16;
 const _: () = assert!(TRACED_LAYER_FLAG as usize >= MAX_CASCADES && TRACED_LAYER_FLAG >= 6);

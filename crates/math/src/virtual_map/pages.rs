@@ -67,6 +67,8 @@ struct Slot {
     last_used: u64,
     /// Its content no longer matches the scene.
     stale: bool,
+    /// The frame that last drew it (0: never).
+    drawn_in: u64,
 }
 
 /// The pool: a fixed number of physical pages, kept across frames.
@@ -153,6 +155,9 @@ impl PagePool {
             if let Some(&physical) = self.resident.get(&page) {
                 let slot = &mut self.slots[physical as usize];
                 let state = if slot.stale { PageState::Dirty } else { PageState::Kept };
+                if slot.stale {
+                    slot.drawn_in = frame;
+                }
                 slot.stale = false;
                 allocation.granted.push(PageGrant { page, physical, state });
                 continue;
@@ -166,7 +171,7 @@ impl PagePool {
                 self.resident.remove(&old);
                 allocation.evicted += 1;
             }
-            *slot = Slot { page: Some(page), last_used: frame, stale: false };
+            *slot = Slot { page: Some(page), last_used: frame, stale: false, drawn_in: frame };
             self.resident.insert(page, physical);
             allocation.granted.push(PageGrant { page, physical, state: PageState::New });
         }
@@ -201,7 +206,7 @@ impl PagePool {
             grant.physical = physical;
             grant.state = PageState::New;
             self.slots[physical as usize] =
-                Slot { page: Some(grant.page), last_used: self.frame, stale: false };
+                Slot { page: Some(grant.page), last_used: self.frame, stale: false, drawn_in: self.frame };
             self.resident.insert(grant.page, physical);
         }
         true
@@ -225,9 +230,10 @@ impl PagePool {
 }
 
 /// A page-table entry: where a virtual page's texels are, for the sampling shaders.
-/// Bit 31 says the entry holds a page; bits 24 to 27 how many levels coarser that
-/// page is than the one asked for (0: the page itself; more: a fallback); bits 0 to
-/// 23 its slot in the pool.
+/// Bit 31 says the entry holds a page; bit 28 that the page read was drawn this frame
+/// (for the pages debug view); bits 24 to 27 how many levels coarser that page is
+/// than the one asked for (0: the page itself; more: a fallback); bits 0 to 23 its
+/// slot in the pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct TableEntry(pub u32);
 
@@ -235,12 +241,23 @@ impl TableEntry {
     /// No resident page over this one, itself or coarser.
     pub const EMPTY: TableEntry = TableEntry(0);
     const VALID: u32 = 1 << 31;
+    const DRAWN: u32 = 1 << 28;
     const SLOT_BITS: u32 = 24;
 
     /// The entry for a page read from `slot`, `coarser` levels up.
     pub fn new(slot: u32, coarser: u32) -> TableEntry {
         debug_assert!(slot < 1 << Self::SLOT_BITS && coarser < 16);
         TableEntry(Self::VALID | (coarser << Self::SLOT_BITS) | slot)
+    }
+
+    /// The entry, saying that its page was drawn this frame where `drawn`.
+    pub fn drawn_if(self, drawn: bool) -> TableEntry {
+        TableEntry(if drawn { self.0 | Self::DRAWN } else { self.0 & !Self::DRAWN })
+    }
+
+    /// Whether the page it reads was drawn this frame.
+    pub fn drawn(self) -> bool {
+        self.0 & Self::DRAWN != 0
     }
 
     /// The slot and how many levels coarser, if the entry holds a page.
@@ -274,7 +291,8 @@ impl PagePool {
         };
         for (&page, &slot) in &self.resident {
             if let Some(i) = index(page) {
-                table[i] = TableEntry::new(slot, 0);
+                let drawn = self.slots[slot as usize].drawn_in == self.frame;
+                table[i] = TableEntry::new(slot, 0).drawn_if(drawn);
             }
         }
         for level in (0..levels.saturating_sub(1)).rev() {
@@ -286,9 +304,9 @@ impl PagePool {
                         continue;
                     }
                     let page = PageKey { level: level as u32, x: origin.x + x, y: origin.y + y };
-                    let parent = index(page.coarser()).and_then(|p| table[p].get());
-                    if let Some((slot, coarser)) = parent {
-                        table[i] = TableEntry::new(slot, coarser + 1);
+                    let parent = index(page.coarser()).map(|p| table[p]);
+                    if let Some((entry, (slot, coarser))) = parent.and_then(|e| Some((e, e.get()?))) {
+                        table[i] = TableEntry::new(slot, coarser + 1).drawn_if(entry.drawn());
                     }
                 }
             }
@@ -466,6 +484,18 @@ pub(super) mod tests {
         let valid = table.iter().filter(|e| e.get().is_some()).count();
         // The coarse page (level 2) covers 4×4 pages of level 0 and 2×2 of level 1.
         assert_eq!(valid, 16 + 4 + 1);
+        // Both were drawn this frame, and every entry that reads them says so; the
+        // next frame keeps them, drawn in no frame but the first.
+        assert!(table.iter().all(|e| e.get().is_none() || e.drawn()));
+        pool.allocate(&[fine, coarse]);
+        let kept = pool.page_table(&clipmap);
+        assert!(kept.iter().all(|e| !e.drawn()));
+        assert_eq!(kept.iter().filter(|e| e.get().is_some()).count(), valid);
+        // A stale page drawn again is marked, the other not.
+        pool.invalidate(|p| p == fine);
+        pool.allocate(&[fine, coarse]);
+        let redrawn = pool.page_table(&clipmap);
+        assert!(redrawn[index(fine)].drawn() && !redrawn[index(coarse)].drawn());
     }
 
     /// The sweep that builds the table gives every entry what resolving it alone

@@ -25,9 +25,12 @@ pub fn wgsl_constants() -> String {
     s += &format!("const TRACED_LAYER_FLAG: u32 = {TRACED_LAYER_FLAG}u;\n");
     s += &format!("const LIGHT_TILE: u32 = {}u;\n", light_list::LIGHT_TILE);
     s += &format!("const LIGHT_WORDS: u32 = {}u;\n", light_list::LIGHT_WORDS);
-    for (name, view) in
-        [("NONE", DebugView::None), ("CASCADES", DebugView::Cascades), ("TRACED", DebugView::Traced)]
-    {
+    for (name, view) in [
+        ("NONE", DebugView::None),
+        ("CASCADES", DebugView::Cascades),
+        ("TRACED", DebugView::Traced),
+        ("PAGES", DebugView::Pages),
+    ] {
         s += &format!("const DEBUG_VIEW_{name}: u32 = {}u;\n", debug_view_code(view));
     }
     for kind in LightKindGpu::all() {

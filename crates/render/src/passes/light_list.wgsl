@@ -7,11 +7,11 @@
 // the cascade view the sum is tinted by the reported light's layer (the per-light
 // passes tint each light's term by its own). Camera: camera.wgsl; vertex stage and
 // normals: surface.wgsl; their outputs and tints: lighting_common.wgsl.
-import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_TRACED, LIGHT_TILE, LIGHT_WORDS, TRACED_LAYER_FLAG};
+import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_PAGES, DEBUG_VIEW_TRACED, LIGHT_TILE, LIGHT_WORDS, TRACED_LAYER_FLAG};
 import package::passes::camera_binding::camera;
 import package::passes::light::Emitter;
 import package::passes::light_kinds::emitter_geometry;
-import package::passes::lighting_common::{CASCADE_TINTS, FragmentOut};
+import package::passes::lighting_common::{FragmentOut, layer_tint, pages_tint};
 import package::passes::scene_common::{alpha_cut, base_color_of, instances};
 import package::passes::shading::blinn_phong;
 import package::passes::surface::SurfaceVertex;
@@ -33,12 +33,14 @@ struct LightList {
 // Layer i: light i's visibility + 2 × the shadow-map layer that shaded it.
 @group(2) @binding(3) var shadow_masks: texture_2d_array<f32>;
 
-// Light `i`'s mask at `texel`: (visibility, layer, traced flag).
+// Light `i`'s mask at `texel`: (visibility, layer code, traced flag). The code is
+// the layer, past TRACED_LAYER_FLAG where the traced view flagged it or the pages
+// view added its page's flags.
 fn listed_visibility(texel: vec2<u32>, i: u32) -> vec3<f32> {
     let packed = textureLoad(shadow_masks, texel, i, 0).x;
     let layer = floor(packed * 0.5);
     let flagged = u32(layer) >= TRACED_LAYER_FLAG;
-    return vec3<f32>(packed - 2.0 * layer, f32(u32(layer) % TRACED_LAYER_FLAG), select(0.0, 1.0, flagged));
+    return vec3<f32>(packed - 2.0 * layer, layer, select(0.0, 1.0, flagged));
 }
 
 @fragment
@@ -83,7 +85,10 @@ fn fs_light_list(in: SurfaceVertex) -> FragmentOut {
     }
     // The cascade view tints by the reported light's layers.
     if camera.debug_view == DEBUG_VIEW_CASCADES {
-        color *= CASCADE_TINTS[u32(shown.y)];
+        color = layer_tint(color, u32(shown.y) % TRACED_LAYER_FLAG);
+    }
+    if camera.debug_view == DEBUG_VIEW_PAGES {
+        color = pages_tint(color, u32(shown.y));
     }
     if camera.debug_view == DEBUG_VIEW_TRACED && traced {
         color = mix(color, vec3<f32>(1.0, 0.0, 1.0), 0.6);

@@ -9,10 +9,10 @@
 // mask stored for the pixel). Camera: camera.wgsl; the
 // vertex stage and normals: surface.wgsl; the light's direction and cone:
 // shading.wgsl; their outputs and tints: lighting_common.wgsl.
-import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
+import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_PAGES, DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
 import package::passes::camera_binding::camera;
 import package::passes::light_binding::light;
-import package::passes::lighting_common::{CASCADE_TINTS, FragmentOut};
+import package::passes::lighting_common::{FragmentOut, layer_tint, pages_tint};
 import package::passes::scene_common::{alpha_cut, base_color_of, instances};
 import package::passes::shading::{blinn_phong, facing_error, light_geometry};
 import package::passes::surface::SurfaceVertex;
@@ -54,7 +54,10 @@ fn fs_lighting(in: SurfaceVertex) -> FragmentOut {
     let direct = light.emitter.radiance * cone * blinn_phong(albedo, inst.specular, inst.shininess, n, l, v);
     var color = light.ambient * albedo + visibility * direct;
     if camera.debug_view == DEBUG_VIEW_CASCADES {
-        color *= CASCADE_TINTS[layer];
+        color = layer_tint(color, layer);
+    }
+    if camera.debug_view == DEBUG_VIEW_PAGES {
+        color = pages_tint(color, u32(shadow.y));
     }
     if camera.debug_view == DEBUG_VIEW_TRACED && traced {
         color = mix(color, vec3<f32>(1.0, 0.0, 1.0), 0.6);

@@ -1,7 +1,7 @@
 // What the lighting passes share: their outputs, in `lighting::TARGETS` order, the
 // surface each pixel shades, and the cascade debug view's tint of each shadow-map
 // layer.
-import package::constants::MAX_CASCADES;
+import package::constants::{MAX_CASCADES, TRACED_LAYER_FLAG};
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
@@ -33,3 +33,29 @@ const CASCADE_TINTS: array<vec3<f32>, MAX_CASCADES> = array<vec3<f32>, MAX_CASCA
     vec3<f32>(1.0, 0.35, 0.35), vec3<f32>(0.35, 1.0, 0.35), vec3<f32>(0.4, 0.5, 1.0), vec3<f32>(1.0, 1.0, 0.3),
     vec3<f32>(1.0, 0.35, 1.0), vec3<f32>(0.3, 1.0, 1.0), vec3<f32>(1.0, 0.65, 0.2), vec3<f32>(0.65, 0.4, 1.0),
 );
+
+// The cascade view's tint of `color` for map layer `layer` (a virtual map's level,
+// up to 15: the tints in turn).
+fn layer_tint(color: vec3<f32>, layer: u32) -> vec3<f32> {
+    return color * CASCADE_TINTS[layer % MAX_CASCADES];
+}
+
+// The pages view's tint of `color` for a mask's layer `code` (virtual_visibility.wgsl:
+// the level, plus TRACED_LAYER_FLAG times its page's flags): the level's tint,
+// brighter over a page drawn this frame, reddened where a coarser page stands in,
+// darkened on a page's border.
+fn pages_tint(color: vec3<f32>, code: u32) -> vec3<f32> {
+    var tinted = layer_tint(color, code % TRACED_LAYER_FLAG);
+    let flags = code / TRACED_LAYER_FLAG;
+    if (flags & 1u) != 0u {
+        // Brighter, keeping the shadows' contrast.
+        tinted *= 1.5;
+    }
+    if (flags & 2u) != 0u {
+        tinted = mix(tinted, vec3<f32>(1.0, 0.0, 0.0), 0.5);
+    }
+    if (flags & 4u) != 0u {
+        tinted *= 0.25;
+    }
+    return tinted;
+}

@@ -11,7 +11,7 @@
 // are not bounded here yet: every pixel is unsure, and rays decide them all.
 import package::passes::light_binding::light;
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
-import package::constants::UNSURE_RING_TEXELS;
+import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::virtual_map::page_lookup::{VirtualTexel, virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel, virtual_texel_size, virtual_tile_depth};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
@@ -40,7 +40,8 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     if REFINE_PENUMBRAE {
         return true;
     }
-    let level = layer;
+    // Past TRACED_LAYER_FLAG: a debug view's flags (virtual_visibility.wgsl).
+    let level = layer % TRACED_LAYER_FLAG;
     let texel = virtual_texel_size(level);
     let depth_range = virtual_map.far - virtual_map.near;
     let point = virtual_light_point(virtual_offset_point(world, n, l, level));

@@ -68,17 +68,23 @@ fn virtual_origin(level: u32) -> vec2<i32> {
     return select(pair.zw, pair.xy, level % 2u == 0u);
 }
 
+// The table's entry for page `page` of `level` (in pages from the light-space
+// origin): 0, no page, outside the level's window.
+fn virtual_page_entry(level: u32, page: vec2<i32>) -> u32 {
+    let side = i32(virtual_map.pages_per_side);
+    let relative = page - virtual_origin(level);
+    if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
+        return 0u;
+    }
+    return page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
+}
+
 // Texel `texel` of `level` (in texels from the light-space origin, y up) through
 // the page table; the far plane (lit) where no page holds it, itself or coarser.
 fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     let size = i32(virtual_map.page_texels);
-    let side = i32(virtual_map.pages_per_side);
     let page = vec2<i32>(floor(vec2<f32>(texel) / f32(size)));
-    let relative = page - virtual_origin(level);
-    if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
-        return VirtualTexel(1.0, false);
-    }
-    let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
+    let entry = virtual_page_entry(level, page);
     if ((entry & 0x80000000u) == 0u) {
         return VirtualTexel(1.0, false);
     }
@@ -108,12 +114,7 @@ fn virtual_slot_tile(slot: u32) -> vec3<i32> {
 // pool when its own level's page is resident: its tile's first texel in xy, its
 // layer in z, and 1 in w; w is 0 where a coarser page stands in for it, or none.
 fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec4<i32> {
-    let side = i32(virtual_map.pages_per_side);
-    let relative = page - virtual_origin(level);
-    if (any(relative < vec2<i32>(0)) || any(relative >= vec2<i32>(side))) {
-        return vec4<i32>(0);
-    }
-    let entry = page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
+    let entry = virtual_page_entry(level, page);
     if ((entry & 0x80000000u) == 0u || ((entry >> 24u) & 0xfu) != 0u) {
         return vec4<i32>(0);
     }
@@ -158,4 +159,23 @@ fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
     let bottom = mix(lit.x, lit.y, weight.x);
     let top = mix(lit.z, lit.w, weight.x);
     return mix(bottom, top, weight.y);
+}
+
+// The pages debug view's flags for a lookup of `level` at light-space `xy`: 1 where
+// its page was drawn this frame (the table's bit 28), 2 where a coarser page stands
+// in for it or none does, 4 within a texel of its page's border.
+fn virtual_page_flags(level: u32, xy: vec2<f32>) -> u32 {
+    let size = f32(virtual_map.page_texels);
+    let p = xy / (virtual_map.finest_texel * exp2(f32(level)));
+    let page = floor(p / size);
+    let within = p - page * size;
+    let entry = virtual_page_entry(level, vec2<i32>(page));
+    var flags = select(0u, 1u, (entry & 0x10000000u) != 0u);
+    if ((entry & 0x80000000u) == 0u || ((entry >> 24u) & 0xfu) != 0u) {
+        flags |= 2u;
+    }
+    if (any(within < vec2<f32>(1.0)) || any(within > vec2<f32>(size - 1.0))) {
+        flags |= 4u;
+    }
+    return flags;
 }

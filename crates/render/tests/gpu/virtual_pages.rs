@@ -231,3 +231,81 @@ mod in_the_frame {
         assert!(differing(&before, &moved) > 50, "the move should change the shadows");
     }
 }
+
+mod pages_view {
+    use gnomon_render::{Frame, OutputRequest, Renderer};
+    use gnomon_scene::{
+        Settings, builtin,
+        settings::{DebugView, Partition, Refine},
+    };
+
+    use crate::support;
+
+    fn pages_view(pool_side: u32) -> Settings {
+        let mut s = support::settings(320, 180, 1024);
+        s.shadow.partition = Partition::Virtual;
+        s.shadow.virtual_map.pool_side = pool_side;
+        s.screen.refine = Refine::Off;
+        s.image.debug_view = DebugView::Pages;
+        s
+    }
+
+    /// Each pixel's RGB, 0 to 255.
+    fn rgb(frame: &Frame) -> Vec<[f32; 3]> {
+        frame.color.chunks(4).map(|p| [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])]).collect()
+    }
+
+    fn sum(pixel: &[f32; 3]) -> f32 {
+        pixel.iter().sum()
+    }
+
+    #[test]
+    fn the_pages_view_tints_levels_darkens_borders_and_brightens_the_pages_drawn() {
+        let scene = builtin::spheres();
+        let request = OutputRequest::default();
+        let plain_settings = Settings { image: support::settings(320, 180, 1024).image, ..pages_view(24) };
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let uploaded = renderer.upload(&scene).unwrap();
+        let plain = renderer.render_uploaded(&uploaded, &scene, &plain_settings, &request).unwrap();
+        // The same pages kept, seen through the view: only the colours change.
+        let kept = renderer.render_uploaded(&uploaded, &scene, &pages_view(24), &request).unwrap();
+        assert_eq!(kept.lights[0].pages.unwrap().drawn, 0);
+        let shadows_differ =
+            plain.visibility.iter().zip(&kept.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+        assert_eq!(shadows_differ, 0, "a debug view changes no shadow");
+        let (plain_rgb, kept_rgb) = (rgb(&plain), rgb(&kept));
+        let tinted = plain_rgb.iter().zip(&kept_rgb).filter(|(a, b)| a != b).count();
+        assert!(tinted > plain_rgb.len() / 2, "{tinted} of {} pixels tinted", plain_rgb.len());
+        // Page borders: a texel wide, darkened to a quarter (about half in sRGB's
+        // steps), where a level's tint keeps 83 % or more.
+        let borders =
+            plain_rgb.iter().zip(&kept_rgb).filter(|(a, b)| sum(a) > 60.0 && sum(b) < 0.6 * sum(a)).count();
+        assert!(borders > 100 && borders < plain_rgb.len() / 10, "{borders} border pixels");
+        // A first frame draws every page: brighter than the kept ones.
+        let drawn = Renderer::new(support::gpu()).unwrap().render(&scene, &pages_view(24), &request).unwrap();
+        // (×1.5 in linear light, about ×1.2 in sRGB's steps): every tinted pixel not
+        // already near white.
+        let shaded: Vec<(&[f32; 3], [f32; 3])> = plain_rgb
+            .iter()
+            .zip(&kept_rgb)
+            .zip(rgb(&drawn))
+            .filter(|((a, b), _)| a != b && sum(b) > 30.0 && sum(b) < 500.0)
+            .map(|((_, b), c)| (b, c))
+            .collect();
+        let brighter = shaded.iter().filter(|(kept, drawn)| sum(drawn) > 1.1 * sum(kept)).count();
+        assert!(brighter * 10 > shaded.len() * 9, "{brighter} of {} brighter where drawn", shaded.len());
+        // A pool too small: the pixels a coarser page stands in for are reddened.
+        let full = Renderer::new(support::gpu()).unwrap().render(&scene, &pages_view(2), &request).unwrap();
+        let p = full.lights[0].pages.unwrap();
+        assert!(p.refused > 0, "{p:?}");
+        // Redder than the same pixel with room for every page (a red share of its
+        // colour a tenth higher), and never the other way.
+        let red_share = |p: &[f32; 3]| p[0] / sum(p).max(1.0);
+        let (full_rgb, roomy_rgb) = (rgb(&full), rgb(&drawn));
+        let redder = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+            a.iter().zip(b).filter(|(x, y)| red_share(x) > red_share(y) + 0.1).count()
+        };
+        let (reddened, paler) = (redder(&full_rgb, &roomy_rgb), redder(&roomy_rgb, &full_rgb));
+        assert!(reddened > full_rgb.len() / 20 && paler == 0, "{reddened} pixels reddened, {paler} paler");
+    }
+}

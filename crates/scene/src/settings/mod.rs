@@ -106,6 +106,12 @@ pub enum DebugView {
     /// Tint magenta each pixel whose shadow rays decided (`screen.refine`): where the
     /// map was unsure, or every pixel with `every-pixel`.
     Traced,
+    /// For a virtual map (`shadow.partition = "virtual"`): tint each pixel by the
+    /// clipmap level it reads (the cascades' tints in turn), darken its page's
+    /// borders, lighten the pages drawn this frame (new or stale; a kept page keeps
+    /// its tint) and redden the pixels whose page a coarser one stands in for
+    /// (the pool was full). Other maps: tinted by layer, as `cascades`.
+    Pages,
 }
 
 /// The output image.

@@ -60,8 +60,13 @@ const RULES: &[(&str, Uses, &str)] = &[
     ("shadow.cascades.sdsm", uses_cascades, CASCADES),
     (
         "image.debug_view",
-        |s, lights| s.image.debug_view != DebugView::Traced || traces_rays(s, lights),
-        "`screen.refine` rays or every-pixel, or auto on the mask path, or the raytraced technique (for the traced view)",
+        |s, lights| match s.image.debug_view {
+            DebugView::Traced => traces_rays(s, lights),
+            DebugView::Pages => lights.iter().any(|l| l.shadow.partition == Partition::Virtual),
+            DebugView::None | DebugView::Cascades => true,
+        },
+        "`screen.refine` rays or every-pixel, or auto on the mask path, or the raytraced technique (for the traced \
+         view); `shadow.partition` virtual (for the pages view)",
     ),
     (
         "screen.penumbra_rays",

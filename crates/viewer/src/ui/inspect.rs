@@ -71,7 +71,7 @@ impl Model {
         if view != self.view {
             self.pending.push(Action::Show(view));
         }
-        // The two tints are values of one setting: ticking one unticks the other.
+        // The tints are values of one setting: ticking one unticks the others.
         for (view, value, label, help) in [
             (DebugView::Cascades, "cascades", "cascade colours", "--debug-view cascades"),
             (
@@ -79,6 +79,13 @@ impl Model {
                 "traced",
                 "traced pixels",
                 "--debug-view traced: magenta where rays decided the shadow (--refine)",
+            ),
+            (
+                DebugView::Pages,
+                "pages",
+                "virtual pages",
+                "--debug-view pages: a virtual map's levels, page borders, pages drawn this frame \
+                 (lighter) and fallbacks (red)",
             ),
         ] {
             let mut tint = self.settings.image.debug_view == view;
