@@ -13,7 +13,7 @@ import package::passes::light_binding::light;
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
-import package::virtual_map::page_lookup::{VirtualTexel, virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel, virtual_texel_size, virtual_tile_depth};
+import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
 // The receiver's depth at the four texels of the block from texel (x, y), in
@@ -24,14 +24,26 @@ fn virtual_block_receiver(x: i32, y: i32, p: vec2<f32>, depth: f32, gradient: ve
     return vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
 }
 
-// Texel `texel` of `level`: from `tile` where its w is 1 (the footprint lies in one
-// page, resident at its own level: no table read per texel), through the table
+// A 2×2 block of stored depths and whether each texel's own page held it.
+struct VirtualBlock {
+    depths: vec4<f32>,
+    exact: bool,
+}
+
+// The block of `level` from texel `corner` (its lower left, light-space y up) up and
+// right, in refine_footprint.wgsl's order ((x, y+1), (x+1, y+1), (x+1, y), (x, y)):
+// gathered in one fetch from `tile` where its w is 1 (the footprint lies in one page,
+// resident at its own level: no table read), through the table texel by texel
 // otherwise.
-fn footprint_texel(level: u32, texel: vec2<i32>, tile: vec4<i32>) -> VirtualTexel {
+fn footprint_block(level: u32, corner: vec2<i32>, tile: vec4<i32>) -> VirtualBlock {
     if tile.w == 1 {
-        return VirtualTexel(virtual_tile_depth(tile.xyz, texel), true);
+        return VirtualBlock(virtual_tile_gather(tile.xyz, corner), true);
     }
-    return virtual_texel(level, texel);
+    let a = virtual_texel(level, corner + vec2<i32>(0, 1));
+    let b = virtual_texel(level, corner + vec2<i32>(1, 1));
+    let c = virtual_texel(level, corner + vec2<i32>(1, 0));
+    let d = virtual_texel(level, corner);
+    return VirtualBlock(vec4<f32>(a.depth, b.depth, c.depth, d.depth), a.exact && b.exact && c.exact && d.exact);
 }
 
 // `layer` is the level the lookup read; `n` the normal it was offset along;
@@ -83,14 +95,11 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     var shadowed = false;
     for (var y = first.y; y < end.y; y += 2) {
         for (var x = first.x; x < end.x; x += 2) {
-            let a = footprint_texel(level, vec2<i32>(x, y + 1), tile);
-            let b = footprint_texel(level, vec2<i32>(x + 1, y + 1), tile);
-            let c = footprint_texel(level, vec2<i32>(x + 1, y), tile);
-            let d = footprint_texel(level, vec2<i32>(x, y), tile);
-            if !(a.exact && b.exact && c.exact && d.exact) {
+            let block = footprint_block(level, vec2<i32>(x, y), tile);
+            if !block.exact {
                 return true;
             }
-            let stored = vec4<f32>(a.depth, b.depth, c.depth, d.depth);
+            let stored = block.depths;
             let receiver = virtual_block_receiver(x, y, p, point.z, gradient);
             let evidence = block_evidence(stored, receiver, all(vec2<i32>(x, y) == base), bounds);
             if evidence.x {

@@ -10,7 +10,7 @@
 // constants name (`shadow_entries` in passes/mod.rs).
 
 import package::constants::VIRTUAL_ORIGIN_VECTORS;
-import package::techniques::bindings::shadow_map;
+import package::techniques::bindings::{shadow_gather, shadow_map};
 import package::variant::{SHADOW_BINDING, SHADOW_GROUP};
 
 struct VirtualMap {
@@ -121,12 +121,20 @@ fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec4<i32> {
     return vec4<i32>(virtual_slot_tile(entry & 0xffffffu), 1);
 }
 
-// The depth of texel `texel` (of a level, y up) from its page's tile at `tile` (the
-// xyz of [`virtual_exact_tile`]), without the table.
-fn virtual_tile_depth(tile: vec3<i32>, texel: vec2<i32>) -> f32 {
+// The 2×2 block of texels from `corner` (its lower left, in texels of a level,
+// light-space y up) up and right, from the tile at `tile` (the xyz of
+// [`virtual_exact_tile`]) in one gather, in the order (x, y+1), (x+1, y+1), (x+1, y),
+// (x, y): the block must lie in the tile's page. Texture rows run down, light-space
+// y up: the block's rows are texture rows `row − 1` (y + 1) and `row` (y), which
+// gather at their shared corner returns as (x, row), (x+1, row), (x+1, row−1),
+// (x, row−1).
+fn virtual_tile_gather(tile: vec3<i32>, corner: vec2<i32>) -> vec4<f32> {
     let size = i32(virtual_map.page_texels);
-    let within = texel - vec2<i32>(floor(vec2<f32>(texel) / f32(size))) * size;
-    return textureLoad(shadow_map, tile.xy + vec2<i32>(within.x, size - 1 - within.y), tile.z, 0);
+    let within = corner - vec2<i32>(floor(vec2<f32>(corner) / f32(size))) * size;
+    let at = tile.xy + vec2<i32>(within.x + 1, size - 1 - within.y);
+    let pool = vec2<f32>(textureDimensions(shadow_map).xy);
+    let g = textureGather(shadow_map, shadow_gather, vec2<f32>(at) / pool, tile.z);
+    return vec4<f32>(g.w, g.z, g.y, g.x);
 }
 
 // The stored depth of texel `texel` of `level` ([`virtual_texel`]'s).
@@ -151,11 +159,32 @@ fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
     let continuous = point.xy / texel_size - vec2<f32>(0.5);
     let base = vec2<i32>(floor(continuous));
     let weight = continuous - floor(continuous);
+    // Most 2×2s lie in one page: its tile from the table once, the four texels in
+    // one gather; through the table texel by texel otherwise. The order: (x, y+1),
+    // (x+1, y+1), (x+1, y), (x, y).
+    let size = f32(virtual_map.page_texels);
+    let first_page = vec2<i32>(floor(vec2<f32>(base) / size));
+    let last_page = vec2<i32>(floor(vec2<f32>(base + vec2<i32>(1)) / size));
+    var tile = vec4<i32>(0);
+    if all(first_page == last_page) {
+        tile = virtual_exact_tile(level, first_page);
+    }
+    var stored: vec4<f32>;
+    if tile.w == 1 {
+        stored = virtual_tile_gather(tile.xyz, base);
+    } else {
+        stored = vec4<f32>(
+            virtual_texel_depth(level, base + vec2<i32>(0, 1)),
+            virtual_texel_depth(level, base + vec2<i32>(1, 1)),
+            virtual_texel_depth(level, base + vec2<i32>(1, 0)),
+            virtual_texel_depth(level, base),
+        );
+    }
     var lit = vec4<f32>(0.0);
-    lit.x = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base));
-    lit.y = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(1, 0)));
-    lit.z = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(0, 1)));
-    lit.w = select(0.0, 1.0, point.z <= virtual_texel_depth(level, base + vec2<i32>(1, 1)));
+    lit.x = select(0.0, 1.0, point.z <= stored.w);
+    lit.y = select(0.0, 1.0, point.z <= stored.z);
+    lit.z = select(0.0, 1.0, point.z <= stored.x);
+    lit.w = select(0.0, 1.0, point.z <= stored.y);
     let bottom = mix(lit.x, lit.y, weight.x);
     let top = mix(lit.z, lit.w, weight.x);
     return mix(bottom, top, weight.y);

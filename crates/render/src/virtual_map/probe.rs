@@ -67,9 +67,15 @@ impl VirtualPages {
         let read =
             pool.buffer("probe readback", bytes, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
         let view = pool.view(&texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
+        // The lookup gathers a 2×2 within one page (`virtual_tile_gather`).
+        let gather = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("virtual probe gather"),
+            ..Default::default()
+        });
         // The places `lookup_probe.wgsl` declares: the shadow resources' from 0.
         let bindings = vec![
             (0, Binding::View(view)),
+            (6, Binding::Sampler(gather)),
             (7, Binding::Buffer(uniform)),
             (8, Binding::Buffer(table)),
             (10, Binding::Buffer(probes_buffer)),
