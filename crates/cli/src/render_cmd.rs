@@ -339,16 +339,20 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
 }
 
 /// `--verbose`'s line on a virtual map's pages: drawn (and in how many runs of
-/// neighbours), kept and refused (whose pixels fell back to a coarser page), and the
-/// pool.
+/// neighbours), kept and refused (whose pixels fell back to a coarser page), those
+/// along shadow edges, and the pool.
 pub(crate) fn pages_line(index: usize, pages: &gnomon_render::PageStats) -> String {
     let texels = u64::from(pages.drawn) * u64::from(pages.page_size).pow(2);
     let fallback = match pages.refused {
         0 => String::new(),
         n => format!("; {n} refused, the pool full: their pixels read a coarser page"),
     };
+    let edges = match pages.edge_levels {
+        0 => String::new(),
+        levels => format!(" and {} along shadow edges (up to {levels} levels finer)", pages.edges),
+    };
     format!(
-        "light {index}: virtual map: {} pages requested, {} drawn ({:.2} M texels, in {} runs), {} kept{fallback}; {} of {} tiles resident",
+        "light {index}: virtual map: {} pages requested{edges}, {} drawn ({:.2} M texels, in {} runs), {} kept{fallback}; {} of {} tiles resident",
         pages.requested,
         pages.drawn,
         texels as f64 / 1e6,

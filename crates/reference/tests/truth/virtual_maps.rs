@@ -60,3 +60,41 @@ fn a_virtual_map_refined_by_rays_matches_the_reference_tracing_few_pixels() {
         assert!((rays as usize) < refined.compared / 5, "{}: {rays} traced", scene.name);
     }
 }
+
+/// The PCF family on a virtual map: each kernel's taps resolve their own page
+/// through the table (`techniques/virtual_query.wgsl`), so a kernel straddling pages
+/// or levels filters the depths a full map would hold there. Alone, each is wrong only
+/// along edges, as the 2×2 lookup is; refined by rays, exact.
+#[test]
+fn the_pcf_family_reads_a_virtual_map_across_pages() {
+    for scene in [builtin::spheres(), builtin::columns()] {
+        let truth = reference(&scene, &settings(Refine::Off));
+        for technique in [Technique::PCF, Technique::PCF_TENT, Technique::PCF_POISSON] {
+            let with = |refine| {
+                let mut s = settings(refine);
+                s.shadow.filter.technique = technique.clone();
+                s
+            };
+            let map = compare(&render(&scene, &with(Refine::Off)), &truth);
+            let refined_frame = render(&scene, &with(Refine::Rays));
+            let refined = compare(&refined_frame, &truth);
+            let rays = refined_frame.lights[0].traced_pixels.expect("a refined frame reports its rays");
+            figure(
+                &format!("{}, virtual map, {technique} alone: mismatch", scene.name),
+                percent(map.mismatch_rate),
+                percent(UNREFINED_MISMATCH),
+            );
+            figure(
+                &format!(
+                    "{}, virtual map, {technique} refined by rays: mismatch ({rays} traced)",
+                    scene.name
+                ),
+                percent(refined.mismatch_rate),
+                percent(REFINED_MISMATCH),
+            );
+            assert!(map.mismatch_rate <= UNREFINED_MISMATCH, "{} {technique}: {map:?}", scene.name);
+            assert!(refined.mismatch_rate <= REFINED_MISMATCH, "{} {technique}: {refined:?}", scene.name);
+            assert!((rays as usize) < refined.compared / 5, "{} {technique}: {rays} traced", scene.name);
+        }
+    }
+}

@@ -287,13 +287,26 @@ impl Renderer {
         settings: &Settings,
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
-        let submit = SubmitRequest {
-            readback: Readback { images: true, shadow_map: request.shadow_map },
-            fixed_layout: request.fixed_layout.as_ref(),
-            clock: None,
-            times: TimesWanted::Now,
+        // A still view of a virtual map settles over frames: each frame's traced
+        // pixels ask for the pages along shadow edges one level finer, which the
+        // next frame draws (`shadow.virtual_map.edge_levels`, `virtual_map/edges.rs`).
+        // The first frame whose pages were settled already, or the frame after the
+        // last level's, is the one returned.
+        let levels = self.settling_frames(scene, settings)?;
+        let mut frames = 0;
+        let submitted = loop {
+            let submit = SubmitRequest {
+                readback: Readback { images: true, shadow_map: request.shadow_map },
+                fixed_layout: request.fixed_layout.as_ref(),
+                clock: None,
+                times: TimesWanted::Now,
+            };
+            let submitted = self.submit(uploaded, scene, settings, submit).await?;
+            if frames == levels || submitted.edges_settled() {
+                break submitted;
+            }
+            frames += 1;
         };
-        let submitted = self.submit(uploaded, scene, settings, submit).await?;
         let frame = submitted.read(&self.gpu, settings).await?;
         self.gpu.deferred_error()?;
         Ok(frame)

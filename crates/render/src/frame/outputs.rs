@@ -359,6 +359,14 @@ impl Submitted {
         }
     }
 
+    /// Whether every virtual light's pages along shadow edges had settled: the last
+    /// frame's traced pixels asked for no page it had not drawn
+    /// ([`crate::PageStats::edges_new`]).
+    pub(super) fn edges_settled(&self) -> bool {
+        let pages = self.lights.iter().filter_map(|light| light.pages);
+        pages.filter(|p| p.edge_levels > 0).all(|p| p.edges_new == Some(0))
+    }
+
     /// The frame left on the GPU; its times are `timings_age` frames old.
     pub(super) fn live(self, timings_age: u32) -> LiveFrame {
         LiveFrame {

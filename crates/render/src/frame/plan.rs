@@ -7,10 +7,13 @@ use gnomon_math::{culling::Frustum, fitting::directional_light_view};
 use gnomon_scene::{
     Camera, Light, Scene, Settings,
     lights::ShadowView,
-    settings::{BiasSettings, CascadeSelection, LightKind, Lighting, Partition, RayUse, Refine},
+    settings::{
+        BiasSettings, CascadeSelection, FilterSettings, KernelUnit, LightKind, Lighting, MAX_KERNEL_TEXELS,
+        Partition, RayUse, Refine,
+    },
 };
 
-use super::Renderer;
+use super::{Renderer, virtual_pages::VirtualLight};
 use crate::{
     GpuScene, RenderError,
     gpu_scene::{CullView, Granularity},
@@ -148,7 +151,45 @@ impl LightPlan {
     }
 }
 
+/// Levels finer than its pixels' footprints that a virtual light's pages along
+/// shadow edges may be: none unless the frame lists the pixels it traces (the mask
+/// path, refinement on), whose list asks for them (`virtual_map/edges.rs`).
+fn edge_levels(mask_path: bool, refine: Refine, shadow: &gnomon_scene::settings::ShadowSettings) -> u32 {
+    if !mask_path {
+        return 0;
+    }
+    match refine {
+        Refine::Off => 0,
+        Refine::Auto | Refine::Rays | Refine::EveryPixel => shadow.virtual_map.edge_levels,
+    }
+}
+
+/// Texels of its level that a technique's filter reaches on a virtual map beyond its
+/// bilinear tap ([`techniques::ShadowTechnique::filter_reach_texels`]): a kernel in
+/// world units is as many texels as the finest level makes it, at most
+/// `MAX_KERNEL_TEXELS` (the shader's clamp, `virtual_kernel_width_texels`).
+fn virtual_filter_reach(technique: techniques::TechniqueRef, filter: &FilterSettings) -> f32 {
+    let kernel = match filter.kernel_unit {
+        KernelUnit::Texels => filter.pcf_kernel,
+        KernelUnit::World => MAX_KERNEL_TEXELS,
+    };
+    technique.filter_reach_texels(filter, kernel)
+}
+
 impl Renderer {
+    /// The most levels finer than their footprints that the pages along shadow edges
+    /// of `settings`' lights in `scene` may be ([`edge_levels`]): how many frames a
+    /// still view takes to settle.
+    pub(super) fn settling_frames(&self, scene: &Scene, settings: &Settings) -> Result<u32, RenderError> {
+        let resolved = self.techniques.resolve_lights(settings, scene)?;
+        let mask_path = settings.uses_shadow_mask(&resolved)?;
+        let levels = resolved.iter().filter(|r| r.shadow.partition == Partition::Virtual).map(|r| {
+            let refine = rays::light_refine(settings.light_refine(r), &r.light);
+            edge_levels(mask_path, refine, &r.shadow)
+        });
+        Ok(levels.max().unwrap_or(0))
+    }
+
     /// Everything about a frame that is decided before recording: the camera, and
     /// each light's settings, layout (fitted, or `fixed_layout` for the reported
     /// light) and uniform.
@@ -199,7 +240,12 @@ impl Renderer {
             };
             let virtual_map = match MapLookup::of(&r.light, shadow) {
                 MapLookup::Virtual => {
-                    Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, index).await?)
+                    let light = VirtualLight {
+                        index,
+                        edge_levels: edge_levels(mask_path, refine, shadow),
+                        filter_reach_texels: virtual_filter_reach(technique, &shadow.filter),
+                    };
+                    Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, light).await?)
                 }
                 MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid => None,
             };

@@ -8,6 +8,7 @@ use super::{
     bindings::CameraDraws,
     plan::{FramePlan, LightPlan},
     recording::{LightBindings, Recording},
+    virtual_record::EdgeList,
 };
 use crate::{
     GpuScene,
@@ -181,6 +182,10 @@ impl Renderer {
                 self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
                 if light.light_gpu.rays.penumbra_rays > 0 {
                     self.record_penumbra_filter(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
+                }
+                if let Some(plan) = &light.virtual_map {
+                    let list = EdgeList { screen: read, counters: &lists.counters };
+                    self.record_edge_requests(rec, plan, list, index as u32);
                 }
             }
         }

@@ -25,7 +25,10 @@ use gnomon_scene::{Camera, Light, Settings, lights::ShadowView, settings::BiasSe
 use super::Renderer;
 use crate::{
     GpuScene, RenderError,
-    virtual_map::{CameraDepth, PageRequests, PixelReach, PoolSize, VirtualMapGpu, VirtualPages},
+    virtual_map::{
+        CameraDepth, EdgeFeedback, EdgeRequests, PageRequestParams, PageRequests, PixelReach, PoolSize,
+        VirtualMapGpu, VirtualPages,
+    },
 };
 
 /// Texels a pcf2x2 lookup and its refinement's footprint test reach from the lookup's
@@ -48,6 +51,8 @@ const FALLBACK_LEVELS: u32 = 3;
 pub(super) struct VirtualLights {
     kept: Vec<Option<KeptPages>>,
     requests: Option<PageRequests>,
+    /// The pass that asks for the pages along shadow edges, built on first use.
+    edge_pass: Option<EdgeRequests>,
 }
 
 /// A light's pool of page tiles, and what its resident pages were drawn under.
@@ -57,6 +62,8 @@ struct KeptPages {
     /// The moving casters' bounds when the pages were last drawn: where their
     /// shadows were.
     moving_before: Vec<Aabb>,
+    /// The pages along shadow edges asked for, where the light's pixels ask.
+    edges: Option<EdgeFeedback>,
 }
 
 /// What every resident page's depths depend on besides its casters: any change
@@ -86,6 +93,17 @@ pub struct PageStats {
     pub runs: u32,
     /// Pages asked for and kept from an earlier frame, drawn nothing.
     pub kept: u32,
+    /// Pages asked for along shadow edges, finer than the pixels' footprints
+    /// (`shadow.virtual_map.edge_levels`), and granted with the others.
+    pub edges: u32,
+    /// Pages along shadow edges that the last frame's traced pixels asked for and no
+    /// frame had before: `Some(0)` once a still view has settled; `None` where no
+    /// earlier frame asked (the first since the light moved).
+    pub edges_new: Option<u32>,
+    /// Levels finer than the footprint's that the pages along edges may be: 0 where
+    /// the light asks for none (`shadow.virtual_map.edge_levels` 0, or the frame
+    /// traces no list of pixels: refinement off, or the forward path).
+    pub edge_levels: u32,
     /// Pages asked for that the full pool had no tile for: their pixels read a
     /// coarser resident page (a fallback, blurrier).
     pub refused: u32,
@@ -99,6 +117,17 @@ pub struct PageStats {
     /// arrival on the CPU: the prepass, the request pass and the wait for them, a
     /// cost the shadow passes' time leaves out.
     pub request_ms: f64,
+}
+
+/// Which light a virtual map is planned for, and what its frame asks of it.
+pub(super) struct VirtualLight {
+    /// The light's index in the frame.
+    pub index: usize,
+    /// Levels finer than the footprint's that its pages along shadow edges may be;
+    /// 0 where the frame lists no traced pixels.
+    pub edge_levels: u32,
+    /// Texels its technique's filter reaches beyond the bilinear tap.
+    pub filter_reach_texels: f32,
 }
 
 /// A virtual light's frame, as decided before recording.
@@ -115,19 +144,23 @@ pub(crate) struct VirtualPlan {
     /// ([`gnomon_math::virtual_map::pages::PagePool::pack`]), and the layers they
     /// are drawn into are cleared by their passes' loads, not tile by tile.
     pub clear_layers: bool,
+    /// The parameters of the pass that asks for the pages along shadow edges after
+    /// the light's trace pass; `None` where `edge_levels` is 0.
+    pub edge_params: Option<PageRequestParams>,
     pub stats: PageStats,
 }
 
 impl Renderer {
     /// A virtual light's pages for this frame: requested by the pixels of a camera
-    /// prepass, granted in the light's pool. Waits for the requests.
+    /// prepass over their filter's reach, and along shadow edges by the pixels the
+    /// last frames traced, granted in the light's pool. Waits for the requests.
     pub(super) async fn plan_virtual(
         &mut self,
         uploaded: &GpuScene,
         light: &Light,
         settings: &Settings,
         camera: &Camera,
-        index: usize,
+        VirtualLight { index, edge_levels, filter_reach_texels }: VirtualLight,
     ) -> Result<VirtualPlan, RenderError> {
         let ShadowView::Parallel { travel } = light.shadow_view() else {
             unreachable!("the technique registry refuses a virtual map for a light other than a sun")
@@ -148,7 +181,7 @@ impl Renderer {
             Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
         let reach = PixelReach {
             footprint_per_depth,
-            reach_texels: LOOKUP_REACH_TEXELS + settings.shadow.bias.normal_offset,
+            reach_texels: LOOKUP_REACH_TEXELS + filter_reach_texels + settings.shadow.bias.normal_offset,
         };
         let clip_from_world = camera.clip_from_world(aspect);
         let depth = gpu.checked("drawing the camera's depth for a virtual map's pages", || {
@@ -175,6 +208,9 @@ impl Renderer {
         } else {
             requested
         };
+        if edge_levels > 0 && self.virtual_lights.edge_pass.is_none() {
+            self.virtual_lights.edge_pass = Some(EdgeRequests::new(&gpu, &self.layouts.trace_screen)?);
+        }
         let kept = self.virtual_lights.kept_for(&gpu, index, size)?;
         let under = DrawnUnder {
             light_from_world: clipmap.light_from_world,
@@ -185,16 +221,27 @@ impl Renderer {
             bias: settings.shadow.bias.clone(),
             still_generation: uploaded.still_generation,
         };
-        kept.mark_stale(under, &clipmap, uploaded.moving_caster_bounds());
+        let moved = kept.mark_stale(under, &clipmap, uploaded.moving_caster_bounds());
+        let edges = kept
+            .edge_pages(&gpu, &clipmap, EdgeAsk { edge_levels, moved, requested: &requested, capacity })
+            .await?;
+        let asked = requested.len() as u32;
+        let mut requested = requested;
+        requested.extend(&edges.pages);
         let mut allocation = kept.pages.allocate(&requested);
         let clear_layers = kept.pages.pack(&mut allocation);
         let table = kept.pages.page_table(&clipmap).iter().map(|entry| entry.0).collect();
-        let uniform = VirtualMapGpu::new(&clipmap, size, footprint_per_depth);
+        let uniform = VirtualMapGpu::new(&clipmap, size, footprint_per_depth, edge_levels);
+        let edge_params =
+            (edge_levels > 0).then(|| PageRequestParams::new(&clipmap, reach, (width, height), edge_levels));
         let to_draw: Vec<_> = allocation.to_draw().copied().collect();
         let runs = runs(&to_draw, size.pages_per_side);
         let drawn = to_draw.len() as u32;
         let stats = PageStats {
-            requested: requested.len() as u32,
+            requested: asked,
+            edges: edges.pages.len() as u32,
+            edges_new: edges.new,
+            edge_levels,
             drawn,
             runs: runs.len() as u32,
             kept: allocation.granted.len() as u32 - drawn,
@@ -204,7 +251,7 @@ impl Renderer {
             page_size: size.page_size,
             request_ms,
         };
-        Ok(VirtualPlan { clipmap, runs, uniform, table, clear_layers, stats })
+        Ok(VirtualPlan { clipmap, runs, uniform, table, clear_layers, edge_params, stats })
     }
 }
 
@@ -227,12 +274,65 @@ fn with_fallbacks(mut requested: Vec<PageKey>, levels: u32) -> Vec<PageKey> {
     requested
 }
 
+/// What a frame asks of a light's pages along shadow edges ([`KeptPages::edge_pages`]).
+struct EdgeAsk<'a> {
+    /// Levels finer than the footprint's the pages may be; 0 asks for none.
+    edge_levels: u32,
+    /// Whether the light or the map's levels changed since the last frame.
+    moved: bool,
+    /// The pages the pixels ask for, in [`PageKey`] order.
+    requested: &'a [PageKey],
+    /// Tiles in the pool.
+    capacity: u32,
+}
+
+/// The pages along shadow edges a frame draws with those its pixels ask for.
+struct EdgePages {
+    /// Those not asked for already, coarse levels first, as many as the pool has
+    /// room for.
+    pages: Vec<PageKey>,
+    /// How many pages the last frame's traced pixels added ([`PageStats::edges_new`]).
+    new: Option<u32>,
+}
+
 impl KeptPages {
+    /// The pages along shadow edges to draw this frame: those the traced pixels of
+    /// the frames since the light last moved asked for, read back from the last
+    /// frame's pass. None when the light moved (they are forgotten), when `edge_levels`
+    /// is 0, or when the pool has no room left.
+    async fn edge_pages(
+        &mut self,
+        gpu: &crate::Gpu,
+        clipmap: &Clipmap,
+        ask: EdgeAsk<'_>,
+    ) -> Result<EdgePages, RenderError> {
+        if ask.edge_levels == 0 {
+            self.edges = None;
+            return Ok(EdgePages { pages: vec![], new: None });
+        }
+        let edges = match &mut self.edges {
+            Some(edges) if edges.fits(clipmap) => edges,
+            slot => slot.insert(EdgeFeedback::new(gpu, clipmap)),
+        };
+        if ask.moved {
+            edges.forget();
+        }
+        let new = edges.collect(gpu).await?;
+        let room = (ask.capacity as usize).saturating_sub(ask.requested.len());
+        Ok(EdgePages { pages: edges.pages_to_add(clipmap, ask.requested, room), new })
+    }
+
+    /// The light's pages along shadow edges, where it has any.
+    pub(super) fn edge_feedback(&mut self) -> Option<&mut EdgeFeedback> {
+        self.edges.as_mut()
+    }
+
     /// Marks stale every resident page when what they were drawn under changed
     /// (`under`), and those under a moving caster (bounds `moving`), where it was
-    /// and where it is.
-    fn mark_stale(&mut self, under: DrawnUnder, clipmap: &Clipmap, moving: Vec<Aabb>) {
-        if self.drawn_under.as_ref() != Some(&under) {
+    /// and where it is. Returns whether what they were drawn under changed.
+    fn mark_stale(&mut self, under: DrawnUnder, clipmap: &Clipmap, moving: Vec<Aabb>) -> bool {
+        let moved = self.drawn_under.as_ref() != Some(&under);
+        if moved {
             self.pages.invalidate_all();
         }
         self.drawn_under = Some(under);
@@ -246,6 +346,7 @@ impl KeptPages {
             self.pages.invalidate(|page| stale.iter().any(|rect| rect.contains(page)));
         }
         self.moving_before = moving;
+        moved
     }
 }
 
@@ -266,6 +367,7 @@ impl VirtualLights {
                 pages: VirtualPages::new(gpu, size)?,
                 drawn_under: None,
                 moving_before: vec![],
+                edges: None,
             });
         }
         Ok(slot.as_mut().expect("made above"))
@@ -276,9 +378,20 @@ impl VirtualLights {
         &mut self.kept[index].as_mut().expect("planned this frame").pages
     }
 
+    /// The edge-page pass and light `index`'s feedback, where the light asks for
+    /// pages along edges this frame (its plan built the pass).
+    pub fn edge_pass(&mut self, index: usize) -> Option<(&mut EdgeRequests, &mut EdgeFeedback)> {
+        let feedback = self.kept.get_mut(index)?.as_mut()?.edge_feedback()?;
+        Some((self.edge_pass.as_mut()?, feedback))
+    }
+
     /// Forgets the pools of the lights past the first `lights`, and of those not
-    /// virtual this frame (`virtual_lights[i]` false).
+    /// virtual this frame (`virtual_lights[i]` false), once a frame; the edge-page
+    /// pass's uniforms of the last frame may be handed out again.
     pub fn keep_only(&mut self, virtual_lights: &[bool]) {
+        if let Some(pass) = &mut self.edge_pass {
+            pass.end_frame();
+        }
         self.kept.truncate(virtual_lights.len());
         for (kept, &is_virtual) in self.kept.iter_mut().zip(virtual_lights) {
             if !is_virtual {

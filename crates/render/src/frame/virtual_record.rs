@@ -16,8 +16,10 @@ use super::{
 use crate::{
     GpuScene,
     pool::{Pool, ViewKey},
+    rays::RefineLists,
     timing::{PassKind, SlotPart},
     uniforms::LightGpu,
+    virtual_map::EdgeTarget,
 };
 
 impl Renderer {
@@ -105,6 +107,30 @@ impl Renderer {
         texture
     }
 
+    /// After light `index`'s trace pass, where it asks for pages along shadow
+    /// edges: the pass that turns its list of traced pixels (`list`: group 1 of
+    /// the trace pass; `counters`: every light's) into requests for the pages one
+    /// level finer round them, read by the next frame (`virtual_map/edges.rs`).
+    pub(super) fn record_edge_requests(
+        &mut self,
+        rec: &mut Recording,
+        plan: &VirtualPlan,
+        list: EdgeList<'_>,
+        index: u32,
+    ) {
+        let Some(params) = plan.edge_params else { return };
+        let Some((pass, feedback)) = self.virtual_lights.edge_pass(index as usize) else { return };
+        let target = EdgeTarget {
+            params,
+            clipmap: &plan.clipmap,
+            screen: list.screen,
+            counters: list.counters,
+            counter_offset: RefineLists::counter_offset(index),
+            feedback,
+        };
+        pass.record(&self.gpu, rec.encoder, target);
+    }
+
     /// A virtual light's uniform and page table for the sampling passes.
     pub(super) fn virtual_buffers(
         pool: &mut Pool,
@@ -116,4 +142,12 @@ impl Renderer {
             page_table: pool.storage(queue, "page table", &plan.table, wgpu::BufferUsages::empty()),
         }
     }
+}
+
+/// A light's list of traced pixels, as the trace pass binds it.
+pub(super) struct EdgeList<'a> {
+    /// Group 1 of the trace pass: the camera, the prepass, the list and the counters.
+    pub screen: &'a wgpu::BindGroup,
+    /// Every light's counters.
+    pub counters: &'a wgpu::Buffer,
 }

@@ -92,11 +92,11 @@ fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
         struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
             light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
-            page_texels, width, height,
+            page_texels, width, height, edge_levels, _pad0, _pad1, _pad2,
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
             light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,
-            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, _pad0, _pad1, _pad2,
+            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, edge_levels, _pad1, _pad2,
         }),
         struct_layout!(crate::virtual_map::SurfaceParams as "SurfaceParams" {
             world_from_clip, view_z_from_world, width, height, _pad0, _pad1,
@@ -127,8 +127,7 @@ fn lookups(technique: TechniqueRef) -> Vec<Lookup> {
     if technique.maps().paraboloid {
         all.push(Lookup::Own(MapLookup::Paraboloid));
     }
-    // A virtual map's lookup is pcf2x2's (the registry's `check_light`).
-    if technique.technique() == gnomon_scene::settings::Technique::PCF2X2 {
+    if technique.virtual_wgsl().is_some() {
         all.push(Lookup::Own(MapLookup::Virtual));
     }
     all
@@ -214,6 +213,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("gpu cull".into(), gpu_cull::gpu_cull_wgsl()));
     out.push(("depth baseline".into(), super::depth_baseline::baseline_wgsl()));
     out.push(("page requests".into(), crate::virtual_map::page_requests_wgsl()));
+    out.push(("edge page requests".into(), crate::virtual_map::edges::edge_requests_wgsl()));
     out.push(("page clear".into(), crate::virtual_map::draw::page_clear_wgsl()));
     out.push(("surface from depth".into(), crate::virtual_map::surface_from_depth_wgsl()));
     out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));

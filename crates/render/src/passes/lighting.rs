@@ -121,9 +121,13 @@ pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -
             (include_str!("paraboloid_visibility.wgsl"), "paraboloid_lookup_visibility")
         }
         MapLookup::Virtual => {
-            // Its filter is page_lookup.wgsl's pcf2x2, across pages: the registry
-            // refuses any other technique for a virtual map (`check_light`).
-            parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+            parts.push(techniques::VIRTUAL_QUERY_WGSL.to_owned());
+            let own = technique.virtual_wgsl().unwrap_or_else(|| {
+                unreachable!("{technique:?} has no virtual lookup; the registry refuses it for virtual maps")
+            });
+            // With its 2D lookup, which the shared shading helpers import.
+            let sources: Vec<&str> = technique.wgsl().iter().chain(own).copied().collect();
+            parts.extend(techniques::technique_wgsl(technique.get(), &sources));
             (include_str!("../virtual_map/virtual_visibility.wgsl"), "virtual_lookup_visibility")
         }
     };

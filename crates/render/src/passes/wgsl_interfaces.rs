@@ -168,6 +168,11 @@ pub(crate) const SAMPLE_SHADOW: WgslInterface =
 pub(crate) const SAMPLE_SHADOW_CUBE: WgslInterface =
     WgslInterface { name: "sample_shadow_cube", params: &[("q", "CubeQuery")], returns: Some("f32") };
 
+/// The technique contract's lookup in a sun's virtual map, through its page table
+/// (`pcf_box_sample_shadow_virtual`, …; techniques/virtual_query.wgsl).
+pub(crate) const SAMPLE_SHADOW_VIRTUAL: WgslInterface =
+    WgslInterface { name: "sample_shadow_virtual", params: &[("q", "VirtualQuery")], returns: Some("f32") };
+
 /// The technique contract's encoding of a texel's linear depth `d` into a filterable
 /// technique's moments (`variance_encode_moments`, …), which the moment pass applies.
 pub(crate) const ENCODE_MOMENTS: WgslInterface = WgslInterface {
@@ -177,8 +182,8 @@ pub(crate) const ENCODE_MOMENTS: WgslInterface = WgslInterface {
 };
 
 /// The contract's functions, for a composer to find each one a technique implements.
-pub(crate) const TECHNIQUE_CONTRACT: [&WgslInterface; 3] =
-    [&SAMPLE_SHADOW, &SAMPLE_SHADOW_CUBE, &ENCODE_MOMENTS];
+pub(crate) const TECHNIQUE_CONTRACT: [&WgslInterface; 4] =
+    [&SAMPLE_SHADOW, &SAMPLE_SHADOW_CUBE, &SAMPLE_SHADOW_VIRTUAL, &ENCODE_MOMENTS];
 
 impl WgslInterface {
     /// The function of `sources` implementing this interface: the one named

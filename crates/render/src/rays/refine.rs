@@ -37,7 +37,7 @@ pub(crate) const PIXEL_BYTES: u64 = 8;
 
 /// The constants the list (`refine_list.wgsl` and the passes that import it) shares
 /// with Rust.
-fn list_wgsl() -> String {
+pub(crate) fn list_wgsl() -> String {
     format!("const REFINE_GROUP_SIZE: u32 = {GROUP_SIZE}u;\nconst REFINE_MAX_GROUPS: u32 = {MAX_GROUPS}u;\n")
 }
 

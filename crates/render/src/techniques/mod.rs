@@ -159,6 +159,15 @@ pub trait ShadowTechnique: Sync {
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         None
     }
+    /// WGSL sources implementing `fn sample_shadow_virtual(q: VirtualQuery) -> f32`
+    /// (as `<module>_sample_shadow_virtual`, or under the contract's own name), the
+    /// lookup in a sun's virtual map through its page table (see
+    /// `virtual_query.wgsl`), for the techniques that can read one; `None` for the
+    /// others, which the settings' checks then refuse with `shadow.partition`
+    /// virtual.
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        None
+    }
     /// The maps it can read besides a plain 2D map.
     fn maps(&self) -> MapSupport;
     /// How far, in texels, the technique's lookup reaches from the receiver's texel
@@ -208,6 +217,10 @@ pub(crate) fn technique_wgsl(technique: &dyn ShadowTechnique, sources: &[&str]) 
 
 /// The helpers every cube lookup shares, which a technique's cube WGSL imports.
 pub(crate) const CUBE_WGSL: &str = include_str!("cube.wgsl");
+
+/// The query and helpers every virtual-map lookup shares, which a technique's
+/// virtual WGSL imports.
+pub(crate) const VIRTUAL_QUERY_WGSL: &str = include_str!("virtual_query.wgsl");
 
 /// Taps in the shared Poisson disk: the most any technique may ask for, the end of
 /// the settings' `POISSON_TAPS` (which `Settings::validate` holds every render to).

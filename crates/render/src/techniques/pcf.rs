@@ -49,6 +49,10 @@ impl ShadowTechnique for Pcf2x2 {
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcf2x2_cube.wgsl")])
     }
+
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcf2x2_virtual.wgsl")])
+    }
 }
 
 impl ShadowTechnique for PcfBox {
@@ -80,6 +84,10 @@ impl ShadowTechnique for PcfBox {
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcf_box_cube.wgsl")])
+    }
+
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcf_box_virtual.wgsl")])
     }
 }
 
@@ -113,6 +121,10 @@ impl ShadowTechnique for PcfTent {
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcf_tent_cube.wgsl")])
     }
+
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcf_tent_virtual.wgsl")])
+    }
 }
 
 impl ShadowTechnique for PcfPoisson {
@@ -144,5 +156,9 @@ impl ShadowTechnique for PcfPoisson {
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcf_poisson_cube.wgsl")])
+    }
+
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcf_poisson_virtual.wgsl")])
     }
 }

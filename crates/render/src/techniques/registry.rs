@@ -15,7 +15,7 @@ use gnomon_scene::{
 use super::{BUILTIN, ShadowTechnique};
 use crate::{
     light_map::MapLookup,
-    passes::wgsl_interfaces::{ENCODE_MOMENTS, SAMPLE_SHADOW, SAMPLE_SHADOW_CUBE},
+    passes::wgsl_interfaces::{ENCODE_MOMENTS, SAMPLE_SHADOW, SAMPLE_SHADOW_CUBE, SAMPLE_SHADOW_VIRTUAL},
 };
 
 /// A registered technique: a cheap handle that compares and hashes by name (names
@@ -96,18 +96,23 @@ impl Default for TechniqueRegistry {
 
 /// What keeps `technique`'s WGSL from implementing the technique contract
 /// (`passes::wgsl_interfaces::TECHNIQUE_CONTRACT`) exactly once: its lookup, its cube
-/// lookup where it has one, and at most one encoding of moments. `None` if nothing.
+/// and virtual-map lookups where it has them, and at most one encoding of moments.
+/// `None` if nothing.
 fn contract_problem(technique: &dyn ShadowTechnique) -> Option<String> {
     let sources = technique.wgsl();
     let lookup = SAMPLE_SHADOW.implementation_in(sources);
     let encoding = ENCODE_MOMENTS.implementation_in(sources);
     let cube = technique.cube_wgsl().map(|cube| SAMPLE_SHADOW_CUBE.implementation_in(cube));
+    let virtual_map = technique.virtual_wgsl().map(|v| SAMPLE_SHADOW_VIRTUAL.implementation_in(v));
     let missing = |name: &str| format!("its WGSL defines neither `{name}` nor `<module>_{name}`");
-    match (lookup, encoding, cube) {
-        (Err(twice), _, _) | (_, Err(twice), _) | (_, _, Some(Err(twice))) => Some(twice),
-        (Ok(None), _, _) => Some(missing(SAMPLE_SHADOW.name)),
-        (_, _, Some(Ok(None))) => Some(missing(SAMPLE_SHADOW_CUBE.name)),
-        (Ok(Some(_)), Ok(_), None | Some(Ok(Some(_)))) => None,
+    match (lookup, encoding, cube, virtual_map) {
+        (Err(twice), ..) | (_, Err(twice), ..) | (_, _, Some(Err(twice)), _) | (.., Some(Err(twice))) => {
+            Some(twice)
+        }
+        (Ok(None), ..) => Some(missing(SAMPLE_SHADOW.name)),
+        (_, _, Some(Ok(None)), _) => Some(missing(SAMPLE_SHADOW_CUBE.name)),
+        (.., Some(Ok(None))) => Some(missing(SAMPLE_SHADOW_VIRTUAL.name)),
+        (Ok(Some(_)), Ok(_), None | Some(Ok(Some(_))), None | Some(Ok(Some(_)))) => None,
     }
 }
 
@@ -207,12 +212,12 @@ impl TechniqueRegistry {
             MapLookup::Paraboloid if !technique.maps().paraboloid => {
                 Err(refuse("with `shadow.map.omni` paraboloid", &|t| t.maps().paraboloid))
             }
-            // The page table's lookup is pcf2x2's (`virtual_map/page_lookup.wgsl`).
-            MapLookup::Virtual if technique.technique() != Technique::PCF2X2 => Err(SettingsError {
+            MapLookup::Virtual if technique.virtual_wgsl().is_none() => Err(SettingsError {
                 setting: "shadow.filter.technique",
                 value: technique.technique().to_string(),
                 valid: format!(
-                    "pcf2x2 for sun `{name}` with `shadow.partition` virtual (its only filter so far)"
+                    "for sun `{name}` with `shadow.partition` virtual: {}",
+                    self.names(|t: &TechniqueRef| t.virtual_wgsl().is_some())
                 ),
             }),
             MapLookup::Map | MapLookup::Cube | MapLookup::Paraboloid | MapLookup::Virtual => Ok(technique),
@@ -384,6 +389,37 @@ mod tests {
                 let found = SAMPLE_SHADOW_CUBE.implementation_in(sources);
                 assert!(
                     matches!(found, Ok(Some(ref name)) if name.ends_with("_sample_shadow_cube")),
+                    "{t:?}: {found:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn virtual_maps_take_the_techniques_with_a_virtual_lookup() {
+        let registry = TechniqueRegistry::builtin();
+        let mut virtual_sun = shadow(Technique::PCSS);
+        virtual_sun.partition = gnomon_scene::settings::Partition::Virtual;
+        let sun = Light::Directional(gnomon_scene::DirectionalLight {
+            direction: glam::Vec3::NEG_Y,
+            color: glam::Vec3::ONE,
+            intensity: 1.0,
+            angular_diameter_degrees: 0.0,
+        });
+        let e = registry.check_light(&virtual_sun, &sun, "sun").unwrap_err();
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "pcss"));
+        assert_eq!(
+            e.valid,
+            "for sun `sun` with `shadow.partition` virtual: pcf2x2, pcf, pcf-tent or pcf-poisson"
+        );
+        for t in registry.iter() {
+            virtual_sun.filter.technique = t.technique();
+            let lookup = t.virtual_wgsl();
+            assert_eq!(registry.check_light(&virtual_sun, &sun, "sun").is_ok(), lookup.is_some(), "{t:?}");
+            if let Some(sources) = lookup {
+                let found = SAMPLE_SHADOW_VIRTUAL.implementation_in(sources);
+                assert!(
+                    matches!(found, Ok(Some(ref name)) if name.ends_with("_sample_shadow_virtual")),
                     "{t:?}: {found:?}"
                 );
             }

@@ -98,6 +98,8 @@ pub struct VirtualPages {
     baseline: DepthBaselinePass,
     pool: Pool,
     bias: BiasSettings,
+    /// The lookup probe's pass, built on the first probe (`probe.rs`).
+    pub(super) probe: Option<super::probe::ProbePass>,
 }
 
 impl VirtualPages {
@@ -140,6 +142,7 @@ impl VirtualPages {
                 baseline: DepthBaselinePass::new(device),
                 pool: Pool::new(device),
                 bias: BiasSettings::default(),
+                probe: None,
             }
         })
     }

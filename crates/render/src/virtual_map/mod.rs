@@ -14,9 +14,11 @@
 //! lookup in `virtual_visibility.wgsl` (see `docs/virtual-maps.md`).
 
 pub(crate) mod draw;
+pub(crate) mod edges;
 mod probe;
 
 pub use draw::{POOL_LAYER_ROWS, PoolSize, PoolTile, VirtualPages};
+pub(crate) use edges::{EdgeFeedback, EdgeRequests, EdgeTarget};
 pub use probe::VirtualProbe;
 
 use bytemuck::{Pod, Zeroable};
@@ -46,6 +48,35 @@ pub(crate) struct PageRequestParams {
     pub page_texels: u32,
     pub width: u32,
     pub height: u32,
+    /// Levels finer than its footprint's that a pixel along a shadow edge may ask
+    /// for (`edge_requests.wgsl`; the request pass itself reads no such thing).
+    pub edge_levels: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl PageRequestParams {
+    /// The parameters of requests from a `width`×`height` image's pixels of
+    /// `reach` into `clipmap`, pages along edges down to `edge_levels` finer.
+    pub fn new(clipmap: &Clipmap, reach: PixelReach, size: (u32, u32), edge_levels: u32) -> Self {
+        PageRequestParams {
+            light_from_world: clipmap.light_from_world,
+            origins: packed_origins(clipmap),
+            finest_texel: clipmap.finest_texel,
+            footprint_per_depth: reach.footprint_per_depth,
+            reach_texels: reach.reach_texels,
+            levels: clipmap.shape.levels,
+            pages_per_side: clipmap.shape.pages_per_side(),
+            page_texels: clipmap.shape.page_size,
+            width: size.0,
+            height: size.1,
+            edge_levels,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
 }
 
 /// A virtual map as the sampling shaders read it (`VirtualMap` in
@@ -68,15 +99,18 @@ pub(crate) struct VirtualMapGpu {
     pub footprint_per_depth: f32,
     /// Rows of tiles in each layer of the pool ([`PoolSize::rows_per_layer`]).
     pub pool_rows_per_layer: u32,
-    pub _pad0: u32,
+    /// Levels finer than its footprint's a pixel reads where their pages hold its
+    /// whole footprint (`virtual_read_level` in virtual_visibility.wgsl).
+    pub edge_levels: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
 
 impl VirtualMapGpu {
     /// `clipmap`'s levels, sampled from a pool of `pool` by pixels whose footprint is
-    /// `footprint_per_depth` per unit of view depth.
-    pub fn new(clipmap: &Clipmap, pool: PoolSize, footprint_per_depth: f32) -> Self {
+    /// `footprint_per_depth` per unit of view depth, down to `edge_levels` finer
+    /// where their pages hold a pixel's footprint.
+    pub fn new(clipmap: &Clipmap, pool: PoolSize, footprint_per_depth: f32, edge_levels: u32) -> Self {
         VirtualMapGpu {
             light_from_world: clipmap.light_from_world,
             origins: packed_origins(clipmap),
@@ -89,7 +123,7 @@ impl VirtualMapGpu {
             pool_pages_per_side: pool.pages_per_side,
             footprint_per_depth,
             pool_rows_per_layer: pool.rows_per_layer,
-            _pad0: 0,
+            edge_levels,
             _pad1: 0,
             _pad2: 0,
         }
@@ -167,7 +201,7 @@ fn compute_pipeline(
     label: &str,
     wgsl: String,
     entry: &str,
-    layout: &wgpu::BindGroupLayout,
+    layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
@@ -175,7 +209,7 @@ fn compute_pipeline(
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
-        bind_group_layouts: &[Some(layout)],
+        bind_group_layouts: &layouts.iter().map(|&layout| Some(layout)).collect::<Vec<_>>(),
         immediate_size: 0,
     });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -234,14 +268,14 @@ impl PageRequests {
                     "page requests",
                     page_requests_wgsl(),
                     "request_pages",
-                    &layout,
+                    &[&layout],
                 ),
                 surface_pipeline: compute_pipeline(
                     device,
                     "surface from depth",
                     surface_from_depth_wgsl(),
                     "surface_from_depth",
-                    &surface_layout,
+                    &[&surface_layout],
                 ),
                 layout,
                 surface_layout,
@@ -320,25 +354,13 @@ impl PageRequests {
                 message: format!("a clipmap of {} levels: give 1 to {MAX_LEVELS}", shape.levels),
             });
         }
-        let side = shape.pages_per_side();
-        let words = (shape.levels as u64 * u64::from(side) * u64::from(side)).div_ceil(32);
+        let words = page_words(clipmap);
         let device = &gpu.device;
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let bits = self.pool.buffer("page request bits", 4 * words, usage);
         let readback_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
         let readback = self.pool.buffer("page request readback", 4 * words, readback_usage);
-        let params = PageRequestParams {
-            light_from_world: clipmap.light_from_world,
-            origins: packed_origins(clipmap),
-            finest_texel: clipmap.finest_texel,
-            footprint_per_depth: reach.footprint_per_depth,
-            reach_texels: reach.reach_texels,
-            levels: shape.levels,
-            pages_per_side: side,
-            page_texels: shape.page_size,
-            width: surface.width(),
-            height: surface.height(),
-        };
+        let params = PageRequestParams::new(clipmap, reach, (surface.width(), surface.height()), 0);
         let uniform = self.pool.uniform(&gpu.queue, "page request parameters", &params);
         let view = self.pool.view(surface, ViewKey::default());
         let bindings = [Binding::View(view), Binding::Buffer(bits.clone()), Binding::Buffer(uniform)];
@@ -393,6 +415,12 @@ impl PageRequests {
         gpu.queue.write_texture(surface.as_image_copy(), bytemuck::cast_slice(&texels), layout, size);
         self.request(gpu, &surface, clipmap, reach).await
     }
+}
+
+/// Words of one bit per page of every level of `clipmap` (the request pass's layout).
+fn page_words(clipmap: &Clipmap) -> u64 {
+    let side = u64::from(clipmap.shape.pages_per_side());
+    (u64::from(clipmap.shape.levels) * side * side).div_ceil(32)
 }
 
 /// The pages whose bits are set in `words` (the request pass's layout), in

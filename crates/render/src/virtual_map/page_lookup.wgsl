@@ -31,7 +31,9 @@ struct VirtualMap {
     footprint_per_depth: f32,
     // Rows of tiles in each layer of the pool; rows run down the layers.
     pool_rows_per_layer: u32,
-    _pad0: u32,
+    // Levels finer than its footprint's that a pixel reads where their pages hold
+    // its whole footprint (`virtual_lookup_visibility`).
+    edge_levels: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -155,8 +157,14 @@ fn virtual_light_point(world: vec3<f32>) -> vec3<f32> {
 // Cook 1987), whatever pages the taps fall in.
 fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
     let point = virtual_light_point(world);
-    let texel_size = virtual_map.finest_texel * exp2(f32(level));
-    let continuous = point.xy / texel_size - vec2<f32>(0.5);
+    return virtual_pcf2x2_at(point.xy / virtual_texel_size(level), point.z, level);
+}
+
+// [`virtual_pcf2x2`] at `texels`, a point in texels of `level` from the light-space
+// origin (texel (i, j) spans [i, i + 1) × [j, j + 1)), against depth `depth`: the tap
+// every filter of a virtual map is made of (techniques/virtual_query.wgsl).
+fn virtual_pcf2x2_at(texels: vec2<f32>, depth: f32, level: u32) -> f32 {
+    let continuous = texels - vec2<f32>(0.5);
     let base = vec2<i32>(floor(continuous));
     let weight = continuous - floor(continuous);
     // Most 2×2s lie in one page: its tile from the table once, the four texels in
@@ -181,10 +189,10 @@ fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
         );
     }
     var lit = vec4<f32>(0.0);
-    lit.x = select(0.0, 1.0, point.z <= stored.w);
-    lit.y = select(0.0, 1.0, point.z <= stored.z);
-    lit.z = select(0.0, 1.0, point.z <= stored.x);
-    lit.w = select(0.0, 1.0, point.z <= stored.y);
+    lit.x = select(0.0, 1.0, depth <= stored.w);
+    lit.y = select(0.0, 1.0, depth <= stored.z);
+    lit.z = select(0.0, 1.0, depth <= stored.x);
+    lit.w = select(0.0, 1.0, depth <= stored.y);
     let bottom = mix(lit.x, lit.y, weight.x);
     let top = mix(lit.z, lit.w, weight.x);
     return mix(bottom, top, weight.y);

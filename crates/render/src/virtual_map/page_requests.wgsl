@@ -21,6 +21,12 @@ struct PageRequestParams {
     page_texels: u32,
     width: u32,
     height: u32,
+    // Levels finer than its footprint's that a pixel along a shadow edge may ask for
+    // (`edge_requests.wgsl`).
+    edge_levels: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // The prepass's surface: the world point in xyz, its view depth in w (0: no surface).
@@ -35,24 +41,23 @@ fn level_origin(level: u32) -> vec2<i32> {
     return select(pair.zw, pair.xy, level % 2u == 0u);
 }
 
-@compute @workgroup_size(8, 8)
-fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= request_params.width || id.y >= request_params.height) {
-        return;
+// The coarsest level whose texels are no larger than the footprint of a pixel at
+// view depth `view_depth` (the level it reads, `virtual_level` in page_lookup.wgsl).
+fn footprint_level(view_depth: f32) -> u32 {
+    let ratio = view_depth * request_params.footprint_per_depth / request_params.finest_texel;
+    if (ratio < 1.0) {
+        return 0u;
     }
-    let surface = textureLoad(request_surface, vec2<i32>(id.xy), 0);
-    if (surface.w <= 0.0) {
-        return;
-    }
-    // The coarsest level whose texels are no larger than the pixel's footprint.
-    let ratio = surface.w * request_params.footprint_per_depth / request_params.finest_texel;
-    var level = 0u;
-    if (ratio >= 1.0) {
-        level = min(u32(floor(log2(ratio))), request_params.levels - 1u);
-    }
+    return min(u32(floor(log2(ratio))), request_params.levels - 1u);
+}
+
+// Marks the pages of `level` that a lookup of that level at world point `world` may
+// read: the square its filter and normal offset reach round the point. Nothing where
+// the point lies outside the level's window.
+fn request_level_pages(world: vec3<f32>, level: u32) {
     let texel = request_params.finest_texel * exp2(f32(level));
     let page_world = texel * f32(request_params.page_texels);
-    let xy = (request_params.light_from_world * vec4<f32>(surface.xyz, 1.0)).xy;
+    let xy = (request_params.light_from_world * vec4<f32>(world, 1.0)).xy;
     let origin = level_origin(level);
     let side = i32(request_params.pages_per_side);
     let centre = vec2<i32>(floor(xy / page_world)) - origin;
@@ -68,4 +73,16 @@ fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
             atomicOr(&page_bits[bit / 32u], 1u << (bit % 32u));
         }
     }
+}
+
+@compute @workgroup_size(8, 8)
+fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= request_params.width || id.y >= request_params.height) {
+        return;
+    }
+    let surface = textureLoad(request_surface, vec2<i32>(id.xy), 0);
+    if (surface.w <= 0.0) {
+        return;
+    }
+    request_level_pages(surface.xyz, footprint_level(surface.w));
 }

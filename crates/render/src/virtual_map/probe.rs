@@ -22,7 +22,49 @@ pub struct VirtualProbe {
     pub level: u32,
 }
 
+/// The probe's pipeline and the sampler its lookup gathers with, built on a pool's
+/// first probe ([`VirtualPages::visibility`]).
+#[derive(Clone)]
+pub(crate) struct ProbePass {
+    pipeline: wgpu::ComputePipeline,
+    /// The lookup gathers a 2×2 within one page (`virtual_tile_gather`).
+    gather: wgpu::Sampler,
+}
+
+impl ProbePass {
+    fn new(gpu: &Gpu) -> Result<ProbePass, RenderError> {
+        let device = &gpu.device;
+        gpu.checked("building the virtual map's lookup probe", || {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("lookup_probe.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(super::lookup_probe_wgsl().into()),
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("virtual lookup probe"),
+                layout: None,
+                module: &module,
+                entry_point: Some("probe_virtual_map"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let gather = device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("virtual probe gather"),
+                ..Default::default()
+            });
+            ProbePass { pipeline, gather }
+        })
+    }
+}
+
 impl VirtualPages {
+    /// The probe's pass, built on the first call.
+    fn probe_pass(&mut self, gpu: &Gpu) -> Result<&ProbePass, RenderError> {
+        if self.probe.is_none() {
+            self.probe = Some(ProbePass::new(gpu)?);
+        }
+        Ok(self.probe.as_ref().expect("built above"))
+    }
+
     /// The fraction of a 2×2 bilinear footprint that sees the light at each probe,
     /// read through the page table of `clipmap` as the pool now stands: a tap whose
     /// page is not resident reads the coarser page standing in for it, and a tap
@@ -38,22 +80,9 @@ impl VirtualPages {
         }
         let device = &gpu.device;
         let words: Vec<u32> = self.page_table(clipmap).iter().map(|e| e.0).collect();
-        let uniform = VirtualMapGpu::new(clipmap, self.size(), 0.0);
+        let uniform = VirtualMapGpu::new(clipmap, self.size(), 0.0, 0);
         let bytes = 4 * probes.len() as u64;
-        let pipeline = gpu.checked("sampling a virtual map", || {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("lookup_probe.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(super::lookup_probe_wgsl().into()),
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("virtual lookup probe"),
-                layout: None,
-                module: &module,
-                entry_point: Some("probe_virtual_map"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+        let ProbePass { pipeline, gather } = self.probe_pass(gpu)?.clone();
         let texture = self.texture().clone();
         let pool = self.frame_pool();
         let uniform = pool.uniform(&gpu.queue, "virtual map", &uniform);
@@ -67,11 +96,6 @@ impl VirtualPages {
         let read =
             pool.buffer("probe readback", bytes, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
         let view = pool.view(&texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
-        // The lookup gathers a 2×2 within one page (`virtual_tile_gather`).
-        let gather = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("virtual probe gather"),
-            ..Default::default()
-        });
         // The places `lookup_probe.wgsl` declares: the shadow resources' from 0.
         let bindings = vec![
             (0, Binding::View(view)),

@@ -309,3 +309,85 @@ mod pages_view {
         assert!(reddened > full_rgb.len() / 20 && paler == 0, "{reddened} pixels reddened, {paler} paler");
     }
 }
+
+/// The pages along shadow edges (`shadow.virtual_map.edge_levels`): the pixels a
+/// frame traces ask for finer pages round them, which narrow the band the next
+/// frame traces, without changing its answer; a still view settles and then draws
+/// nothing; a light that turns forgets them.
+mod along_edges {
+    use gnomon_render::{Frame, OutputRequest, PageStats, Renderer};
+    use gnomon_scene::{
+        Settings, builtin,
+        settings::{Partition, Refine},
+    };
+
+    use crate::support;
+
+    fn virtual_sun(edge_levels: u32, refine: Refine) -> Settings {
+        let mut s = support::settings(320, 180, 1024);
+        s.shadow.partition = Partition::Virtual;
+        s.shadow.virtual_map.edge_levels = edge_levels;
+        s.screen.refine = refine;
+        s
+    }
+
+    fn pages(frame: &Frame) -> PageStats {
+        frame.lights[0].pages.expect("a virtual light reports its pages")
+    }
+
+    fn traced(frame: &Frame) -> u32 {
+        frame.lights[0].traced_pixels.expect("a refined light counts its traced pixels")
+    }
+
+    /// Light-facing pixels whose shadow (lit or not, at a half) differs from `truth`'s.
+    fn wrong(frame: &Frame, truth: &Frame) -> usize {
+        let side = |v: f32| v.is_finite().then_some(v >= 0.5);
+        frame.visibility.iter().zip(&truth.visibility).filter(|(a, b)| side(**a) != side(**b)).count()
+    }
+
+    #[test]
+    fn finer_pages_along_edges_halve_the_traced_pixels_keep_the_answer_and_settle() {
+        let scene = builtin::spheres();
+        let request = OutputRequest::default();
+        let render =
+            |s: &Settings| Renderer::new(support::gpu()).unwrap().render(&scene, s, &request).unwrap();
+        // Every pixel traced: the ray-traced answer the others are held to.
+        let truth = render(&virtual_sun(0, Refine::EveryPixel));
+        let plain = render(&virtual_sun(0, Refine::Auto));
+        let p = pages(&plain);
+        assert_eq!((p.edges, p.edge_levels), (0, 0), "{p:?}");
+
+        let s = virtual_sun(2, Refine::Auto);
+        let mut renderer = Renderer::new(support::gpu()).unwrap();
+        let uploaded = renderer.upload(&scene).unwrap();
+        let settled = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let p = pages(&settled);
+        assert!(p.edges > 0 && p.edge_levels == 2 && p.refused == 0, "{p:?}");
+        // Each level halves the band of unsure texels round an edge: two levels
+        // should leave well under half the pixels to rays.
+        let (before, after) = (traced(&plain), traced(&settled));
+        assert!(before > 1000 && 2 * after < before, "traced {before} without the pages, {after} with");
+        // The map is sure only where it is right: no pixel more is wrong.
+        let (plain_wrong, settled_wrong) = (wrong(&plain, &truth), wrong(&settled, &truth));
+        assert!(settled_wrong <= plain_wrong, "wrong: {plain_wrong} without the pages, {settled_wrong} with");
+
+        // Settled: the same view again asks for no new page and draws none.
+        let again = renderer.render_uploaded(&uploaded, &scene, &s, &request).unwrap();
+        let p = pages(&again);
+        assert_eq!((p.drawn, p.edges_new), (0, Some(0)), "{p:?}");
+        assert_eq!(traced(&again), after);
+        // A turned sun's edges are elsewhere: its first frame forgets them, and it
+        // settles as a renderer that never saw the old sun does.
+        let mut turned = s.clone();
+        turned.light.sun_azimuth = Some(turned.light.sun_azimuth.unwrap_or(0.0) + 10.0);
+        let kept = renderer.render_uploaded(&uploaded, &scene, &turned, &request).unwrap();
+        let fresh = render(&turned);
+        let (k, f) = (pages(&kept), pages(&fresh));
+        assert!(f.edges > 0, "{f:?}");
+        assert_eq!(
+            (k.edges, k.requested, traced(&kept)),
+            (f.edges, f.requested, traced(&fresh)),
+            "{k:?} {f:?}"
+        );
+    }
+}

@@ -18,6 +18,14 @@ pub const MAX_LOD_BIAS: u32 = 2;
 pub const LOD_BIAS_RANGE: SettingRange =
     SettingRange::closed("shadow.virtual_map.lod_bias", 0.0, MAX_LOD_BIAS as f64, "levels");
 
+/// The most levels finer than a pixel's footprint that the pages along a shadow
+/// edge may be drawn at: 2 draws them with texels a quarter of the footprint wide.
+pub const MAX_EDGE_LEVELS: u32 = 2;
+
+/// `shadow.virtual_map.edge_levels`'s range.
+pub const EDGE_LEVELS_RANGE: SettingRange =
+    SettingRange::closed("shadow.virtual_map.edge_levels", 0.0, MAX_EDGE_LEVELS as f64, "levels");
+
 /// `shadow.virtual_map.pool_side`'s range.
 pub const POOL_SIDE_RANGE: SettingRange =
     SettingRange::closed("shadow.virtual_map.pool_side", 2.0, MAX_POOL_SIDE as f64, "tiles");
@@ -35,9 +43,12 @@ pub const POOL_SIDE_RANGE: SettingRange =
 #[serde(default, deny_unknown_fields)]
 pub struct VirtualMapSettings {
     /// Page tiles per side of the physical pool, one depth texture of (side · 128)²
-    /// texels. The default, 24² tiles of 128², holds 576 pages: 9.4 M texels, 0.56×
-    /// four 2048² cascades. When a frame asks for more pages than it holds, pixels
-    /// read a coarser resident page instead.
+    /// texels. The default, 32² tiles of 128², holds 1,024 pages: 16.8 M texels, as
+    /// many as four 2048² cascades; the pages the pixels read at their footprints
+    /// take 140–230 of them on the views, and those along shadow edges
+    /// (`edge_levels`) the rest. When a frame asks for more pages than it holds,
+    /// pixels read a coarser resident page instead, and pages along edges are left
+    /// out first.
     #[cfg_attr(feature = "cli", arg(long = "page-pool", value_name = "TILES", default_value_t = VirtualMapSettings::default().pool_side, help_heading = "Virtual map"))]
     pub pool_side: u32,
     /// Levels finer than a pixel's footprint that its lookup reads: 0 reads texels
@@ -46,17 +57,29 @@ pub struct VirtualMapSettings {
     /// unsure, so rays decide fewer pixels.
     #[cfg_attr(feature = "cli", arg(long = "page-lod-bias", value_name = "LEVELS", default_value_t = VirtualMapSettings::default().lod_bias, help_heading = "Virtual map"))]
     pub lod_bias: u32,
+    /// Levels finer still that the pages along shadow edges are drawn at, with the
+    /// sun and casters still (adaptive shadow maps, Fernando, Fernandez, Bala and
+    /// Greenberg, SIGGRAPH 2001). The pixels that rays decided in one frame ask for
+    /// the pages one level finer around them for the next, up to this many levels,
+    /// and a pixel reads the finest level whose pages hold its whole footprint: the
+    /// band the map is unsure of, and so the pixels traced, narrows with each level
+    /// (a still view settles in 1 + this many frames; `render` renders them). The
+    /// pages are kept while the light stands still; a light that moves drops them.
+    /// 0 turns it off.
+    #[cfg_attr(feature = "cli", arg(long = "page-edge-levels", value_name = "LEVELS", default_value_t = VirtualMapSettings::default().edge_levels, help_heading = "Virtual map"))]
+    pub edge_levels: u32,
 }
 
 impl Default for VirtualMapSettings {
     fn default() -> Self {
-        Self { pool_side: 24, lod_bias: 0 }
+        Self { pool_side: 32, lod_bias: 0, edge_levels: MAX_EDGE_LEVELS }
     }
 }
 
 impl VirtualMapSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
         POOL_SIDE_RANGE.check(self.pool_side)?;
-        LOD_BIAS_RANGE.check(self.lod_bias)
+        LOD_BIAS_RANGE.check(self.lod_bias)?;
+        EDGE_LEVELS_RANGE.check(self.edge_levels)
     }
 }

@@ -1,0 +1,6 @@
+// pcf-tent on a virtual map: the tent kernel, each tap through the page table.
+import package::techniques::virtual_query::{VirtualQuery, virtual_kernel_width_texels, virtual_pcf_kernel};
+
+fn pcf_tent_sample_shadow_virtual(q: VirtualQuery) -> f32 {
+    return virtual_pcf_kernel(q, virtual_kernel_width_texels(q), true);
+}

@@ -1,0 +1,81 @@
+// What every technique's `sample_shadow_virtual` receives, and the helpers they
+// share: a sun's virtual map (`--partition virtual`) is read through its page table,
+// each bilinear tap resolving its own page (`virtual_pcf2x2_at`,
+// virtual_map/page_lookup.wgsl), so that a kernel may straddle pages, resident at
+// its level or stood in for by a coarser one. A tap is a point in texels of the
+// level the pixel reads; the kernels are the 2D maps' (pcf.wgsl, common.wgsl) with
+// their taps moved there.
+import package::constants::MAX_KERNEL_TEXELS;
+import package::passes::light_binding::light;
+import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::pcf::pair_tap;
+import package::variant::POISSON_DISK;
+import package::virtual_map::page_lookup::virtual_pcf2x2_at;
+
+// One lookup in a virtual map.
+struct VirtualQuery {
+    // The (offset) receiver in texels of `level` from the light-space origin: texel
+    // (i, j) spans [i, i + 1) × [j, j + 1).
+    texels: vec2<f32>,
+    // The receiver's depth as the map stores it (0 at the near plane, 1 at the far).
+    depth: f32,
+    // The clipmap level the pixel reads.
+    level: u32,
+    // World size of one texel of the level.
+    texel_world: f32,
+    // Fragment position in pixels, for per-pixel noise.
+    pixel: vec2<f32>,
+    // The receiver plane's change of depth per texel, for receiver-plane depth bias;
+    // zero without it.
+    gradient: vec2<f32>,
+};
+
+// One bilinear comparison tap `offset` texels from the lookup, with the compared
+// depth moved along the receiver's plane.
+fn virtual_compare_tap(q: VirtualQuery, offset: vec2<f32>) -> f32 {
+    return virtual_pcf2x2_at(q.texels + offset, q.depth + dot(q.gradient, offset), q.level);
+}
+
+// The kernel width in texels of the level read (kernel_width_texels for a virtual
+// map): --pcf-kernel as given, or converted from world units by the level's texel.
+fn virtual_kernel_width_texels(q: VirtualQuery) -> f32 {
+    if light.pcf.kernel_in_world == 1u {
+        return clamp(light.pcf.kernel_width / q.texel_world, 1.0, MAX_KERNEL_TEXELS);
+    }
+    return light.pcf.kernel_width;
+}
+
+// A rotated Poisson disk of `count` bilinear taps, `radius` texels wide (pcf_poisson).
+fn virtual_pcf_poisson(q: VirtualQuery, radius: f32, count: u32) -> f32 {
+    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
+    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    var sum = 0.0;
+    for (var i = 0u; i < count; i++) {
+        sum += virtual_compare_tap(q, rotation * POISSON_DISK[i] * radius);
+    }
+    return sum / f32(count);
+}
+
+// A box or tent kernel `width` texels wide from bilinear taps with exact weights
+// (pcf_kernel, after Castaño 2013: two neighbouring texel cells read by one tap).
+fn virtual_pcf_kernel(q: VirtualQuery, width: f32, tent: bool) -> f32 {
+    let h = 0.5 * width;
+    let p = q.texels;
+    let first = floor(p - vec2<f32>(h));
+    let cells = i32(floor(p.x + h) - first.x) + 1;
+    let rows = i32(floor(p.y + h) - first.y) + 1;
+    var sum = 0.0;
+    var total = 0.0;
+    for (var j = 0; j < rows; j += 2) {
+        let ty = pair_tap(p.y, first.y + f32(j), h, tent);
+        for (var i = 0; i < cells; i += 2) {
+            let tx = pair_tap(p.x, first.x + f32(i), h, tent);
+            let w = tx.y * ty.y;
+            if w > 0.0 {
+                sum += w * virtual_compare_tap(q, vec2<f32>(tx.x, ty.x));
+                total += w;
+            }
+        }
+    }
+    return sum / max(total, 1e-12);
+}
