@@ -37,6 +37,10 @@ impl ShadowTechnique for Pcss {
         &[include_str!("pcss.wgsl")]
     }
 
+    fn virtual_wgsl(&self) -> Option<&'static [&'static str]> {
+        Some(&[include_str!("pcss_virtual.wgsl")])
+    }
+
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcss_cube.wgsl")])
     }

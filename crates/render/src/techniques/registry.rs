@@ -398,7 +398,7 @@ mod tests {
     #[test]
     fn virtual_maps_take_the_techniques_with_a_virtual_lookup() {
         let registry = TechniqueRegistry::builtin();
-        let mut virtual_sun = shadow(Technique::PCSS);
+        let mut virtual_sun = shadow(Technique::VSM);
         virtual_sun.partition = gnomon_scene::settings::Partition::Virtual;
         let sun = Light::Directional(gnomon_scene::DirectionalLight {
             direction: glam::Vec3::NEG_Y,
@@ -407,10 +407,10 @@ mod tests {
             angular_diameter_degrees: 0.0,
         });
         let e = registry.check_light(&virtual_sun, &sun, "sun").unwrap_err();
-        assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "pcss"));
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "vsm"));
         assert_eq!(
             e.valid,
-            "for sun `sun` with `shadow.partition` virtual: pcf2x2, pcf, pcf-tent or pcf-poisson"
+            "for sun `sun` with `shadow.partition` virtual: pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
         );
         for t in registry.iter() {
             virtual_sun.filter.technique = t.technique();

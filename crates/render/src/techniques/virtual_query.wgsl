@@ -10,7 +10,7 @@ import package::passes::light_binding::light;
 import package::techniques::common::interleaved_gradient_noise;
 import package::techniques::pcf::pair_tap;
 import package::variant::POISSON_DISK;
-import package::virtual_map::page_lookup::virtual_pcf2x2_at;
+import package::virtual_map::page_lookup::{virtual_map, virtual_pcf2x2_at};
 
 // One lookup in a virtual map.
 struct VirtualQuery {
@@ -29,6 +29,12 @@ struct VirtualQuery {
     // zero without it.
     gradient: vec2<f32>,
 };
+
+// The distance along the light's axis of a point of stored depth `depth` (the
+// virtual map's depth is linear between its own near and far planes).
+fn virtual_distance(depth: f32) -> f32 {
+    return virtual_map.near + depth * (virtual_map.far - virtual_map.near);
+}
 
 // One bilinear comparison tap `offset` texels from the lookup, with the compared
 // depth moved along the receiver's plane.

@@ -317,8 +317,8 @@ pub enum Partition {
     /// pages around the camera, each level twice the area of the one before. Only the
     /// pages that visible pixels read, at their own footprint, are drawn, into a pool
     /// of tiles (--page-pool), and kept until the light or a caster over them moves.
-    /// Filtered by pcf2x2 or a PCF kernel (pcf, pcf-tent, pcf-poisson), each tap
-    /// through the page table; not PCSS or the filterable maps yet.
+    /// Filtered by pcf2x2, a PCF kernel (pcf, pcf-tent, pcf-poisson) or pcss, each
+    /// tap through the page table; not the filterable maps yet.
     Virtual,
 }
 
