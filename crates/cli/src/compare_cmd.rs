@@ -100,6 +100,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         None => vec![None; args.techniques.len()],
     };
     let aliasing = gnomon_viewer::measure_aliasing(&frames[0].frame, settings);
+    let virtual_levels = frames[0].frame.virtual_levels.as_ref();
     let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
     let drawn = lab::drawn_metrics(&scene, settings, &frames.iter().map(|r| &r.frame).collect::<Vec<_>>())?;
 
@@ -118,7 +119,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         scene: &scene.name,
         width: reference.width,
         height: reference.height,
-        shadow_resolution: settings.shadow.map.resolution,
+        shadow_resolution: virtual_levels.map_or(settings.shadow.map.resolution, |l| l.resolution),
+        virtual_levels: virtual_levels.map(|l| l.projections.len() as u32),
         light: format!("{:?}", settings.resolve_light(&scene)?),
         reference_samples: reference.samples,
         adapter: gpu.info.adapter.clone(),

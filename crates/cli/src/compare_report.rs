@@ -50,7 +50,10 @@ pub struct Report<'a> {
     pub scene: &'a str,
     pub width: u32,
     pub height: u32,
+    /// Texels per side of each layer (each level's window, for a virtual map).
     pub shadow_resolution: u32,
+    /// A virtual map's levels (`--partition virtual`); `None` for a 2D or cube map.
+    pub virtual_levels: Option<u32>,
     pub light: String,
     pub reference_samples: u32,
     pub adapter: String,
@@ -73,12 +76,15 @@ fn technique_label(r: &Row) -> String {
 /// `metrics.md`: the header, the table over the compared pixels and the table over
 /// the edge ([`edge_table`]).
 pub fn markdown_table(report: &Report, soft: bool) -> String {
+    let map = match report.virtual_levels {
+        Some(levels) => format!("virtual map of {levels} levels of {}²", report.shadow_resolution),
+        None => format!("shadow map {}²", report.shadow_resolution),
+    };
     let mut s = format!(
-        "`{}` at {}×{}, shadow map {}², reference {} on {} ({})\n\n",
+        "`{}` at {}×{}, {map}, reference {} on {} ({})\n\n",
         report.scene,
         report.width,
         report.height,
-        report.shadow_resolution,
         if soft { format!("{} samples/pixel", report.reference_samples) } else { "exact".into() },
         report.adapter,
         report.backend

@@ -34,7 +34,7 @@ pub use clusters::CLUSTERS_BUILT;
 pub use device::{DeferredErrors, Gpu, GpuInfo};
 pub use frame::{
     CpuTimings, Creations, DrawStats, Frame, FrameCost, LayerCache, LightShadows, LightStats, LiveFrame,
-    OutputRequest, PageStats, PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows,
+    OutputRequest, PageStats, PassTimings, ReceiverVariant, Renderer, ShadowMapImage, Shadows, VirtualLevels,
 };
 pub use gpu_scene::{GpuCullUnavailable, GpuScene};
 pub use layout::{ShadowLayout, light_projection};

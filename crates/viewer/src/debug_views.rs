@@ -18,9 +18,20 @@ use gnomon_reference::{
 use gnomon_render::Frame;
 use gnomon_scene::{Settings, settings::CascadeSelection};
 
-/// Lloyd's m over `frame`, with the cascade selection of `settings`.
+/// Lloyd's m over `frame`, with the cascade selection of `settings`; over a virtual
+/// map's levels, each pixel at the level its footprint picks (finer along shadow
+/// edges: `shadow.virtual_map.edge_levels`).
 pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
-    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
+    let (projections, splits, select_by_projection, resolution) = match &frame.virtual_levels {
+        Some(levels) => (&levels.projections, &levels.splits, false, levels.resolution),
+        None => (
+            &frame.cascades,
+            &frame.cascade_splits,
+            settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
+            frame.shadow_resolution,
+        ),
+    };
+    let layers: Vec<glam::Mat4> = projections.iter().map(|p| p.clip_from_world()).collect();
     aliasing::measure(&AliasingInput {
         width: frame.width,
         height: frame.height,
@@ -30,9 +41,9 @@ pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
         camera: &frame.camera,
         light: &frame.light,
         layers: &layers,
-        splits: &frame.cascade_splits,
-        select_by_projection: settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
-        resolution: frame.shadow_resolution,
+        splits,
+        select_by_projection,
+        resolution,
     })
 }
 

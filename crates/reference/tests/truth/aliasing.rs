@@ -412,3 +412,44 @@ fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
     assert!(e_clamped <= e_full + 2e-4, "mismatch {e_clamped} clamped against {e_full}");
     assert!(e_clamped < 0.005, "the box's shadow is kept: mismatch {e_clamped}");
 }
+
+/// A virtual map reports its levels (`Frame::virtual_levels`) as layers split where
+/// a pixel's footprint moves to the next level. A level's texels are the coarsest no
+/// larger than the footprint along the camera's axis at the pixel's view depth, so
+/// they span between half a pixel and one there; off the axis, a pixel at the same
+/// view depth is nearer along its ray and narrower by up to cos θ at the image's
+/// corner (θ half its diagonal field of view), so m lies within [cos θ / 2, 1 / cos θ],
+/// and on average between a half and one. A level off by one doubles or halves m.
+#[test]
+fn a_virtual_maps_levels_give_texels_between_half_a_pixel_and_one() {
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (320, 180);
+    s.shadow.partition = Partition::Virtual;
+    s.screen.refine = Refine::Off;
+    let frame = render(&builtin::columns(), &s);
+    let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
+    assert_eq!(levels.splits.len(), levels.projections.len() + 1);
+    assert!(levels.splits.windows(2).all(|w| w[0] < w[1]), "{:?}", levels.splits);
+    let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
+    let image = aliasing::measure(&AliasingInput {
+        width: frame.width,
+        height: frame.height,
+        position: &frame.position,
+        normal: &frame.normal,
+        depth: &frame.depth,
+        camera: &frame.camera,
+        light: &frame.light,
+        layers: &layers,
+        splits: &levels.splits,
+        select_by_projection: false,
+        resolution: levels.resolution,
+    });
+    let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
+    assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
+    let aspect = frame.width as f32 / frame.height as f32;
+    let tan_diagonal = (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() * (aspect * aspect + 1.0).sqrt();
+    let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
+    let outside = defined.iter().filter(|&&m| !(0.5 * cos..=1.0 / cos).contains(&m)).count();
+    assert_eq!(outside, 0, "m from {} to {}: mean {}, max {}", 0.5 * cos, 1.0 / cos, image.mean, image.max);
+    assert!(image.mean > 0.5 && image.mean <= 1.0, "mean m {}", image.mean);
+}

@@ -36,7 +36,7 @@ pub use outputs::{
 };
 pub use receiver::{LightShadows, ReceiverVariant, Shadows};
 pub use recording::DrawStats;
-pub use virtual_pages::PageStats;
+pub use virtual_pages::{PageStats, VirtualLevels};
 
 use crate::{
     Gpu, GpuScene, RenderError,

@@ -92,6 +92,9 @@ pub struct Frame {
     pub shadow_depth_clamp: bool,
     /// Texels per side of each layer of the reported light's map.
     pub shadow_resolution: u32,
+    /// The reported light's virtual map's levels (`--partition virtual`), in the
+    /// place of the layout above, which such a light fits but does not draw.
+    pub virtual_levels: Option<super::VirtualLevels>,
     /// The reported light's map read back, when [`OutputRequest::shadow_map`] asked for it.
     pub shadow_map: Option<ShadowMapImage>,
     /// GPU time of each pass, where the device has timestamp queries.
@@ -328,6 +331,7 @@ pub(super) struct Submitted {
     resolution: u32,
     layout: ShadowLayout,
     moment_format: Option<wgpu::TextureFormat>,
+    virtual_levels: Option<super::VirtualLevels>,
     shadow_mask: bool,
 }
 
@@ -355,6 +359,7 @@ impl Submitted {
             resolution: shown.map_resolution(),
             layout: shown.layout,
             moment_format: shown.filterable_map.is_some().then_some(shown.moment_format),
+            virtual_levels: shown.virtual_map.as_ref().map(|plan| plan.levels()),
             shadow_mask: mask_path,
         }
     }
@@ -459,6 +464,7 @@ impl Submitted {
             cascade_splits: layout.splits,
             shadow_depth_clamp: layout.depth_clamp,
             shadow_resolution: resolution,
+            virtual_levels: self.virtual_levels,
             shadow_map,
             timings: self.timings,
             stats: self.stats,

@@ -150,6 +150,50 @@ pub(crate) struct VirtualPlan {
     pub stats: PageStats,
 }
 
+/// A virtual map's clipmap levels as a frame reports them
+/// ([`crate::Frame::virtual_levels`]): each level's whole window as a layer, and the
+/// view depths where a pixel's footprint moves to the next level, as cascades report
+/// theirs, so that what measures a cascade's texels per pixel measures a level's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VirtualLevels {
+    /// Each level's window, finest first: its own projection.
+    pub projections: Vec<gnomon_math::LightProjection>,
+    /// The view depths bounding the levels a pixel's footprint picks (one more than
+    /// the levels, from 0 to infinity). Along shadow edges pixels may read up to
+    /// `shadow.virtual_map.edge_levels` finer.
+    pub splits: Vec<f32>,
+    /// Texels per side of each level's window.
+    pub resolution: u32,
+}
+
+impl VirtualPlan {
+    /// The clipmap's levels, as the frame reports them.
+    pub fn levels(&self) -> VirtualLevels {
+        let clipmap = &self.clipmap;
+        let side = clipmap.shape.pages_per_side();
+        let projections = (0..clipmap.shape.levels)
+            .map(|level| {
+                let size = clipmap.page_size(level);
+                let origin = clipmap.origins[level as usize].as_vec2() * size;
+                let width = size * side as f32;
+                let window = (origin.x, origin.x + width, origin.y, origin.y + width);
+                gnomon_math::LightProjection::orthographic(
+                    clipmap.light_from_world,
+                    window,
+                    clipmap.near,
+                    clipmap.far,
+                )
+            })
+            .collect();
+        // Level l from the footprint ratio 2^l on (`virtual_level`), the last to infinity.
+        let per_depth = self.uniform.footprint_per_depth.max(f32::MIN_POSITIVE);
+        let mut splits = vec![0.0];
+        splits.extend((1..clipmap.shape.levels).map(|l| clipmap.texel_size(l) / per_depth));
+        splits.push(f32::INFINITY);
+        VirtualLevels { projections, splits, resolution: side * clipmap.shape.page_size }
+    }
+}
+
 impl Renderer {
     /// A virtual light's pages for this frame: requested by the pixels of a camera
     /// prepass over their filter's reach, and along shadow edges by the pixels the
