@@ -216,16 +216,26 @@ impl Clipmap {
         self.pages_over(level, in_light.min.truncate(), in_light.max.truncate())
     }
 
+    /// The level a pixel at light-space point `xy` whose footprint is `footprint`
+    /// world units reads: its footprint's ([`Clipmap::level_for_footprint`]), or the
+    /// finest coarser level whose window holds the point. A level's window is
+    /// `virtual_resolution` of its texels wide around the camera: a pixel far to the
+    /// side of a small one reads a coarser level, as in a clipmap's outer rings. None
+    /// where no level's window holds it.
+    pub fn level_for_point(&self, xy: Vec2, footprint: f32) -> Option<u32> {
+        (self.level_for_footprint(footprint)..self.shape.levels)
+            .find(|&level| self.page_at(level, xy).is_some())
+    }
+
     /// Every page a pixel at world point `point` whose footprint is `footprint`
     /// world units reads, through a filter that reaches `reach_texels` texels of its
     /// level from the point (the kernel's radius, the normal offset's, a texel for
-    /// bilinear taps): the rectangle of pages of its level over that square. Nothing
-    /// for a point outside the level's window.
+    /// bilinear taps): the rectangle of pages of its level ([`Clipmap::level_for_point`])
+    /// over that square. Nothing for a point outside every level's window.
     pub fn request(&self, point: Vec3, footprint: f32, reach_texels: f32) -> Option<PageRect> {
-        let level = self.level_for_footprint(footprint);
         let xy = self.light_xy(point);
+        let level = self.level_for_point(xy, footprint)?;
         let reach = reach_texels * self.texel_size(level);
-        self.page_at(level, xy)?;
         self.pages_over(level, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
     }
 

@@ -208,3 +208,23 @@ fn a_rect_projection_puts_each_page_texel_where_the_page_projection_does() {
     let run = PageRect { level: 4, min: glam::IVec2::new(-2, 5), max: glam::IVec2::new(0, 5) };
     assert_eq!(map.run_clip_from_world(first, 3), map.rect_clip_from_world(&run));
 }
+
+#[test]
+fn a_point_outside_its_levels_window_reads_the_finest_coarser_level_that_holds_it() {
+    let shape = ClipmapShape { virtual_resolution: 1024, page_size: 128, levels: 6 };
+    let bounds = Aabb::new(Vec3::splat(-500.0), Vec3::splat(500.0));
+    let map = Clipmap::new(shape, Vec3::NEG_Y, Vec3::ZERO, &bounds, 64.0);
+    let footprint = map.texel_size(1);
+    let near = map.light_xy(Vec3::new(1.0, 0.0, 1.0));
+    assert_eq!(map.level_for_point(near, footprint), Some(1));
+    // Level 1's window is 1024 of its texels wide around the camera: a point beyond
+    // it reads the first level whose window reaches it, and asks for that level's pages.
+    let half_window = |level: u32| 512.0 * map.texel_size(level);
+    let far_point = Vec3::new(1.5 * half_window(1), 0.0, 0.0);
+    let xy = map.light_xy(far_point);
+    let level = map.level_for_point(xy, footprint).expect("a coarser window holds it");
+    assert!(level > 1 && map.page_at(level, xy).is_some() && map.page_at(level - 1, xy).is_none(), "{level}");
+    let rect = map.request(far_point, footprint, 2.0).expect("pages asked for");
+    assert_eq!(rect.level, level);
+    assert_eq!(map.level_for_point(Vec2::splat(1e9), footprint), None);
+}

@@ -126,3 +126,34 @@ fn pcss_on_a_virtual_map_follows_the_penumbrae_as_on_a_single_map() {
     assert!(on_virtual.mae <= 1.25 * on_single.mae, "{on_virtual:?} against {on_single:?}");
     assert!(on_virtual.mae < 0.5 * hard.mae, "{on_virtual:?} against pcf2x2's {hard:?}");
 }
+
+/// Levels of 1024² texels read four levels finer than the footprint
+/// (`level_resolution` 1024, `lod_bias` 2): each level's window is narrow, and the
+/// pixels to the sides of the view lie outside their footprint's level's window. They
+/// read the finest coarser level that holds them (`Clipmap::level_for_point`, and
+/// `virtual_window_level` in page_lookup.wgsl), so the map alone is still wrong only
+/// along edges, and refined exact.
+#[test]
+fn pixels_outside_their_levels_window_read_a_coarser_level() {
+    for scene in [builtin::spheres(), builtin::columns()] {
+        let with = |refine| {
+            let mut s = settings(refine);
+            s.shadow.virtual_map.level_resolution = 1024;
+            s.shadow.virtual_map.lod_bias = 2;
+            s
+        };
+        let truth = reference(&scene, &with(Refine::Off));
+        let map_frame = render(&scene, &with(Refine::Off));
+        let map = compare(&map_frame, &truth);
+        let refined = compare(&render(&scene, &with(Refine::Rays)), &truth);
+        figure(
+            &format!("{}, virtual map of 1024² levels, lod bias 2, alone: mismatch", scene.name),
+            percent(map.mismatch_rate),
+            percent(UNREFINED_MISMATCH),
+        );
+        assert!(map.mismatch_rate <= UNREFINED_MISMATCH, "{}: {map:?}", scene.name);
+        assert!(refined.mismatch_rate <= REFINED_MISMATCH, "{}: {refined:?}", scene.name);
+        let pages = map_frame.lights[0].pages.expect("a virtual light reports its pages");
+        assert!(pages.refused == 0, "{}: {pages:?}", scene.name);
+    }
+}

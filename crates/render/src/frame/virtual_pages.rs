@@ -220,7 +220,10 @@ impl Renderer {
             2.0 * (0.5 * camera.fov_y_degrees.to_radians()).tan() / height as f32 / (1u32 << lod_bias) as f32;
         // The farthest pixel the camera can see: at the scene's farthest corner.
         let farthest = uploaded.bounds.corners().iter().map(|c| c.distance(camera.eye)).fold(0.0, f32::max);
-        let shape = ClipmapShape::DEFAULT;
+        let shape = ClipmapShape {
+            virtual_resolution: settings.shadow.virtual_map.level_resolution,
+            ..ClipmapShape::DEFAULT
+        };
         let clipmap =
             Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
         let reach = PixelReach {

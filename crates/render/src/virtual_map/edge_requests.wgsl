@@ -11,7 +11,7 @@ import package::rays::refine_list::unsure_pixels;
 import package::constants::TRACED_LAYER_FLAG;
 import package::passes::screen_common::prepass_surface;
 import package::variant::REFINE_GROUP_SIZE;
-import package::virtual_map::page_requests::{footprint_level, request_level_pages, request_params};
+import package::virtual_map::page_requests::{footprint_level, request_level_pages, request_params, window_level};
 
 // The light's refinement counters (`RefineCounters` in refine_append.wgsl), read
 // only: the pass is dispatched by them.
@@ -35,7 +35,7 @@ fn request_edge_pages(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         }
         // The level the pixel read; past TRACED_LAYER_FLAG, a debug view's flags.
         let read = (entry.layer & 0xffffu) % TRACED_LAYER_FLAG;
-        let footprint = footprint_level(surface.w);
+        let footprint = window_level(surface.xyz, footprint_level(surface.w));
         if read == 0u || read + request_params.edge_levels <= footprint {
             continue;
         }

@@ -60,6 +60,24 @@ fn virtual_level(view_depth: f32) -> u32 {
     return min(u32(floor(log2(ratio))), virtual_map.levels - 1u);
 }
 
+// The level a pixel at world point `world` whose footprint picks `level` reads: that
+// level, or the finest coarser one whose window holds the point, as its page requests
+// chose (`window_level` in page_requests.wgsl); the coarsest where none does.
+fn virtual_window_level(world: vec3<f32>, level: u32) -> u32 {
+    let xy = (virtual_map.light_from_world * vec4<f32>(world, 1.0)).xy;
+    let side = i32(virtual_map.pages_per_side);
+    var l = level;
+    while l + 1u < virtual_map.levels {
+        let page_world = virtual_texel_size(l) * f32(virtual_map.page_texels);
+        let page = vec2<i32>(floor(xy / page_world)) - virtual_origin(l);
+        if all(page >= vec2<i32>(0)) && all(page < vec2<i32>(side)) {
+            break;
+        }
+        l++;
+    }
+    return l;
+}
+
 // World size of a texel of `level`.
 fn virtual_texel_size(level: u32) -> f32 {
     return virtual_map.finest_texel * exp2(f32(level));

@@ -51,6 +51,25 @@ fn footprint_level(view_depth: f32) -> u32 {
     return min(u32(floor(log2(ratio))), request_params.levels - 1u);
 }
 
+// Whether the light-space point `xy` lies in `level`'s window.
+fn in_level_window(xy: vec2<f32>, level: u32) -> bool {
+    let page_world = request_params.finest_texel * exp2(f32(level)) * f32(request_params.page_texels);
+    let page = vec2<i32>(floor(xy / page_world)) - level_origin(level);
+    return all(page >= vec2<i32>(0)) && all(page < vec2<i32>(i32(request_params.pages_per_side)));
+}
+
+// The level a pixel at world point `world` whose footprint picks `level` reads: that
+// level, or the finest coarser one whose window holds the point (`Clipmap::
+// level_for_point`); `levels` where none does.
+fn window_level(world: vec3<f32>, level: u32) -> u32 {
+    let xy = (request_params.light_from_world * vec4<f32>(world, 1.0)).xy;
+    var l = level;
+    while l < request_params.levels && !in_level_window(xy, l) {
+        l++;
+    }
+    return l;
+}
+
 // Marks the pages of `level` that a lookup of that level at world point `world` may
 // read: the square its filter and normal offset reach round the point. Nothing where
 // the point lies outside the level's window.
@@ -84,5 +103,8 @@ fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
     if (surface.w <= 0.0) {
         return;
     }
-    request_level_pages(surface.xyz, footprint_level(surface.w));
+    let level = window_level(surface.xyz, footprint_level(surface.w));
+    if level < request_params.levels {
+        request_level_pages(surface.xyz, level);
+    }
 }

@@ -10,7 +10,7 @@ import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
 import package::techniques::common::MAX_RECEIVER_SLOPE_PER_TEXEL;
 import package::techniques::virtual_query::VirtualQuery;
 import package::variant::sample_shadow_virtual;
-import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_level, virtual_light_point, virtual_map, virtual_page_flags, virtual_texel_size};
+import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_level, virtual_window_level, virtual_light_point, virtual_map, virtual_page_flags, virtual_texel_size};
 
 // The receiver's point as its lookup reads it: pushed along its unit normal `n`,
 // lit from `l`, by the normal offset in texels of `level`, times 1 − N·L (as
@@ -91,7 +91,7 @@ fn virtual_lookup_visibility(
     pixel: vec2<f32>,
     view_depth: f32,
 ) -> vec2<f32> {
-    let level = virtual_read_level(world, n, l, virtual_level(view_depth));
+    let level = virtual_read_level(world, n, l, virtual_window_level(world, virtual_level(view_depth)));
     let point = virtual_offset_point(world, n, l, level);
     let light_point = virtual_light_point(point);
     let texel = virtual_texel_size(level);

@@ -32,20 +32,36 @@ fn near_grid(x: f32, margin: f32) -> bool {
 
 #[test]
 fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
+    // Unreal's levels, and levels of 1024² read at texels 8× finer than the pixels,
+    // whose windows leave many of the points to coarser levels
+    // (`Clipmap::level_for_point`).
+    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0);
+    assert_eq!(fell_back, 0);
+    let small = ClipmapShape { virtual_resolution: 1024, ..ClipmapShape::DEFAULT };
+    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125);
+    assert!(fell_back > 500, "{fell_back} points read a coarser level than their footprint's");
+}
+
+/// Checks the GPU's requests against the clipmap's for surfaces whose footprint is
+/// `footprint_scale` times a 240-pixel-high camera's; returns how many points read
+/// a coarser level than their footprint's.
+fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_scale: f32) -> usize {
     let gpu = gpu();
     let camera = Vec3::new(2.0, 6.0, 9.0);
     let bounds = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 12.0, 30.0));
     // A 60° camera 240 pixels high, seeing up to 40 units away; the filter reaches
     // 2.5 texels.
-    let reach =
-        PixelReach { footprint_per_depth: 2.0 * (30f32.to_radians()).tan() / 240.0, reach_texels: 2.5 };
+    let reach = PixelReach {
+        footprint_per_depth: footprint_scale * 2.0 * (30f32.to_radians()).tan() / 240.0,
+        reach_texels: 2.5,
+    };
     let travel = Vec3::new(-0.4, -1.0, 0.3);
-    let clipmap =
-        Clipmap::new(ClipmapShape::DEFAULT, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
+    let clipmap = Clipmap::new(shape, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
     let (width, height) = (96u32, 64u32);
     let mut rng = Lcg(17);
     let mut texels = Vec::with_capacity((width * height) as usize);
     let mut expected = BTreeSet::new();
+    let mut fell_back = 0;
     for _ in 0..width * height {
         // Surfaces from 0.5 to 40 units away, in every direction round the camera.
         let direction =
@@ -53,13 +69,19 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
         let depth = 0.5 + 39.5 * rng.next() * rng.next();
         let point = camera + direction * depth;
         let footprint = depth * reach.footprint_per_depth;
-        let level = clipmap.level_for_footprint(footprint);
         let xy = clipmap.light_xy(point);
+        let level = clipmap.level_for_point(xy, footprint).unwrap_or(0);
         let page = clipmap.page_size(level);
         let spread = reach.reach_texels * clipmap.texel_size(level);
         // Pixels on a boundary of levels or pages are left out (as background): the
         // two sides' rounding may differ there by an ulp.
+        // So are points on the edge of a window the level search passed over.
+        let on_window_edge = (clipmap.level_for_footprint(footprint)..level).any(|l| {
+            let size = clipmap.page_size(l);
+            near_grid(xy.x / size, 1e-3) || near_grid(xy.y / size, 1e-3)
+        });
         let ambiguous = near_grid((footprint / clipmap.finest_texel).log2(), 1e-3)
+            || on_window_edge
             || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
                 .iter()
                 .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3));
@@ -67,6 +89,7 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
             texels.push(Vec4::ZERO);
             continue;
         }
+        fell_back += usize::from(level > clipmap.level_for_footprint(footprint));
         texels.push(point.extend(depth));
         if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
             expected.extend(rect.pages());
@@ -102,6 +125,7 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
     let missing: Vec<_> = expected.difference(&asked).take(5).collect();
     let extra: Vec<_> = asked.difference(&expected).take(5).collect();
     assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
+    fell_back
 }
 
 /// A frame's virtual pages: a renderer kept across frames draws only pages new or

@@ -149,6 +149,7 @@ pub static ALL: &[&SettingRange] = &[
     &super::POOL_SIDE_RANGE,
     &super::LOD_BIAS_RANGE,
     &super::EDGE_LEVELS_RANGE,
+    &super::LEVEL_RESOLUTION_RANGE,
     &super::CASCADE_COUNT_RANGE,
     &super::SPLIT_LAMBDA_RANGE,
     &super::CASCADE_BLEND_RANGE,

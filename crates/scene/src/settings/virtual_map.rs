@@ -1,10 +1,14 @@
-//! A virtual shadow map's settings (`--partition virtual`, issue 53): the pool of
-//! page tiles the pages a frame reads are drawn into. The clipmap's shape (16384²
-//! levels in 128² pages) is `gnomon_math::virtual_map::ClipmapShape::DEFAULT`.
+//! A virtual shadow map's settings (`--partition virtual`, issue 53): the size of its
+//! levels, the pool of page tiles the pages a frame reads are drawn into, and how
+//! finely it reads. The rest of the clipmap's shape (128² pages, 16 levels) is
+//! `gnomon_math::virtual_map::ClipmapShape::DEFAULT`.
 
 use serde::{Deserialize, Serialize};
 
 use super::{SettingsError, ranges::SettingRange};
+
+/// Texels per side of a virtual map's page (`gnomon_math::virtual_map::ClipmapShape`).
+pub const PAGE_TEXELS: u32 = gnomon_math::virtual_map::ClipmapShape::DEFAULT.page_size;
 
 /// The most page tiles per side of the pool: 64² tiles of 128² texels are one
 /// 8192² depth texture, 256 MiB.
@@ -25,6 +29,11 @@ pub const MAX_EDGE_LEVELS: u32 = 2;
 /// `shadow.virtual_map.edge_levels`'s range.
 pub const EDGE_LEVELS_RANGE: SettingRange =
     SettingRange::closed("shadow.virtual_map.edge_levels", 0.0, MAX_EDGE_LEVELS as f64, "levels");
+
+/// The smallest and largest virtual levels: 1024² texels (8² pages) to 32768² (256²
+/// pages; a page table of 16 such levels is 4 MiB).
+pub const LEVEL_RESOLUTION_RANGE: SettingRange =
+    SettingRange::closed("shadow.virtual_map.level_resolution", 1024.0, 32768.0, "texels");
 
 /// `shadow.virtual_map.pool_side`'s range.
 pub const POOL_SIDE_RANGE: SettingRange =
@@ -68,11 +77,18 @@ pub struct VirtualMapSettings {
     /// 0 turns it off.
     #[cfg_attr(feature = "cli", arg(long = "page-edge-levels", value_name = "LEVELS", default_value_t = VirtualMapSettings::default().edge_levels, help_heading = "Virtual map"))]
     pub edge_levels: u32,
+    /// Texels per side of each virtual level, a multiple of the 128-texel page: 16384
+    /// (Unreal's) by default. Each level's window is this many of its texels wide
+    /// around the camera; a pixel outside its footprint's level's window reads the
+    /// finest coarser level whose window holds it. Smaller levels make a smaller page
+    /// table and coarser texels at the sides of wide views.
+    #[cfg_attr(feature = "cli", arg(long = "virtual-res", value_name = "TEXELS", default_value_t = VirtualMapSettings::default().level_resolution, help_heading = "Virtual map"))]
+    pub level_resolution: u32,
 }
 
 impl Default for VirtualMapSettings {
     fn default() -> Self {
-        Self { pool_side: 32, lod_bias: 0, edge_levels: MAX_EDGE_LEVELS }
+        Self { pool_side: 32, lod_bias: 0, edge_levels: MAX_EDGE_LEVELS, level_resolution: PAGE_TEXELS * 128 }
     }
 }
 
@@ -80,6 +96,33 @@ impl VirtualMapSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
         POOL_SIDE_RANGE.check(self.pool_side)?;
         LOD_BIAS_RANGE.check(self.lod_bias)?;
-        EDGE_LEVELS_RANGE.check(self.edge_levels)
+        EDGE_LEVELS_RANGE.check(self.edge_levels)?;
+        LEVEL_RESOLUTION_RANGE.check(self.level_resolution)?;
+        if !self.level_resolution.is_multiple_of(PAGE_TEXELS) {
+            return Err(SettingsError {
+                setting: "shadow.virtual_map.level_resolution",
+                value: self.level_resolution.to_string(),
+                valid: format!("a multiple of the {PAGE_TEXELS}-texel page"),
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_levels_resolution_is_a_whole_number_of_pages_in_range() {
+        let with =
+            |level_resolution| VirtualMapSettings { level_resolution, ..Default::default() }.validate();
+        assert_eq!(with(16384), Ok(()));
+        assert_eq!(with(1024 + 128), Ok(()));
+        let e = with(1100).unwrap_err();
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.virtual_map.level_resolution", "1100"));
+        assert!(e.valid.contains("128-texel page"), "{e}");
+        assert_eq!(with(65536).unwrap_err().setting, "shadow.virtual_map.level_resolution");
+        assert_eq!(with(512).unwrap_err().setting, "shadow.virtual_map.level_resolution");
     }
 }
