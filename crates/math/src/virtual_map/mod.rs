@@ -27,7 +27,7 @@ pub mod runs;
 
 use glam::{IVec2, Mat4, Vec2, Vec3};
 
-use crate::{Aabb, projection::view_from_world_look_at};
+use crate::{Aabb, LightProjection, projection::view_from_world_look_at};
 
 /// The size of a virtual map: how many texels each level has and how they are paged.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -192,19 +192,23 @@ impl Clipmap {
 
     /// Whether page `page` of `level` lies in the level's window.
     fn in_window(&self, level: u32, page: IVec2) -> bool {
-        let rel = page - self.origins[level as usize];
-        let side = self.shape.pages_per_side() as i32;
-        rel.x >= 0 && rel.y >= 0 && rel.x < side && rel.y < side
+        let window = self.level_window(level);
+        page.cmpge(window.min).all() && page.cmple(window.max).all()
+    }
+
+    /// Every page of `level`'s window: `pages_per_side`² pages from its origin.
+    pub fn level_window(&self, level: u32) -> PageRect {
+        let min = self.origins[level as usize];
+        PageRect { level, min, max: min + IVec2::splat(self.shape.pages_per_side() as i32 - 1) }
     }
 
     /// The pages of `level` over the light-space rectangle `low..=high`, clipped to
     /// the level's window; None where it lies outside it.
     pub fn pages_over(&self, level: u32, low: Vec2, high: Vec2) -> Option<PageRect> {
         let size = self.page_size(level);
-        let origin = self.origins[level as usize];
-        let last = origin + IVec2::splat(self.shape.pages_per_side() as i32 - 1);
-        let min = (low / size).floor().as_ivec2().max(origin);
-        let max = (high / size).floor().as_ivec2().min(last);
+        let window = self.level_window(level);
+        let min = (low / size).floor().as_ivec2().max(window.min);
+        let max = (high / size).floor().as_ivec2().min(window.max);
         (min.x <= max.x && min.y <= max.y).then_some(PageRect { level, min, max })
     }
 
@@ -263,39 +267,24 @@ impl Clipmap {
     /// at full resolution, each page's texels where [`Clipmap::page_clip_from_world`]
     /// puts them.
     pub fn rect_clip_from_world(&self, rect: &PageRect) -> Mat4 {
+        self.rect_projection(rect).clip_from_world()
+    }
+
+    /// The orthographic projection of the pages of `rect` over the clipmap's depth
+    /// range. Page `(x, y)` of it covers its columns `(x − min.x) · page_size …` and,
+    /// v down, its rows `(max.y − y) · page_size …`.
+    pub fn rect_projection(&self, rect: &PageRect) -> LightProjection {
         let size = self.page_size(rect.level);
         let (left, bottom) = (rect.min.x as f32 * size, rect.min.y as f32 * size);
-        let pages = (rect.max - rect.min + IVec2::ONE).as_vec2();
-        let clip_from_light = glam::camera::rh::proj::directx::orthographic(
-            left,
-            left + size * pages.x,
-            bottom,
-            bottom + size * pages.y,
-            self.near,
-            self.far,
-        );
-        clip_from_light * self.light_from_world
+        let (right, top) = ((rect.max.x + 1) as f32 * size, (rect.max.y + 1) as f32 * size);
+        LightProjection::orthographic(self.light_from_world, (left, right, bottom, top), self.near, self.far)
     }
-}
 
-impl Clipmap {
-    /// World to the clip space of `level`'s whole window: what a full-resolution
-    /// (`virtual_resolution`²) map of the level would be drawn with. Page `(x, y)` of
-    /// the window covers its columns `(x − origin.x) · page_size …` and, v down, its
-    /// rows `(origin.y + pages_per_side − 1 − y) · page_size …`.
+    /// World to the clip space of `level`'s whole window ([`Clipmap::level_window`]):
+    /// what a full-resolution (`virtual_resolution`²) map of the level would be drawn
+    /// with.
     pub fn level_clip_from_world(&self, level: u32) -> Mat4 {
-        let size = self.page_size(level);
-        let origin = self.origins[level as usize].as_vec2() * size;
-        let width = size * self.shape.pages_per_side() as f32;
-        let clip_from_light = glam::camera::rh::proj::directx::orthographic(
-            origin.x,
-            origin.x + width,
-            origin.y,
-            origin.y + width,
-            self.near,
-            self.far,
-        );
-        clip_from_light * self.light_from_world
+        self.rect_clip_from_world(&self.level_window(level))
     }
 }
 

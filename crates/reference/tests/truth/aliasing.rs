@@ -25,9 +25,15 @@ use gnomon_scene::{
     },
 };
 
-fn mean_m(frame: &Frame, s: &Settings) -> f32 {
-    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
-    let image = aliasing::measure(&AliasingInput {
+/// What Lloyd's m is measured from over `frame`: its pixels against the layers
+/// `layers` (each a map of `resolution`²), a pixel picking its layer by `splits`.
+fn frame_input<'a>(
+    frame: &'a Frame,
+    layers: &'a [glam::Mat4],
+    splits: &'a [f32],
+    resolution: u32,
+) -> AliasingInput<'a> {
+    AliasingInput {
         width: frame.width,
         height: frame.height,
         position: &frame.position,
@@ -35,10 +41,18 @@ fn mean_m(frame: &Frame, s: &Settings) -> f32 {
         depth: &frame.depth,
         camera: &frame.camera,
         light: &frame.light,
-        layers: &layers,
-        splits: &frame.cascade_splits,
+        layers,
+        splits,
+        select_by_projection: false,
+        resolution,
+    }
+}
+
+fn mean_m(frame: &Frame, s: &Settings) -> f32 {
+    let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
+    let image = aliasing::measure(&AliasingInput {
         select_by_projection: s.shadow.cascades.cascade_selection == CascadeSelection::Projection,
-        resolution: frame.shadow_resolution,
+        ..frame_input(frame, &layers, &frame.cascade_splits, frame.shadow_resolution)
     });
     assert!(image.measured > frame.pixel_count() / 2, "m measured over {} pixels", image.measured);
     image.mean
@@ -431,19 +445,7 @@ fn a_virtual_maps_levels_give_texels_between_half_a_pixel_and_one() {
     assert_eq!(levels.splits.len(), levels.projections.len() + 1);
     assert!(levels.splits.windows(2).all(|w| w[0] < w[1]), "{:?}", levels.splits);
     let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
-    let image = aliasing::measure(&AliasingInput {
-        width: frame.width,
-        height: frame.height,
-        position: &frame.position,
-        normal: &frame.normal,
-        depth: &frame.depth,
-        camera: &frame.camera,
-        light: &frame.light,
-        layers: &layers,
-        splits: &levels.splits,
-        select_by_projection: false,
-        resolution: levels.resolution,
-    });
+    let image = aliasing::measure(&frame_input(&frame, &layers, &levels.splits, levels.resolution));
     let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
     assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
     let aspect = frame.width as f32 / frame.height as f32;

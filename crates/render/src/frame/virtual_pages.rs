@@ -172,18 +172,7 @@ impl VirtualPlan {
         let clipmap = &self.clipmap;
         let side = clipmap.shape.pages_per_side();
         let projections = (0..clipmap.shape.levels)
-            .map(|level| {
-                let size = clipmap.page_size(level);
-                let origin = clipmap.origins[level as usize].as_vec2() * size;
-                let width = size * side as f32;
-                let window = (origin.x, origin.x + width, origin.y, origin.y + width);
-                gnomon_math::LightProjection::orthographic(
-                    clipmap.light_from_world,
-                    window,
-                    clipmap.near,
-                    clipmap.far,
-                )
-            })
+            .map(|level| clipmap.rect_projection(&clipmap.level_window(level)))
             .collect();
         // Level l from the footprint ratio 2^l on (`virtual_level`), the last to infinity.
         let per_depth = self.uniform.footprint_per_depth.max(f32::MIN_POSITIVE);
