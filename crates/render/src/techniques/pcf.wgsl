@@ -42,19 +42,45 @@ fn pair_tap(p: f32, i: f32, h: f32, tent: bool) -> vec2<f32> {
     return vec2<f32>(x - p, w);
 }
 
+// The bilinear taps of a box or tent kernel round the texel point `p`: `taps` per
+// axis, tap k reading cells `first + 2k` and `first + 2k + 1`. Every map kind's
+// kernel walks the same grid and differs only in how it reads a tap (`pcf_kernel`
+// here, `virtual_pcf_kernel` through a page table).
+struct KernelGrid {
+    p: vec2<f32>,
+    // The first texel cell the kernel touches, per axis.
+    first: vec2<f32>,
+    half_width: f32,
+    taps: vec2<i32>,
+    tent: bool,
+};
+
+fn kernel_grid(p: vec2<f32>, width: f32, tent: bool) -> KernelGrid {
+    let h = 0.5 * width;
+    let first = floor(p - vec2<f32>(h));
+    let cells = vec2<i32>(floor(p + vec2<f32>(h)) - first) + vec2<i32>(1);
+    return KernelGrid(p, first, h, (cells + vec2<i32>(1)) / 2, tent);
+}
+
+// Tap k along x: its offset from p in texels, and its weight along x.
+fn kernel_grid_x(g: KernelGrid, k: i32) -> vec2<f32> {
+    return pair_tap(g.p.x, g.first.x + f32(2 * k), g.half_width, g.tent);
+}
+
+// Tap k along y: its offset from p in texels, and its weight along y.
+fn kernel_grid_y(g: KernelGrid, k: i32) -> vec2<f32> {
+    return pair_tap(g.p.y, g.first.y + f32(2 * k), g.half_width, g.tent);
+}
+
 fn pcf_kernel(q: ShadowQuery, width: f32, tent: bool) -> f32 {
     let gradient = receiver_depth_gradient(q);
-    let h = 0.5 * width;
-    let p = q.coords.xy * light.map.resolution;
-    let first = floor(p - vec2<f32>(h));
-    let cells = i32(floor(p.x + h) - first.x) + 1;
-    let rows = i32(floor(p.y + h) - first.y) + 1;
+    let g = kernel_grid(q.coords.xy * light.map.resolution, width, tent);
     var sum = 0.0;
     var total = 0.0;
-    for (var j = 0; j < rows; j += 2) {
-        let ty = pair_tap(p.y, first.y + f32(j), h, tent);
-        for (var i = 0; i < cells; i += 2) {
-            let tx = pair_tap(p.x, first.x + f32(i), h, tent);
+    for (var j = 0; j < g.taps.y; j++) {
+        let ty = kernel_grid_y(g, j);
+        for (var i = 0; i < g.taps.x; i++) {
+            let tx = kernel_grid_x(g, i);
             let w = tx.y * ty.y;
             if w > 0.0 {
                 sum += w * compare_tap(q, gradient, vec2<f32>(tx.x, ty.x));

@@ -8,7 +8,7 @@
 import package::constants::MAX_KERNEL_TEXELS;
 import package::passes::light_binding::light;
 import package::techniques::common::interleaved_gradient_noise;
-import package::techniques::pcf::pair_tap;
+import package::techniques::pcf::{kernel_grid, kernel_grid_x, kernel_grid_y};
 import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::{virtual_map, virtual_pcf2x2_at};
 
@@ -63,19 +63,16 @@ fn virtual_pcf_poisson(q: VirtualQuery, radius: f32, count: u32) -> f32 {
 }
 
 // A box or tent kernel `width` texels wide from bilinear taps with exact weights
-// (pcf_kernel, after Castaño 2013: two neighbouring texel cells read by one tap).
+// (pcf.wgsl's kernel grid, after Castaño 2013: two neighbouring texel cells read by
+// one tap).
 fn virtual_pcf_kernel(q: VirtualQuery, width: f32, tent: bool) -> f32 {
-    let h = 0.5 * width;
-    let p = q.texels;
-    let first = floor(p - vec2<f32>(h));
-    let cells = i32(floor(p.x + h) - first.x) + 1;
-    let rows = i32(floor(p.y + h) - first.y) + 1;
+    let g = kernel_grid(q.texels, width, tent);
     var sum = 0.0;
     var total = 0.0;
-    for (var j = 0; j < rows; j += 2) {
-        let ty = pair_tap(p.y, first.y + f32(j), h, tent);
-        for (var i = 0; i < cells; i += 2) {
-            let tx = pair_tap(p.x, first.x + f32(i), h, tent);
+    for (var j = 0; j < g.taps.y; j++) {
+        let ty = kernel_grid_y(g, j);
+        for (var i = 0; i < g.taps.x; i++) {
+            let tx = kernel_grid_x(g, i);
             let w = tx.y * ty.y;
             if w > 0.0 {
                 sum += w * virtual_compare_tap(q, vec2<f32>(tx.x, ty.x));
