@@ -31,6 +31,14 @@ fn interleaved_gradient_noise(pixel: vec2<f32>) -> f32 {
     return fract(52.9829189 * fract(dot(floor(pixel), vec2<f32>(0.06711056, 0.00583715))));
 }
 
+// A rotation by a per-pixel angle from interleaved gradient noise: a Poisson disk
+// turned differently at each pixel trades the banding of one fixed pattern for
+// noise that neighbouring pixels average out.
+fn disk_rotation(pixel: vec2<f32>) -> mat2x2<f32> {
+    let angle = 6.2831853 * interleaved_gradient_noise(pixel);
+    return mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+}
+
 // The largest depth slope, per texel, that the receiver plane may have: beyond it
 // the screen-space derivatives come from a silhouette or a sliver triangle, not a
 // plane, and extrapolating them across a kernel would do more harm than good.
@@ -74,8 +82,7 @@ fn compare_tap(q: ShadowQuery, gradient: vec2<f32>, offset: vec2<f32>) -> f32 {
 // them to `radius` texels, and averages the comparison taps there.
 fn pcf_poisson(q: ShadowQuery, radius: f32, count: u32) -> f32 {
     let gradient = receiver_depth_gradient(q);
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     var sum = 0.0;
     for (var i = 0u; i < count; i++) {
         sum += compare_tap(q, gradient, rotation * POISSON_DISK[i] * radius);

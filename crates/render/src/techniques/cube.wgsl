@@ -5,7 +5,7 @@
 import package::constants::MAX_KERNEL_TEXELS;
 import package::passes::light_binding::light;
 import package::techniques::bindings::{shadow_compare, shadow_cube};
-import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::common::disk_rotation;
 import package::variant::POISSON_DISK;
 
 // One cube lookup.
@@ -72,8 +72,7 @@ fn cube_compare_tap(q: CubeQuery, texels: vec2<f32>) -> f32 {
 
 // A rotated Poisson disk of `count` bilinear taps, `radius` texels wide.
 fn cube_pcf_poisson(q: CubeQuery, radius: f32, count: u32) -> f32 {
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     var sum = 0.0;
     for (var i = 0u; i < count; i++) {
         sum += cube_compare_tap(q, rotation * POISSON_DISK[i] * radius);

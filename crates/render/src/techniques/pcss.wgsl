@@ -15,7 +15,7 @@
 import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::bindings::shadow_map;
-import package::techniques::common::{ShadowQuery, interleaved_gradient_noise, pcf_poisson, receiver_depth_gradient};
+import package::techniques::common::{ShadowQuery, disk_rotation, pcf_poisson, receiver_depth_gradient};
 import package::variant::POISSON_DISK;
 
 // Radius in texels of layer `layer` of a world length `world` that lies at light
@@ -35,8 +35,7 @@ fn pcss_sample_shadow(q: ShadowQuery) -> f32 {
     let search = clamp(world_to_texels(q.layer, search_world, near), 1.0, max_radius);
 
     let gradient = receiver_depth_gradient(q);
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     let dims = vec2<i32>(textureDimensions(shadow_map));
     let taps = light.pcss.blocker_taps;
     var blocker_sum = 0.0;

@@ -3,7 +3,7 @@
 // offset is across the ray, in texels at the receiver.
 import package::passes::light_binding::light;
 import package::techniques::bindings::{shadow_cube, shadow_gather};
-import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::common::disk_rotation;
 import package::techniques::cube::{CubeQuery, cube_direction, cube_pcf_poisson, cube_tap_depth};
 import package::variant::POISSON_DISK;
 
@@ -17,8 +17,7 @@ fn pcss_sample_shadow_cube(q: CubeQuery) -> f32 {
     // 1. The search region: a blocker at distance t hides the light from the receiver
     // within size·(d − t)/t across the ray at the receiver, the most at the near plane.
     let search = clamp(size * (d_receiver - near) / near / q.texel_world, 1.0, max_radius);
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     let taps = light.pcss.blocker_taps;
     var blocker_sum = 0.0;
     var blockers = 0.0;

@@ -7,7 +7,7 @@
 // 3. a Poisson disk of bilinear taps that wide.
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
-import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::common::disk_rotation;
 import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson};
 import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::virtual_texel_depth;
@@ -17,8 +17,7 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     let d_receiver = virtual_distance(q.depth);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, virtual_distance(0.0));
     let search = clamp(search_world / q.texel_world, 1.0, max_radius);
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     var blocker_sum = 0.0;
     var blockers = 0.0;
     for (var i = 0u; i < light.pcss.blocker_taps; i++) {

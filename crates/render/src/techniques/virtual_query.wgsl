@@ -7,7 +7,7 @@
 // their taps moved there.
 import package::constants::MAX_KERNEL_TEXELS;
 import package::passes::light_binding::light;
-import package::techniques::common::interleaved_gradient_noise;
+import package::techniques::common::disk_rotation;
 import package::techniques::pcf::{kernel_grid, kernel_grid_x, kernel_grid_y};
 import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::{virtual_map, virtual_pcf2x2_at};
@@ -53,8 +53,7 @@ fn virtual_kernel_width_texels(q: VirtualQuery) -> f32 {
 
 // A rotated Poisson disk of `count` bilinear taps, `radius` texels wide (pcf_poisson).
 fn virtual_pcf_poisson(q: VirtualQuery, radius: f32, count: u32) -> f32 {
-    let angle = 6.2831853 * interleaved_gradient_noise(q.pixel);
-    let rotation = mat2x2<f32>(cos(angle), sin(angle), -sin(angle), cos(angle));
+    let rotation = disk_rotation(q.pixel);
     var sum = 0.0;
     for (var i = 0u; i < count; i++) {
         sum += virtual_compare_tap(q, rotation * POISSON_DISK[i] * radius);
