@@ -41,15 +41,15 @@ const FRAME_ASPECT: f32 = 16.0 / 9.0;
 /// once the scene's instances are placed.
 pub fn default_camera(scene: &Scene) -> Camera {
     let triangles = world_triangles(scene);
-    if is_interior(scene, &triangles) {
-        interior_camera(scene, &triangles)
+    let probe = Probe::new(&triangles);
+    if is_interior(scene, &probe) {
+        interior_camera(scene, &probe)
     } else {
         exterior_camera(scene, &triangles)
     }
 }
 
-/// Every instance's triangles in world space (a flat list: the probe casts a few
-/// dozen rays, for which a BVH would cost more than it saves).
+/// Every instance's triangles in world space (a flat list, in each mesh's index order).
 fn world_triangles(scene: &Scene) -> Vec<[Vec3A; 3]> {
     let mut out = Vec::with_capacity(scene.triangle_count());
     for inst in &scene.instances {
@@ -61,8 +61,78 @@ fn world_triangles(scene: &Scene) -> Vec<[Vec3A; 3]> {
     out
 }
 
-/// The nearest triangle along a ray: (distance, whether its front face, by its
-/// counter-clockwise winding, faces the ray's origin). Möller–Trumbore, both faces.
+/// Triangles in each run whose bounds a probe ray tests before the triangles
+/// themselves. A mesh's index order keeps neighbours together, so most runs are small
+/// and a ray skips nearly all of them: the few hundred probe rays cost Sponza's 279 K
+/// triangles about 0.01 s instead of 0.8 s testing every triangle (perf, on this
+/// project's 2-core machine), with no tree to build, which would cost more than these
+/// rays save.
+const PROBE_RUN: usize = 32;
+
+/// The box round one run of [`PROBE_RUN`] triangles.
+struct RunBounds {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+/// The scene's triangles for the probe rays, with their runs' bounds.
+struct Probe<'a> {
+    triangles: &'a [[Vec3A; 3]],
+    runs: Vec<RunBounds>,
+}
+
+impl<'a> Probe<'a> {
+    fn new(triangles: &'a [[Vec3A; 3]]) -> Probe<'a> {
+        let runs = triangles
+            .chunks(PROBE_RUN)
+            .map(|run| {
+                let (min, max) =
+                    run.iter().flatten().fold(
+                        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+                        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+                    );
+                // A margin, so that a hit the triangle test accepts at the edge of its
+                // tolerance is never lost to the box.
+                let pad = Vec3A::splat(1e-4 * (max - min).max_element() + 1e-6);
+                RunBounds { min: min - pad, max: max + pad }
+            })
+            .collect();
+        Probe { triangles, runs }
+    }
+
+    /// The nearest triangle along a ray: (distance, whether its front face, by its
+    /// counter-clockwise winding, faces the ray's origin).
+    fn nearest_hit(&self, origin: Vec3A, direction: Vec3A) -> Option<(f32, bool)> {
+        let inverse = direction.recip();
+        let mut best: Option<(f32, bool)> = None;
+        for (run, bounds) in self.triangles.chunks(PROBE_RUN).zip(&self.runs) {
+            let within = best.map_or(f32::INFINITY, |(t, _)| t);
+            if !ray_meets_box(bounds, origin, inverse, within) {
+                continue;
+            }
+            if let Some(hit) = nearest_hit(run, origin, direction)
+                && hit.0 < within
+            {
+                best = Some(hit);
+            }
+        }
+        best
+    }
+}
+
+/// Whether a ray from `origin` whose direction's reciprocal is `inverse` meets the box
+/// before distance `within` (the slab test, Kay & Kajiya 1986). An axis the ray runs
+/// parallel to at the box's very face gives NaN, which the comparisons let through:
+/// a box wrongly kept costs a few triangle tests, one wrongly skipped a wall.
+fn ray_meets_box(bounds: &RunBounds, origin: Vec3A, inverse: Vec3A, within: f32) -> bool {
+    let (t0, t1) = ((bounds.min - origin) * inverse, (bounds.max - origin) * inverse);
+    let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+    let missed = near > far || far < 0.0 || near > within;
+    !missed
+}
+
+/// The nearest of `triangles` along a ray, as [`Probe::nearest_hit`]: Möller–Trumbore,
+/// both faces.
 fn nearest_hit(triangles: &[[Vec3A; 3]], origin: Vec3A, direction: Vec3A) -> Option<(f32, bool)> {
     let mut best: Option<(f32, bool)> = None;
     for [a, b, c] in triangles {
@@ -88,7 +158,7 @@ fn nearest_hit(triangles: &[[Vec3A; 3]], origin: Vec3A, direction: Vec3A) -> Opt
 }
 
 /// Whether the scene is walled in (see the module's documentation).
-fn is_interior(scene: &Scene, triangles: &[[Vec3A; 3]]) -> bool {
+fn is_interior(scene: &Scene, probe: &Probe) -> bool {
     let bounds = scene.bounds();
     let (min, max, extent) = (Vec3A::from(bounds.min), Vec3A::from(bounds.max), Vec3A::from(bounds.extent()));
     let centre = Vec3A::from(bounds.center());
@@ -117,7 +187,8 @@ fn is_interior(scene: &Scene, triangles: &[[Vec3A; 3]]) -> bool {
                         max.z,
                         origin.z,
                     ));
-                    nearest_hit(triangles, origin, direction)
+                    probe
+                        .nearest_hit(origin, direction)
                         .is_some_and(|(t, facing)| facing && t >= WALL_DISTANCE * reach)
                 })
                 .count();
@@ -171,7 +242,7 @@ const VIEW_RAYS: [f32; 3] = [-0.5, 0.0, 0.5];
 /// and slightly down: of the candidate spots (both ends, a few distances and
 /// heights), the one whose view runs freest, never one that sees a back face (a
 /// spot inside a column or behind a wall).
-fn interior_camera(scene: &Scene, triangles: &[[Vec3A; 3]]) -> Camera {
+fn interior_camera(scene: &Scene, probe: &Probe) -> Camera {
     let bounds = scene.bounds();
     let (centre, extent) = (bounds.center(), bounds.extent());
     let axis = if extent.x >= extent.z { Vec3::X } else { Vec3::Z };
@@ -193,7 +264,7 @@ fn interior_camera(scene: &Scene, triangles: &[[Vec3A; 3]]) -> Camera {
                 for x in VIEW_RAYS {
                     for y in VIEW_RAYS {
                         let d = (forward + tan_half * (y * up + x * FRAME_ASPECT * right)).normalize();
-                        match nearest_hit(triangles, eye.into(), d.into()) {
+                        match probe.nearest_hit(eye.into(), d.into()) {
                             Some((_, false)) => free.clear(),
                             Some((t, true)) => free.push(t),
                             None => free.push(2.0 * half_length),
@@ -221,7 +292,7 @@ fn interior_camera(scene: &Scene, triangles: &[[Vec3A; 3]]) -> Camera {
     let radius = bounds.bounding_radius().max(1e-3);
     // No spot sees only front faces: the probe was wrong, so frame the outside.
     let Some((_, eye, target)) = best else {
-        return exterior_camera(scene, triangles);
+        return exterior_camera(scene, probe.triangles);
     };
     Camera {
         eye,
@@ -334,5 +405,51 @@ mod tests {
             wall(Vec3::new(20.0, 4.0, 0.0), FRAC_PI_2),
         ];
         assert_eq!(default_camera(&scene_of(outward)).fov_y_degrees, EXTERIOR_FOV_DEGREES);
+    }
+
+    /// The runs' boxes skip only triangles no ray meets first: from a grid of points,
+    /// some on the floor's plane and on a wall's face, rays in every direction
+    /// (horizontal ones among them, parallel to the floor) find the hit and the face
+    /// that testing every triangle finds.
+    #[test]
+    fn the_probe_finds_what_testing_every_triangle_finds() {
+        let scene = scene_of(vec![
+            (geometry::plane(40.0, 40.0), Mat4::IDENTITY),
+            (geometry::cuboid(Vec3::new(20.0, 4.0, 0.5)), Mat4::from_translation(Vec3::new(0.0, 4.0, -20.0))),
+            (geometry::uv_sphere(3.0, 24, 12), Mat4::from_translation(Vec3::new(4.0, 3.0, 2.0))),
+            (geometry::cylinder(1.0, 6.0, 16), Mat4::from_translation(Vec3::new(-6.0, 0.0, -5.0))),
+        ]);
+        let triangles = world_triangles(&scene);
+        let probe = Probe::new(&triangles);
+        assert!(probe.runs.len() > 10, "{} runs", probe.runs.len());
+        let (mut rays, mut hits) = (0, 0);
+        for x in [-15.0f32, -3.0, 0.0, 7.5] {
+            for y in [0.0f32, 1.0, 3.0, 7.0] {
+                for z in [-19.5f32, -8.0, 0.0, 12.0] {
+                    // Directions spread over the sphere (a Fibonacci lattice), and the
+                    // eight horizontal ones.
+                    let lattice = (0..40).map(|k| {
+                        let (h, turn) = (1.0 - 2.0 * (k as f32 + 0.5) / 40.0, 2.4 * k as f32);
+                        let r = (1.0 - h * h).sqrt();
+                        Vec3A::new(r * turn.cos(), h, r * turn.sin())
+                    });
+                    let level = (0..8).map(|k| {
+                        let turn = std::f32::consts::FRAC_PI_4 * k as f32;
+                        Vec3A::new(turn.cos(), 0.0, turn.sin())
+                    });
+                    let origin = Vec3A::new(x, y, z);
+                    for direction in lattice.chain(level) {
+                        let (found, truth) = (
+                            probe.nearest_hit(origin, direction),
+                            nearest_hit(&triangles, origin, direction),
+                        );
+                        assert_eq!(found, truth, "from {origin} along {direction}");
+                        rays += 1;
+                        hits += usize::from(truth.is_some());
+                    }
+                }
+            }
+        }
+        assert!(hits > rays / 3 && hits < rays, "{hits} of {rays} rays hit");
     }
 }
