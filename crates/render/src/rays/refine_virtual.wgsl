@@ -13,7 +13,7 @@ import package::passes::light_binding::light;
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
-import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel, virtual_texel_size, virtual_tile_gather};
+import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
 // The receiver's depth at the four texels of the block from texel (x, y), in
@@ -24,26 +24,15 @@ fn virtual_block_receiver(x: i32, y: i32, p: vec2<f32>, depth: f32, gradient: ve
     return vec4<f32>(r + gradient.y, r + gradient.x + gradient.y, r + gradient.x, r);
 }
 
-// A 2×2 block of stored depths and whether each texel's own page held it.
-struct VirtualBlock {
-    depths: vec4<f32>,
-    exact: bool,
-}
-
-// The block of `level` from texel `corner` (its lower left, light-space y up) up and
-// right, in refine_footprint.wgsl's order ((x, y+1), (x+1, y+1), (x+1, y), (x, y)):
-// gathered in one fetch from `tile` where its w is 1 (the footprint lies in one page,
-// resident at its own level: no table read), through the table texel by texel
-// otherwise.
+// The block of `level` from texel `corner` in refine_footprint.wgsl's order ((x,
+// y+1), (x+1, y+1), (x+1, y), (x, y)): gathered from `tile` with no table read where
+// its w is 1 (the whole footprint lies in one page, resident at its own level), else
+// as `virtual_block` finds it (the footprint spans pages).
 fn footprint_block(level: u32, corner: vec2<i32>, tile: vec4<i32>) -> VirtualBlock {
     if tile.w == 1 {
         return VirtualBlock(virtual_tile_gather(tile.xyz, corner), true);
     }
-    let a = virtual_texel(level, corner + vec2<i32>(0, 1));
-    let b = virtual_texel(level, corner + vec2<i32>(1, 1));
-    let c = virtual_texel(level, corner + vec2<i32>(1, 0));
-    let d = virtual_texel(level, corner);
-    return VirtualBlock(vec4<f32>(a.depth, b.depth, c.depth, d.depth), a.exact && b.exact && c.exact && d.exact);
+    return virtual_block(level, corner);
 }
 
 // `layer` is the level the lookup read; `n` the normal it was offset along;

@@ -162,6 +162,35 @@ fn virtual_texel_depth(level: u32, texel: vec2<i32>) -> f32 {
     return virtual_texel(level, texel).depth;
 }
 
+// A 2×2 block of stored depths, in the order (x, y+1), (x+1, y+1), (x+1, y), (x, y),
+// and whether its own level's pages held every texel of it.
+struct VirtualBlock {
+    depths: vec4<f32>,
+    exact: bool,
+}
+
+// The block of `level` from texel `corner` (its lower left, light-space y up) up and
+// right. Most blocks lie in one page: its tile from the table once, the four texels
+// in one gather where the page is resident at its own level; through the table
+// texel by texel otherwise (a block across a page border, or a page a coarser one
+// stands in for).
+fn virtual_block(level: u32, corner: vec2<i32>) -> VirtualBlock {
+    let size = f32(virtual_map.page_texels);
+    let first_page = vec2<i32>(floor(vec2<f32>(corner) / size));
+    let last_page = vec2<i32>(floor(vec2<f32>(corner + vec2<i32>(1)) / size));
+    if all(first_page == last_page) {
+        let tile = virtual_exact_tile(level, first_page);
+        if tile.w == 1 {
+            return VirtualBlock(virtual_tile_gather(tile.xyz, corner), true);
+        }
+    }
+    let a = virtual_texel(level, corner + vec2<i32>(0, 1));
+    let b = virtual_texel(level, corner + vec2<i32>(1, 1));
+    let c = virtual_texel(level, corner + vec2<i32>(1, 0));
+    let d = virtual_texel(level, corner);
+    return VirtualBlock(vec4<f32>(a.depth, b.depth, c.depth, d.depth), a.exact && b.exact && c.exact && d.exact);
+}
+
 // The light's view of a world point: light-space x and y, and the depth the map
 // stores for it (0 at the near plane, 1 at the far one).
 fn virtual_light_point(world: vec3<f32>) -> vec3<f32> {
@@ -185,27 +214,7 @@ fn virtual_pcf2x2_at(texels: vec2<f32>, depth: f32, level: u32) -> f32 {
     let continuous = texels - vec2<f32>(0.5);
     let base = vec2<i32>(floor(continuous));
     let weight = continuous - floor(continuous);
-    // Most 2×2s lie in one page: its tile from the table once, the four texels in
-    // one gather; through the table texel by texel otherwise. The order: (x, y+1),
-    // (x+1, y+1), (x+1, y), (x, y).
-    let size = f32(virtual_map.page_texels);
-    let first_page = vec2<i32>(floor(vec2<f32>(base) / size));
-    let last_page = vec2<i32>(floor(vec2<f32>(base + vec2<i32>(1)) / size));
-    var tile = vec4<i32>(0);
-    if all(first_page == last_page) {
-        tile = virtual_exact_tile(level, first_page);
-    }
-    var stored: vec4<f32>;
-    if tile.w == 1 {
-        stored = virtual_tile_gather(tile.xyz, base);
-    } else {
-        stored = vec4<f32>(
-            virtual_texel_depth(level, base + vec2<i32>(0, 1)),
-            virtual_texel_depth(level, base + vec2<i32>(1, 1)),
-            virtual_texel_depth(level, base + vec2<i32>(1, 0)),
-            virtual_texel_depth(level, base),
-        );
-    }
+    let stored = virtual_block(level, base).depths;
     var lit = vec4<f32>(0.0);
     lit.x = select(0.0, 1.0, depth <= stored.w);
     lit.y = select(0.0, 1.0, depth <= stored.z);
