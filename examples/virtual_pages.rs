@@ -45,6 +45,8 @@ fn main() -> anyhow::Result<()> {
     let reach = PixelReach {
         footprint_per_depth: 2.0 * (0.5 * fov).tan() / frame.height as f32,
         reach_texels: PCF2X2_REACH_TEXELS,
+        // Only refinement under a sun with an angular size searches its cone.
+        area_search: None,
     };
     // The farthest pixel the camera can see: at the scene's farthest corner.
     let bounds = scene.bounds();

@@ -101,6 +101,19 @@ impl PageRect {
     }
 }
 
+/// The refinement's search over a sun's cone from a receiver (its footprint test's,
+/// under a sun with an angular size whose penumbrae rays refine): the cone's radius
+/// is `cone_tan` times the receiver's distance behind the map's near plane, read in
+/// the level whose texels it spans in at most `cap_texels`
+/// ([`Clipmap::search_level`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaSearch {
+    /// The tangent of the sun's angular radius.
+    pub cone_tan: f32,
+    /// PCSS's `shadow.filter.pcss.max_radius`: the most texels the search spans.
+    pub cap_texels: f32,
+}
+
 /// One frame's clipmap for a sun: where each level lies, and its depth range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
@@ -241,6 +254,39 @@ impl Clipmap {
         let level = self.level_for_point(xy, footprint)?;
         let reach = reach_texels * self.texel_size(level);
         self.pages_over(level, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
+    }
+
+    /// The level in whose texels a search `radius` world units wide round a pixel of
+    /// `level` spans at most `cap_texels`: `level`, or as many levels coarser as it
+    /// takes, up to the coarsest.
+    pub fn search_level(&self, level: u32, radius: f32, cap_texels: f32) -> u32 {
+        let texels = radius / (self.texel_size(level) * cap_texels);
+        let coarser = texels.log2().ceil().max(0.0) as u32;
+        (level + coarser).min(self.shape.levels - 1)
+    }
+
+    /// The pages that the refinement's search over a sun's cone reads for a pixel of
+    /// `level` at world point `point` whose own lookup reaches `reach_texels` of
+    /// `level`: the cone from the point to the sun's disk at the near plane, in the
+    /// search's level ([`Clipmap::search_level`]), a texel more for the taps'
+    /// rounding, and the lookup's reach in that level's texels. Nothing where the
+    /// point lies outside the search level's window.
+    pub fn search_request(
+        &self,
+        point: Vec3,
+        level: u32,
+        search: AreaSearch,
+        reach_texels: f32,
+    ) -> Option<PageRect> {
+        let light = self.light_from_world.transform_point3(point);
+        let cone = search.cone_tan * (-light.z - self.near).max(0.0);
+        let read = self.search_level(level, cone, search.cap_texels);
+        let texel = self.texel_size(read);
+        let radius = (cone / texel).clamp(1.0, search.cap_texels);
+        let reach = (radius + 1.0 + reach_texels / 2f32.powi((read - level) as i32)) * texel;
+        let xy = light.truncate();
+        self.page_at(read, xy)?;
+        self.pages_over(read, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
     }
 
     /// World to the clip space of page `page` alone: the orthographic projection of

@@ -14,6 +14,7 @@ use gnomon_scene::{
 };
 
 use super::{Renderer, virtual_pages::VirtualLight};
+use crate::virtual_map::AreaSearch;
 use crate::{
     GpuScene, RenderError,
     gpu_scene::{CullView, Granularity},
@@ -176,6 +177,18 @@ fn virtual_filter_reach(technique: techniques::TechniqueRef, filter: &FilterSett
     technique.filter_reach_texels(filter, kernel)
 }
 
+/// The refinement's search over a virtual sun's cone, which its page requests ask
+/// for: where rays refine the penumbrae of a sun with an angular size (the
+/// classification's `REFINE_PENUMBRAE`), none otherwise.
+fn virtual_area_search(refine: Refine, light: &Light, filter: &FilterSettings) -> Option<AreaSearch> {
+    let searched = match refine {
+        Refine::Rays | Refine::Auto => rays::LightSize::of(light) == rays::LightSize::Area,
+        Refine::Off | Refine::EveryPixel => false,
+    };
+    searched
+        .then(|| AreaSearch { cone_tan: light.emission().area.size(), cap_texels: filter.pcss.max_radius })
+}
+
 impl Renderer {
     /// The most levels finer than their footprints that the pages along shadow edges
     /// of `settings`' lights in `scene` may be ([`edge_levels`]): how many frames a
@@ -244,6 +257,7 @@ impl Renderer {
                         index,
                         edge_levels: edge_levels(mask_path, refine, shadow),
                         filter_reach_texels: virtual_filter_reach(technique, &shadow.filter),
+                        area_search: virtual_area_search(refine, &r.light, &shadow.filter),
                     };
                     Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, light).await?)
                 }

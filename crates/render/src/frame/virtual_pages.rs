@@ -26,8 +26,8 @@ use super::Renderer;
 use crate::{
     GpuScene, RenderError,
     virtual_map::{
-        CameraDepth, EdgeFeedback, EdgeRequests, PageRequestParams, PageRequests, PixelReach, PoolSize,
-        VirtualMapGpu, VirtualPages,
+        AreaSearch, CameraDepth, EdgeFeedback, EdgeRequests, PageRequestParams, PageRequests, PixelReach,
+        PoolSize, VirtualMapGpu, VirtualPages,
     },
 };
 
@@ -128,6 +128,8 @@ pub(super) struct VirtualLight {
     pub edge_levels: u32,
     /// Texels its technique's filter reaches beyond the bilinear tap.
     pub filter_reach_texels: f32,
+    /// The refinement's search over a sun's cone, where rays refine its penumbrae.
+    pub area_search: Option<AreaSearch>,
 }
 
 /// A virtual light's frame, as decided before recording.
@@ -193,7 +195,7 @@ impl Renderer {
         light: &Light,
         settings: &Settings,
         camera: &Camera,
-        VirtualLight { index, edge_levels, filter_reach_texels }: VirtualLight,
+        VirtualLight { index, edge_levels, filter_reach_texels, area_search }: VirtualLight,
     ) -> Result<VirtualPlan, RenderError> {
         let ShadowView::Parallel { travel } = light.shadow_view() else {
             unreachable!("the technique registry refuses a virtual map for a light other than a sun")
@@ -218,6 +220,7 @@ impl Renderer {
         let reach = PixelReach {
             footprint_per_depth,
             reach_texels: LOOKUP_REACH_TEXELS + filter_reach_texels + settings.shadow.bias.normal_offset,
+            area_search,
         };
         let clip_from_world = camera.clip_from_world(aspect);
         let depth = gpu.checked("drawing the camera's depth for a virtual map's pages", || {

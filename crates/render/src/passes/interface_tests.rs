@@ -92,7 +92,7 @@ fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
         struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
             light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
-            page_texels, width, height, edge_levels, _pad0, _pad1, _pad2,
+            page_texels, width, height, edge_levels, area_cone_tan, area_cap_texels, near,
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
             light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,

@@ -96,6 +96,19 @@ fn projected_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, 
 // Taps a side of `area_unsure`'s grid over the light's footprint.
 const AREA_SEARCH_TAPS: i32 = 6;
 
+// The texel of tap (i, j) of the grid over a search `radius` texels round texel
+// position `p` (texel centres at whole numbers).
+fn area_search_texel(p: vec2<f32>, radius: f32, i: i32, j: i32) -> vec2<i32> {
+    let step = (vec2<f32>(f32(i), f32(j)) + vec2<f32>(0.5)) / f32(AREA_SEARCH_TAPS) * 2.0 - vec2<f32>(1.0);
+    return vec2<i32>(floor(p + step * radius + vec2<f32>(0.5)));
+}
+
+// The grid's spacing in texels over a search `radius` texels: a caster seen at a tap
+// may reach as far as the next tap toward the receiver.
+fn area_search_spacing(radius: f32) -> f32 {
+    return max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
+}
+
 // Under a light with an area: whether the map shows, for the receiver at texel
 // position `p` (its plane: depth `receiver` + `gradient` per texel, at light
 // distance `distance`), both a caster inside the cone from the receiver to the light
@@ -112,13 +125,12 @@ fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, la
     let near = light.map.near;
     let radius = clamp(emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near), 1.0, light.pcss.max_penumbra_texels);
     let last = vec2<i32>(i32(light.map.resolution) - 1);
-    let spacing = max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
+    let spacing = area_search_spacing(radius);
     var casters = false;
     var light_seen = false;
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
         for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
-            let step = (vec2<f32>(f32(i), f32(j)) + vec2<f32>(0.5)) / f32(AREA_SEARCH_TAPS) * 2.0 - vec2<f32>(1.0);
-            let texel = clamp(vec2<i32>(floor(p + step * radius + vec2<f32>(0.5))), vec2<i32>(0), last);
+            let texel = clamp(area_search_texel(p, radius, i, j), vec2<i32>(0), last);
             let offset = vec2<f32>(texel) - p;
             let stored = textureLoad(shadow_map, texel, layer, 0);
             if stored > receiver + dot(gradient, offset) - margin {

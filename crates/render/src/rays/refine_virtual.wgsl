@@ -7,13 +7,16 @@
 //
 // A texel that its own level's page does not hold (the pool was full and a coarser
 // page stands in, or no page holds it) says nothing exact: the pixel is unsure and
-// a ray decides, as past a 2D map's edge. Under a light with an area, the penumbrae
-// are not bounded here yet: every pixel is unsure, and rays decide them all.
+// a ray decides, as past a 2D map's edge. Under a light with an area, the pixel is
+// also unsure where the light's footprint in the level holds casters over part of it
+// (`virtual_area_unsure`, refine_map.wgsl's `area_unsure` through the page table).
 import package::passes::light_binding::light;
 import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
-import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_texel_size, virtual_tile_gather};
+import package::passes::light_kinds::emitter_cone_radius;
+import package::rays::refine_map::{AREA_SEARCH_TAPS, area_search_spacing, area_search_texel};
+import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
 // The receiver's depth at the four texels of the block from texel (x, y), in
@@ -38,9 +41,6 @@ fn footprint_block(level: u32, corner: vec2<i32>, tile: vec4<i32>) -> VirtualBlo
 // `layer` is the level the lookup read; `n` the normal it was offset along;
 // `geometric_n` gives the receiver's plane.
 fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
-    if REFINE_PENUMBRAE {
-        return true;
-    }
     // Past TRACED_LAYER_FLAG: a debug view's flags (virtual_visibility.wgsl).
     let level = layer % TRACED_LAYER_FLAG;
     let texel = virtual_texel_size(level);
@@ -98,5 +98,53 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
             shadowed = shadowed || evidence.z;
         }
     }
-    return lit && shadowed;
+    if lit && shadowed {
+        return true;
+    }
+    let distance = virtual_map.near + surface_point.z * depth_range;
+    return REFINE_PENUMBRAE && virtual_area_unsure(p, point.z, gradient, margin, level, distance);
+}
+
+// Under a light with an area: whether the map shows both a caster inside the cone
+// from the receiver (at texel position `p` of `level`, its plane `receiver` +
+// `gradient` per texel, at light distance `distance`; `margin` in the same depth per
+// texel) to the light and a texel with nothing in front of the receiver:
+// refine_map.wgsl's `area_unsure` (its grid over PCSS's blocker-search region,
+// Fernando 2005), each tap through the page table. The grid spans at most
+// `max_penumbra_texels` texels, as on a 2D map; where the cone is wider in the
+// pixel's own fine texels, the search reads the coarser level whose texels it spans
+// in that many, so that it covers the whole cone (`virtual_search_level`). The page
+// requests ask for those pages (`request_area_search`, page_requests.wgsl); a tap
+// its own page does not hold makes the pixel unsure, as in the footprint.
+fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, level: u32, distance: f32) -> bool {
+    let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
+    let search = virtual_search_level(level, cone, light.pcss.max_penumbra_texels);
+    // The receiver's plane and margin in texels of the search's level.
+    let scale = exp2(f32(search - level));
+    let q = (p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5);
+    let g = gradient * scale;
+    let texel = virtual_texel_size(search);
+    let radius = clamp(cone / texel, 1.0, light.pcss.max_penumbra_texels);
+    let spacing = area_search_spacing(radius);
+    var casters = false;
+    var light_seen = false;
+    for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
+        for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
+            let tap = area_search_texel(q, radius, i, j);
+            let stored = virtual_texel(search, tap);
+            if !stored.exact {
+                return true;
+            }
+            let offset = vec2<f32>(tap) - q;
+            if stored.depth > receiver + dot(g, offset) - margin * scale {
+                light_seen = true;
+                continue;
+            }
+            let at = virtual_map.near + stored.depth * (virtual_map.far - virtual_map.near);
+            if (length(offset) - spacing) * texel <= emitter_cone_radius(light.emitter, distance, at) {
+                casters = true;
+            }
+        }
+    }
+    return casters && light_seen;
 }

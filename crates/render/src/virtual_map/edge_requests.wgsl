@@ -11,7 +11,7 @@ import package::rays::refine_list::unsure_pixels;
 import package::constants::TRACED_LAYER_FLAG;
 import package::passes::screen_common::prepass_surface;
 import package::variant::REFINE_GROUP_SIZE;
-import package::virtual_map::page_requests::{footprint_level, request_level_pages, request_params, window_level};
+import package::virtual_map::page_requests::{footprint_level, request_area_search, request_level_pages, request_params, window_level};
 
 // The light's refinement counters (`RefineCounters` in refine_append.wgsl), read
 // only: the pass is dispatched by them.
@@ -39,6 +39,9 @@ fn request_edge_pages(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         if read == 0u || read + request_params.edge_levels <= footprint {
             continue;
         }
-        request_level_pages(surface.xyz, read - 1u);
+        request_level_pages(surface.xyz, read - 1u, request_params.reach_texels);
+        if request_params.area_cone_tan > 0.0 {
+            request_area_search(surface.xyz, read - 1u);
+        }
     }
 }

@@ -23,6 +23,7 @@ pub use probe::VirtualProbe;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
+pub use gnomon_math::virtual_map::AreaSearch;
 use gnomon_math::virtual_map::{Clipmap, MAX_LEVELS, PageKey};
 
 use crate::{
@@ -51,9 +52,14 @@ pub(crate) struct PageRequestParams {
     /// Levels finer than its footprint's that a pixel along a shadow edge may ask
     /// for (`edge_requests.wgsl`; the request pass itself reads no such thing).
     pub edge_levels: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
+    /// Under a light with an area whose penumbrae rays refine: the tangent of the
+    /// sun's angular radius ([`AreaSearch::cone_tan`]); 0 asks for no search's pages.
+    pub area_cone_tan: f32,
+    /// The search's cap in texels ([`AreaSearch::cap_texels`]).
+    pub area_cap_texels: f32,
+    /// Distance along the light's axis of the clipmap's depth-0 plane, where the
+    /// search's cone is measured.
+    pub near: f32,
 }
 
 impl PageRequestParams {
@@ -72,9 +78,9 @@ impl PageRequestParams {
             width: size.0,
             height: size.1,
             edge_levels,
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
+            area_cone_tan: reach.area_search.map_or(0.0, |a| a.cone_tan),
+            area_cap_texels: reach.area_search.map_or(0.0, |a| a.cap_texels),
+            near: clipmap.near,
         }
     }
 }
@@ -150,6 +156,10 @@ pub struct PixelReach {
     /// Texels of its level that the pixel's filter reaches from its point: the
     /// kernel's radius, the normal offset's and a texel for bilinear taps.
     pub reach_texels: f32,
+    /// Under a sun with an angular size whose penumbrae rays refine, the search of
+    /// the refinement's footprint test over the sun's cone (`virtual_area_unsure`,
+    /// refine_virtual.wgsl), whose pages each pixel asks for too.
+    pub area_search: Option<AreaSearch>,
 }
 
 /// The page-request pipeline, and the pass that unprojects a camera depth prepass

@@ -83,6 +83,16 @@ fn virtual_texel_size(level: u32) -> f32 {
     return virtual_map.finest_texel * exp2(f32(level));
 }
 
+// The level in whose texels a search `radius` world units wide round a pixel of
+// `level` spans at most `cap` texels (PCSS's `max_penumbra_texels`, which a 2D map's
+// coarser texels stretch as far): `level` itself, or as many levels coarser as it
+// takes (`search_level` in page_requests.wgsl, which asks for its pages).
+fn virtual_search_level(level: u32, radius: f32, cap: f32) -> u32 {
+    let texels = radius / (virtual_texel_size(level) * cap);
+    let coarser = u32(max(ceil(log2(texels)), 0.0));
+    return min(level + coarser, virtual_map.levels - 1u);
+}
+
 fn virtual_origin(level: u32) -> vec2<i32> {
     let pair = virtual_map.origins[level / 2u];
     return select(pair.zw, pair.xy, level % 2u == 0u);

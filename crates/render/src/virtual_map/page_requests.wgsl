@@ -24,9 +24,12 @@ struct PageRequestParams {
     // Levels finer than its footprint's that a pixel along a shadow edge may ask for
     // (`edge_requests.wgsl`).
     edge_levels: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // Under a sun with an angular size whose penumbrae rays refine: the tangent of
+    // its angular radius (0: no search), the search's cap in texels, and the
+    // clipmap's near plane, where the cone is measured (`AreaSearch`).
+    area_cone_tan: f32,
+    area_cap_texels: f32,
+    near: f32,
 }
 
 // The prepass's surface: the world point in xyz, its view depth in w (0: no surface).
@@ -71,9 +74,9 @@ fn window_level(world: vec3<f32>, level: u32) -> u32 {
 }
 
 // Marks the pages of `level` that a lookup of that level at world point `world` may
-// read: the square its filter and normal offset reach round the point. Nothing where
+// read: the square `reach_texels` of its texels reach round the point. Nothing where
 // the point lies outside the level's window.
-fn request_level_pages(world: vec3<f32>, level: u32) {
+fn request_level_pages(world: vec3<f32>, level: u32, reach_texels: f32) {
     let texel = request_params.finest_texel * exp2(f32(level));
     let page_world = texel * f32(request_params.page_texels);
     let xy = (request_params.light_from_world * vec4<f32>(world, 1.0)).xy;
@@ -83,7 +86,7 @@ fn request_level_pages(world: vec3<f32>, level: u32) {
     if (any(centre < vec2<i32>(0)) || any(centre >= vec2<i32>(side))) {
         return;
     }
-    let reach = request_params.reach_texels * texel;
+    let reach = reach_texels * texel;
     let low = max(vec2<i32>(floor((xy - reach) / page_world)) - origin, vec2<i32>(0));
     let high = min(vec2<i32>(floor((xy + reach) / page_world)) - origin, vec2<i32>(side - 1));
     for (var y = low.y; y <= high.y; y++) {
@@ -92,6 +95,29 @@ fn request_level_pages(world: vec3<f32>, level: u32) {
             atomicOr(&page_bits[bit / 32u], 1u << (bit % 32u));
         }
     }
+}
+
+// The level in whose texels a search `radius` world units wide round a pixel of
+// `level` spans at most `cap` texels: `virtual_search_level` (page_lookup.wgsl).
+fn search_level(level: u32, radius: f32, cap: f32) -> u32 {
+    let texels = radius / (request_params.finest_texel * exp2(f32(level)) * cap);
+    let coarser = u32(max(ceil(log2(texels)), 0.0));
+    return min(level + coarser, request_params.levels - 1u);
+}
+
+// Marks the pages that the refinement's search over the sun's cone reads for a pixel
+// of `level` at world point `world` (`virtual_area_unsure`, refine_virtual.wgsl):
+// the cone's radius in texels of the search's level, a texel more for its taps'
+// rounding, and the lookup's own reach (its normal offset) in those texels.
+fn request_area_search(world: vec3<f32>, level: u32) {
+    let distance = -(request_params.light_from_world * vec4<f32>(world, 1.0)).z;
+    let cone = request_params.area_cone_tan * max(distance - request_params.near, 0.0);
+    let cap = request_params.area_cap_texels;
+    let search = search_level(level, cone, cap);
+    let texel = request_params.finest_texel * exp2(f32(search));
+    let radius = clamp(cone / texel, 1.0, cap);
+    let lookup = request_params.reach_texels / exp2(f32(search - level));
+    request_level_pages(world, search, radius + 1.0 + lookup);
 }
 
 @compute @workgroup_size(8, 8)
@@ -105,6 +131,9 @@ fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let level = window_level(surface.xyz, footprint_level(surface.w));
     if level < request_params.levels {
-        request_level_pages(surface.xyz, level);
+        request_level_pages(surface.xyz, level, request_params.reach_texels);
+        if request_params.area_cone_tan > 0.0 {
+            request_area_search(surface.xyz, level);
+        }
     }
 }

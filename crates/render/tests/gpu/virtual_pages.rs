@@ -9,7 +9,7 @@ use gnomon_math::{
     Aabb,
     virtual_map::{Clipmap, ClipmapShape, PageKey},
 };
-use gnomon_render::virtual_map::{PageRequests, PixelReach};
+use gnomon_render::virtual_map::{AreaSearch, PageRequests, PixelReach};
 
 use crate::support::gpu;
 
@@ -35,17 +35,40 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
     // Unreal's levels, and levels of 1024² read at texels 8× finer than the pixels,
     // whose windows leave many of the points to coarser levels
     // (`Clipmap::level_for_point`).
-    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0);
-    assert_eq!(fell_back, 0);
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, None);
+    assert_eq!(asked.fell_back, 0);
     let small = ClipmapShape { virtual_resolution: 1024, ..ClipmapShape::DEFAULT };
-    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125);
+    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125, None).fell_back;
     assert!(fell_back > 500, "{fell_back} points read a coarser level than their footprint's");
 }
 
+/// Under a sun 10° wide whose penumbrae rays refine, each pixel also asks for the
+/// pages its footprint test's search over the sun's cone reads, in the level whose
+/// texels the cone spans in at most 32 (`Clipmap::search_request`).
+#[test]
+fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
+    let search = AreaSearch { cone_tan: 5f32.to_radians().tan(), cap_texels: 32.0 };
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, Some(search));
+    // 16 measured: the coarser levels' pages round the points whose cone is widest.
+    assert!(asked.search_only >= 10, "{} pages only the search asks for", asked.search_only);
+}
+
+/// What the requests of [`asks_for_exactly_the_pages_the_clipmap_names`] held.
+struct Asked {
+    /// Points that read a coarser level than their footprint's.
+    fell_back: usize,
+    /// Pages that only the search over a sun's cone asked for.
+    search_only: usize,
+}
+
 /// Checks the GPU's requests against the clipmap's for surfaces whose footprint is
-/// `footprint_scale` times a 240-pixel-high camera's; returns how many points read
-/// a coarser level than their footprint's.
-fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_scale: f32) -> usize {
+/// `footprint_scale` times a 240-pixel-high camera's, and the pages of `search` over
+/// a sun's cone.
+fn asks_for_exactly_the_pages_the_clipmap_names(
+    shape: ClipmapShape,
+    footprint_scale: f32,
+    search: Option<AreaSearch>,
+) -> Asked {
     let gpu = gpu();
     let camera = Vec3::new(2.0, 6.0, 9.0);
     let bounds = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 12.0, 30.0));
@@ -54,6 +77,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_s
     let reach = PixelReach {
         footprint_per_depth: footprint_scale * 2.0 * (30f32.to_radians()).tan() / 240.0,
         reach_texels: 2.5,
+        area_search: search,
     };
     let travel = Vec3::new(-0.4, -1.0, 0.3);
     let clipmap = Clipmap::new(shape, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
@@ -61,6 +85,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_s
     let mut rng = Lcg(17);
     let mut texels = Vec::with_capacity((width * height) as usize);
     let mut expected = BTreeSet::new();
+    let mut searched_pages = BTreeSet::new();
     let mut fell_back = 0;
     for _ in 0..width * height {
         // Surfaces from 0.5 to 40 units away, in every direction round the camera.
@@ -82,6 +107,9 @@ fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_s
         });
         let ambiguous = near_grid((footprint / clipmap.finest_texel).log2(), 1e-3)
             || on_window_edge
+            || search.is_some_and(|search| {
+                search_is_ambiguous(&clipmap, point, level, search, reach.reach_texels)
+            })
             || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
                 .iter()
                 .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3));
@@ -93,6 +121,11 @@ fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_s
         texels.push(point.extend(depth));
         if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
             expected.extend(rect.pages());
+        }
+        let searched =
+            search.and_then(|search| clipmap.search_request(point, level, search, reach.reach_texels));
+        if let Some(rect) = searched {
+            searched_pages.extend(rect.pages());
         }
     }
     let surface = gpu.device.create_texture(&gnomon_render::wgpu::TextureDescriptor {
@@ -120,12 +153,32 @@ fn asks_for_exactly_the_pages_the_clipmap_names(shape: ClipmapShape, footprint_s
     let asked: Vec<PageKey> =
         pollster::block_on(requests.request(gpu, &surface, &clipmap, reach)).expect("requested");
     let asked: BTreeSet<PageKey> = asked.into_iter().collect();
+    let search_only = searched_pages.difference(&expected).count();
+    expected.extend(searched_pages);
     let levels: BTreeSet<u32> = expected.iter().map(|p| p.level).collect();
     assert!(expected.len() > 100 && levels.len() >= 4, "{} pages over levels {levels:?}", expected.len());
     let missing: Vec<_> = expected.difference(&asked).take(5).collect();
     let extra: Vec<_> = asked.difference(&expected).take(5).collect();
     assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
-    fell_back
+    Asked { fell_back, search_only }
+}
+
+/// Whether the search's pages for a pixel of `level` at `point` lie where the GPU's
+/// rounding and the CPU's may differ: its level's boundary, its square's page edges.
+fn search_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, search: AreaSearch, reach: f32) -> bool {
+    let light = clipmap.light_from_world.transform_point3(point);
+    let cone = search.cone_tan * (-light.z - clipmap.near).max(0.0);
+    let read = clipmap.search_level(level, cone, search.cap_texels);
+    let texel = clipmap.texel_size(read);
+    let radius = (cone / texel).clamp(1.0, search.cap_texels);
+    let spread = (radius + 1.0 + reach / 2f32.powi((read - level) as i32)) * texel;
+    let page = clipmap.page_size(read);
+    let xy = light.truncate();
+    near_grid((cone / (clipmap.texel_size(level) * search.cap_texels)).log2(), 1e-3)
+        || near_grid(cone / texel, 1e-3)
+        || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
+            .iter()
+            .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
 }
 
 /// A frame's virtual pages: a renderer kept across frames draws only pages new or
