@@ -228,3 +228,51 @@ fn a_point_outside_its_levels_window_reads_the_finest_coarser_level_that_holds_i
     assert_eq!(rect.level, level);
     assert_eq!(map.level_for_point(Vec2::splat(1e9), footprint), None);
 }
+
+/// The search over a sun's cone reads the finest level whose texels span the cone in
+/// at most the cap, never finer than the pixel's own, at most the coarsest; and its
+/// pages cover the whole cone, or the cap's texels of the coarsest (random points,
+/// random cones).
+#[test]
+fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
+    let map = clipmap(Vec3::new(5.0, 2.0, 3.0));
+    let coarsest = map.shape.levels - 1;
+    let mut rng = Lcg(29);
+    let mut coarser = 0;
+    for _ in 0..2000 {
+        let level = (rng.next() * 6.0) as u32;
+        let radius = map.texel_size(level) * 2f32.powf(rng.range(-4.0, 12.0));
+        let cap = rng.range(1.0, 64.0);
+        let read = map.search_level(level, radius, cap);
+        assert!(read >= level && read <= coarsest, "{level} {radius} {cap}: {read}");
+        if read < coarsest {
+            assert!(radius <= cap * map.texel_size(read) * 1.0001, "{level} {radius} {cap}: {read}");
+        }
+        if read > level {
+            coarser += 1;
+            assert!(
+                radius > cap * map.texel_size(read - 1) * 0.9999,
+                "{level} {radius} {cap}: {read} is too coarse"
+            );
+        }
+    }
+    assert!(coarser > 500, "{coarser} searches read a coarser level");
+
+    let search = AreaSearch { cone_tan: 0.1, cap_texels: 16.0 };
+    for _ in 0..500 {
+        let point = Vec3::new(rng.range(-20.0, 20.0), rng.range(0.0, 10.0), rng.range(-15.0, 15.0));
+        let level = (rng.next() * 4.0) as u32;
+        let Some(rect) = map.search_request(point, level, search, 2.0) else { continue };
+        let light = map.light_from_world.transform_point3(point);
+        let cone = search.cone_tan * (-light.z - map.near).max(0.0);
+        // The cone, clamped to the cap at the coarsest level.
+        let texel = map.texel_size(rect.level);
+        let reach = cone.min(search.cap_texels * texel).max(texel);
+        for corner in [Vec2::new(-1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0), Vec2::new(1.0, -1.0)]
+        {
+            let xy = light.truncate() + corner * reach;
+            let page = map.page_at(rect.level, xy);
+            assert!(page.is_none_or(|p| rect.contains(p)), "{point}: {xy} outside {rect:?}");
+        }
+    }
+}
