@@ -114,6 +114,20 @@ pub struct AreaSearch {
     pub cap_texels: f32,
 }
 
+/// Where the refinement's search over a sun's cone reads for one pixel
+/// ([`Clipmap::search_square`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SearchSquare {
+    /// The level it reads.
+    pub level: u32,
+    /// The pixel's light-space point, x and y: the square's centre.
+    pub centre: Vec2,
+    /// The cone's radius at the near plane, world units.
+    pub cone: f32,
+    /// The square's half-width, world units.
+    pub reach: f32,
+}
+
 /// One frame's clipmap for a sun: where each level lies, and its depth range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
@@ -265,12 +279,29 @@ impl Clipmap {
         (level + coarser).min(self.shape.levels - 1)
     }
 
-    /// The pages that the refinement's search over a sun's cone reads for a pixel of
-    /// `level` at world point `point` whose own lookup reaches `reach_texels` of
+    /// The square that the refinement's search over a sun's cone reads for a pixel
+    /// of `level` at world point `point` whose own lookup reaches `reach_texels` of
     /// `level`: the cone from the point to the sun's disk at the near plane, in the
     /// search's level ([`Clipmap::search_level`]), a texel more for the taps'
-    /// rounding, and the lookup's reach in that level's texels. Nothing where the
-    /// point lies outside the search level's window.
+    /// rounding, and the lookup's reach in that level's texels.
+    pub fn search_square(
+        &self,
+        point: Vec3,
+        level: u32,
+        search: AreaSearch,
+        reach_texels: f32,
+    ) -> SearchSquare {
+        let light = self.light_from_world.transform_point3(point);
+        let cone = search.cone_tan * (-light.z - self.near).max(0.0);
+        let read = self.search_level(level, cone, search.cap_texels);
+        let texel = self.texel_size(read);
+        let radius = (cone / texel).clamp(1.0, search.cap_texels);
+        let reach = (radius + 1.0 + reach_texels / 2f32.powi((read - level) as i32)) * texel;
+        SearchSquare { level: read, centre: light.truncate(), cone, reach }
+    }
+
+    /// The pages of [`Clipmap::search_square`]'s square. Nothing where the point lies
+    /// outside the search level's window.
     pub fn search_request(
         &self,
         point: Vec3,
@@ -278,15 +309,10 @@ impl Clipmap {
         search: AreaSearch,
         reach_texels: f32,
     ) -> Option<PageRect> {
-        let light = self.light_from_world.transform_point3(point);
-        let cone = search.cone_tan * (-light.z - self.near).max(0.0);
-        let read = self.search_level(level, cone, search.cap_texels);
-        let texel = self.texel_size(read);
-        let radius = (cone / texel).clamp(1.0, search.cap_texels);
-        let reach = (radius + 1.0 + reach_texels / 2f32.powi((read - level) as i32)) * texel;
-        let xy = light.truncate();
-        self.page_at(read, xy)?;
-        self.pages_over(read, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
+        let square = self.search_square(point, level, search, reach_texels);
+        self.page_at(square.level, square.centre)?;
+        let half = Vec2::splat(square.reach);
+        self.pages_over(square.level, square.centre - half, square.centre + half)
     }
 
     /// World to the clip space of page `page` alone: the orthographic projection of

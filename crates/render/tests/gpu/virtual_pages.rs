@@ -166,17 +166,12 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
 /// Whether the search's pages for a pixel of `level` at `point` lie where the GPU's
 /// rounding and the CPU's may differ: its level's boundary, its square's page edges.
 fn search_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, search: AreaSearch, reach: f32) -> bool {
-    let light = clipmap.light_from_world.transform_point3(point);
-    let cone = search.cone_tan * (-light.z - clipmap.near).max(0.0);
-    let read = clipmap.search_level(level, cone, search.cap_texels);
-    let texel = clipmap.texel_size(read);
-    let radius = (cone / texel).clamp(1.0, search.cap_texels);
-    let spread = (radius + 1.0 + reach / 2f32.powi((read - level) as i32)) * texel;
-    let page = clipmap.page_size(read);
-    let xy = light.truncate();
-    near_grid((cone / (clipmap.texel_size(level) * search.cap_texels)).log2(), 1e-3)
-        || near_grid(cone / texel, 1e-3)
-        || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
+    let square = clipmap.search_square(point, level, search, reach);
+    let page = clipmap.page_size(square.level);
+    let (xy, spread) = (square.centre, Vec2::splat(square.reach));
+    near_grid((square.cone / (clipmap.texel_size(level) * search.cap_texels)).log2(), 1e-3)
+        || near_grid(square.cone / clipmap.texel_size(square.level), 1e-3)
+        || [xy - spread, xy, xy + spread]
             .iter()
             .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
 }
