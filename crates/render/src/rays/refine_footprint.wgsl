@@ -97,13 +97,34 @@ const FOOTPRINT_EDGE_UNSURE: bool = true;
 // against its surface traced a quarter more of `columns`, whose coarse facets'
 // biases differ, for fewer errors past folds than this: docs/rays.md.)
 fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool {
+    return leaves_unsure(footprint_evidence(uv, bounds, layer));
+}
+
+// What texels say of a pixel's light: whether any of them leaves it unsure, and
+// whether they hold evidence of light (nothing in front of the receiver) and of a
+// caster.
+struct Evidence {
+    unsure: bool,
+    light: bool,
+    casters: bool,
+};
+
+// Whether texels' evidence leaves the pixel unsure: a texel did, or they show both
+// light and a caster.
+fn leaves_unsure(e: Evidence) -> bool {
+    return e.unsure || (e.light && e.casters);
+}
+
+// The evidence of `footprint_unsure`'s texels, which a light with an area weighs
+// against its search over the light's cone (refine_map.wgsl's `area_unsure`).
+fn footprint_evidence(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> Evidence {
     let size = light.map.resolution;
     // Texel (i, j) holds the depth at its centre, (i + ½, j + ½) texels.
     let base = vec2<i32>(floor(uv * size - vec2<f32>(0.5)));
     let first = base - vec2<i32>(UNSURE_RING_TEXELS);
     let end = base + vec2<i32>(2 + UNSURE_RING_TEXELS);
     if any(first < vec2<i32>(0)) || any(end > vec2<i32>(i32(size))) {
-        return FOOTPRINT_EDGE_UNSURE;
+        return Evidence(FOOTPRINT_EDGE_UNSURE, false, false);
     }
     var lit = false;
     var shadowed = false;
@@ -117,13 +138,13 @@ fn footprint_unsure(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> bool 
             let receiver = footprint_receiver(x, y);
             let evidence = block_evidence(stored, receiver, all(vec2<i32>(x, y) == base), bounds);
             if evidence.x {
-                return true;
+                return Evidence(true, false, false);
             }
             lit = lit || evidence.y;
             shadowed = shadowed || evidence.z;
         }
     }
-    return lit && shadowed;
+    return Evidence(false, lit, shadowed);
 }
 
 // What a 2×2 block of stored depths says against the receiver's depths at the same

@@ -25,7 +25,7 @@
 import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
 import package::passes::light_kinds::emitter_cone_radius;
 import package::passes::map_visibility::{local_texel_world_size, shadow_coords};
-import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_unsure, map_step, receiver_bias};
+import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_evidence, leaves_unsure, map_step, receiver_bias};
 import package::techniques::bindings::shadow_map;
 import package::variant::REFINE_PENUMBRAE;
 
@@ -87,10 +87,12 @@ fn projected_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, 
 
     map_plane = MapPlane(c.xy * size - vec2<f32>(0.5), c.z, gradient);
     let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
-    if footprint_unsure(c.xy, FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing), layer) {
+    let bounds = FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing);
+    let footprint = footprint_evidence(c.xy, bounds, layer);
+    if leaves_unsure(footprint) {
         return true;
     }
-    return REFINE_PENUMBRAE && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, margin, layer, distance);
+    return REFINE_PENUMBRAE && area_unsure(c.xy * size - vec2<f32>(0.5), c.z, gradient, bounds, footprint, layer, distance);
 }
 
 // Taps a side of `area_unsure`'s grid over the light's footprint.
@@ -109,41 +111,93 @@ fn area_search_spacing(radius: f32) -> f32 {
     return max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
 }
 
-// Under a light with an area: whether the map shows, for the receiver at texel
+// What a tap of the search over the light's cone holds, its stored depth `stored`
+// against the receiver's plane there, `plane`, as the footprint judges a texel
+// (`FootprintBounds`'s `tolerance` and `margin`, here in the search's texels):
+// light behind the plane or within `tolerance` in front of it, a caster more than
+// `margin` in front, and in between either: a caster touching the receiver, or the
+// receiver itself. A coarse texel's margin is wide, and a caster's whole lead over
+// the receiver can lie inside it (a box's shadow under a 10° sun, read at a level
+// whose texels are 8 times the pixel's).
+const TAP_LIGHT: u32 = 0u;
+const TAP_CASTER: u32 = 1u;
+const TAP_EITHER: u32 = 2u;
+
+fn search_tap(stored: f32, plane: f32, tolerance: f32, margin: f32) -> u32 {
+    if stored >= plane - tolerance {
+        return TAP_LIGHT;
+    }
+    return select(TAP_EITHER, TAP_CASTER, stored <= plane - margin);
+}
+
+// The depth of the nearest caster a tap of `kind` with stored depth `stored` may
+// hold: its own, or where the margin ends for a tap that may be either.
+fn tap_caster_depth(kind: u32, stored: f32, plane: f32, margin: f32) -> f32 {
+    return select(stored, plane - margin, kind == TAP_EITHER);
+}
+
+// Whether a pixel whose footprint shows `footprint` (neither unsure nor both) and
+// whose search over the light's cone shows `search` keeps the map's answer: where
+// both show light alone (lit), or both casters alone over a search as wide as the
+// cone grows up to the casters it found (`covers_cone`: the umbra). Anything else
+// is unsure: casters over part of the cone; a search that saw no caster where the
+// footprint did (a caster thinner than the search's coarser texels, or nearer the
+// receiver than their margin) or no light where the footprint did; casters over a
+// search capped short of the cone at their height, past whose edge light may come
+// (a box's long shadow under a low, wide sun: the map's heightfield holds the box
+// over all of it, but the cone's rays pass beside the box, not under it).
+fn cone_unsure(search: Evidence, footprint: Evidence, covers_cone: bool) -> bool {
+    let lit = footprint.light && search.light && !search.casters;
+    let umbra = footprint.casters && search.casters && !search.light && covers_cone;
+    return search.unsure || !(lit || umbra);
+}
+
+// Under a light with an area: whether the map leaves unsure the receiver at texel
 // position `p` (its plane: depth `receiver` + `gradient` per texel, at light
-// distance `distance`), both a caster inside the cone from the receiver to the light
-// (a depth in front of the receiver's plane by more than `margin`, no farther to
-// the side than the cone's radius at the caster's own distance, give or take the
-// grid's spacing) and a
-// texel with nothing in front of the receiver. The grid covers the cone's
-// cross-section at the map's near plane, PCSS's blocker-search region (Fernando
-// 2005), capped at light.pcss.max_penumbra_texels. A technique's own estimate of the
-// penumbra can be too narrow (PCSS's under a low sun is half the true width); this
-// bounds it by the geometry instead. Casters over the whole region leave the
-// technique's answer: most likely the umbra.
-fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, layer: u32, distance: f32) -> bool {
+// distance `distance`; `bounds` the footprint's), whose footprint showed
+// `footprint` (`cone_unsure`). Its search, a grid over the cone's cross-section at
+// the map's near plane (PCSS's blocker-search region, Fernando 2005), capped at
+// light.pcss.max_penumbra_texels, finds casters inside the cone from the receiver
+// to the light (no farther to the side than the cone's radius at the caster's own
+// distance, give or take the grid's spacing) and light: a texel with nothing in
+// front of the receiver. A caster too far to the side to reach the cone says
+// neither (counting it as light traced every umbra whose casters stand above the
+// receiver by less than the search's reach). A technique's own estimate of the penumbra can be
+// too narrow (PCSS's under a low sun is half the true width); this bounds it by the
+// geometry instead.
+fn area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds: FootprintBounds, footprint: Evidence, layer: u32, distance: f32) -> bool {
     let near = light.map.near;
-    let radius = clamp(emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near), 1.0, light.pcss.max_penumbra_texels);
+    let cone = emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near);
+    let radius = clamp(cone, 1.0, light.pcss.max_penumbra_texels);
     let last = vec2<i32>(i32(light.map.resolution) - 1);
     let spacing = area_search_spacing(radius);
-    var casters = false;
-    var light_seen = false;
+    var search = Evidence(false, false, false);
+    // The widest the cone grows, in texels, up to the casters it holds.
+    var reach = 0.0;
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
         for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
             let texel = clamp(area_search_texel(p, radius, i, j), vec2<i32>(0), last);
             let offset = vec2<f32>(texel) - p;
             let stored = textureLoad(shadow_map, texel, layer, 0);
-            if stored > receiver + dot(gradient, offset) - margin {
-                light_seen = true;
+            let plane = receiver + dot(gradient, offset);
+            let kind = search_tap(stored, plane, bounds.tolerance, bounds.margin);
+            if kind == TAP_LIGHT {
+                search.light = true;
                 continue;
             }
             // A caster seen at this tap may reach as far as the next tap toward the
             // receiver: the tap grid's spacing is the slack of the test.
-            let at = light_distance_from_depth(stored);
-            if (length(offset) - spacing) * texel_world_size_at(layer, at) <= emitter_cone_radius(light.emitter, distance, at) {
-                casters = true;
+            let at = light_distance_from_depth(tap_caster_depth(kind, stored, plane, bounds.margin));
+            let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel_world_size_at(layer, at);
+            if length(offset) - spacing > cone_at {
+                continue;
             }
+            if kind == TAP_EITHER {
+                return true;
+            }
+            search.casters = true;
+            reach = max(reach, cone_at);
         }
     }
-    return casters && light_seen;
+    return cone_unsure(search, footprint, reach <= radius);
 }

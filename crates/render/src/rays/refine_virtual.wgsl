@@ -8,14 +8,15 @@
 // A texel that its own level's page does not hold (the pool was full and a coarser
 // page stands in, or no page holds it) says nothing exact: the pixel is unsure and
 // a ray decides, as past a 2D map's edge. Under a light with an area, the pixel is
-// also unsure where the light's footprint in the level holds casters over part of it
+// also unsure where a search over the light's cone, in a level coarse enough to span
+// it, does not agree with the footprint that the pixel is lit or in the umbra
 // (`virtual_area_unsure`, refine_map.wgsl's `area_unsure` through the page table).
 import package::passes::light_binding::light;
-import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
+import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
-import package::rays::refine_map::{AREA_SEARCH_TAPS, area_search_spacing, area_search_texel};
+import package::rays::refine_map::{AREA_SEARCH_TAPS, TAP_EITHER, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth};
 import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
@@ -102,49 +103,60 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
         return true;
     }
     let distance = virtual_map.near + surface_point.z * depth_range;
-    return REFINE_PENUMBRAE && virtual_area_unsure(p, point.z, gradient, margin, level, distance);
+    return REFINE_PENUMBRAE && virtual_area_unsure(p, point.z, gradient, bounds, Evidence(false, lit, shadowed), level, distance);
 }
 
-// Under a light with an area: whether the map shows both a caster inside the cone
-// from the receiver (at texel position `p` of `level`, its plane `receiver` +
-// `gradient` per texel, at light distance `distance`; `margin` in the same depth per
-// texel) to the light and a texel with nothing in front of the receiver:
-// refine_map.wgsl's `area_unsure` (its grid over PCSS's blocker-search region,
-// Fernando 2005), each tap through the page table. The grid spans at most
-// `max_penumbra_texels` texels, as on a 2D map; where the cone is wider in the
-// pixel's own fine texels, the search reads the coarser level whose texels it spans
-// in that many, so that it covers the whole cone (`virtual_search_level`). The page
+// Under a light with an area: refine_map.wgsl's `area_unsure` for the receiver at
+// texel position `p` of `level` (its plane `receiver` + `gradient` per texel, at
+// light distance `distance`; `bounds` its footprint's, in the same depth per texel),
+// whose footprint showed `footprint`, each tap through the page table. The grid
+// spans at most `max_penumbra_texels` texels, as on a 2D map; where the cone is
+// wider in the pixel's own fine texels, the search reads the coarser level whose
+// texels it spans in that many, so that it covers the whole cone
+// (`virtual_search_level`); only past the coarsest level is it capped. The page
 // requests ask for those pages (`request_area_search`, page_requests.wgsl); a tap
 // its own page does not hold makes the pixel unsure, as in the footprint.
-fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, margin: f32, level: u32, distance: f32) -> bool {
+fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds: FootprintBounds, footprint: Evidence, level: u32, distance: f32) -> bool {
     let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
-    let search = virtual_search_level(level, cone, light.pcss.max_penumbra_texels);
-    // The receiver's plane and margin in texels of the search's level.
-    let scale = exp2(f32(search - level));
+    let cap = light.pcss.max_penumbra_texels;
+    let search_level = virtual_search_level(level, cone, cap);
+    // The receiver's plane and bounds in texels of the search's level.
+    let scale = exp2(f32(search_level - level));
     let q = (p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5);
     let g = gradient * scale;
-    let texel = virtual_texel_size(search);
-    let radius = clamp(cone / texel, 1.0, light.pcss.max_penumbra_texels);
+    let tolerance = bounds.tolerance * scale;
+    let margin = bounds.margin * scale;
+    let texel = virtual_texel_size(search_level);
+    let radius = clamp(cone / texel, 1.0, cap);
     let spacing = area_search_spacing(radius);
-    var casters = false;
-    var light_seen = false;
+    var search = Evidence(false, false, false);
+    // The widest the cone grows, in world units, up to the casters it holds.
+    var reach = 0.0;
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
         for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
             let tap = area_search_texel(q, radius, i, j);
-            let stored = virtual_texel(search, tap);
+            let stored = virtual_texel(search_level, tap);
             if !stored.exact {
                 return true;
             }
             let offset = vec2<f32>(tap) - q;
-            if stored.depth > receiver + dot(g, offset) - margin * scale {
-                light_seen = true;
+            let plane = receiver + dot(g, offset);
+            let kind = search_tap(stored.depth, plane, tolerance, margin);
+            if kind == TAP_LIGHT {
+                search.light = true;
                 continue;
             }
-            let at = virtual_map.near + stored.depth * (virtual_map.far - virtual_map.near);
-            if (length(offset) - spacing) * texel <= emitter_cone_radius(light.emitter, distance, at) {
-                casters = true;
+            let at = virtual_map.near + tap_caster_depth(kind, stored.depth, plane, margin) * (virtual_map.far - virtual_map.near);
+            let cone_at = emitter_cone_radius(light.emitter, distance, at);
+            if (length(offset) - spacing) * texel > cone_at {
+                continue;
             }
+            if kind == TAP_EITHER {
+                return true;
+            }
+            search.casters = true;
+            reach = max(reach, cone_at);
         }
     }
-    return casters && light_seen;
+    return cone_unsure(search, footprint, reach <= radius * texel);
 }
