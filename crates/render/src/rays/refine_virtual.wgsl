@@ -16,7 +16,7 @@ import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
-import package::rays::refine_map::{AREA_SEARCH_TAPS, TAP_EITHER, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth};
+import package::rays::refine_map::{AREA_SEARCH_TAPS, AREA_SEARCH_WIDER, ConeSearch, TAP_EITHER, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth, wider_look, wider_radius};
 import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
@@ -112,51 +112,75 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
 // whose footprint showed `footprint`, each tap through the page table. The grid
 // spans at most `max_penumbra_texels` texels, as on a 2D map; where the cone is
 // wider in the pixel's own fine texels, the search reads the coarser level whose
-// texels it spans in that many, so that it covers the whole cone
-// (`virtual_search_level`); only past the coarsest level is it capped. The page
-// requests ask for those pages (`request_area_search`, page_requests.wgsl); a tap
-// its own page does not hold makes the pixel unsure, as in the footprint.
+// texels it spans in that many, so that it covers the cone at the near plane
+// (`virtual_search_level`), and looks wider in that level only past the coarsest
+// (`wider_look`). The page requests ask for those pages (`request_area_search`,
+// page_requests.wgsl); a tap its own page does not hold makes the pixel unsure, as
+// in the footprint.
 fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds: FootprintBounds, footprint: Evidence, level: u32, distance: f32) -> bool {
     let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
     let cap = light.pcss.max_penumbra_texels;
     let search_level = virtual_search_level(level, cone, cap);
     // The receiver's plane and bounds in texels of the search's level.
     let scale = exp2(f32(search_level - level));
-    let q = (p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5);
-    let g = gradient * scale;
-    let tolerance = bounds.tolerance * scale;
-    let margin = bounds.margin * scale;
-    let texel = virtual_texel_size(search_level);
-    let radius = clamp(cone / texel, 1.0, cap);
+    let plane = VirtualPlane((p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5), receiver, gradient * scale, search_level);
+    let scaled = FootprintBounds(bounds.tolerance * scale, bounds.margin * scale, bounds.own_bias, bounds.surface, bounds.grazing);
+    let radius = clamp(cone / virtual_texel_size(search_level), 1.0, cap);
+    let first = virtual_area_grid(plane, radius, scaled, distance);
+    if !wider_look(first, radius) {
+        return cone_unsure(first.evidence, footprint, first.reach <= radius);
+    }
+    // Outside a page the requests asked for, the wider grid's taps make the pixel
+    // unsure: a ray decides.
+    let rim = wider_radius(first.reach);
+    let wider = min(rim, cap * AREA_SEARCH_WIDER);
+    let second = virtual_area_grid(plane, wider, scaled, distance);
+    return cone_unsure(second.evidence, footprint, rim <= wider && second.reach <= wider);
+}
+
+// The receiver's plane in texels of a search's level: depth `depth` at texel
+// position `p`, changing by `gradient` per texel.
+struct VirtualPlane {
+    p: vec2<f32>,
+    depth: f32,
+    gradient: vec2<f32>,
+    level: u32,
+};
+
+// refine_map.wgsl's `area_grid` on a virtual map's level, `radius` texels of it
+// round `plane`, each tap through the page table; a tap that its own page does not
+// hold makes the pixel unsure.
+fn virtual_area_grid(plane: VirtualPlane, radius: f32, bounds: FootprintBounds, distance: f32) -> ConeSearch {
+    let texel = virtual_texel_size(plane.level);
     let spacing = area_search_spacing(radius);
-    var search = Evidence(false, false, false);
-    // The widest the cone grows, in world units, up to the casters it holds.
-    var reach = 0.0;
+    var found = ConeSearch(Evidence(false, false, false), 0.0);
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
         for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
-            let tap = area_search_texel(q, radius, i, j);
-            let stored = virtual_texel(search_level, tap);
+            let tap = area_search_texel(plane.p, radius, i, j);
+            let stored = virtual_texel(plane.level, tap);
             if !stored.exact {
-                return true;
+                found.evidence.unsure = true;
+                return found;
             }
-            let offset = vec2<f32>(tap) - q;
-            let plane = receiver + dot(g, offset);
-            let kind = search_tap(stored.depth, plane, tolerance, margin);
+            let offset = vec2<f32>(tap) - plane.p;
+            let receiver = plane.depth + dot(plane.gradient, offset);
+            let kind = search_tap(stored.depth, receiver, bounds.tolerance, bounds.margin);
             if kind == TAP_LIGHT {
-                search.light = true;
+                found.evidence.light = true;
                 continue;
             }
-            let at = virtual_map.near + tap_caster_depth(kind, stored.depth, plane, margin) * (virtual_map.far - virtual_map.near);
-            let cone_at = emitter_cone_radius(light.emitter, distance, at);
-            if (length(offset) - spacing) * texel > cone_at {
+            let at = virtual_map.near + tap_caster_depth(kind, stored.depth, receiver, bounds.margin) * (virtual_map.far - virtual_map.near);
+            let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel;
+            if length(offset) - spacing > cone_at {
                 continue;
             }
             if kind == TAP_EITHER {
-                return true;
+                found.evidence.unsure = true;
+                return found;
             }
-            search.casters = true;
-            reach = max(reach, cone_at);
+            found.evidence.casters = true;
+            found.reach = max(found.reach, cone_at);
         }
     }
-    return cone_unsure(search, footprint, reach <= radius * texel);
+    return found;
 }
