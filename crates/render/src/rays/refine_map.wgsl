@@ -240,16 +240,28 @@ fn area_grid(plane: MapPlane, radius: f32, bounds: FootprintBounds, layer: u32, 
             // receiver: the tap grid's spacing is the slack of the test.
             let at = light_distance_from_depth(tap_caster_depth(kind, stored, receiver, bounds.margin));
             let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel_world_size_at(layer, at);
-            if length(offset) - spacing > cone_at {
-                continue;
-            }
-            if kind == TAP_EITHER {
-                found.evidence.unsure = true;
+            if weigh_caster(&found, kind, length(offset) - spacing, cone_at) {
                 return found;
             }
-            found.evidence.casters = true;
-            found.reach = max(found.reach, cone_at);
         }
     }
     return found;
+}
+
+// Weighs a tap of `kind` TAP_CASTER or TAP_EITHER, `beside` texels to the side of
+// the receiver (less the grid's spacing, its slack), where the cone is `cone_at`
+// texels wide at the caster's height. Too far to reach the cone, it says nothing;
+// else a tap that may be either makes the pixel unsure (returns true: the search
+// stops), and a caster joins `found`.
+fn weigh_caster(found: ptr<function, ConeSearch>, kind: u32, beside: f32, cone_at: f32) -> bool {
+    if beside > cone_at {
+        return false;
+    }
+    if kind == TAP_EITHER {
+        (*found).evidence.unsure = true;
+        return true;
+    }
+    (*found).evidence.casters = true;
+    (*found).reach = max((*found).reach, cone_at);
+    return false;
 }

@@ -16,7 +16,7 @@ import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH
 import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
-import package::rays::refine_map::{AREA_SEARCH_TAPS, AREA_SEARCH_WIDER, ConeSearch, TAP_EITHER, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth, wider_look, wider_radius};
+import package::rays::refine_map::{AREA_SEARCH_TAPS, AREA_SEARCH_WIDER, ConeSearch, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth, weigh_caster, wider_look, wider_radius};
 import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
@@ -171,15 +171,9 @@ fn virtual_area_grid(plane: VirtualPlane, radius: f32, bounds: FootprintBounds, 
             }
             let at = virtual_map.near + tap_caster_depth(kind, stored.depth, receiver, bounds.margin) * (virtual_map.far - virtual_map.near);
             let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel;
-            if length(offset) - spacing > cone_at {
-                continue;
-            }
-            if kind == TAP_EITHER {
-                found.evidence.unsure = true;
+            if weigh_caster(&found, kind, length(offset) - spacing, cone_at) {
                 return found;
             }
-            found.evidence.casters = true;
-            found.reach = max(found.reach, cone_at);
         }
     }
     return found;
