@@ -231,8 +231,9 @@ fn a_point_outside_its_levels_window_reads_the_finest_coarser_level_that_holds_i
 
 /// The search over a sun's cone reads the finest level whose texels span the cone in
 /// at most the cap, never finer than the pixel's own, at most the coarsest; and its
-/// pages cover the whole cone, or the cap's texels of the coarsest (random points,
-/// random cones).
+/// pages cover the whole cone, or the cap's texels of the coarsest, and the cap's
+/// texels round the point in the finer levels it also reads (random points, random
+/// cones).
 #[test]
 fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
     let map = clipmap(Vec3::new(5.0, 2.0, 3.0));
@@ -259,20 +260,38 @@ fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
     assert!(coarser > 500, "{coarser} searches read a coarser level");
 
     let search = AreaSearch { cone_tan: 0.1, cap_texels: 16.0 };
+    let mut finer = 0;
     for _ in 0..500 {
         let point = Vec3::new(rng.range(-20.0, 20.0), rng.range(0.0, 10.0), rng.range(-15.0, 15.0));
         let level = (rng.next() * 4.0) as u32;
-        let Some(rect) = map.search_request(point, level, search, 2.0) else { continue };
+        let rects = map.search_requests(point, level, search, 2.0);
         let light = map.light_from_world.transform_point3(point);
         let cone = search.cone_tan * (-light.z - map.near).max(0.0);
-        // The cone, clamped to the cap at the coarsest level.
-        let texel = map.texel_size(rect.level);
-        let reach = cone.min(search.cap_texels * texel).max(texel);
-        for corner in [Vec2::new(-1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0), Vec2::new(1.0, -1.0)]
-        {
-            let xy = light.truncate() + corner * reach;
-            let page = map.page_at(rect.level, xy);
-            assert!(page.is_none_or(|p| rect.contains(p)), "{point}: {xy} outside {rect:?}");
+        let read = map.search_level(level, cone, search.cap_texels);
+        // The cone, clamped to the cap at the coarsest level; and the cap's texels
+        // round the point in each of the (at most) AREA_SEARCH_FINER_LEVELS finer
+        // levels, none finer than the pixel's.
+        let first = read.saturating_sub(AREA_SEARCH_FINER_LEVELS).max(level);
+        for l in first..=read {
+            let texel = map.texel_size(l);
+            let reach = if l == read {
+                cone.min(search.cap_texels * texel).max(texel)
+            } else {
+                search.cap_texels * texel
+            };
+            let Some(page) = map.page_at(l, light.truncate()) else { continue };
+            let rect = rects.iter().find(|r| r.level == l).expect("a rectangle for each level read");
+            assert!(rect.contains(page));
+            finer += usize::from(l < read);
+            for corner in
+                [Vec2::new(-1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0), Vec2::new(1.0, -1.0)]
+            {
+                let xy = light.truncate() + corner * reach;
+                let page = map.page_at(l, xy);
+                assert!(page.is_none_or(|p| rect.contains(p)), "{point}: {xy} outside {rect:?}");
+            }
         }
+        assert!(rects.iter().all(|r| (first..=read).contains(&r.level)), "{point}: {rects:?}");
     }
+    assert!(finer > 100, "{finer} finer grids");
 }

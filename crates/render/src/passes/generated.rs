@@ -21,6 +21,10 @@ pub fn wgsl_constants() -> String {
     s += &format!("const MAX_BLUR_TAPS: u32 = {}u;\n", 2 * gnomon_scene::settings::MAX_BLUR_RADIUS + 1);
     s += &format!("const MAX_KERNEL_TEXELS: f32 = {:?};\n", gnomon_scene::settings::MAX_KERNEL_TEXELS);
     s += &format!("const VIRTUAL_ORIGIN_VECTORS: u32 = {}u;\n", crate::virtual_map::ORIGIN_VECTORS);
+    s += &format!(
+        "const AREA_SEARCH_FINER_LEVELS: u32 = {}u;\n",
+        gnomon_math::virtual_map::AREA_SEARCH_FINER_LEVELS
+    );
     s += &format!("const UNSURE_RING_TEXELS: i32 = {}i;\n", crate::rays::refine::UNSURE_RING_TEXELS);
     s += &format!("const TRACED_LAYER_FLAG: u32 = {TRACED_LAYER_FLAG}u;\n");
     s += &format!("const LIGHT_TILE: u32 = {}u;\n", light_list::LIGHT_TILE);

@@ -207,12 +207,46 @@ fn area_unsure(plane: MapPlane, bounds: FootprintBounds, footprint: Evidence, la
     let radius = clamp(cone, 1.0, cap);
     let first = area_grid(plane, radius, bounds, layer, distance);
     if !wider_look(first, radius) {
-        return cone_unsure(first.evidence, footprint, first.reach <= radius);
+        if cone_unsure(first.evidence, footprint, first.reach <= radius) {
+            return true;
+        }
+        // Lit, or an umbra the grid covers: light alone over a grid capped short
+        // of the cone proves no light past its edge.
+        return !first.evidence.casters && wider_grids_find_casters(plane, bounds, layer, distance, WiderGrids(radius, min(cone, cap * AREA_SEARCH_WIDER)));
     }
     let rim = wider_radius(first.reach);
     let wider = min(rim, cap * AREA_SEARCH_WIDER);
     let second = area_grid(plane, wider, bounds, layer, distance);
     return cone_unsure(second.evidence, footprint, rim <= wider && second.reach <= wider);
+}
+
+// The radii of `wider_grids_find_casters`'s grids: from twice `first`, doubling, up to
+// `widest`.
+struct WiderGrids {
+    first: f32,
+    widest: f32,
+};
+
+// Whether grids wider than a first one that saw light alone over a search capped
+// short of the cone (`grids.first` texels; the cone `grids.widest` or wider) find a
+// caster that reaches the cone, or a tap that may be one: each grid twice as wide as
+// the one before, up to the cone at the near plane or `AREA_SEARCH_WIDER` times the
+// cap. Light alone in a capped grid proves nothing past its edge: the long penumbra
+// of a box under a low, wide sun lies past a single map's cap, where the box stands
+// higher than the cap reaches. Each grid's taps lie twice as far apart as the one
+// before's, so a caster is looked for at a spacing that grows with its distance to
+// the side of the receiver, as its share of the sun's disk shrinks
+// (refine_virtual.wgsl's `finer_grids` reads a virtual map's levels the same way).
+fn wider_grids_find_casters(plane: MapPlane, bounds: FootprintBounds, layer: u32, distance: f32, grids: WiderGrids) -> bool {
+    var radius = grids.first;
+    while radius < grids.widest {
+        radius = min(2.0 * radius, grids.widest);
+        let found = area_grid(plane, radius, bounds, layer, distance).evidence;
+        if found.unsure || found.casters {
+            return true;
+        }
+    }
+    return false;
 }
 
 // A grid of `AREA_SEARCH_TAPS`² taps `radius` texels round the receiver's plane

@@ -13,7 +13,7 @@
 // (`virtual_area_unsure`, refine_map.wgsl's `area_unsure` through the page table).
 import package::passes::light_binding::light;
 import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
-import package::constants::{TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
+import package::constants::{AREA_SEARCH_FINER_LEVELS, TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
 import package::rays::refine_map::{AREA_SEARCH_TAPS, AREA_SEARCH_WIDER, ConeSearch, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth, weigh_caster, wider_look, wider_radius};
@@ -121,21 +121,60 @@ fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds:
     let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
     let cap = light.pcss.max_penumbra_texels;
     let search_level = virtual_search_level(level, cone, cap);
-    // The receiver's plane and bounds in texels of the search's level.
-    let scale = exp2(f32(search_level - level));
-    let plane = VirtualPlane((p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5), receiver, gradient * scale, search_level);
-    let scaled = FootprintBounds(bounds.tolerance * scale, bounds.margin * scale, bounds.own_bias, bounds.surface, bounds.grazing);
+    let receiver_plane = VirtualPlane(p, receiver, gradient, level);
+    let plane = plane_in_level(receiver_plane, search_level);
+    let scaled = bounds_in_level(bounds, search_level - level);
     let radius = clamp(cone / virtual_texel_size(search_level), 1.0, cap);
     let first = virtual_area_grid(plane, radius, scaled, distance);
-    if !wider_look(first, radius) {
-        return cone_unsure(first.evidence, footprint, first.reach <= radius);
+    var search = first.evidence;
+    var covers = first.reach <= radius;
+    if wider_look(first, radius) {
+        // Outside a page the requests asked for, the wider grid's taps make the pixel
+        // unsure: a ray decides.
+        let rim = wider_radius(first.reach);
+        let wider = min(rim, cap * AREA_SEARCH_WIDER);
+        let second = virtual_area_grid(plane, wider, scaled, distance);
+        search = second.evidence;
+        covers = rim <= wider && second.reach <= wider;
     }
-    // Outside a page the requests asked for, the wider grid's taps make the pixel
-    // unsure: a ray decides.
-    let rim = wider_radius(first.reach);
-    let wider = min(rim, cap * AREA_SEARCH_WIDER);
-    let second = virtual_area_grid(plane, wider, scaled, distance);
-    return cone_unsure(second.evidence, footprint, rim <= wider && second.reach <= wider);
+    if cone_unsure(search, footprint, covers) {
+        return true;
+    }
+    let finer = finer_grids(receiver_plane, bounds, search_level, distance);
+    return cone_unsure(Evidence(finer.unsure || search.unsure, finer.light || search.light, finer.casters || search.casters), footprint, covers);
+}
+
+// The evidence of grids `cap` texels round the receiver in the levels finer than
+// the search's (at most AREA_SEARCH_FINER_LEVELS of them, down to the pixel's own):
+// the search's grid, its taps a sixth of the cone apart, misses a caster narrower
+// than that (a post under a 10° sun), while each finer grid's taps lie half as far
+// apart as the next coarser's over a quarter of its area, so a caster is looked for
+// at a spacing that grows with its distance to the side of the receiver, as its
+// share of the sun's disk shrinks.
+fn finer_grids(receiver: VirtualPlane, bounds: FootprintBounds, search_level: u32, distance: f32) -> Evidence {
+    var found = Evidence(false, false, false);
+    let cap = light.pcss.max_penumbra_texels;
+    let first = max(receiver.level, search_level - min(search_level, AREA_SEARCH_FINER_LEVELS));
+    for (var l = first; l < search_level; l++) {
+        let grid = virtual_area_grid(plane_in_level(receiver, l), cap, bounds_in_level(bounds, l - receiver.level), distance);
+        found = Evidence(found.unsure || grid.evidence.unsure, found.light || grid.evidence.light, found.casters || grid.evidence.casters);
+        if found.unsure {
+            return found;
+        }
+    }
+    return found;
+}
+
+// `plane` (in texels of its own level) in texels of the coarser `level`.
+fn plane_in_level(plane: VirtualPlane, level: u32) -> VirtualPlane {
+    let scale = exp2(f32(level - plane.level));
+    return VirtualPlane((plane.p + vec2<f32>(0.5)) / scale - vec2<f32>(0.5), plane.depth, plane.gradient * scale, level);
+}
+
+// A footprint's `bounds` in texels `coarser` levels coarser than its own.
+fn bounds_in_level(bounds: FootprintBounds, coarser: u32) -> FootprintBounds {
+    let scale = exp2(f32(coarser));
+    return FootprintBounds(bounds.tolerance * scale, bounds.margin * scale, bounds.own_bias, bounds.surface, bounds.grazing);
 }
 
 // The receiver's plane in texels of a search's level: depth `depth` at texel

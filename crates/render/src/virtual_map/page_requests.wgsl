@@ -4,7 +4,7 @@
 // Many pixels share a page; atomicOr keeps one bit for all of them. The same
 // arithmetic as `Clipmap::request` in gnomon-math, which the tests hold it to.
 
-import package::constants::VIRTUAL_ORIGIN_VECTORS;
+import package::constants::{AREA_SEARCH_FINER_LEVELS, VIRTUAL_ORIGIN_VECTORS};
 
 struct PageRequestParams {
     light_from_world: mat4x4<f32>,
@@ -118,6 +118,11 @@ fn request_area_search(world: vec3<f32>, level: u32) {
     let radius = clamp(cone / texel, 1.0, cap);
     let lookup = request_params.reach_texels / exp2(f32(search - level));
     request_level_pages(world, search, radius + 1.0 + lookup);
+    // The finer levels' grids, `cap` texels round the point (`finer_grids`).
+    let first = max(level, search - min(search, AREA_SEARCH_FINER_LEVELS));
+    for (var l = first; l < search; l++) {
+        request_level_pages(world, l, cap + 1.0 + request_params.reach_texels / exp2(f32(l - level)));
+    }
 }
 
 @compute @workgroup_size(8, 8)

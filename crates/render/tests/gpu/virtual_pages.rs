@@ -44,7 +44,8 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
 
 /// Under a sun 10° wide whose penumbrae rays refine, each pixel also asks for the
 /// pages its footprint test's search over the sun's cone reads, in the level whose
-/// texels the cone spans in at most 32 (`Clipmap::search_request`).
+/// texels the cone spans in at most 32, and in the finer levels it also reads
+/// (`Clipmap::search_requests`).
 #[test]
 fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
     let search = AreaSearch { cone_tan: 5f32.to_radians().tan(), cap_texels: 32.0 };
@@ -122,10 +123,10 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
             expected.extend(rect.pages());
         }
-        let searched =
-            search.and_then(|search| clipmap.search_request(point, level, search, reach.reach_texels));
-        if let Some(rect) = searched {
-            searched_pages.extend(rect.pages());
+        if let Some(search) = search {
+            for rect in clipmap.search_requests(point, level, search, reach.reach_texels) {
+                searched_pages.extend(rect.pages());
+            }
         }
     }
     let surface = gpu.device.create_texture(&gnomon_render::wgpu::TextureDescriptor {
@@ -164,16 +165,21 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
 }
 
 /// Whether the search's pages for a pixel of `level` at `point` lie where the GPU's
-/// rounding and the CPU's may differ: its level's boundary, its square's page edges.
+/// rounding and the CPU's may differ: its level's boundary, its squares' page edges
+/// (the search level's and the finer levels').
 fn search_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, search: AreaSearch, reach: f32) -> bool {
     let square = clipmap.search_square(point, level, search, reach);
-    let page = clipmap.page_size(square.level);
-    let (xy, spread) = (square.centre, Vec2::splat(square.reach));
+    let mut squares = clipmap.finer_search_squares(&square, level, search, reach);
+    squares.push(square);
     near_grid((square.cone / (clipmap.texel_size(level) * search.cap_texels)).log2(), 1e-3)
         || near_grid(square.cone / clipmap.texel_size(square.level), 1e-3)
-        || [xy - spread, xy, xy + spread]
-            .iter()
-            .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
+        || squares.iter().any(|s| {
+            let page = clipmap.page_size(s.level);
+            let (xy, spread) = (s.centre, Vec2::splat(s.reach));
+            [xy - spread, xy, xy + spread]
+                .iter()
+                .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
+        })
 }
 
 /// A frame's virtual pages: a renderer kept across frames draws only pages new or
