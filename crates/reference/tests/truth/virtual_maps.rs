@@ -381,7 +381,7 @@ fn the_umbra_under_a_high_roof_is_not_traced() {
         traced.iter().filter(|t| **t).count().abs_diff(rays) * 50 <= rays,
         "the tinted pixels are the traced"
     );
-    // Measured: 4,070 of the umbra's 11,771 traced (12,537 pixels in all); with no
+    // Measured: 4,070 of the umbra's 11,771 traced (12,624 pixels in all); with no
     // second look, 9,133 (17,600).
     assert!(traced_in_umbra <= shadowed / 2, "{traced_in_umbra} of the umbra's {shadowed} traced");
     assert!(gross <= metrics.compared / 1000, "{gross} pixels off; {metrics:?}");

@@ -99,16 +99,35 @@ fn projected_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, 
 const AREA_SEARCH_TAPS: i32 = 6;
 
 // The texel of tap (i, j) of the grid over a search `radius` texels round texel
-// position `p` (texel centres at whole numbers).
-fn area_search_texel(p: vec2<f32>, radius: f32, i: i32, j: i32) -> vec2<i32> {
+// position `p` (texel centres at whole numbers), along each of the map's axes.
+fn area_search_texel(p: vec2<f32>, radius: vec2<f32>, i: i32, j: i32) -> vec2<i32> {
     let step = (vec2<f32>(f32(i), f32(j)) + vec2<f32>(0.5)) / f32(AREA_SEARCH_TAPS) * 2.0 - vec2<f32>(1.0);
     return vec2<i32>(floor(p + step * radius + vec2<f32>(0.5)));
 }
 
-// The grid's spacing in texels over a search `radius` texels: a caster seen at a tap
-// may reach as far as the next tap toward the receiver.
-fn area_search_spacing(radius: f32) -> f32 {
-    return max(2.0 * radius / f32(AREA_SEARCH_TAPS), 1.0);
+// The grid's spacing in texels over a search `radius` texels, along each of the
+// map's axes: a caster seen at a tap may reach as far as the next tap toward the
+// receiver.
+fn area_search_spacing(radius: vec2<f32>) -> vec2<f32> {
+    return max(2.0 * radius / f32(AREA_SEARCH_TAPS), vec2<f32>(1.0));
+}
+
+// A texel's size along the map's x and y axes over `texel_world_size_at`'s, the
+// larger of the two. A sun's map fitted to a window wider than it is tall (the
+// receivers under a low sun: long across the light, short along it) has texels
+// shorter along y; a search measured in the larger texel alone spans only part of
+// the cone along the shorter axis (on `grazing` under a 2° sun, the fading tip of
+// the box's shadow kept PCSS's umbra). Spot maps have square texels; a warped map's
+// are measured as their largest extent (`local_texel_world_size`), so taken square.
+fn texel_shape(layer: u32) -> vec2<f32> {
+    if light.cascades[layer].warped != 0u {
+        return vec2<f32>(1.0);
+    }
+    // World units to clip units along the map's axes: the lengths of the first two
+    // rows of the projection (an orthographic or symmetric perspective one).
+    let m = light.cascade_clip_from_world[layer];
+    let scale = vec2<f32>(length(vec3<f32>(m[0].x, m[1].x, m[2].x)), length(vec3<f32>(m[0].y, m[1].y, m[2].y)));
+    return vec2<f32>(min(scale.x, scale.y)) / scale;
 }
 
 // What a tap of the search over the light's cone holds, its stored depth `stored`
@@ -200,31 +219,40 @@ fn wider_radius(reach: f32) -> f32 {
 // that stand higher than it reaches (`wider_look`). A technique's own estimate of
 // the penumbra can be too narrow (PCSS's under a low sun is half the true width);
 // this bounds it by the geometry instead.
+//
+// The cone and the casters' reach are measured in the larger of the map's two texel
+// sizes (`texel_world_size_at`); each grid's radius along an axis is that length in
+// the axis's own texels (`texel_shape`), up to the cap.
 fn area_unsure(plane: MapPlane, bounds: FootprintBounds, footprint: Evidence, layer: u32, distance: f32) -> bool {
     let near = light.map.near;
+    let shape = texel_shape(layer);
     let cone = emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near);
     let cap = light.pcss.max_penumbra_texels;
-    let radius = clamp(cone, 1.0, cap);
+    let radius = clamp(vec2<f32>(cone) / shape, vec2<f32>(1.0), vec2<f32>(cap));
+    // How far the grid reaches round the receiver along both axes, in larger texels.
+    let spans = min(radius.x * shape.x, radius.y * shape.y);
     let first = area_grid(plane, radius, bounds, layer, distance);
-    if !wider_look(first, radius) {
-        if cone_unsure(first.evidence, footprint, first.reach <= radius) {
+    if !wider_look(first, spans) {
+        if cone_unsure(first.evidence, footprint, first.reach <= spans) {
             return true;
         }
         // Lit, or an umbra the grid covers: light alone over a grid capped short
         // of the cone proves no light past its edge.
-        return !first.evidence.casters && wider_grids_find_casters(plane, bounds, layer, distance, WiderGrids(radius, min(cone, cap * AREA_SEARCH_WIDER)));
+        let widest = min(vec2<f32>(cone) / shape, vec2<f32>(cap * AREA_SEARCH_WIDER));
+        return !first.evidence.casters && wider_grids_find_casters(plane, bounds, layer, distance, WiderGrids(radius, widest));
     }
-    let rim = wider_radius(first.reach);
-    let wider = min(rim, cap * AREA_SEARCH_WIDER);
+    let rim = vec2<f32>(wider_radius(first.reach)) / shape;
+    let wider = min(rim, vec2<f32>(cap * AREA_SEARCH_WIDER));
     let second = area_grid(plane, wider, bounds, layer, distance);
-    return cone_unsure(second.evidence, footprint, rim <= wider && second.reach <= wider);
+    let wider_spans = min(wider.x * shape.x, wider.y * shape.y);
+    return cone_unsure(second.evidence, footprint, all(rim <= wider) && second.reach <= wider_spans);
 }
 
-// The radii of `wider_grids_find_casters`'s grids: from twice `first`, doubling, up to
-// `widest`.
+// The radii of `wider_grids_find_casters`'s grids, in texels along each of the map's
+// axes: from twice `first`, doubling, up to `widest`.
 struct WiderGrids {
-    first: f32,
-    widest: f32,
+    first: vec2<f32>,
+    widest: vec2<f32>,
 };
 
 // Whether grids wider than a first one that saw light alone over a search capped
@@ -239,7 +267,7 @@ struct WiderGrids {
 // (refine_virtual.wgsl's `finer_grids` reads a virtual map's levels the same way).
 fn wider_grids_find_casters(plane: MapPlane, bounds: FootprintBounds, layer: u32, distance: f32, grids: WiderGrids) -> bool {
     var radius = grids.first;
-    while radius < grids.widest {
+    while any(radius < grids.widest) {
         radius = min(2.0 * radius, grids.widest);
         let found = area_grid(plane, radius, bounds, layer, distance).evidence;
         if found.unsure || found.casters {
@@ -250,13 +278,16 @@ fn wider_grids_find_casters(plane: MapPlane, bounds: FootprintBounds, layer: u32
 }
 
 // A grid of `AREA_SEARCH_TAPS`² taps `radius` texels round the receiver's plane
-// `plane`: casters inside the cone from the receiver to the light (no farther to the
-// side than the cone's radius at the caster's own distance, give or take the grid's
-// spacing) and light, a texel with nothing in front of the receiver. A caster too
-// far to the side to reach the cone says neither (counting it as light traced every
-// umbra whose casters stand above the receiver by less than the grid's reach).
-fn area_grid(plane: MapPlane, radius: f32, bounds: FootprintBounds, layer: u32, distance: f32) -> ConeSearch {
+// `plane` (along each of the map's axes): casters inside the cone from the receiver
+// to the light (no farther to the side than the cone's radius at the caster's own
+// distance, give or take the grid's spacing) and light, a texel with nothing in
+// front of the receiver. A caster too far to the side to reach the cone says
+// neither (counting it as light traced every umbra whose casters stand above the
+// receiver by less than the grid's reach).
+fn area_grid(plane: MapPlane, radius: vec2<f32>, bounds: FootprintBounds, layer: u32, distance: f32) -> ConeSearch {
     let last = vec2<i32>(i32(light.map.resolution) - 1);
+    // Offsets in larger texels (`texel_shape`), as the cone is.
+    let shape = texel_shape(layer);
     let spacing = area_search_spacing(radius);
     var found = ConeSearch(Evidence(false, false, false), 0.0);
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
@@ -271,10 +302,15 @@ fn area_grid(plane: MapPlane, radius: f32, bounds: FootprintBounds, layer: u32, 
                 continue;
             }
             // A caster seen at this tap may reach as far as the next tap toward the
-            // receiver: the tap grid's spacing is the slack of the test.
+            // receiver: the tap grid's spacing, along each axis, is the slack of the
+            // test. (Along each axis rather than along the offset, as a virtual map's
+            // square grid has it: with texels shorter along one axis, the spacing
+            // along the longer one would stand for both, and traced 9 % more of
+            // `grazing` under a 10° sun on a single map.)
             let at = light_distance_from_depth(tap_caster_depth(kind, stored, receiver, bounds.margin));
             let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel_world_size_at(layer, at);
-            if weigh_caster(&found, kind, length(offset) - spacing, cone_at) {
+            let beside = length(max(abs(offset) - spacing, vec2<f32>(0.0)) * shape);
+            if weigh_caster(&found, kind, beside, cone_at) {
                 return found;
             }
         }

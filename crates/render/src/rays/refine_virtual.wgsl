@@ -191,11 +191,11 @@ struct VirtualPlane {
 // hold makes the pixel unsure.
 fn virtual_area_grid(plane: VirtualPlane, radius: f32, bounds: FootprintBounds, distance: f32) -> ConeSearch {
     let texel = virtual_texel_size(plane.level);
-    let spacing = area_search_spacing(radius);
+    let spacing = area_search_spacing(vec2<f32>(radius)).x;
     var found = ConeSearch(Evidence(false, false, false), 0.0);
     for (var j = 0; j < AREA_SEARCH_TAPS; j++) {
         for (var i = 0; i < AREA_SEARCH_TAPS; i++) {
-            let tap = area_search_texel(plane.p, radius, i, j);
+            let tap = area_search_texel(plane.p, vec2<f32>(radius), i, j);
             let stored = virtual_texel(plane.level, tap);
             if !stored.exact {
                 found.evidence.unsure = true;

@@ -151,7 +151,7 @@ pub struct ScreenSpaceSettings {
     pub lighting: Lighting,
     /// Shadow rays per refined pixel under a light with an area, stratified over the
     /// light's disk, cone or sphere as the CPU reference samples it: 1 to 256. 16
-    /// rays and an edge-aware filter take PCSS's penumbra error to 0.22–0.42× on the
+    /// rays and an edge-aware filter take PCSS's penumbra error to 0.11–0.41× on the
     /// measured scenes (docs/rays.md).
     #[cfg_attr(
         feature = "cli",
