@@ -109,6 +109,11 @@ struct Evidence {
     casters: bool,
 };
 
+// The evidence of two sets of texels or taps together.
+fn joined(a: Evidence, b: Evidence) -> Evidence {
+    return Evidence(a.unsure || b.unsure, a.light || b.light, a.casters || b.casters);
+}
+
 // Whether texels' evidence leaves the pixel unsure: a texel did, or they show both
 // light and a caster.
 fn leaves_unsure(e: Evidence) -> bool {

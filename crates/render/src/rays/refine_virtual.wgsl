@@ -12,7 +12,7 @@
 // it, does not agree with the footprint that the pixel is lit or in the umbra
 // (`virtual_area_unsure`, refine_map.wgsl's `area_unsure` through the page table).
 import package::passes::light_binding::light;
-import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, receiver_bias};
+import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, block_evidence, joined, receiver_bias};
 import package::constants::{AREA_SEARCH_FINER_LEVELS, TRACED_LAYER_FLAG, UNSURE_RING_TEXELS};
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
@@ -141,7 +141,7 @@ fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds:
         return true;
     }
     let finer = finer_grids(receiver_plane, bounds, search_level, distance);
-    return cone_unsure(Evidence(finer.unsure || search.unsure, finer.light || search.light, finer.casters || search.casters), footprint, covers);
+    return cone_unsure(joined(search, finer), footprint, covers);
 }
 
 // The evidence of grids `cap` texels round the receiver in the levels finer than
@@ -157,7 +157,7 @@ fn finer_grids(receiver: VirtualPlane, bounds: FootprintBounds, search_level: u3
     let first = max(receiver.level, search_level - min(search_level, AREA_SEARCH_FINER_LEVELS));
     for (var l = first; l < search_level; l++) {
         let grid = virtual_area_grid(plane_in_level(receiver, l), cap, bounds_in_level(bounds, l - receiver.level), distance);
-        found = Evidence(found.unsure || grid.evidence.unsure, found.light || grid.evidence.light, found.casters || grid.evidence.casters);
+        found = joined(found, grid.evidence);
         if found.unsure {
             return found;
         }
