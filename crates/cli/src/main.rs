@@ -161,15 +161,26 @@ mod tests {
 
     use super::Cli;
 
-    /// Every option of every subcommand explains itself in `--help`.
+    /// Every option of every subcommand explains itself in `--help`, in words a
+    /// user reads: no rustdoc link (``[`NAME`]``) leaks in from the settings' doc
+    /// comments, which clap prints as they are.
     #[test]
     fn every_option_has_help_text() {
         let mut command = Cli::command();
         command.build();
         for sub in command.get_subcommands() {
             for arg in sub.get_arguments() {
-                let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
-                assert!(!help.trim().is_empty(), "`{} --{}` has no help", sub.get_name(), arg.get_id());
+                let short = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+                let long = arg.get_long_help().map(|h| h.to_string()).unwrap_or_default();
+                assert!(!short.trim().is_empty(), "`{} --{}` has no help", sub.get_name(), arg.get_id());
+                for help in [short, long] {
+                    assert!(
+                        !help.contains("[`"),
+                        "`{} --{}`'s help has a rustdoc link: {help}",
+                        sub.get_name(),
+                        arg.get_id()
+                    );
+                }
             }
         }
     }

@@ -101,7 +101,12 @@ fn the_pcf_family_reads_a_virtual_map_across_pages() {
 
 /// PCSS on a virtual sun (`pcss_virtual.wgsl`): its blocker search and kernel, tap by
 /// tap through the page table, follow penumbrae that widen from each contact as PCSS
-/// on a single 2D map does, against the Monte Carlo reference of a sun 4° wide.
+/// on a single 2D map does, against the Monte Carlo reference of a sun 4° wide. Each
+/// is held to a single map of the same texel density: these penumbrae are 2.9 px
+/// wide, and PCSS's error here follows the texels a pixel spans (the aliasing m the
+/// compare command prints): 0.75 for the virtual map, whose texels follow the
+/// pixels, and 0.78 for a 512² single map; 0.19 for the virtual map read two levels
+/// finer (`lod_bias` 2) and 0.20 for a 2048² one.
 #[test]
 fn pcss_on_a_virtual_map_follows_the_penumbrae_as_on_a_single_map() {
     let scene = builtin::contact();
@@ -111,20 +116,32 @@ fn pcss_on_a_virtual_map_follows_the_penumbrae_as_on_a_single_map() {
     s.reference.samples = 128;
     s.shadow.filter.technique = Technique::PCSS;
     let truth = reference(&scene, &s);
-    let on_virtual = compare(&render(&scene, &s), &truth);
-    s.shadow.partition = Partition::Single;
-    let on_single = compare(&render(&scene, &s), &truth);
-    s.shadow.filter.technique = Technique::PCF2X2;
-    let hard = compare(&render(&scene, &s), &truth);
-    figure(
-        "contact, sun 4°: PCSS MAE on a virtual map (on a single map; pcf2x2's)",
-        format!("{:.4} ({:.4}; {:.4})", on_virtual.mae, on_single.mae, hard.mae),
-        format!("≤ 1.25 × {:.4}", on_single.mae),
-    );
-    // Measured on lavapipe: 0.0022 on the virtual map, 0.0026 on the single map,
-    // 0.0080 for the hard 2×2. Penumbrae three times too wide fail it (0.0192).
-    assert!(on_virtual.mae <= 1.25 * on_single.mae, "{on_virtual:?} against {on_single:?}");
-    assert!(on_virtual.mae < 0.5 * hard.mae, "{on_virtual:?} against pcf2x2's {hard:?}");
+    let mut hard = None;
+    for (lod_bias, single_resolution) in [(0, 512), (2, 2048)] {
+        let mut s = s.clone();
+        s.shadow.virtual_map.lod_bias = lod_bias;
+        let on_virtual = compare(&render(&scene, &s), &truth);
+        s.shadow.partition = Partition::Single;
+        s.shadow.map.resolution = single_resolution;
+        let on_single = compare(&render(&scene, &s), &truth);
+        figure(
+            &format!(
+                "contact, sun 4°: PCSS MAE on a virtual map, lod bias {lod_bias} (on a {single_resolution}² single map)"
+            ),
+            format!("{:.4} ({:.4})", on_virtual.mae, on_single.mae),
+            format!("≤ 1.25 × {:.4}", on_single.mae),
+        );
+        // Measured on lavapipe: 0.0022 (0.0023) and 0.0012 (0.0012). Penumbrae three
+        // times too wide fail it (0.0192).
+        assert!(
+            on_virtual.mae <= 1.25 * on_single.mae,
+            "lod bias {lod_bias}: {on_virtual:?} against {on_single:?}"
+        );
+        s.shadow.filter.technique = Technique::PCF2X2;
+        let hard = hard.get_or_insert_with(|| compare(&render(&scene, &s), &truth));
+        // pcf2x2's 0.0075 on the 512² map: PCSS's penumbrae are there.
+        assert!(on_virtual.mae < 0.5 * hard.mae, "{on_virtual:?} against pcf2x2's {hard:?}");
+    }
 }
 
 /// Levels of 1024² texels read four levels finer than the footprint

@@ -60,7 +60,7 @@ fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(CascadeChoiceGpu as "CascadeChoice" { by_projection, blend, _pad0, _pad1 }),
         struct_layout!(BiasGpu as "Bias" { normal_offset, depth, slope, receiver_plane }),
         struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
-        struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, _pad0, _pad1 }),
+        struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, max_search_texels, _pad1 }),
         struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
         struct_layout!(RaysGpu as "Rays" { penumbra_rays, _pad0, _pad1, _pad2 }),
         struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),

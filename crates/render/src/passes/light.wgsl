@@ -67,7 +67,7 @@ struct Pcf {
 struct Pcss {
     blocker_taps: u32,
     max_penumbra_texels: f32,  // largest filter radius
-    _pad0: u32,
+    max_search_texels: f32,    // largest blocker-search radius
     _pad1: u32,
 };
 

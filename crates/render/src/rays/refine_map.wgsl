@@ -22,7 +22,7 @@
 //
 // What this cannot see: a caster thinner than a texel that the map's rasterization
 // missed altogether leaves no depth to disagree with.
-import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
+import package::passes::light_binding::{light, light_distance_from_depth, texel_shape, texel_world_size_at};
 import package::passes::light_kinds::emitter_cone_radius;
 import package::passes::map_visibility::{local_texel_world_size, shadow_coords};
 import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_evidence, leaves_unsure, map_step, receiver_bias};
@@ -112,24 +112,6 @@ fn area_search_spacing(radius: vec2<f32>) -> vec2<f32> {
     return max(2.0 * radius / f32(AREA_SEARCH_TAPS), vec2<f32>(1.0));
 }
 
-// A texel's size along the map's x and y axes over `texel_world_size_at`'s, the
-// larger of the two. A sun's map fitted to a window wider than it is tall (the
-// receivers under a low sun: long across the light, short along it) has texels
-// shorter along y; a search measured in the larger texel alone spans only part of
-// the cone along the shorter axis (on `grazing` under a 2° sun, the fading tip of
-// the box's shadow kept PCSS's umbra). Spot maps have square texels; a warped map's
-// are measured as their largest extent (`local_texel_world_size`), so taken square.
-fn texel_shape(layer: u32) -> vec2<f32> {
-    if light.cascades[layer].warped != 0u {
-        return vec2<f32>(1.0);
-    }
-    // World units to clip units along the map's axes: the lengths of the first two
-    // rows of the projection (an orthographic or symmetric perspective one).
-    let m = light.cascade_clip_from_world[layer];
-    let scale = vec2<f32>(length(vec3<f32>(m[0].x, m[1].x, m[2].x)), length(vec3<f32>(m[0].y, m[1].y, m[2].y)));
-    return vec2<f32>(min(scale.x, scale.y)) / scale;
-}
-
 // What a tap of the search over the light's cone holds, its stored depth `stored`
 // against the receiver's plane there, `plane`, as the footprint judges a texel
 // (`FootprintBounds`'s `tolerance` and `margin`, here in the search's texels):
@@ -215,7 +197,7 @@ fn wider_radius(reach: f32) -> f32 {
 // at light distance `distance` (`bounds` the footprint's), whose footprint showed
 // `footprint` (`cone_unsure`). Its search, a grid over the cone's cross-section at
 // the map's near plane (PCSS's blocker-search region, Fernando 2005), capped at
-// light.pcss.max_penumbra_texels, looks again wider where it found casters alone
+// light.pcss.max_search_texels, looks again wider where it found casters alone
 // that stand higher than it reaches (`wider_look`). A technique's own estimate of
 // the penumbra can be too narrow (PCSS's under a low sun is half the true width);
 // this bounds it by the geometry instead.
@@ -227,7 +209,7 @@ fn area_unsure(plane: MapPlane, bounds: FootprintBounds, footprint: Evidence, la
     let near = light.map.near;
     let shape = texel_shape(layer);
     let cone = emitter_cone_radius(light.emitter, distance, near) / texel_world_size_at(layer, near);
-    let cap = light.pcss.max_penumbra_texels;
+    let cap = light.pcss.max_search_texels;
     let radius = clamp(vec2<f32>(cone) / shape, vec2<f32>(1.0), vec2<f32>(cap));
     // How far the grid reaches round the receiver along both axes, in larger texels.
     let spans = min(radius.x * shape.x, radius.y * shape.y);

@@ -110,7 +110,7 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
 // texel position `p` of `level` (its plane `receiver` + `gradient` per texel, at
 // light distance `distance`; `bounds` its footprint's, in the same depth per texel),
 // whose footprint showed `footprint`, each tap through the page table. The grid
-// spans at most `max_penumbra_texels` texels, as on a 2D map; where the cone is
+// spans at most `max_search_texels` texels, as on a 2D map; where the cone is
 // wider in the pixel's own fine texels, the search reads the coarser level whose
 // texels it spans in that many, so that it covers the cone at the near plane
 // (`virtual_search_level`), and looks wider in that level only past the coarsest
@@ -119,7 +119,7 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
 // in the footprint.
 fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds: FootprintBounds, footprint: Evidence, level: u32, distance: f32) -> bool {
     let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
-    let cap = light.pcss.max_penumbra_texels;
+    let cap = light.pcss.max_search_texels;
     let search_level = virtual_search_level(level, cone, cap);
     let receiver_plane = VirtualPlane(p, receiver, gradient, level);
     let plane = plane_in_level(receiver_plane, search_level);
@@ -153,7 +153,7 @@ fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds:
 // share of the sun's disk shrinks.
 fn finer_grids(receiver: VirtualPlane, bounds: FootprintBounds, search_level: u32, distance: f32) -> Evidence {
     var found = Evidence(false, false, false);
-    let cap = light.pcss.max_penumbra_texels;
+    let cap = light.pcss.max_search_texels;
     let first = max(receiver.level, search_level - min(search_level, AREA_SEARCH_FINER_LEVELS));
     for (var l = first; l < search_level; l++) {
         let grid = virtual_area_grid(plane_in_level(receiver, l), cap, bounds_in_level(bounds, l - receiver.level), distance);

@@ -79,8 +79,9 @@ fn compare_tap(q: ShadowQuery, gradient: vec2<f32>, offset: vec2<f32>) -> f32 {
 }
 
 // Rotates the first `count` points of the Poisson disk by a per-pixel angle, scales
-// them to `radius` texels, and averages the comparison taps there.
-fn pcf_poisson(q: ShadowQuery, radius: f32, count: u32) -> f32 {
+// them to `radius` texels along each of the map's axes (a disk in the world is an
+// ellipse in oblong texels: `texel_shape`), and averages the comparison taps there.
+fn pcf_poisson(q: ShadowQuery, radius: vec2<f32>, count: u32) -> f32 {
     let gradient = receiver_depth_gradient(q);
     let rotation = disk_rotation(q.pixel);
     var sum = 0.0;

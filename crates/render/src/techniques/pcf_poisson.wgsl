@@ -3,5 +3,5 @@ import package::passes::light_binding::light;
 import package::techniques::common::{ShadowQuery, kernel_width_texels, pcf_poisson};
 
 fn pcf_poisson_sample_shadow(q: ShadowQuery) -> f32 {
-    return pcf_poisson(q, 0.5 * kernel_width_texels(q), light.pcf.poisson_taps);
+    return pcf_poisson(q, vec2<f32>(0.5 * kernel_width_texels(q)), light.pcf.poisson_taps);
 }

@@ -1,6 +1,6 @@
 //! `pcss`: percentage-closer soft shadows (Fernando 2005). The light's size is the
 //! light's own (spot disk radius, point light sphere radius or sun angular diameter), the same parameter the
-//! reference's area light uses; the search settings are carried in `light.light_size`, `blocker_taps` and `max_penumbra_texels`.
+//! reference's area light uses; the search settings are carried in `light.light_size`, `blocker_taps`, `max_search_texels` and `max_penumbra_texels`.
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
@@ -30,7 +30,7 @@ impl ShadowTechnique for Pcss {
 
     /// The largest penumbra radius it may filter with.
     fn filter_reach_texels(&self, s: &FilterSettings, _: f32) -> f32 {
-        s.pcss.max_radius
+        s.pcss.max_penumbra
     }
 
     fn wgsl(&self) -> &'static [&'static str] {

@@ -12,7 +12,7 @@
 // 3. PCF over a Poisson disk of that radius.
 // Both the search region and the penumbra are converted to texels with the map's
 // projection: perspective texels grow with distance, orthographic ones do not.
-import package::passes::light_binding::{light, light_distance_from_depth, texel_world_size_at};
+import package::passes::light_binding::{light, light_distance_from_depth, texel_shape, texel_world_size_at};
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::bindings::shadow_map;
 import package::techniques::common::{ShadowQuery, disk_rotation, pcf_poisson, receiver_depth_gradient};
@@ -25,14 +25,18 @@ fn world_to_texels(layer: u32, world: f32, at: f32) -> f32 {
 }
 
 fn pcss_sample_shadow(q: ShadowQuery) -> f32 {
-    let max_radius = light.pcss.max_penumbra_texels;
+    let max_search = light.pcss.max_search_texels;
+    let max_penumbra = light.pcss.max_penumbra_texels;
     let d_receiver = q.distance;
     let near = light.map.near;
 
     // 1. The search region: the cross-section at the near plane of the cone from the
     // receiver to the light, where the nearest possible blockers lie.
+    // Measured along each of the map's axes in that axis's own texels
+    // (`texel_shape`): a disk in the world, an ellipse on an oblong-texel map.
+    let shape = texel_shape(q.layer);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, near);
-    let search = clamp(world_to_texels(q.layer, search_world, near), 1.0, max_radius);
+    let search = clamp(world_to_texels(q.layer, search_world, near) / shape, vec2<f32>(1.0), vec2<f32>(max_search));
 
     let gradient = receiver_depth_gradient(q);
     let rotation = disk_rotation(q.pixel);
@@ -58,7 +62,7 @@ fn pcss_sample_shadow(q: ShadowQuery) -> f32 {
 
     // 2. The penumbra's radius at the receiver.
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
-    let penumbra = world_to_texels(q.layer, penumbra_world, d_receiver);
+    let penumbra = world_to_texels(q.layer, penumbra_world, d_receiver) / shape;
     // 3. At least the bilinear tap's own half-texel footprint.
-    return pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.pcf.poisson_taps);
+    return pcf_poisson(q, clamp(penumbra, vec2<f32>(0.5), vec2<f32>(max_penumbra)), light.pcf.poisson_taps);
 }

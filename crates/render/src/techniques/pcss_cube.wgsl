@@ -9,14 +9,15 @@ import package::variant::POISSON_DISK;
 
 fn pcss_sample_shadow_cube(q: CubeQuery) -> f32 {
     let size = light.emitter.size;
-    let max_radius = light.pcss.max_penumbra_texels;
+    let max_search = light.pcss.max_search_texels;
+    let max_penumbra = light.pcss.max_penumbra_texels;
     let range = light.emitter.range;
     let near = light.map.near;
     let d_receiver = q.depth * range;
 
     // 1. The search region: a blocker at distance t hides the light from the receiver
     // within size·(d − t)/t across the ray at the receiver, the most at the near plane.
-    let search = clamp(size * (d_receiver - near) / near / q.texel_world, 1.0, max_radius);
+    let search = clamp(size * (d_receiver - near) / near / q.texel_world, 1.0, max_search);
     let rotation = disk_rotation(q.pixel);
     let taps = light.pcss.blocker_taps;
     var blocker_sum = 0.0;
@@ -36,5 +37,5 @@ fn pcss_sample_shadow_cube(q: CubeQuery) -> f32 {
     // 2. The penumbra's radius at the receiver, by similar triangles.
     let penumbra = size * max(d_receiver - d_blocker, 0.0) / d_blocker / q.texel_world;
     // 3. At least the bilinear tap's own half-texel footprint.
-    return cube_pcf_poisson(q, clamp(penumbra, 0.5, max_radius), light.pcf.poisson_taps);
+    return cube_pcf_poisson(q, clamp(penumbra, 0.5, max_penumbra), light.pcf.poisson_taps);
 }

@@ -13,10 +13,11 @@ import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::virtual_texel_depth;
 
 fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
-    let max_radius = light.pcss.max_penumbra_texels;
+    let max_search = light.pcss.max_search_texels;
+    let max_penumbra = light.pcss.max_penumbra_texels;
     let d_receiver = virtual_distance(q.depth);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, virtual_distance(0.0));
-    let search = clamp(search_world / q.texel_world, 1.0, max_radius);
+    let search = clamp(search_world / q.texel_world, 1.0, max_search);
     let rotation = disk_rotation(q.pixel);
     var blocker_sum = 0.0;
     var blockers = 0.0;
@@ -33,5 +34,5 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     }
     let d_blocker = blocker_sum / blockers;
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
-    return virtual_pcf_poisson(q, clamp(penumbra_world / q.texel_world, 0.5, max_radius), light.pcf.poisson_taps);
+    return virtual_pcf_poisson(q, clamp(penumbra_world / q.texel_world, 0.5, max_penumbra), light.pcf.poisson_taps);
 }

@@ -159,10 +159,10 @@ pub struct PcfGpu {
 pub struct PcssGpu {
     /// Taps of the blocker search, at most the Poisson disk's size.
     pub blocker_taps: u32,
-    /// The largest blocker-search and penumbra radius, in texels.
+    /// The largest penumbra radius, in texels.
     pub max_penumbra_texels: f32,
-    /// Padding.
-    pub _pad0: u32,
+    /// The largest blocker-search radius, in texels.
+    pub max_search_texels: f32,
     /// Padding.
     pub _pad1: u32,
 }
@@ -316,7 +316,8 @@ impl LightGpu {
             },
             pcss: PcssGpu {
                 blocker_taps: f.pcss.blocker_samples,
-                max_penumbra_texels: f.pcss.max_radius,
+                max_penumbra_texels: f.pcss.max_penumbra,
+                max_search_texels: f.pcss.max_radius,
                 ..Default::default()
             },
             rays: RaysGpu {

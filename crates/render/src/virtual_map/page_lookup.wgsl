@@ -84,7 +84,7 @@ fn virtual_texel_size(level: u32) -> f32 {
 }
 
 // The level in whose texels a search `radius` world units wide round a pixel of
-// `level` spans at most `cap` texels (PCSS's `max_penumbra_texels`, which a 2D map's
+// `level` spans at most `cap` texels (PCSS's `max_search_texels`, which a 2D map's
 // coarser texels stretch as far): `level` itself, or as many levels coarser as it
 // takes (`search_level` in page_requests.wgsl, which asks for its pages).
 fn virtual_search_level(level: u32, radius: f32, cap: f32) -> u32 {

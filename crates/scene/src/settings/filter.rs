@@ -175,7 +175,7 @@ pub struct FilterSettings {
     /// Unit of --pcf-kernel.
     #[cfg_attr(feature = "cli", arg(long, value_enum, default_value_t, help_heading = "Shadow filter"))]
     pub kernel_unit: KernelUnit,
-    /// Taps of `pcf-poisson` and of PCSS's filtering step ([`POISSON_TAPS`]).
+    /// Taps of `pcf-poisson` and of PCSS's filtering step.
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = FilterSettings::default().poisson_samples, help_heading = "Shadow filter"))]
     pub poisson_samples: u32,
     /// Receiver-plane depth bias for the PCF family and PCSS: tilt the compared depth
@@ -183,7 +183,7 @@ pub struct FilterSettings {
     /// of its shadow coordinates, so wide kernels don't shadow their own receiver.
     #[cfg_attr(feature = "cli", arg(long, value_name = "BOOL", default_value_t = FilterSettings::default().receiver_plane_bias, action = clap::ArgAction::Set, help_heading = "Shadow filter"))]
     pub receiver_plane_bias: bool,
-    /// PCSS: blocker-search taps and the largest penumbra radius.
+    /// PCSS: blocker-search taps, and the largest search and penumbra radii.
     #[cfg_attr(feature = "cli", command(flatten))]
     #[patch(nesting)]
     pub pcss: PcssSettings,
@@ -223,6 +223,9 @@ pub const BLOCKER_SAMPLES_RANGE: SettingRange = SettingRange::closed(
 /// `shadow.filter.pcss.max_radius`' range.
 pub const PCSS_MAX_RADIUS_RANGE: SettingRange =
     SettingRange::closed("shadow.filter.pcss.max_radius", 1.0, 64.0, "texels");
+/// `shadow.filter.pcss.max_penumbra`'s range.
+pub const PCSS_MAX_PENUMBRA_RANGE: SettingRange =
+    SettingRange::closed("shadow.filter.pcss.max_penumbra", 1.0, 64.0, "texels");
 /// `shadow.filter.moments.blur_radius`' range: [`MAX_BLUR_RADIUS`].
 pub const BLUR_RADIUS_RANGE: SettingRange =
     SettingRange::closed("shadow.filter.moments.blur_radius", 0.0, MAX_BLUR_RADIUS as f64, "texels");
@@ -287,18 +290,26 @@ impl Default for FilterSettings {
 ))]
 #[serde(default, deny_unknown_fields)]
 pub struct PcssSettings {
-    /// Depth taps of PCSS's blocker search ([`POISSON_TAPS`]).
+    /// Depth taps of PCSS's blocker search.
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", default_value_t = PcssSettings::default().blocker_samples, help_heading = "PCSS"))]
     pub blocker_samples: u32,
-    /// Largest blocker-search and penumbra radius, in texels. Wider penumbrae are
-    /// clipped to it.
+    /// Largest blocker-search radius, in texels. The search spans the light's cone
+    /// at the map's near plane, which under a spot's perspective can be hundreds of
+    /// texels: spread that wide, its taps average unrelated casters.
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_radius, help_heading = "PCSS"))]
     pub max_radius: f32,
+    /// Largest penumbra radius, in texels: wider penumbrae are clipped to it. A
+    /// separate cap from the search's: a fine map under a low, wide sun (a single
+    /// map fitted to the receivers) has penumbrae wider than 32 texels, and clipping
+    /// them there doubled PCSS's penumbra error on `grazing` under a 2° sun
+    /// (docs/wide-suns.md).
+    #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_penumbra, help_heading = "PCSS"))]
+    pub max_penumbra: f32,
 }
 
 impl Default for PcssSettings {
     fn default() -> Self {
-        Self { blocker_samples: 32, max_radius: 32.0 }
+        Self { blocker_samples: 32, max_radius: 32.0, max_penumbra: 64.0 }
     }
 }
 

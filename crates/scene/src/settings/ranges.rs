@@ -134,6 +134,7 @@ pub static ALL: &[&SettingRange] = &[
     &super::POISSON_SAMPLES_RANGE,
     &super::BLOCKER_SAMPLES_RANGE,
     &super::PCSS_MAX_RADIUS_RANGE,
+    &super::PCSS_MAX_PENUMBRA_RANGE,
     &super::BLUR_RADIUS_RANGE,
     &super::MIN_VARIANCE_RANGE,
     &super::BLEEDING_REDUCTION_RANGE,

@@ -540,6 +540,7 @@ impl FilterSettings {
         POISSON_SAMPLES_RANGE.check(f.poisson_samples)?;
         BLOCKER_SAMPLES_RANGE.check(f.pcss.blocker_samples)?;
         PCSS_MAX_RADIUS_RANGE.check(f.pcss.max_radius)?;
+        PCSS_MAX_PENUMBRA_RANGE.check(f.pcss.max_penumbra)?;
         f.moments.validate()?;
         Ok(())
     }
