@@ -225,7 +225,7 @@ pub const PCSS_MAX_RADIUS_RANGE: SettingRange =
     SettingRange::closed("shadow.filter.pcss.max_radius", 1.0, 64.0, "texels");
 /// `shadow.filter.pcss.max_penumbra`'s range.
 pub const PCSS_MAX_PENUMBRA_RANGE: SettingRange =
-    SettingRange::closed("shadow.filter.pcss.max_penumbra", 1.0, 64.0, "texels");
+    SettingRange::closed("shadow.filter.pcss.max_penumbra", 1.0, 256.0, "texels");
 /// `shadow.filter.moments.blur_radius`' range: [`MAX_BLUR_RADIUS`].
 pub const BLUR_RADIUS_RANGE: SettingRange =
     SettingRange::closed("shadow.filter.moments.blur_radius", 0.0, MAX_BLUR_RADIUS as f64, "texels");
@@ -302,7 +302,9 @@ pub struct PcssSettings {
     /// separate cap from the search's: a fine map under a low, wide sun (a single
     /// map fitted to the receivers) has penumbrae wider than 32 texels, and clipping
     /// them there doubled PCSS's penumbra error on `grazing` under a 2° sun
-    /// (docs/wide-suns.md).
+    /// (docs/measured.md, "Soft shadows"). A point light's 2048² cube faces under
+    /// a wide sphere want more (up to 256); a virtual map asks for the pages as far
+    /// as it reaches, so on one it costs pages.
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_penumbra, help_heading = "PCSS"))]
     pub max_penumbra: f32,
 }
