@@ -24,11 +24,12 @@ fn texel_world_size_at(layer: u32, distance: f32) -> f32 {
 // A texel's size along the map's x and y axes over `texel_world_size_at`'s, the
 // larger of the two. A sun's map fitted to a window wider than it is tall (the
 // receivers under a low sun: long across the light, short along it) has texels
-// shorter along y; a search or a filter measured in the larger texel alone spans only part
-// of its world radius along the shorter axis (on `grazing` under a 2° sun, the fading
-// tip of the box's shadow: the refinement's search kept PCSS's umbra, and PCSS's
-// penumbra was half as wide as the truth's). Spot maps have square texels; a warped map's
-// are measured as their largest extent (`local_texel_world_size`), so taken square.
+// shorter along y; a search or a filter measured in the larger texel alone spans
+// only part of its world radius along the shorter axis (on `grazing` under a 2° sun,
+// the fading tip of the box's shadow: the refinement's search kept PCSS's umbra, and
+// PCSS's penumbra was half as wide as the truth's). Spot maps have square texels; a
+// warped map's are measured as their largest extent (`local_texel_world_size`), so
+// taken square.
 fn texel_shape(layer: u32) -> vec2<f32> {
     if light.cascades[layer].warped != 0u {
         return vec2<f32>(1.0);

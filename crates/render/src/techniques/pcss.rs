@@ -28,9 +28,9 @@ impl ShadowTechnique for Pcss {
         Tunables::BIAS
     }
 
-    /// The largest penumbra radius it may filter with.
+    /// The farther of its two reaches: the blocker search's cap and the penumbra's.
     fn filter_reach_texels(&self, s: &FilterSettings, _: f32) -> f32 {
-        s.pcss.max_penumbra
+        s.pcss.max_radius.max(s.pcss.max_penumbra)
     }
 
     fn wgsl(&self) -> &'static [&'static str] {
@@ -43,5 +43,21 @@ impl ShadowTechnique for Pcss {
 
     fn cube_wgsl(&self) -> Option<&'static [&'static str]> {
         Some(&[include_str!("pcss_cube.wgsl")])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A virtual map asks for the pages as far as the reach: the blocker search's
+    /// taps and the filter's both read there, whichever cap is the larger.
+    #[test]
+    fn the_reach_covers_the_search_and_the_filter() {
+        let mut f = FilterSettings::default();
+        for (search, penumbra, reach) in [(48.0, 16.0, 48.0), (16.0, 48.0, 48.0), (32.0, 32.0, 32.0)] {
+            (f.pcss.max_radius, f.pcss.max_penumbra) = (search, penumbra);
+            assert_eq!(Pcss.filter_reach_texels(&f, 3.0), reach, "search {search}, penumbra {penumbra}");
+        }
     }
 }
