@@ -47,6 +47,8 @@ fn main() -> anyhow::Result<()> {
         reach_texels: PCF2X2_REACH_TEXELS,
         // Only refinement under a sun with an angular size searches its cone.
         area_search: None,
+        // Only PCSS reads the sun's cone in coarser levels.
+        cone: None,
     };
     // The farthest pixel the camera can see: at the scene's farthest corner.
     let bounds = scene.bounds();

@@ -124,6 +124,24 @@ pub struct AreaSearch {
     pub cap_texels: f32,
 }
 
+/// A lookup that reads the sun's cone from its receiver in coarser levels, as PCSS's
+/// blocker search and filter do on a virtual map: a cone `c` world units wide at the
+/// near plane is read in the levels from the pixel's own up to the one whose texels
+/// it spans in at most `level_cap_texels` ([`Clipmap::search_level`]), and in each of
+/// them as many texels as it spans there, at most `reach_cap_texels` and at least
+/// one ([`Clipmap::cone_requests`]). So a wide penumbra is read as a mip chain is,
+/// in a level where it spans a bounded number of texels, however fine the pixel's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConeReach {
+    /// The tangent of the sun's angular radius.
+    pub cone_tan: f32,
+    /// The most texels of its level the coarsest read spans: the smaller of the
+    /// lookup's caps (PCSS's search's and its filter's).
+    pub level_cap_texels: f32,
+    /// The most texels of any level a read reaches: the larger of the caps.
+    pub reach_cap_texels: f32,
+}
+
 /// Where the refinement's search over a sun's cone reads for one pixel
 /// ([`Clipmap::search_square`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -302,7 +320,7 @@ impl Clipmap {
         reach_texels: f32,
     ) -> SearchSquare {
         let light = self.light_from_world.transform_point3(point);
-        let cone = search.cone_tan * (-light.z - self.near).max(0.0);
+        let cone = self.cone_radius(point, search.cone_tan);
         let read = self.search_level(level, cone, search.cap_texels);
         let texel = self.texel_size(read);
         let radius = (cone / texel).clamp(1.0, search.cap_texels);
@@ -350,6 +368,41 @@ impl Clipmap {
                 self.page_at(square.level, square.centre)?;
                 let half = Vec2::splat(square.reach);
                 self.pages_over(square.level, square.centre - half, square.centre + half)
+            })
+            .collect()
+    }
+
+    /// The cone's radius at the near plane from world point `point`, world units:
+    /// `cone_tan` times the point's distance behind the plane.
+    pub fn cone_radius(&self, point: Vec3, cone_tan: f32) -> f32 {
+        let light = self.light_from_world.transform_point3(point);
+        cone_tan * (-light.z - self.near).max(0.0)
+    }
+
+    /// The pages a lookup of `cone` reads for a pixel of `level` at world point
+    /// `point` whose own lookup reaches `reach_texels` (its normal offset, its
+    /// bilinear taps) in each level's texels: a rectangle in each level from `level`
+    /// to the coarsest `cone` reads, over the square of as many texels as the cone
+    /// spans there (at most [`ConeReach::reach_cap_texels`], at least one), a texel
+    /// more for the taps' rounding, and the lookup's reach. Nothing in a level whose
+    /// window does not hold the point.
+    pub fn cone_requests(
+        &self,
+        point: Vec3,
+        level: u32,
+        cone: ConeReach,
+        reach_texels: f32,
+    ) -> Vec<PageRect> {
+        let radius = self.cone_radius(point, cone.cone_tan);
+        let coarsest = self.search_level(level, radius, cone.level_cap_texels);
+        let centre = self.light_xy(point);
+        (level..=coarsest)
+            .filter_map(|l| {
+                self.page_at(l, centre)?;
+                let texel = self.texel_size(l);
+                let spans = (radius / texel).clamp(1.0, cone.reach_cap_texels);
+                let half = Vec2::splat((spans + 1.0 + reach_texels) * texel);
+                self.pages_over(l, centre - half, centre + half)
             })
             .collect()
     }

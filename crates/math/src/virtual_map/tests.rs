@@ -295,3 +295,51 @@ fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
     }
     assert!(finer > 100, "{finer} finer grids");
 }
+
+/// A cone's requests hold every texel that PCSS's two reads over it touch: its blocker
+/// search over the whole cone, in the level where the cone spans at most the smaller
+/// cap, and its filter over any penumbra narrower than the cone, in the level where
+/// that penumbra spans at most the larger cap (`pcss_virtual.wgsl`); and they ask for
+/// no level coarser than the search's.
+#[test]
+fn cone_requests_hold_the_search_and_every_narrower_filter() {
+    let map = clipmap(Vec3::new(2.0, 5.0, 3.0));
+    let cone = ConeReach { cone_tan: 0.05, level_cap_texels: 32.0, reach_cap_texels: 64.0 };
+    let reach = 2.0;
+    let mut rng = Lcg(31);
+    let mut coarser = 0;
+    for _ in 0..500 {
+        let point = Vec3::new(rng.range(-20.0, 20.0), rng.range(0.0, 10.0), rng.range(-15.0, 15.0));
+        let level = (rng.next() * 4.0) as u32;
+        let rects = map.cone_requests(point, level, cone, reach);
+        let radius = map.cone_radius(point, cone.cone_tan);
+        let search = map.search_level(level, radius, cone.level_cap_texels);
+        coarser += usize::from(search > level);
+        assert!(rects.iter().all(|r| (level..=search).contains(&r.level)), "{point}: {rects:?}");
+        let centre = map.light_xy(point);
+        let holds = |l: u32, texels: f32| {
+            let Some(page) = map.page_at(l, centre) else { return };
+            let rect = rects.iter().find(|r| r.level == l).expect("a rectangle for each level read");
+            assert!(rect.contains(page));
+            let half = (texels + reach) * map.texel_size(l);
+            for corner in
+                [Vec2::new(-1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0), Vec2::new(1.0, -1.0)]
+            {
+                let xy = centre + corner * half;
+                let page = map.page_at(l, xy);
+                assert!(page.is_none_or(|p| rect.contains(p)), "{point}: {xy} outside {rect:?}");
+            }
+        };
+        // The search's taps: the cone in its level's texels, clamped as the shader does.
+        let texel = map.texel_size(search);
+        holds(search, (radius / texel).clamp(1.0, cone.level_cap_texels) + 1.0);
+        for _ in 0..8 {
+            let penumbra = radius * rng.next();
+            let filter = map.search_level(level, penumbra, cone.reach_cap_texels);
+            assert!(filter <= search, "{point}: a filter in {filter}, the search in {search}");
+            let texel = map.texel_size(filter);
+            holds(filter, (penumbra / texel).clamp(0.5, cone.reach_cap_texels) + 1.0);
+        }
+    }
+    assert!(coarser > 100, "{coarser} cones read a coarser level");
+}

@@ -165,16 +165,18 @@ fn edge_levels(mask_path: bool, refine: Refine, shadow: &gnomon_scene::settings:
     }
 }
 
-/// Texels of its level that a technique's filter reaches on a virtual map beyond its
-/// bilinear tap ([`techniques::ShadowTechnique::filter_reach_texels`]): a kernel in
-/// world units is as many texels as the finest level makes it, at most
+/// How far a technique's lookup reads on a virtual map beyond its bilinear tap
+/// ([`techniques::ShadowTechnique::virtual_reach`]): a kernel in world units is as many texels as the finest level makes it, at most
 /// `MAX_KERNEL_TEXELS` (the shader's clamp, `virtual_kernel_width_texels`).
-fn virtual_filter_reach(technique: techniques::TechniqueRef, filter: &FilterSettings) -> f32 {
+fn virtual_filter_reach(
+    technique: techniques::TechniqueRef,
+    filter: &FilterSettings,
+) -> techniques::VirtualReach {
     let kernel = match filter.kernel_unit {
         KernelUnit::Texels => filter.pcf_kernel,
         KernelUnit::World => MAX_KERNEL_TEXELS,
     };
-    technique.filter_reach_texels(filter, kernel)
+    technique.virtual_reach(filter, kernel)
 }
 
 /// The refinement's search over a virtual sun's cone, which its page requests ask
@@ -256,7 +258,7 @@ impl Renderer {
                     let light = VirtualLight {
                         index,
                         edge_levels: edge_levels(mask_path, refine, shadow),
-                        filter_reach_texels: virtual_filter_reach(technique, &shadow.filter),
+                        reach: virtual_filter_reach(technique, &shadow.filter),
                         area_search: virtual_area_search(refine, &r.light, &shadow.filter),
                     };
                     Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, light).await?)

@@ -25,9 +25,10 @@ use gnomon_scene::{Camera, Light, Settings, lights::ShadowView, settings::BiasSe
 use super::Renderer;
 use crate::{
     GpuScene, RenderError,
+    techniques::VirtualReach,
     virtual_map::{
-        AreaSearch, CameraDepth, EdgeFeedback, EdgeRequests, PageRequestParams, PageRequests, PixelReach,
-        PoolSize, VirtualMapGpu, VirtualPages,
+        AreaSearch, CameraDepth, ConeReach, EdgeFeedback, EdgeRequests, PageRequestParams, PageRequests,
+        PixelReach, PoolSize, VirtualMapGpu, VirtualPages,
     },
 };
 
@@ -126,8 +127,8 @@ pub(super) struct VirtualLight {
     /// Levels finer than the footprint's that its pages along shadow edges may be;
     /// 0 where the frame lists no traced pixels.
     pub edge_levels: u32,
-    /// Texels its technique's filter reaches beyond the bilinear tap.
-    pub filter_reach_texels: f32,
+    /// How far its technique's lookup reads.
+    pub reach: VirtualReach,
     /// The refinement's search over a sun's cone, where rays refine its penumbrae.
     pub area_search: Option<AreaSearch>,
 }
@@ -195,7 +196,7 @@ impl Renderer {
         light: &Light,
         settings: &Settings,
         camera: &Camera,
-        VirtualLight { index, edge_levels, filter_reach_texels, area_search }: VirtualLight,
+        VirtualLight { index, edge_levels, reach, area_search }: VirtualLight,
     ) -> Result<VirtualPlan, RenderError> {
         let ShadowView::Parallel { travel } = light.shadow_view() else {
             unreachable!("the technique registry refuses a virtual map for a light other than a sun")
@@ -217,10 +218,25 @@ impl Renderer {
         };
         let clipmap =
             Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
+        let (filter_reach_texels, cone) = match reach {
+            VirtualReach::Texels(texels) => (texels, None),
+            // A search over a cone reaches at least a texel round the receiver, even
+            // where the sun has no size and its cone none.
+            VirtualReach::Cone { level_cap, reach_cap } => {
+                let cone_tan = light.emission().area.size();
+                let cone = (cone_tan > 0.0).then_some(ConeReach {
+                    cone_tan,
+                    level_cap_texels: level_cap,
+                    reach_cap_texels: reach_cap,
+                });
+                (1.0, cone)
+            }
+        };
         let reach = PixelReach {
             footprint_per_depth,
             reach_texels: LOOKUP_REACH_TEXELS + filter_reach_texels + settings.shadow.bias.normal_offset,
             area_search,
+            cone,
         };
         let clip_from_world = camera.clip_from_world(aspect);
         let depth = gpu.checked("drawing the camera's depth for a virtual map's pages", || {

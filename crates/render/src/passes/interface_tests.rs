@@ -92,7 +92,8 @@ fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
         struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
             light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
-            page_texels, width, height, edge_levels, area_cone_tan, area_cap_texels, near,
+            page_texels, width, height, edge_levels, area_cone_tan, area_cap_texels, near, cone_tan,
+            cone_level_cap_texels, cone_reach_cap_texels, _pad0,
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
             light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,

@@ -104,6 +104,25 @@ impl MapSupport {
     pub const LINEAR_DEPTH: MapSupport = MapSupport { paraboloid: false, warped: false, clamped_depth: true };
 }
 
+/// How far a technique's lookup on a virtual map reads
+/// ([`ShadowTechnique::virtual_reach`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VirtualReach {
+    /// Texels of the pixel's own level round its texel (beyond the bilinear
+    /// footprint).
+    Texels(f32),
+    /// The sun's cone from the receiver, read in the levels from the pixel's own up
+    /// to the one whose texels the cone spans in at most `level_cap` texels, and in
+    /// each as many texels as it spans there, at most `reach_cap`
+    /// ([`gnomon_math::virtual_map::ConeReach`]).
+    Cone {
+        /// The most texels of its level the coarsest read spans.
+        level_cap: f32,
+        /// The most texels of any level a read reaches.
+        reach_cap: f32,
+    },
+}
+
 /// The settings that move where a technique puts its shadow edges: what
 /// `gnomon calibrate` may sweep for it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -174,6 +193,13 @@ pub trait ShadowTechnique: Sync {
     /// (beyond the bilinear footprint): a sample-fitted cascade keeps this margin
     /// around its samples. `kernel_texels` is the PCF kernel's width in texels.
     fn filter_reach_texels(&self, settings: &FilterSettings, kernel_texels: f32) -> f32;
+    /// How far its lookup on a sun's virtual map reads (which pages each pixel asks
+    /// for): the filter's reach in the pixel's own level
+    /// ([`ShadowTechnique::filter_reach_texels`]), unless it reads the sun's cone in
+    /// coarser levels, as PCSS does.
+    fn virtual_reach(&self, settings: &FilterSettings, kernel_texels: f32) -> VirtualReach {
+        VirtualReach::Texels(self.filter_reach_texels(settings, kernel_texels))
+    }
     /// The settings that move its shadow edges.
     fn tunables(&self) -> Tunables;
     /// The filterable map the technique samples, if any.

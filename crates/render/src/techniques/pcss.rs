@@ -4,7 +4,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique, Tunables};
+use super::{MapSupport, ShadowTechnique, Tunables, VirtualReach};
 
 pub struct Pcss;
 
@@ -33,6 +33,14 @@ impl ShadowTechnique for Pcss {
         s.pcss.max_radius.max(s.pcss.max_penumbra)
     }
 
+    /// On a virtual map its blocker search reads the cone in the level where it
+    /// spans at most the search's cap, and its filter a penumbra in the level where
+    /// it spans at most the filter's (pcss_virtual.wgsl).
+    fn virtual_reach(&self, s: &FilterSettings, _: f32) -> VirtualReach {
+        let (search, filter) = (s.pcss.max_radius, s.pcss.max_penumbra);
+        VirtualReach::Cone { level_cap: search.min(filter), reach_cap: search.max(filter) }
+    }
+
     fn wgsl(&self) -> &'static [&'static str] {
         &[include_str!("pcss.wgsl")]
     }
@@ -50,14 +58,24 @@ impl ShadowTechnique for Pcss {
 mod tests {
     use super::*;
 
-    /// A virtual map asks for the pages as far as the reach: the blocker search's
-    /// taps and the filter's both read there, whichever cap is the larger.
+    /// A sample-fitted cascade keeps a margin as wide as the reach: the blocker
+    /// search's taps and the filter's both read there, whichever cap is the larger.
+    /// On a virtual map each reads the sun's cone in the level where it spans at most
+    /// its cap: the coarsest level read is the smaller cap's, and no read reaches
+    /// further than the larger cap.
     #[test]
     fn the_reach_covers_the_search_and_the_filter() {
         let mut f = FilterSettings::default();
-        for (search, penumbra, reach) in [(48.0, 16.0, 48.0), (16.0, 48.0, 48.0), (32.0, 32.0, 32.0)] {
+        for (search, penumbra, reach, smaller) in
+            [(48.0, 16.0, 48.0, 16.0), (16.0, 48.0, 48.0, 16.0), (32.0, 32.0, 32.0, 32.0)]
+        {
             (f.pcss.max_radius, f.pcss.max_penumbra) = (search, penumbra);
             assert_eq!(Pcss.filter_reach_texels(&f, 3.0), reach, "search {search}, penumbra {penumbra}");
+            assert_eq!(
+                Pcss.virtual_reach(&f, 3.0),
+                VirtualReach::Cone { level_cap: smaller, reach_cap: reach },
+                "search {search}, penumbra {penumbra}"
+            );
         }
     }
 }

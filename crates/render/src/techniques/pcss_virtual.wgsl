@@ -1,38 +1,57 @@
 // pcss on a virtual map: pcss.wgsl's three steps (Fernando 2005) for a sun, with
-// every tap through the page table, in texels of the level the pixel reads (whose
-// size is the same everywhere: the map is orthographic):
+// every tap through the page table. Each step reads the level where its width spans
+// at most its cap, as a mip chain is read: the pixel's own level, or a coarser one
+// where the cone or the penumbra is wider than the cap in the pixel's texels (whose
+// size is the same everywhere in a level: the map is orthographic). So a wide sun's
+// search sees its whole cone and a wide penumbra is not clipped, however fine the
+// pixel's level; its page requests ask for those levels (`request_cone`,
+// page_requests.wgsl).
 // 1. the blocker search over the cone from the receiver to the sun's disk at the
-//    map's near plane, each tap the stored depth of its texel;
+//    map's near plane, each tap the stored depth of its texel, in the level where
+//    the cone spans at most `max_search_texels`;
 // 2. the penumbra's radius from the blockers' mean distance (`emitter_penumbra_radius`);
-// 3. a Poisson disk of bilinear taps that wide.
+// 3. a Poisson disk of bilinear taps that wide, in the level where it spans at most
+//    `max_penumbra_texels`.
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::common::disk_rotation;
-import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson};
+import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson, virtual_query_in_level};
 import package::variant::POISSON_DISK;
-import package::virtual_map::page_lookup::virtual_texel_depth;
+import package::virtual_map::page_lookup::{virtual_search_level, virtual_texel_depth};
+
+// The blockers among `light.pcss.blocker_taps` taps of a Poisson disk `radius` texels
+// wide round the query: the sum of their distances along the light's axis in x, their
+// count in y.
+fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> vec2<f32> {
+    let rotation = disk_rotation(q.pixel);
+    var found = vec2<f32>(0.0);
+    for (var i = 0u; i < light.pcss.blocker_taps; i++) {
+        let offset = rotation * POISSON_DISK[i] * radius;
+        let stored = virtual_texel_depth(q.level, vec2<i32>(floor(q.texels + offset)));
+        if stored < q.depth + dot(q.gradient, offset) {
+            found += vec2<f32>(virtual_distance(stored), 1.0);
+        }
+    }
+    return found;
+}
 
 fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     let max_search = light.pcss.max_search_texels;
     let max_penumbra = light.pcss.max_penumbra_texels;
     let d_receiver = virtual_distance(q.depth);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, virtual_distance(0.0));
-    let search = clamp(search_world / q.texel_world, 1.0, max_search);
-    let rotation = disk_rotation(q.pixel);
-    var blocker_sum = 0.0;
-    var blockers = 0.0;
-    for (var i = 0u; i < light.pcss.blocker_taps; i++) {
-        let offset = rotation * POISSON_DISK[i] * search;
-        let stored = virtual_texel_depth(q.level, vec2<i32>(floor(q.texels + offset)));
-        if stored < q.depth + dot(q.gradient, offset) {
-            blocker_sum += virtual_distance(stored);
-            blockers += 1.0;
-        }
+    let s = virtual_query_in_level(q, virtual_search_level(q.level, search_world, max_search));
+    var found = pcss_virtual_blockers(s, clamp(search_world / s.texel_world, 1.0, max_search));
+    if s.level > q.level {
+        // A coarser level's texels sample a thin caster (a post, a branch) at too few
+        // points to be found: the pixel's own level is searched too, as far as its cap.
+        found += pcss_virtual_blockers(q, max_search);
     }
-    if blockers == 0.0 {
+    if found.y == 0.0 {
         return 1.0;
     }
-    let d_blocker = blocker_sum / blockers;
+    let d_blocker = found.x / found.y;
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
-    return virtual_pcf_poisson(q, clamp(penumbra_world / q.texel_world, 0.5, max_penumbra), light.pcf.poisson_taps);
+    let f = virtual_query_in_level(q, virtual_search_level(q.level, penumbra_world, max_penumbra));
+    return virtual_pcf_poisson(f, clamp(penumbra_world / f.texel_world, 0.5, max_penumbra), light.pcf.poisson_taps);
 }

@@ -28,7 +28,23 @@ struct VirtualQuery {
     // The receiver plane's change of depth per texel, for receiver-plane depth bias;
     // zero without it.
     gradient: vec2<f32>,
+    // The normal offset's shift of the receiver's point at `level`'s texel, in light
+    // space: x and y in world units, z in the map's depth. A coarser level's offset
+    // is as many of its own texels, so 2^k times this shift (`virtual_query_in_level`).
+    offset: vec3<f32>,
 };
+
+// The same lookup in `level`, the query's own or a coarser one: the receiver pushed
+// by that level's normal offset, in its texels, its plane's slope per texel of it.
+// A filter wider than its cap in the query's level reads it there, as a mip chain
+// is read (pcss_virtual.wgsl).
+fn virtual_query_in_level(q: VirtualQuery, level: u32) -> VirtualQuery {
+    let scale = exp2(f32(level - q.level));
+    let texel = q.texel_world * scale;
+    let further = q.offset * (scale - 1.0);
+    let texels = (q.texels * q.texel_world + further.xy) / texel;
+    return VirtualQuery(texels, q.depth + further.z, level, texel, q.pixel, q.gradient * scale, q.offset * scale);
+}
 
 // The distance along the light's axis of a point of stored depth `depth` (the
 // virtual map's depth is linear between its own near and far planes).

@@ -23,7 +23,7 @@ pub use probe::VirtualProbe;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
-pub use gnomon_math::virtual_map::AreaSearch;
+pub use gnomon_math::virtual_map::{AreaSearch, ConeReach};
 use gnomon_math::virtual_map::{Clipmap, MAX_LEVELS, PageKey};
 
 use crate::{
@@ -60,6 +60,15 @@ pub(crate) struct PageRequestParams {
     /// Distance along the light's axis of the clipmap's depth-0 plane, where the
     /// search's cone is measured.
     pub near: f32,
+    /// Under a technique that reads the sun's cone in coarser levels (PCSS): the
+    /// tangent of the sun's angular radius ([`ConeReach::cone_tan`]); 0 asks for no
+    /// cone's pages.
+    pub cone_tan: f32,
+    /// [`ConeReach::level_cap_texels`].
+    pub cone_level_cap_texels: f32,
+    /// [`ConeReach::reach_cap_texels`].
+    pub cone_reach_cap_texels: f32,
+    pub _pad0: u32,
 }
 
 impl PageRequestParams {
@@ -81,6 +90,10 @@ impl PageRequestParams {
             area_cone_tan: reach.area_search.map_or(0.0, |a| a.cone_tan),
             area_cap_texels: reach.area_search.map_or(0.0, |a| a.cap_texels),
             near: clipmap.near,
+            cone_tan: reach.cone.map_or(0.0, |c| c.cone_tan),
+            cone_level_cap_texels: reach.cone.map_or(0.0, |c| c.level_cap_texels),
+            cone_reach_cap_texels: reach.cone.map_or(0.0, |c| c.reach_cap_texels),
+            _pad0: 0,
         }
     }
 }
@@ -160,6 +173,10 @@ pub struct PixelReach {
     /// the refinement's footprint test over the sun's cone (`virtual_area_unsure`,
     /// refine_virtual.wgsl), whose pages each pixel asks for too.
     pub area_search: Option<AreaSearch>,
+    /// Under a technique that reads the sun's cone in coarser levels (PCSS), that
+    /// cone, whose pages each pixel asks for in every level it may read
+    /// ([`gnomon_math::virtual_map::Clipmap::cone_requests`]).
+    pub cone: Option<ConeReach>,
 }
 
 /// The page-request pipeline, and the pass that unprojects a camera depth prepass

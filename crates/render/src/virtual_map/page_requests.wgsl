@@ -30,6 +30,14 @@ struct PageRequestParams {
     area_cone_tan: f32,
     area_cap_texels: f32,
     near: f32,
+    // Under a technique that reads the sun's cone in coarser levels (PCSS): the
+    // tangent of the sun's angular radius (0: none), the texels of its level the
+    // coarsest read spans at most, and the most texels of any level a read reaches
+    // (`ConeReach`).
+    cone_tan: f32,
+    cone_level_cap_texels: f32,
+    cone_reach_cap_texels: f32,
+    _pad0: u32,
 }
 
 // The prepass's surface: the world point in xyz, its view depth in w (0: no surface).
@@ -125,6 +133,23 @@ fn request_area_search(world: vec3<f32>, level: u32) {
     }
 }
 
+// Marks the pages a lookup that reads the sun's cone in coarser levels (PCSS,
+// pcss_virtual.wgsl) reads for a pixel of `level` at world point `world`: in each
+// level from `level` to the one whose texels the cone spans in at most the level cap,
+// as many texels as the cone spans there (at most the reach cap, at least one), a
+// texel more for the taps' rounding, and the lookup's own reach
+// (`Clipmap::cone_requests`).
+fn request_cone(world: vec3<f32>, level: u32) {
+    let distance = -(request_params.light_from_world * vec4<f32>(world, 1.0)).z;
+    let cone = request_params.cone_tan * max(distance - request_params.near, 0.0);
+    let coarsest = search_level(level, cone, request_params.cone_level_cap_texels);
+    for (var l = level; l <= coarsest; l++) {
+        let texel = request_params.finest_texel * exp2(f32(l));
+        let spans = clamp(cone / texel, 1.0, request_params.cone_reach_cap_texels);
+        request_level_pages(world, l, spans + 1.0 + request_params.reach_texels);
+    }
+}
+
 @compute @workgroup_size(8, 8)
 fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= request_params.width || id.y >= request_params.height) {
@@ -139,6 +164,9 @@ fn request_pages(@builtin(global_invocation_id) id: vec3<u32>) {
         request_level_pages(surface.xyz, level, request_params.reach_texels);
         if request_params.area_cone_tan > 0.0 {
             request_area_search(surface.xyz, level);
+        }
+        if request_params.cone_tan > 0.0 {
+            request_cone(surface.xyz, level);
         }
     }
 }

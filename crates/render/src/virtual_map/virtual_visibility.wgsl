@@ -96,7 +96,8 @@ fn virtual_lookup_visibility(
     let light_point = virtual_light_point(point);
     let texel = virtual_texel_size(level);
     let gradient = virtual_receiver_gradient(world_dx, world_dy, texel);
-    let q = VirtualQuery(light_point.xy / texel, light_point.z, level, texel, pixel, gradient);
+    let offset = light_point - virtual_light_point(world);
+    let q = VirtualQuery(light_point.xy / texel, light_point.z, level, texel, pixel, gradient, offset);
     let visibility = sample_shadow_virtual(q);
     var code = level;
     if camera.debug_view == DEBUG_VIEW_PAGES {

@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use glam::{Vec2, Vec3, Vec4};
 use gnomon_math::{
     Aabb,
-    virtual_map::{Clipmap, ClipmapShape, PageKey},
+    virtual_map::{Clipmap, ClipmapShape, ConeReach, PageKey},
 };
 use gnomon_render::virtual_map::{AreaSearch, PageRequests, PixelReach};
 
@@ -35,10 +35,10 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
     // Unreal's levels, and levels of 1024² read at texels 8× finer than the pixels,
     // whose windows leave many of the points to coarser levels
     // (`Clipmap::level_for_point`).
-    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, None);
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, Searches::NONE);
     assert_eq!(asked.fell_back, 0);
     let small = ClipmapShape { virtual_resolution: 1024, ..ClipmapShape::DEFAULT };
-    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125, None).fell_back;
+    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125, Searches::NONE).fell_back;
     assert!(fell_back > 500, "{fell_back} points read a coarser level than their footprint's");
 }
 
@@ -49,26 +49,53 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
 #[test]
 fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
     let search = AreaSearch { cone_tan: 5f32.to_radians().tan(), cap_texels: 32.0 };
-    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, Some(search));
+    let searches = Searches { area: Some(search), cone: None };
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
     // 16 measured: the coarser levels' pages round the points whose cone is widest.
     assert!(asked.search_only >= 10, "{} pages only the search asks for", asked.search_only);
+}
+
+/// Under PCSS on a sun 10° wide, each pixel also asks for the pages its blocker
+/// search and its filter may read over the sun's cone, in every level from its own
+/// to the one whose texels the cone spans in at most the search's cap
+/// (`Clipmap::cone_requests`).
+#[test]
+fn the_gpu_asks_for_the_pages_of_pcss_over_a_wide_suns_cone() {
+    let cone =
+        ConeReach { cone_tan: 5f32.to_radians().tan(), level_cap_texels: 32.0, reach_cap_texels: 64.0 };
+    let searches = Searches { area: None, cone: Some(cone) };
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
+    assert!(asked.search_only >= 10, "{} pages only the cone asks for", asked.search_only);
+}
+
+/// The searches over a sun's cone whose pages a pixel also asks for.
+#[derive(Clone, Copy)]
+struct Searches {
+    /// The refinement's footprint test's.
+    area: Option<AreaSearch>,
+    /// PCSS's, in coarser levels.
+    cone: Option<ConeReach>,
+}
+
+impl Searches {
+    const NONE: Searches = Searches { area: None, cone: None };
 }
 
 /// What the requests of [`asks_for_exactly_the_pages_the_clipmap_names`] held.
 struct Asked {
     /// Points that read a coarser level than their footprint's.
     fell_back: usize,
-    /// Pages that only the search over a sun's cone asked for.
+    /// Pages that only the searches over a sun's cone asked for.
     search_only: usize,
 }
 
 /// Checks the GPU's requests against the clipmap's for surfaces whose footprint is
-/// `footprint_scale` times a 240-pixel-high camera's, and the pages of `search` over
-/// a sun's cone.
+/// `footprint_scale` times a 240-pixel-high camera's, and the pages of `searches`
+/// over a sun's cone.
 fn asks_for_exactly_the_pages_the_clipmap_names(
     shape: ClipmapShape,
     footprint_scale: f32,
-    search: Option<AreaSearch>,
+    searches: Searches,
 ) -> Asked {
     let gpu = gpu();
     let camera = Vec3::new(2.0, 6.0, 9.0);
@@ -78,7 +105,8 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
     let reach = PixelReach {
         footprint_per_depth: footprint_scale * 2.0 * (30f32.to_radians()).tan() / 240.0,
         reach_texels: 2.5,
-        area_search: search,
+        area_search: searches.area,
+        cone: searches.cone,
     };
     let travel = Vec3::new(-0.4, -1.0, 0.3);
     let clipmap = Clipmap::new(shape, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
@@ -108,9 +136,12 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         });
         let ambiguous = near_grid((footprint / clipmap.finest_texel).log2(), 1e-3)
             || on_window_edge
-            || search.is_some_and(|search| {
+            || searches.area.is_some_and(|search| {
                 search_is_ambiguous(&clipmap, point, level, search, reach.reach_texels)
             })
+            || searches
+                .cone
+                .is_some_and(|cone| cone_is_ambiguous(&clipmap, point, level, cone, reach.reach_texels))
             || [xy - Vec2::splat(spread), xy, xy + Vec2::splat(spread)]
                 .iter()
                 .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3));
@@ -123,12 +154,40 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
             expected.extend(rect.pages());
         }
-        if let Some(search) = search {
+        if let Some(search) = searches.area {
             for rect in clipmap.search_requests(point, level, search, reach.reach_texels) {
                 searched_pages.extend(rect.pages());
             }
         }
+        if let Some(cone) = searches.cone {
+            for rect in clipmap.cone_requests(point, level, cone, reach.reach_texels) {
+                searched_pages.extend(rect.pages());
+            }
+        }
     }
+    let surface = surface_texture(gpu, &texels, width, height);
+    let mut requests = PageRequests::new(gpu).expect("the pass builds");
+    let asked: Vec<PageKey> =
+        pollster::block_on(requests.request(gpu, &surface, &clipmap, reach)).expect("requested");
+    let asked: BTreeSet<PageKey> = asked.into_iter().collect();
+    let search_only = searched_pages.difference(&expected).count();
+    expected.extend(searched_pages);
+    let levels: BTreeSet<u32> = expected.iter().map(|p| p.level).collect();
+    assert!(expected.len() > 100 && levels.len() >= 4, "{} pages over levels {levels:?}", expected.len());
+    let missing: Vec<_> = expected.difference(&asked).take(5).collect();
+    let extra: Vec<_> = asked.difference(&expected).take(5).collect();
+    assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
+    Asked { fell_back, search_only }
+}
+
+/// The prepass's surface as the request pass reads it: `texels` (world point, view
+/// depth) in a `width`×`height` texture.
+fn surface_texture(
+    gpu: &gnomon_render::Gpu,
+    texels: &[Vec4],
+    width: u32,
+    height: u32,
+) -> gnomon_render::wgpu::Texture {
     let surface = gpu.device.create_texture(&gnomon_render::wgpu::TextureDescriptor {
         label: Some("test surface"),
         size: gnomon_render::wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -142,7 +201,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
     });
     gpu.queue.write_texture(
         surface.as_image_copy(),
-        bytemuck::cast_slice(&texels),
+        bytemuck::cast_slice(texels),
         gnomon_render::wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(16 * width),
@@ -150,18 +209,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         },
         surface.size(),
     );
-    let mut requests = PageRequests::new(gpu).expect("the pass builds");
-    let asked: Vec<PageKey> =
-        pollster::block_on(requests.request(gpu, &surface, &clipmap, reach)).expect("requested");
-    let asked: BTreeSet<PageKey> = asked.into_iter().collect();
-    let search_only = searched_pages.difference(&expected).count();
-    expected.extend(searched_pages);
-    let levels: BTreeSet<u32> = expected.iter().map(|p| p.level).collect();
-    assert!(expected.len() > 100 && levels.len() >= 4, "{} pages over levels {levels:?}", expected.len());
-    let missing: Vec<_> = expected.difference(&asked).take(5).collect();
-    let extra: Vec<_> = asked.difference(&expected).take(5).collect();
-    assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
-    Asked { fell_back, search_only }
+    surface
 }
 
 /// Whether the search's pages for a pixel of `level` at `point` lie where the GPU's
@@ -179,6 +227,25 @@ fn search_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, search: AreaS
             [xy - spread, xy, xy + spread]
                 .iter()
                 .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
+        })
+}
+
+/// Whether the cone's pages for a pixel of `level` at `point` lie where the GPU's
+/// rounding and the CPU's may differ: the boundary of its coarsest level, the cone's
+/// span in a level's texels where the cap clamps it, its squares' page edges.
+fn cone_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, cone: ConeReach, reach: f32) -> bool {
+    let radius = clipmap.cone_radius(point, cone.cone_tan);
+    let coarsest = clipmap.search_level(level, radius, cone.level_cap_texels);
+    let xy = clipmap.light_xy(point);
+    near_grid((radius / (clipmap.texel_size(level) * cone.level_cap_texels)).log2(), 1e-3)
+        || (level..=coarsest).any(|l| {
+            let texel = clipmap.texel_size(l);
+            let spans = (radius / texel).clamp(1.0, cone.reach_cap_texels);
+            let (page, spread) = (clipmap.page_size(l), Vec2::splat((spans + 1.0 + reach) * texel));
+            near_grid(spans, 1e-3)
+                || [xy - spread, xy, xy + spread]
+                    .iter()
+                    .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
         })
 }
 

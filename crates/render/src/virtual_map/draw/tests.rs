@@ -48,6 +48,7 @@ fn setup() -> Setup {
         footprint_per_depth: 2.0 * (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() / 128.0,
         reach_texels: 2.0,
         area_search: None,
+        cone: None,
     };
     let travel = Vec3::new(0.3, -1.0, 0.2);
     let bounds = scene.bounds();
