@@ -11,10 +11,11 @@
 //    the cone spans at most `max_search_texels`;
 // 2. the penumbra's radius from the blockers' mean distance (`emitter_penumbra_radius`);
 // 3. a Poisson disk of bilinear taps that wide, in the level where it spans at most
-//    `max_penumbra_texels`.
+//    `max_penumbra_texels` and where the receiver's plane may be trusted that far
+//    (`pcss_virtual_filter_level`).
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
-import package::techniques::common::disk_rotation;
+import package::techniques::common::{MAX_RECEIVER_SLOPE_PER_TEXEL, disk_rotation};
 import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson, virtual_query_in_level};
 import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::{virtual_search_level, virtual_texel_depth};
@@ -35,9 +36,24 @@ fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> vec2<f32> {
     return found;
 }
 
+// The level the filter reads a penumbra `radius` world units wide in: the one where it
+// spans at most `max_penumbra_texels`, but no coarser than where the receiver's plane
+// changes depth by more than MAX_RECEIVER_SLOPE_PER_TEXEL a texel. Its taps compare
+// depths along that plane (receiver-plane bias), which a surface edge-on to the sun
+// does not follow so far from the pixel: the wider filter let light leak onto such
+// walls (Sponza, 960×540, 3° sun: all-pixel MAE 0.0205 before coarser levels,
+// 0.0242 with them unbounded, 0.0213 so bounded).
+fn pcss_virtual_filter_level(q: VirtualQuery, radius: f32) -> u32 {
+    var level = virtual_search_level(q.level, radius, light.pcss.max_penumbra_texels);
+    let slope = length(q.gradient);
+    while level > q.level && slope * exp2(f32(level - q.level)) > MAX_RECEIVER_SLOPE_PER_TEXEL {
+        level--;
+    }
+    return level;
+}
+
 fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     let max_search = light.pcss.max_search_texels;
-    let max_penumbra = light.pcss.max_penumbra_texels;
     let d_receiver = virtual_distance(q.depth);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, virtual_distance(0.0));
     let s = virtual_query_in_level(q, virtual_search_level(q.level, search_world, max_search));
@@ -52,6 +68,7 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     }
     let d_blocker = found.x / found.y;
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
-    let f = virtual_query_in_level(q, virtual_search_level(q.level, penumbra_world, max_penumbra));
-    return virtual_pcf_poisson(f, clamp(penumbra_world / f.texel_world, 0.5, max_penumbra), light.pcf.poisson_taps);
+    let f = virtual_query_in_level(q, pcss_virtual_filter_level(q, penumbra_world));
+    let radius = clamp(penumbra_world / f.texel_world, 0.5, light.pcss.max_penumbra_texels);
+    return virtual_pcf_poisson(f, radius, light.pcf.poisson_taps);
 }
