@@ -166,9 +166,10 @@ fn edge_levels(mask_path: bool, refine: Refine, shadow: &gnomon_scene::settings:
 }
 
 /// How far a technique's lookup reads on a virtual map beyond its bilinear tap
-/// ([`techniques::ShadowTechnique::virtual_reach`]): a kernel in world units is as many texels as the finest level makes it, at most
-/// `MAX_KERNEL_TEXELS` (the shader's clamp, `virtual_kernel_width_texels`).
-fn virtual_filter_reach(
+/// ([`techniques::ShadowTechnique::virtual_reach`]): a kernel in world units is as
+/// many texels as the finest level makes it, at most `MAX_KERNEL_TEXELS` (the
+/// shader's clamp, `virtual_kernel_width_texels`).
+fn virtual_lookup_reach(
     technique: techniques::TechniqueRef,
     filter: &FilterSettings,
 ) -> techniques::VirtualReach {
@@ -258,7 +259,7 @@ impl Renderer {
                     let light = VirtualLight {
                         index,
                         edge_levels: edge_levels(mask_path, refine, shadow),
-                        reach: virtual_filter_reach(technique, &shadow.filter),
+                        reach: virtual_lookup_reach(technique, &shadow.filter),
                         area_search: virtual_area_search(refine, &r.light, &shadow.filter),
                     };
                     Some(self.plan_virtual(uploaded, &r.light, &light_settings, &camera, light).await?)

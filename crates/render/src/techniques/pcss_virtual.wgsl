@@ -20,17 +20,24 @@ import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virt
 import package::variant::POISSON_DISK;
 import package::virtual_map::page_lookup::{virtual_search_level, virtual_texel_depth};
 
+// What a blocker search found: the sum of its blockers' distances along the light's
+// axis, and how many there were.
+struct PcssBlockers {
+    distance_sum: f32,
+    count: f32,
+}
+
 // The blockers among `light.pcss.blocker_taps` taps of a Poisson disk `radius` texels
-// wide round the query: the sum of their distances along the light's axis in x, their
-// count in y.
-fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> vec2<f32> {
+// wide round the query.
+fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> PcssBlockers {
     let rotation = disk_rotation(q.pixel);
-    var found = vec2<f32>(0.0);
+    var found = PcssBlockers(0.0, 0.0);
     for (var i = 0u; i < light.pcss.blocker_taps; i++) {
         let offset = rotation * POISSON_DISK[i] * radius;
         let stored = virtual_texel_depth(q.level, vec2<i32>(floor(q.texels + offset)));
         if stored < q.depth + dot(q.gradient, offset) {
-            found += vec2<f32>(virtual_distance(stored), 1.0);
+            found.distance_sum += virtual_distance(stored);
+            found.count += 1.0;
         }
     }
     return found;
@@ -61,12 +68,13 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     if s.level > q.level {
         // A coarser level's texels sample a thin caster (a post, a branch) at too few
         // points to be found: the pixel's own level is searched too, as far as its cap.
-        found += pcss_virtual_blockers(q, max_search);
+        let own = pcss_virtual_blockers(q, max_search);
+        found = PcssBlockers(found.distance_sum + own.distance_sum, found.count + own.count);
     }
-    if found.y == 0.0 {
+    if found.count == 0.0 {
         return 1.0;
     }
-    let d_blocker = found.x / found.y;
+    let d_blocker = found.distance_sum / found.count;
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
     let f = virtual_query_in_level(q, pcss_virtual_filter_level(q, penumbra_world));
     let radius = clamp(penumbra_world / f.texel_world, 0.5, light.pcss.max_penumbra_texels);
