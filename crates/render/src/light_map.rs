@@ -19,26 +19,28 @@ pub(crate) enum MapLookup {
     Cube,
     /// Through a point light's dual paraboloids, into two 2D layers.
     Paraboloid,
-    /// Through a sun's virtual map: the clipmap level of the receiver's footprint,
-    /// its page found in the page table (`virtual_map/page_lookup.wgsl`).
+    /// Through a sun's or a spot's virtual map: the clipmap level of the receiver's
+    /// footprint, its page found in the page table (`virtual_map/page_lookup.wgsl`).
     Virtual,
 }
 
 impl MapLookup {
     /// The map `light` draws under `shadow`: `shadow.map.omni` for an
-    /// omnidirectional view, `shadow.partition` for a sun's (a virtual partition of
-    /// any other light is refused by the technique registry's `check_light`).
+    /// omnidirectional view, `shadow.partition` for a sun's or a spot's (a virtual
+    /// partition of a point light is refused by the technique registry's
+    /// `check_light`).
     pub fn of(light: &Light, shadow: &ShadowSettings) -> MapLookup {
         match (light.shadow_view(), shadow.map.omni, shadow.partition) {
             (ShadowView::Omni { .. }, OmniMap::Cube, _) => MapLookup::Cube,
             (ShadowView::Omni { .. }, OmniMap::Paraboloid, _) => MapLookup::Paraboloid,
-            (ShadowView::Parallel { .. }, _, Partition::Virtual) => MapLookup::Virtual,
+            (ShadowView::Parallel { .. } | ShadowView::Frustum { .. }, _, Partition::Virtual) => {
+                MapLookup::Virtual
+            }
             (
-                ShadowView::Parallel { .. },
+                ShadowView::Parallel { .. } | ShadowView::Frustum { .. },
                 OmniMap::Cube | OmniMap::Paraboloid,
                 Partition::Single | Partition::Cascades,
-            )
-            | (ShadowView::Frustum { .. }, OmniMap::Cube | OmniMap::Paraboloid, _) => MapLookup::Map,
+            ) => MapLookup::Map,
         }
     }
 }

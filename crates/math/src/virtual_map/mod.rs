@@ -1,4 +1,5 @@
-//! Virtual shadow maps for a sun: the clipmap's geometry and the pages a pixel needs.
+//! Virtual shadow maps for a sun or a spot: the clipmap's geometry and the pages a
+//! pixel needs.
 //!
 //! A virtual map replaces the few large textures of cascades with a clipmap of
 //! *virtual* levels around the camera, each [`ClipmapShape::virtual_resolution`]²
@@ -9,25 +10,34 @@
 //! SIGGRAPH 1998) the way Unreal Engine 5's virtual shadow maps are.
 //!
 //! The geometry here is what the GPU passes and the page pool ([`pages`]) share:
-//! - Every level looks along the light with the same rigid `light_from_world`, so a
-//!   distance in light space is a distance in the world.
+//! - Every level projects the world into one *map space* ([`MapProjection`]): x and y
+//!   in map units, and the depth the map stores. A sun's is orthographic along its rigid
+//!   `light_from_world`, so its map units are world units; a spot's is its perspective
+//!   frustum, so its map units are its normalized device coordinates and a texel's
+//!   world size grows with the distance from the light ([`Clipmap::world_per_map`]).
+//!   Either way a plane in the world stays a plane in map space, so depth is affine
+//!   in texels over a receiver's plane.
 //! - Level `l`'s texels are `2^l` times level 0's, and level 0's are a power of two in
-//!   world units. Pages are anchored at the light-space origin, not at the camera, so a
+//!   map units. Pages are anchored at the map-space origin, not at the camera, so a
 //!   page keeps its place in the world as the camera moves: a kept page stays valid,
 //!   and the page of level `l + 1` over a point is the page of level `l` over it with
 //!   its coordinates halved ([`PageKey::coarser`]).
-//! - Each level's window of `pages_per_side`² pages is centred on the camera, snapped
-//!   to whole pages.
+//! - A sun's level windows of `pages_per_side`² pages are centred on the camera,
+//!   snapped to whole pages ([`Clipmap::new`]). A spot's are fixed on its axis, level
+//!   0's over its whole frustum: a mip chain ([`Clipmap::spot`]).
 //! - A pixel asks for the finest level whose texels are no smaller than its footprint
 //!   (about one texel per pixel), and for every page its filter and normal offset may
 //!   reach ([`Clipmap::request`]).
 
+mod map_space;
 pub mod pages;
 pub mod runs;
 
+pub use map_space::MapProjection;
+
 use glam::{IVec2, Mat4, Vec2, Vec3};
 
-use crate::{Aabb, LightProjection, projection::view_from_world_look_at};
+use crate::{Aabb, LightProjection, ProjectionKind, projection::view_from_world_look_at};
 
 /// The size of a virtual map: how many texels each level has and how they are paged.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -111,30 +121,30 @@ impl PageRect {
     }
 }
 
-/// The refinement's search over a sun's cone from a receiver (its footprint test's,
-/// under a sun with an angular size whose penumbrae rays refine): the cone's radius
-/// is `cone_tan` times the receiver's distance behind the map's near plane, read in
-/// the level whose texels it spans in at most `cap_texels`
-/// ([`Clipmap::search_level`]).
+/// The refinement's search over the cone from a receiver to the light's area (its
+/// footprint test's, under a light with a size whose penumbrae rays refine): the
+/// cone's radius at the map's near plane ([`Clipmap::cone_radius`]), read in the
+/// level whose texels it spans in at most `cap_texels` ([`Clipmap::search_level`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AreaSearch {
-    /// The tangent of the sun's angular radius.
-    pub cone_tan: f32,
+    /// The light's size: the tangent of a sun's angular radius, a spot's disk's
+    /// radius in world units.
+    pub light_size: f32,
     /// PCSS's `shadow.filter.pcss.max_radius`: the most texels the search spans.
     pub cap_texels: f32,
 }
 
-/// A lookup that reads the sun's cone from its receiver in coarser levels, as PCSS's
-/// blocker search and filter do on a virtual map: a cone `c` world units wide at the
-/// near plane is read in the levels from the pixel's own up to the one whose texels
+/// A lookup that reads the cone from its receiver to the light's area in coarser
+/// levels, as PCSS's blocker search and filter do on a virtual map: a cone `c` map
+/// units wide at the near plane ([`Clipmap::cone_radius`]) is read in the levels from the pixel's own up to the one whose texels
 /// it spans in at most `level_cap_texels` ([`Clipmap::search_level`]), and in each of
 /// them as many texels as it spans there, at most `reach_cap_texels` and at least
 /// one ([`Clipmap::cone_requests`]). So a wide penumbra is read as a mip chain is,
 /// in a level where it spans a bounded number of texels, however fine the pixel's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConeReach {
-    /// The tangent of the sun's angular radius.
-    pub cone_tan: f32,
+    /// The light's size, as [`AreaSearch::light_size`].
+    pub light_size: f32,
     /// The most texels of its level the coarsest read spans: the smaller of the
     /// lookup's caps (PCSS's search's and its filter's).
     pub level_cap_texels: f32,
@@ -148,29 +158,32 @@ pub struct ConeReach {
 pub struct SearchSquare {
     /// The level it reads.
     pub level: u32,
-    /// The pixel's light-space point, x and y: the square's centre.
+    /// The pixel's map-space point, x and y: the square's centre.
     pub centre: Vec2,
-    /// The cone's radius at the near plane, world units.
+    /// The cone's radius at the near plane, map units.
     pub cone: f32,
-    /// The square's half-width, world units.
+    /// The square's half-width, map units.
     pub reach: f32,
 }
 
-/// One frame's clipmap for a sun: where each level lies, and its depth range.
+/// One frame's clipmap for a sun or a spot: where each level lies, and its depth range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
     /// Its levels' size and paging.
     pub shape: ClipmapShape,
-    /// World to the light's view space: a rotation only, looking along the light's
-    /// travel (−z), so that light-space x and y are world units.
+    /// World to the light's view space: rigid, looking along the light's travel
+    /// (−z), so that light-space distances are world units.
     pub light_from_world: Mat4,
-    /// World size of one texel of level 0, a power of two; level `l`'s is `2^l` times it.
+    /// How the light's view space projects into map space.
+    pub projection: MapProjection,
+    /// Map-space size of one texel of level 0, a power of two; level `l`'s is `2^l`
+    /// times it.
     pub finest_texel: f32,
     /// Each level's first page: the level covers pages `origin .. origin +
     /// pages_per_side` in x and y.
     pub origins: Vec<IVec2>,
-    /// Distance along the light's view axis of the depth-0 plane: in front of the
-    /// whole scene, so that every caster of a page is drawn.
+    /// Distance along the light's view axis of the depth-0 plane: in front of every
+    /// caster a page may draw (a sun's: the whole scene).
     pub near: f32,
     /// Distance along the light's view axis of the depth-1 plane: behind the scene.
     pub far: f32,
@@ -209,20 +222,46 @@ impl Clipmap {
         // Light space looks down −z: the nearest point has the largest z.
         let margin = 1e-3 * in_light.extent().z.max(1e-6);
         let (near, far) = (-in_light.max.z - margin, -in_light.min.z + margin);
-        Clipmap { shape, light_from_world, finest_texel, origins, near, far }
+        let projection = MapProjection::Orthographic;
+        Clipmap { shape, light_from_world, projection, finest_texel, origins, near, far }
     }
 
-    /// World size of a texel of `level`.
+    /// The clipmap of a spot looking along `-z` of `light_from_world` (rigid) through a
+    /// square frustum whose half-angle has tangent `tan_half_fov`, from `near` to `far`
+    /// along its axis: a mip chain in its normalized device coordinates. Level 0's
+    /// window is the whole frustum, `[−1, 1]²` in `virtual_resolution`² texels, and
+    /// each coarser level halves the texels over it, down to 2 × 2 pages (the windows
+    /// stay centred on the axis); its windows are fixed, so no move of the camera
+    /// invalidates a page. `shape.levels` is cut to those levels
+    /// (`log2(pages_per_side)`, at least 1). A pixel reads the level whose texels,
+    /// which grow with the distance from the light, match its footprint.
+    pub fn spot(
+        shape: ClipmapShape,
+        light_from_world: Mat4,
+        tan_half_fov: f32,
+        near: f32,
+        far: f32,
+    ) -> Clipmap {
+        let chain = shape.pages_per_side().max(2).ilog2();
+        let shape = ClipmapShape { levels: shape.levels.min(chain), ..shape };
+        let finest_texel = 2.0 / shape.virtual_resolution as f32;
+        let half = (shape.pages_per_side() / 2) as i32;
+        let origins = vec![IVec2::splat(-half); shape.levels as usize];
+        let projection = MapProjection::Perspective { tan_half_fov };
+        Clipmap { shape, light_from_world, projection, finest_texel, origins, near, far }
+    }
+
+    /// Map-space size of a texel of `level`.
     pub fn texel_size(&self, level: u32) -> f32 {
         self.finest_texel * 2f32.powi(level as i32)
     }
 
-    /// World size of a page of `level`.
+    /// Map-space size of a page of `level`.
     pub fn page_size(&self, level: u32) -> f32 {
         page_world_size(self.shape, self.finest_texel, level)
     }
 
-    /// The level a pixel whose footprint is `footprint` world units reads: the
+    /// The level a pixel whose footprint is `footprint` map units reads: the
     /// coarsest whose texels are no larger than the footprint (level 0 where even
     /// its texels are larger, the coarsest level where every level's are smaller).
     pub fn level_for_footprint(&self, footprint: f32) -> u32 {
@@ -231,11 +270,6 @@ impl Clipmap {
             return 0;
         }
         (ratio.log2().floor() as u32).min(self.shape.levels.saturating_sub(1))
-    }
-
-    /// A world point's place in light space, x and y.
-    pub fn light_xy(&self, world: Vec3) -> Vec2 {
-        self.light_from_world.transform_point3(world).truncate()
     }
 
     /// The page of `level` over the light-space point `xy`, if it lies in the level's
@@ -268,15 +302,30 @@ impl Clipmap {
     }
 
     /// The pages of `level` that a caster within `bounds` can write: those over its
-    /// light-space shadow, the rectangle its corners cover seen from the light. A
-    /// caster that moves dirties these pages where it was and where it is.
+    /// shadow in map space, the rectangle its corners cover seen from the light (for
+    /// a spot, the whole window where a corner lies before its near plane, where the
+    /// projection stops bounding it). A caster that moves dirties these pages where
+    /// it was and where it is.
     pub fn pages_under(&self, level: u32, bounds: &Aabb) -> Option<PageRect> {
         let in_light = bounds.transformed(self.light_from_world);
-        self.pages_over(level, in_light.min.truncate(), in_light.max.truncate())
+        match self.projection {
+            MapProjection::Orthographic => {
+                self.pages_over(level, in_light.min.truncate(), in_light.max.truncate())
+            }
+            MapProjection::Perspective { .. } if -in_light.max.z < self.near => {
+                Some(self.level_window(level))
+            }
+            MapProjection::Perspective { .. } => {
+                let corners = bounds.corners().map(|c| self.map_xy(c));
+                let low = corners.iter().copied().fold(Vec2::INFINITY, Vec2::min);
+                let high = corners.iter().copied().fold(Vec2::NEG_INFINITY, Vec2::max);
+                self.pages_over(level, low, high)
+            }
+        }
     }
 
-    /// The level a pixel at light-space point `xy` whose footprint is `footprint`
-    /// world units reads: its footprint's ([`Clipmap::level_for_footprint`]), or the
+    /// The level a pixel at map-space point `xy` whose footprint is `footprint`
+    /// map units reads: its footprint's ([`Clipmap::level_for_footprint`]), or the
     /// finest coarser level whose window holds the point. A level's window is
     /// `virtual_resolution` of its texels wide around the camera: a pixel far to the
     /// side of a small one reads a coarser level, as in a clipmap's outer rings. None
@@ -290,15 +339,19 @@ impl Clipmap {
     /// world units reads, through a filter that reaches `reach_texels` texels of its
     /// level from the point (the kernel's radius, the normal offset's, a texel for
     /// bilinear taps): the rectangle of pages of its level ([`Clipmap::level_for_point`])
-    /// over that square. Nothing for a point outside every level's window.
+    /// over that square. Nothing for a point outside every level's window, or that the
+    /// map does not see ([`Clipmap::sees`]).
     pub fn request(&self, point: Vec3, footprint: f32, reach_texels: f32) -> Option<PageRect> {
-        let xy = self.light_xy(point);
-        let level = self.level_for_point(xy, footprint)?;
+        if !self.sees(point) {
+            return None;
+        }
+        let xy = self.map_xy(point);
+        let level = self.level_for_point(xy, self.map_footprint(point, footprint))?;
         let reach = reach_texels * self.texel_size(level);
         self.pages_over(level, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
     }
 
-    /// The level in whose texels a search `radius` world units wide round a pixel of
+    /// The level in whose texels a search `radius` map units wide round a pixel of
     /// `level` spans at most `cap_texels`: `level`, or as many levels coarser as it
     /// takes, up to the coarsest.
     pub fn search_level(&self, level: u32, radius: f32, cap_texels: f32) -> u32 {
@@ -319,13 +372,12 @@ impl Clipmap {
         search: AreaSearch,
         reach_texels: f32,
     ) -> SearchSquare {
-        let light = self.light_from_world.transform_point3(point);
-        let cone = self.cone_radius(point, search.cone_tan);
+        let cone = self.cone_radius(point, search.light_size);
         let read = self.search_level(level, cone, search.cap_texels);
         let texel = self.texel_size(read);
         let radius = (cone / texel).clamp(1.0, search.cap_texels);
         let reach = (radius + 1.0 + reach_texels / 2f32.powi((read - level) as i32)) * texel;
-        SearchSquare { level: read, centre: light.truncate(), cone, reach }
+        SearchSquare { level: read, centre: self.map_xy(point), cone, reach }
     }
 
     /// The squares of the finer levels' grids that the same search also reads
@@ -372,13 +424,6 @@ impl Clipmap {
             .collect()
     }
 
-    /// The cone's radius at the near plane from world point `point`, world units:
-    /// `cone_tan` times the point's distance behind the plane.
-    pub fn cone_radius(&self, point: Vec3, cone_tan: f32) -> f32 {
-        let light = self.light_from_world.transform_point3(point);
-        cone_tan * (-light.z - self.near).max(0.0)
-    }
-
     /// The pages a lookup of `cone` reads for a pixel of `level` at world point
     /// `point` whose own lookup reaches `reach_texels` (its normal offset, its
     /// bilinear taps) in each level's texels: a rectangle in each level from `level`
@@ -393,9 +438,9 @@ impl Clipmap {
         cone: ConeReach,
         reach_texels: f32,
     ) -> Vec<PageRect> {
-        let radius = self.cone_radius(point, cone.cone_tan);
+        let radius = self.cone_radius(point, cone.light_size);
         let coarsest = self.search_level(level, radius, cone.level_cap_texels);
-        let centre = self.light_xy(point);
+        let centre = self.map_xy(point);
         (level..=coarsest)
             .filter_map(|l| {
                 self.page_at(l, centre)?;
@@ -407,8 +452,8 @@ impl Clipmap {
             .collect()
     }
 
-    /// World to the clip space of page `page` alone: the orthographic projection of
-    /// its light-space window over the clipmap's depth range, which a page's depth
+    /// World to the clip space of page `page` alone: the projection of its map-space
+    /// window over the clipmap's depth range, which a page's depth
     /// pass draws with into its physical page.
     pub fn page_clip_from_world(&self, page: PageKey) -> Mat4 {
         self.run_clip_from_world(page, 1)
@@ -434,14 +479,40 @@ impl Clipmap {
         self.rect_projection(rect).clip_from_world()
     }
 
-    /// The orthographic projection of the pages of `rect` over the clipmap's depth
-    /// range. Page `(x, y)` of it covers its columns `(x − min.x) · page_size …` and,
-    /// v down, its rows `(max.y − y) · page_size …`.
+    /// The projection of the pages of `rect` over the clipmap's depth range: a sun's
+    /// orthographic one of their light-space window; a spot's perspective, followed by
+    /// the scale and offset of their window in its normalized device coordinates onto
+    /// [−1, 1]². Page `(x, y)` of it covers its columns `(x − min.x) · page_size …`
+    /// and, v down, its rows `(max.y − y) · page_size …`.
     pub fn rect_projection(&self, rect: &PageRect) -> LightProjection {
         let size = self.page_size(rect.level);
         let (left, bottom) = (rect.min.x as f32 * size, rect.min.y as f32 * size);
         let (right, top) = ((rect.max.x + 1) as f32 * size, (rect.max.y + 1) as f32 * size);
-        LightProjection::orthographic(self.light_from_world, (left, right, bottom, top), self.near, self.far)
+        let MapProjection::Perspective { tan_half_fov } = self.projection else {
+            return LightProjection::orthographic(
+                self.light_from_world,
+                (left, right, bottom, top),
+                self.near,
+                self.far,
+            );
+        };
+        // Map x in left..right to −1..1: scale by 2 / width, centre on the window's.
+        let (width, height) = (right - left, top - bottom);
+        let window_from_map = Mat4::from_cols(
+            glam::Vec4::new(2.0 / width, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 2.0 / height, 0.0, 0.0),
+            glam::Vec4::Z,
+            glam::Vec4::new(-(left + right) / width, -(bottom + top) / height, 0.0, 1.0),
+        );
+        LightProjection {
+            light_from_world: self.light_from_world,
+            clip_from_light: window_from_map * self.map_from_light(),
+            // A texel's world size, 2 d tan(fov / 2) / resolution, is the window's
+            // width over its texels at distance d.
+            kind: ProjectionKind::Perspective { fov: 2.0 * (tan_half_fov * 0.5 * width.max(height)).atan() },
+            near: self.near,
+            far: self.far,
+        }
     }
 
     /// World to the clip space of `level`'s whole window ([`Clipmap::level_window`]):
@@ -459,3 +530,6 @@ fn page_world_size(shape: ClipmapShape, finest_texel: f32, level: u32) -> f32 {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod spot_tests;

@@ -41,7 +41,7 @@ fn the_coarsest_level_covers_the_scene_and_each_level_halves_the_texel() {
     // Every corner of the scene lies in the coarsest level's window.
     let coarsest = shape.levels - 1;
     for corner in scene().corners() {
-        assert!(map.page_at(coarsest, map.light_xy(corner)).is_some(), "{corner}");
+        assert!(map.page_at(coarsest, map.map_xy(corner)).is_some(), "{corner}");
     }
     // The depth range holds the whole scene.
     for corner in scene().corners() {
@@ -80,7 +80,7 @@ fn the_window_follows_the_camera_by_whole_pages_and_stays_centred() {
     for level in 0..before.shape.levels {
         let size = after.page_size(level);
         // The camera's page is the window's centre page.
-        let centre = (after.light_xy(Vec3::new(3.0, 0.0, 1.0)) / size).floor().as_ivec2();
+        let centre = (after.map_xy(Vec3::new(3.0, 0.0, 1.0)) / size).floor().as_ivec2();
         assert_eq!(centre - after.origins[level as usize], IVec2::splat(half), "level {level}");
         // A page keeps its world place: its projection depends on its key alone.
         let key = PageKey { level, x: 2, y: -1 };
@@ -115,7 +115,7 @@ fn a_request_covers_every_texel_the_filter_reaches() {
         let rect = map.request(point, footprint, reach).expect("the point lies in its level's window");
         let level = map.level_for_footprint(footprint);
         assert_eq!(rect.level, level);
-        let xy = map.light_xy(point);
+        let xy = map.map_xy(point);
         let step = map.texel_size(level) * reach;
         for (dx, dy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (0.0, 0.0)] {
             let tap = xy + Vec2::new(dx, dy) * step;
@@ -215,13 +215,13 @@ fn a_point_outside_its_levels_window_reads_the_finest_coarser_level_that_holds_i
     let bounds = Aabb::new(Vec3::splat(-500.0), Vec3::splat(500.0));
     let map = Clipmap::new(shape, Vec3::NEG_Y, Vec3::ZERO, &bounds, 64.0);
     let footprint = map.texel_size(1);
-    let near = map.light_xy(Vec3::new(1.0, 0.0, 1.0));
+    let near = map.map_xy(Vec3::new(1.0, 0.0, 1.0));
     assert_eq!(map.level_for_point(near, footprint), Some(1));
     // Level 1's window is 1024 of its texels wide around the camera: a point beyond
     // it reads the first level whose window reaches it, and asks for that level's pages.
     let half_window = |level: u32| 512.0 * map.texel_size(level);
     let far_point = Vec3::new(1.5 * half_window(1), 0.0, 0.0);
-    let xy = map.light_xy(far_point);
+    let xy = map.map_xy(far_point);
     let level = map.level_for_point(xy, footprint).expect("a coarser window holds it");
     assert!(level > 1 && map.page_at(level, xy).is_some() && map.page_at(level - 1, xy).is_none(), "{level}");
     let rect = map.request(far_point, footprint, 2.0).expect("pages asked for");
@@ -259,14 +259,14 @@ fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
     }
     assert!(coarser > 500, "{coarser} searches read a coarser level");
 
-    let search = AreaSearch { cone_tan: 0.1, cap_texels: 16.0 };
+    let search = AreaSearch { light_size: 0.1, cap_texels: 16.0 };
     let mut finer = 0;
     for _ in 0..500 {
         let point = Vec3::new(rng.range(-20.0, 20.0), rng.range(0.0, 10.0), rng.range(-15.0, 15.0));
         let level = (rng.next() * 4.0) as u32;
         let rects = map.search_requests(point, level, search, 2.0);
         let light = map.light_from_world.transform_point3(point);
-        let cone = search.cone_tan * (-light.z - map.near).max(0.0);
+        let cone = search.light_size * (-light.z - map.near).max(0.0);
         let read = map.search_level(level, cone, search.cap_texels);
         // The cone, clamped to the cap at the coarsest level; and the cap's texels
         // round the point in each of the (at most) AREA_SEARCH_FINER_LEVELS finer
@@ -304,7 +304,7 @@ fn the_cone_search_reads_the_finest_level_that_spans_it_and_covers_it() {
 #[test]
 fn cone_requests_hold_the_search_and_every_narrower_filter() {
     let map = clipmap(Vec3::new(2.0, 5.0, 3.0));
-    let cone = ConeReach { cone_tan: 0.05, level_cap_texels: 32.0, reach_cap_texels: 64.0 };
+    let cone = ConeReach { light_size: 0.05, level_cap_texels: 32.0, reach_cap_texels: 64.0 };
     let reach = 2.0;
     let mut rng = Lcg(31);
     let mut coarser = 0;
@@ -312,11 +312,11 @@ fn cone_requests_hold_the_search_and_every_narrower_filter() {
         let point = Vec3::new(rng.range(-20.0, 20.0), rng.range(0.0, 10.0), rng.range(-15.0, 15.0));
         let level = (rng.next() * 4.0) as u32;
         let rects = map.cone_requests(point, level, cone, reach);
-        let radius = map.cone_radius(point, cone.cone_tan);
+        let radius = map.cone_radius(point, cone.light_size);
         let search = map.search_level(level, radius, cone.level_cap_texels);
         coarser += usize::from(search > level);
         assert!(rects.iter().all(|r| (level..=search).contains(&r.level)), "{point}: {rects:?}");
-        let centre = map.light_xy(point);
+        let centre = map.map_xy(point);
         let holds = |l: u32, texels: f32| {
             let Some(page) = map.page_at(l, centre) else { return };
             let rect = rects.iter().find(|r| r.level == l).expect("a rectangle for each level read");

@@ -24,3 +24,4 @@ mod refine_soft;
 mod screen_space;
 mod soft_shadows;
 mod virtual_maps;
+mod virtual_spots;

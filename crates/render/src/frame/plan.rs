@@ -189,7 +189,7 @@ fn virtual_area_search(refine: Refine, light: &Light, filter: &FilterSettings) -
         Refine::Off | Refine::EveryPixel => false,
     };
     searched
-        .then(|| AreaSearch { cone_tan: light.emission().area.size(), cap_texels: filter.pcss.max_radius })
+        .then(|| AreaSearch { light_size: light.emission().area.size(), cap_texels: filter.pcss.max_radius })
 }
 
 impl Renderer {

@@ -1,8 +1,8 @@
 //! The frame's own pages (laid out anew, drawn in runs into the pool's layers with
 //! the shadow pass's pipelines, culled per run) hold the depth that a full-resolution
 //! map of their level holds at every texel: the same pass over the bounding rectangle
-//! of the level's pages, drawn whole. On the spheres, and on Sponza where the shared
-//! scenes are present.
+//! of the level's pages, drawn whole. On the spheres under a sun and a spot, and on
+//! Sponza where the shared scenes are present.
 
 use std::collections::BTreeMap;
 
@@ -10,7 +10,7 @@ use glam::IVec2;
 use gnomon_math::virtual_map::{PageKey, PageRect};
 use gnomon_scene::{
     Scene, Settings, builtin,
-    settings::{Partition, Refine},
+    settings::{LightKind, Partition, Refine},
 };
 
 use super::{
@@ -143,6 +143,17 @@ fn virtual_sun(width: u32, height: u32) -> Settings {
 #[test]
 fn the_frames_pages_hold_a_full_resolution_maps_depth_on_the_spheres() {
     let seen = compare_pages(&builtin::spheres(), &virtual_sun(320, 180));
+    assert!(seen.covered > seen.texels / 10, "the pages hold casters: {seen:?}");
+    assert_holds(&seen);
+}
+
+/// A spot's pages: drawn with its perspective projection, each run's window scaled
+/// onto its tiles, as the full map of their level is.
+#[test]
+fn the_frames_pages_hold_a_full_resolution_maps_depth_under_a_spot() {
+    let mut s = virtual_sun(320, 180);
+    s.light.kind = LightKind::Spot;
+    let seen = compare_pages(&builtin::spheres(), &s);
     assert!(seen.covered > seen.texels / 10, "the pages hold casters: {seen:?}");
     assert_holds(&seen);
 }

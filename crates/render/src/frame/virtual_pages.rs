@@ -1,4 +1,4 @@
-//! A sun's virtual shadow map in the frame (`--partition virtual`, issue 53).
+//! A sun's or a spot's virtual shadow map in the frame (`--partition virtual`, issue 53).
 //!
 //! Before recording, [`Renderer::plan_virtual`] draws a depth prepass from the
 //! camera, asks the GPU which pages of the clipmap its pixels read
@@ -14,9 +14,9 @@
 
 use glam::Mat4;
 use gnomon_math::{
-    Aabb,
+    Aabb, spot_light_projection,
     virtual_map::{
-        Clipmap, ClipmapShape, PageKey,
+        Clipmap, ClipmapShape, MapProjection, PageKey,
         runs::{PageRun, runs},
     },
 };
@@ -72,6 +72,7 @@ struct KeptPages {
 #[derive(Clone, Debug, PartialEq)]
 struct DrawnUnder {
     light_from_world: Mat4,
+    projection: MapProjection,
     finest_texel: f32,
     levels: u32,
     near: f32,
@@ -198,9 +199,6 @@ impl Renderer {
         camera: &Camera,
         VirtualLight { index, edge_levels, reach, area_search }: VirtualLight,
     ) -> Result<VirtualPlan, RenderError> {
-        let ShadowView::Parallel { travel } = light.shadow_view() else {
-            unreachable!("the technique registry refuses a virtual map for a light other than a sun")
-        };
         let started = web_time::Instant::now();
         let gpu = self.gpu.clone();
         let (width, height) = (settings.image.width, settings.image.height);
@@ -216,16 +214,27 @@ impl Renderer {
             virtual_resolution: settings.shadow.virtual_map.level_resolution,
             ..ClipmapShape::DEFAULT
         };
-        let clipmap =
-            Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth);
+        let clipmap = match light.shadow_view() {
+            ShadowView::Parallel { travel } => {
+                Clipmap::new(shape, travel, camera.eye, &uploaded.bounds, farthest * footprint_per_depth)
+            }
+            // The spot's 2D map's frustum, paged: the same depths where both have texels.
+            ShadowView::Frustum { position, axis, half_angle, near, far } => {
+                let frustum = spot_light_projection(position, axis, half_angle, near, far);
+                Clipmap::spot(shape, frustum.light_from_world, half_angle.tan(), near, far)
+            }
+            ShadowView::Omni { .. } => {
+                unreachable!("the technique registry refuses a virtual map for a point light")
+            }
+        };
         let (filter_reach_texels, cone) = match reach {
             VirtualReach::Texels(texels) => (texels, None),
             // A search over a cone reaches at least a texel round the receiver, even
             // where the sun has no size and its cone none.
             VirtualReach::Cone { level_cap, reach_cap } => {
-                let cone_tan = light.emission().area.size();
-                let cone = (cone_tan > 0.0).then_some(ConeReach {
-                    cone_tan,
+                let light_size = light.emission().area.size();
+                let cone = (light_size > 0.0).then_some(ConeReach {
+                    light_size,
                     level_cap_texels: level_cap,
                     reach_cap_texels: reach_cap,
                 });
@@ -269,6 +278,7 @@ impl Renderer {
         let kept = self.virtual_lights.kept_for(&gpu, index, size)?;
         let under = DrawnUnder {
             light_from_world: clipmap.light_from_world,
+            projection: clipmap.projection,
             finest_texel: clipmap.finest_texel,
             levels: shape.levels,
             near: clipmap.near,

@@ -90,14 +90,17 @@ fn struct_layouts() -> Vec<StructLayout> {
             world_from_clip, light_from_world, splits, near, far, cascade_count, blend,
         }),
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
+        struct_layout!(crate::virtual_map::MapSpaceGpu as "MapSpace" {
+            light_from_world, near, far, tan_half_fov, perspective,
+        }),
         struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
-            light_from_world, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
-            page_texels, width, height, edge_levels, area_cone_tan, area_cap_texels, near, cone_tan,
-            cone_level_cap_texels, cone_reach_cap_texels, _pad0,
+            map, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
+            page_texels, width, height, edge_levels, area_light_size, area_cap_texels, cone_light_size,
+            cone_level_cap_texels, cone_reach_cap_texels, _pad0, _pad1,
         }),
         struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
-            light_from_world, origins, finest_texel, near, far, levels, pages_per_side, page_texels,
-            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, edge_levels, _pad1, _pad2,
+            map, origins, finest_texel, levels, pages_per_side, page_texels,
+            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, edge_levels,
         }),
         struct_layout!(crate::virtual_map::SurfaceParams as "SurfaceParams" {
             world_from_clip, view_z_from_world, width, height, _pad0, _pad1,

@@ -1,9 +1,10 @@
-// Whether a sun's virtual map is unsure of a pixel: the footprint test of
+// Whether a virtual map is unsure of a pixel: the footprint test of
 // refine_footprint.wgsl (the bilinear 2×2 and a ring of UNSURE_RING_TEXELS texels,
 // each stored depth against the receiver's plane there) on the level the pixel read,
-// each texel found through the page table. The map is orthographic, so the plane's
-// depth is affine in texels, with the slope the receiver's normal gives it in light
-// space.
+// each texel found through the page table. A plane stays a plane in map space
+// (orthographic for a sun, perspective for a spot: map_space.wgsl), so the plane's
+// depth is affine in texels, with the slope the receiver's normal gives it there
+// (`map_plane_gradient`).
 //
 // A texel that its own level's page does not hold (the pool was full and a coarser
 // page stands in, or no page holds it) says nothing exact: the pixel is unsure and
@@ -17,7 +18,8 @@ import package::constants::{AREA_SEARCH_FINER_LEVELS, TRACED_LAYER_FLAG, UNSURE_
 import package::variant::REFINE_PENUMBRAE;
 import package::passes::light_kinds::emitter_cone_radius;
 import package::rays::refine_map::{AREA_SEARCH_TAPS, AREA_SEARCH_WIDER, ConeSearch, TAP_LIGHT, area_search_spacing, area_search_texel, cone_unsure, search_tap, tap_caster_depth, weigh_caster, wider_look, wider_radius};
-import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_light_point, virtual_map, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
+import package::virtual_map::map_space::{map_distance, map_near_radius, map_plane_gradient, map_radius_at, map_texel_along_ray};
+import package::virtual_map::page_lookup::{VirtualBlock, virtual_block, virtual_exact_tile, virtual_map, virtual_map_point, virtual_search_level, virtual_texel, virtual_texel_size, virtual_tile_gather};
 import package::virtual_map::virtual_visibility::virtual_offset_point;
 
 // The receiver's depth at the four texels of the block from texel (x, y), in
@@ -45,26 +47,23 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     // Past TRACED_LAYER_FLAG: a debug view's flags (virtual_visibility.wgsl).
     let level = layer % TRACED_LAYER_FLAG;
     let texel = virtual_texel_size(level);
-    let depth_range = virtual_map.far - virtual_map.near;
-    let point = virtual_light_point(virtual_offset_point(world, n, l, level));
-    // The plane a·x + b·y + c·z = const in light space (looking down −z, depth
-    // (−z − near) / range): depth changes by (a, b) / c / range per world unit.
-    let plane = (virtual_map.light_from_world * vec4<f32>(geometric_n, 0.0)).xyz;
-    if abs(plane.z) < 1e-6 {
+    let point = virtual_map_point(virtual_offset_point(world, n, l, level)).xyz;
+    let plane = map_plane_gradient(virtual_map.map, world, geometric_n, texel);
+    if plane.z == 0.0 {
         // The receiver is seen edge-on from the light.
         return true;
     }
-    let gradient = plane.xy / plane.z * texel / depth_range;
+    let gradient = plane.xy;
     let slope = abs(gradient.x) + abs(gradient.y);
     // A texel's length along the light's ray, in depth.
-    let along_ray = texel / depth_range;
+    let along_ray = map_texel_along_ray(virtual_map.map, world, texel);
     let margin = UNSURE_DEPTH_TEXELS * along_ray + (light.bias.slope + 1.0) * slope;
     let own_bias = receiver_bias(max(abs(gradient.x), abs(gradient.y)), point.z);
     // Texel (i, j) holds the depth at its centre, continuous position (i, j).
     let p = point.xy / texel - vec2<f32>(0.5);
     let base = vec2<i32>(floor(p));
     // The surface itself, as far behind the lookup's plane as the offset moved it.
-    let surface_point = virtual_light_point(world);
+    let surface_point = virtual_map_point(world).xyz;
     let surface = surface_point.z + dot(gradient, surface_point.xy / texel - vec2<f32>(0.5) - p) - point.z;
     let grazing = dot(geometric_n, l) < UNSURE_GRAZING_COS;
     let bounds = FootprintBounds(0.5 * slope, margin, own_bias, surface, grazing);
@@ -102,7 +101,7 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
     if lit && shadowed {
         return true;
     }
-    let distance = virtual_map.near + surface_point.z * depth_range;
+    let distance = map_distance(virtual_map.map, surface_point.z);
     return REFINE_PENUMBRAE && virtual_area_unsure(p, point.z, gradient, bounds, Evidence(false, lit, shadowed), level, distance);
 }
 
@@ -118,7 +117,7 @@ fn virtual_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l:
 // page_requests.wgsl); a tap its own page does not hold makes the pixel unsure, as
 // in the footprint.
 fn virtual_area_unsure(p: vec2<f32>, receiver: f32, gradient: vec2<f32>, bounds: FootprintBounds, footprint: Evidence, level: u32, distance: f32) -> bool {
-    let cone = emitter_cone_radius(light.emitter, distance, virtual_map.near);
+    let cone = map_near_radius(virtual_map.map, emitter_cone_radius(light.emitter, distance, virtual_map.map.near));
     let cap = light.pcss.max_search_texels;
     let search_level = virtual_search_level(level, cone, cap);
     let receiver_plane = VirtualPlane(p, receiver, gradient, level);
@@ -208,8 +207,8 @@ fn virtual_area_grid(plane: VirtualPlane, radius: f32, bounds: FootprintBounds, 
                 found.evidence.light = true;
                 continue;
             }
-            let at = virtual_map.near + tap_caster_depth(kind, stored.depth, receiver, bounds.margin) * (virtual_map.far - virtual_map.near);
-            let cone_at = emitter_cone_radius(light.emitter, distance, at) / texel;
+            let at = map_distance(virtual_map.map, tap_caster_depth(kind, stored.depth, receiver, bounds.margin));
+            let cone_at = map_radius_at(virtual_map.map, emitter_cone_radius(light.emitter, distance, at), at) / texel;
             if weigh_caster(&found, kind, length(offset) - spacing, cone_at) {
                 return found;
             }

@@ -1,14 +1,14 @@
-// pcss on a virtual map: pcss.wgsl's three steps (Fernando 2005) for a sun, with
-// every tap through the page table. Each step reads the level where its width spans
-// at most its cap, as a mip chain is read: the pixel's own level, or a coarser one
-// where the cone or the penumbra is wider than the cap in the pixel's texels (whose
-// size is the same everywhere in a level: the map is orthographic). So a wide sun's
-// search sees its whole cone and a wide penumbra is not clipped, however fine the
-// pixel's level; its page requests ask for those levels (`request_cone`,
-// page_requests.wgsl).
-// 1. the blocker search over the cone from the receiver to the sun's disk at the
-//    map's near plane, each tap the stored depth of its texel, in the level where
-//    the cone spans at most `max_search_texels`;
+// pcss on a virtual map: pcss.wgsl's three steps (Fernando 2005) for a sun or a
+// spot, with every tap through the page table. Each step reads the level where its
+// width spans at most its cap, as a mip chain is read: the pixel's own level, or a
+// coarser one where the cone or the penumbra is wider than the cap in the pixel's
+// texels. So a wide light's search sees its whole cone and a wide penumbra is not
+// clipped, however fine the pixel's level; its page requests ask for those levels
+// (`request_cone`, page_requests.wgsl).
+// 1. the blocker search over the cone from the receiver to the light's area at the
+//    map's near plane (in map units there, `map_near_radius`), each tap the stored
+//    depth of its texel, in the level where the cone spans at most
+//    `max_search_texels`;
 // 2. the penumbra's radius from the blockers' mean distance (`emitter_penumbra_radius`);
 // 3. a Poisson disk of bilinear taps that wide, in the level where it spans at most
 //    `max_penumbra_texels` and where the receiver's plane may be trusted that far
@@ -18,7 +18,8 @@ import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radi
 import package::techniques::common::{MAX_RECEIVER_SLOPE_PER_TEXEL, disk_rotation};
 import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson, virtual_query_in_level};
 import package::variant::POISSON_DISK;
-import package::virtual_map::page_lookup::{virtual_search_level, virtual_texel_depth};
+import package::virtual_map::map_space::map_near_radius;
+import package::virtual_map::page_lookup::{virtual_map, virtual_search_level, virtual_texel_depth};
 
 // What a blocker search found: the sum of its blockers' distances along the light's
 // axis, and how many there were.
@@ -43,7 +44,7 @@ fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> PcssBlockers {
     return found;
 }
 
-// The level the filter reads a penumbra `radius` world units wide in: the one where it
+// The level the filter reads a penumbra `radius` map units wide in: the one where it
 // spans at most `max_penumbra_texels`, but no coarser than where the receiver's plane
 // changes depth by more than MAX_RECEIVER_SLOPE_PER_TEXEL a texel. Its taps compare
 // depths along that plane (receiver-plane bias), which a surface edge-on to the sun
@@ -63,8 +64,9 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     let max_search = light.pcss.max_search_texels;
     let d_receiver = virtual_distance(q.depth);
     let search_world = emitter_cone_radius(light.emitter, d_receiver, virtual_distance(0.0));
-    let s = virtual_query_in_level(q, virtual_search_level(q.level, search_world, max_search));
-    var found = pcss_virtual_blockers(s, clamp(search_world / s.texel_world, 1.0, max_search));
+    let search = map_near_radius(virtual_map.map, search_world);
+    let s = virtual_query_in_level(q, virtual_search_level(q.level, search, max_search));
+    var found = pcss_virtual_blockers(s, clamp(search / s.texel_map, 1.0, max_search));
     if s.level > q.level {
         // A coarser level's texels sample a thin caster (a post, a branch) at too few
         // points to be found: the pixel's own level is searched too, as far as its cap.
@@ -76,7 +78,9 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     }
     let d_blocker = found.distance_sum / found.count;
     let penumbra_world = emitter_penumbra_radius(light.emitter, max(d_receiver - d_blocker, 0.0), d_blocker);
-    let f = virtual_query_in_level(q, pcss_virtual_filter_level(q, penumbra_world));
+    // World units per map unit at the receiver: 1 for a sun.
+    let world_per_map = q.texel_world / q.texel_map;
+    let f = virtual_query_in_level(q, pcss_virtual_filter_level(q, penumbra_world / world_per_map));
     let radius = clamp(penumbra_world / f.texel_world, 0.5, light.pcss.max_penumbra_texels);
     return virtual_pcf_poisson(f, radius, light.pcf.poisson_taps);
 }

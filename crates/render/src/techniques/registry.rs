@@ -191,19 +191,18 @@ impl TechniqueRegistry {
             value: technique.technique().to_string(),
             valid: format!("for point light `{name}` {map}: {}", self.names(fits)),
         };
-        let virtual_for = |kind: &str| SettingsError {
-            setting: "shadow.partition",
-            value: "virtual".into(),
-            valid: format!("single or cascades for {kind} `{name}`: a virtual map is a sun's so far"),
-        };
         match (light.shadow_view(), shadow.partition) {
-            (ShadowView::Frustum { .. }, Partition::Virtual) => return Err(virtual_for("spot light")),
-            (ShadowView::Omni { .. }, Partition::Virtual) => return Err(virtual_for("point light")),
-            (ShadowView::Parallel { .. }, _)
-            | (
-                ShadowView::Frustum { .. } | ShadowView::Omni { .. },
-                Partition::Single | Partition::Cascades,
-            ) => {}
+            (ShadowView::Omni { .. }, Partition::Virtual) => {
+                return Err(SettingsError {
+                    setting: "shadow.partition",
+                    value: "virtual".into(),
+                    valid: format!(
+                        "single or cascades for point light `{name}`: a virtual map is a sun's or a spot's so far"
+                    ),
+                });
+            }
+            (ShadowView::Parallel { .. } | ShadowView::Frustum { .. }, _)
+            | (ShadowView::Omni { .. }, Partition::Single | Partition::Cascades) => {}
         }
         match MapLookup::of(light, shadow) {
             MapLookup::Cube if technique.cube_wgsl().is_none() => {
@@ -216,7 +215,7 @@ impl TechniqueRegistry {
                 setting: "shadow.filter.technique",
                 value: technique.technique().to_string(),
                 valid: format!(
-                    "for sun `{name}` with `shadow.partition` virtual: {}",
+                    "for light `{name}` with `shadow.partition` virtual: {}",
                     self.names(|t: &TechniqueRef| t.virtual_wgsl().is_some())
                 ),
             }),
@@ -410,7 +409,7 @@ mod tests {
         assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "vsm"));
         assert_eq!(
             e.valid,
-            "for sun `sun` with `shadow.partition` virtual: pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
+            "for light `sun` with `shadow.partition` virtual: pcf2x2, pcf, pcf-tent, pcf-poisson or pcss"
         );
         for t in registry.iter() {
             virtual_sun.filter.technique = t.technique();

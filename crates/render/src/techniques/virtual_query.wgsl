@@ -1,5 +1,5 @@
 // What every technique's `sample_shadow_virtual` receives, and the helpers they
-// share: a sun's virtual map (`--partition virtual`) is read through its page table,
+// share: a virtual map (`--partition virtual`) is read through its page table,
 // each bilinear tap resolving its own page (`virtual_pcf2x2_at`,
 // virtual_map/page_lookup.wgsl), so that a kernel may straddle pages, resident at
 // its level or stood in for by a coarser one. A tap is a point in texels of the
@@ -10,26 +10,30 @@ import package::passes::light_binding::light;
 import package::techniques::common::disk_rotation;
 import package::techniques::pcf::{kernel_grid, kernel_grid_x, kernel_grid_y};
 import package::variant::POISSON_DISK;
+import package::virtual_map::map_space::map_distance;
 import package::virtual_map::page_lookup::{virtual_map, virtual_pcf2x2_at};
 
 // One lookup in a virtual map.
 struct VirtualQuery {
-    // The (offset) receiver in texels of `level` from the light-space origin: texel
+    // The (offset) receiver in texels of `level` from the map-space origin: texel
     // (i, j) spans [i, i + 1) × [j, j + 1).
     texels: vec2<f32>,
     // The receiver's depth as the map stores it (0 at the near plane, 1 at the far).
     depth: f32,
     // The clipmap level the pixel reads.
     level: u32,
-    // World size of one texel of the level.
+    // Map-space size of one texel of the level (map_space.wgsl).
+    texel_map: f32,
+    // World size of one texel of the level at the receiver (a spot's grow with the
+    // distance from it).
     texel_world: f32,
     // Fragment position in pixels, for per-pixel noise.
     pixel: vec2<f32>,
     // The receiver plane's change of depth per texel, for receiver-plane depth bias;
     // zero without it.
     gradient: vec2<f32>,
-    // The normal offset's shift of the receiver's point at `level`'s texel, in light
-    // space: x and y in world units, z in the map's depth. A coarser level's offset
+    // The normal offset's shift of the receiver's point at `level`'s texel, in map
+    // space: x and y in map units, z in the map's depth. A coarser level's offset
     // is as many of its own texels, so 2^k times this shift (`virtual_query_in_level`).
     offset: vec3<f32>,
 };
@@ -40,16 +44,16 @@ struct VirtualQuery {
 // is read (pcss_virtual.wgsl).
 fn virtual_query_in_level(q: VirtualQuery, level: u32) -> VirtualQuery {
     let scale = exp2(f32(level - q.level));
-    let texel = q.texel_world * scale;
+    let texel = q.texel_map * scale;
     let further = q.offset * (scale - 1.0);
-    let texels = (q.texels * q.texel_world + further.xy) / texel;
-    return VirtualQuery(texels, q.depth + further.z, level, texel, q.pixel, q.gradient * scale, q.offset * scale);
+    let texels = (q.texels * q.texel_map + further.xy) / texel;
+    return VirtualQuery(texels, q.depth + further.z, level, texel, q.texel_world * scale, q.pixel, q.gradient * scale, q.offset * scale);
 }
 
-// The distance along the light's axis of a point of stored depth `depth` (the
-// virtual map's depth is linear between its own near and far planes).
+// The distance along the light's axis of a point of stored depth `depth`
+// (`map_distance`).
 fn virtual_distance(depth: f32) -> f32 {
-    return virtual_map.near + depth * (virtual_map.far - virtual_map.near);
+    return map_distance(virtual_map.map, depth);
 }
 
 // One bilinear comparison tap `offset` texels from the lookup, with the compared

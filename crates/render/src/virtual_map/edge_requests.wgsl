@@ -35,12 +35,12 @@ fn request_edge_pages(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num
         }
         // The level the pixel read; past TRACED_LAYER_FLAG, a debug view's flags.
         let read = (entry.layer & 0xffffu) % TRACED_LAYER_FLAG;
-        let footprint = window_level(surface.xyz, footprint_level(surface.w));
+        let footprint = window_level(surface.xyz, footprint_level(surface.xyz, surface.w));
         if read == 0u || read + request_params.edge_levels <= footprint {
             continue;
         }
         request_level_pages(surface.xyz, read - 1u, request_params.reach_texels);
-        if request_params.area_cone_tan > 0.0 {
+        if request_params.area_light_size > 0.0 {
             request_area_search(surface.xyz, read - 1u);
         }
     }

@@ -24,7 +24,7 @@ pub use probe::VirtualProbe;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 pub use gnomon_math::virtual_map::{AreaSearch, ConeReach};
-use gnomon_math::virtual_map::{Clipmap, MAX_LEVELS, PageKey};
+use gnomon_math::virtual_map::{Clipmap, MAX_LEVELS, MapProjection, PageKey};
 
 use crate::{
     Frame, Gpu, RenderError,
@@ -34,11 +34,42 @@ use crate::{
 /// Vectors of two levels' origins in [`PageRequestParams::origins`].
 pub(crate) const ORIGIN_VECTORS: usize = (MAX_LEVELS as usize).div_ceil(2);
 
+/// Where a virtual map's levels lie in the world, as every virtual-map pass reads it
+/// (`MapSpace` in map_space.wgsl; [`gnomon_math::virtual_map::MapProjection`]).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct MapSpaceGpu {
+    pub light_from_world: Mat4,
+    pub near: f32,
+    pub far: f32,
+    /// A spot's frustum's half-angle's tangent; 0 for a sun.
+    pub tan_half_fov: f32,
+    /// 1 for a spot's perspective map space, 0 for a sun's orthographic one.
+    pub perspective: u32,
+}
+
+impl MapSpaceGpu {
+    /// `clipmap`'s map space.
+    pub fn of(clipmap: &Clipmap) -> Self {
+        let (tan_half_fov, perspective) = match clipmap.projection {
+            MapProjection::Orthographic => (0.0, 0),
+            MapProjection::Perspective { tan_half_fov } => (tan_half_fov, 1),
+        };
+        MapSpaceGpu {
+            light_from_world: clipmap.light_from_world,
+            near: clipmap.near,
+            far: clipmap.far,
+            tan_half_fov,
+            perspective,
+        }
+    }
+}
+
 /// The request pass's uniform: see `page_requests.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct PageRequestParams {
-    pub light_from_world: Mat4,
+    pub map: MapSpaceGpu,
     /// Each level's first page, two levels to a vector.
     pub origins: [[i32; 4]; ORIGIN_VECTORS],
     pub finest_texel: f32,
@@ -52,23 +83,20 @@ pub(crate) struct PageRequestParams {
     /// Levels finer than its footprint's that a pixel along a shadow edge may ask
     /// for (`edge_requests.wgsl`; the request pass itself reads no such thing).
     pub edge_levels: u32,
-    /// Under a light with an area whose penumbrae rays refine: the tangent of the
-    /// sun's angular radius ([`AreaSearch::cone_tan`]); 0 asks for no search's pages.
-    pub area_cone_tan: f32,
+    /// Under a light with an area whose penumbrae rays refine: its size
+    /// ([`AreaSearch::light_size`]); 0 asks for no search's pages.
+    pub area_light_size: f32,
     /// The search's cap in texels ([`AreaSearch::cap_texels`]).
     pub area_cap_texels: f32,
-    /// Distance along the light's axis of the clipmap's depth-0 plane, where the
-    /// search's cone is measured.
-    pub near: f32,
-    /// Under a technique that reads the sun's cone in coarser levels (PCSS): the
-    /// tangent of the sun's angular radius ([`ConeReach::cone_tan`]); 0 asks for no
-    /// cone's pages.
-    pub cone_tan: f32,
+    /// Under a technique that reads the light's cone in coarser levels (PCSS): the
+    /// light's size ([`ConeReach::light_size`]); 0 asks for no cone's pages.
+    pub cone_light_size: f32,
     /// [`ConeReach::level_cap_texels`].
     pub cone_level_cap_texels: f32,
     /// [`ConeReach::reach_cap_texels`].
     pub cone_reach_cap_texels: f32,
     pub _pad0: u32,
+    pub _pad1: u32,
 }
 
 impl PageRequestParams {
@@ -76,7 +104,7 @@ impl PageRequestParams {
     /// `reach` into `clipmap`, pages along edges down to `edge_levels` finer.
     pub fn new(clipmap: &Clipmap, reach: PixelReach, size: (u32, u32), edge_levels: u32) -> Self {
         PageRequestParams {
-            light_from_world: clipmap.light_from_world,
+            map: MapSpaceGpu::of(clipmap),
             origins: packed_origins(clipmap),
             finest_texel: clipmap.finest_texel,
             footprint_per_depth: reach.footprint_per_depth,
@@ -87,13 +115,13 @@ impl PageRequestParams {
             width: size.0,
             height: size.1,
             edge_levels,
-            area_cone_tan: reach.area_search.map_or(0.0, |a| a.cone_tan),
+            area_light_size: reach.area_search.map_or(0.0, |a| a.light_size),
             area_cap_texels: reach.area_search.map_or(0.0, |a| a.cap_texels),
-            near: clipmap.near,
-            cone_tan: reach.cone.map_or(0.0, |c| c.cone_tan),
+            cone_light_size: reach.cone.map_or(0.0, |c| c.light_size),
             cone_level_cap_texels: reach.cone.map_or(0.0, |c| c.level_cap_texels),
             cone_reach_cap_texels: reach.cone.map_or(0.0, |c| c.reach_cap_texels),
             _pad0: 0,
+            _pad1: 0,
         }
     }
 }
@@ -103,12 +131,10 @@ impl PageRequestParams {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct VirtualMapGpu {
-    pub light_from_world: Mat4,
+    pub map: MapSpaceGpu,
     /// Each level's first page, two levels to a vector.
     pub origins: [[i32; 4]; ORIGIN_VECTORS],
     pub finest_texel: f32,
-    pub near: f32,
-    pub far: f32,
     pub levels: u32,
     pub pages_per_side: u32,
     pub page_texels: u32,
@@ -121,8 +147,6 @@ pub(crate) struct VirtualMapGpu {
     /// Levels finer than its footprint's a pixel reads where their pages hold its
     /// whole footprint (`virtual_read_level` in virtual_visibility.wgsl).
     pub edge_levels: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
 }
 
 impl VirtualMapGpu {
@@ -131,11 +155,9 @@ impl VirtualMapGpu {
     /// where their pages hold a pixel's footprint.
     pub fn new(clipmap: &Clipmap, pool: PoolSize, footprint_per_depth: f32, edge_levels: u32) -> Self {
         VirtualMapGpu {
-            light_from_world: clipmap.light_from_world,
+            map: MapSpaceGpu::of(clipmap),
             origins: packed_origins(clipmap),
             finest_texel: clipmap.finest_texel,
-            near: clipmap.near,
-            far: clipmap.far,
             levels: clipmap.shape.levels,
             pages_per_side: clipmap.shape.pages_per_side(),
             page_texels: clipmap.shape.page_size,
@@ -143,8 +165,6 @@ impl VirtualMapGpu {
             footprint_per_depth,
             pool_rows_per_layer: pool.rows_per_layer,
             edge_levels,
-            _pad1: 0,
-            _pad2: 0,
         }
     }
 }

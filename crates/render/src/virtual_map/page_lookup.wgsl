@@ -12,16 +12,15 @@
 import package::constants::VIRTUAL_ORIGIN_VECTORS;
 import package::techniques::bindings::{shadow_gather, shadow_map};
 import package::variant::{SHADOW_BINDING, SHADOW_GROUP};
+import package::virtual_map::map_space::{MapSpace, map_point};
 
 struct VirtualMap {
-    light_from_world: mat4x4<f32>,
+    // Where world points lie on the levels (map_space.wgsl).
+    map: MapSpace,
     // Each level's first page, two levels to a vector: level 2k in xy, 2k + 1 in zw.
     origins: array<vec4<i32>, VIRTUAL_ORIGIN_VECTORS>,
-    // World size of a texel of level 0; level l's is 2^l times it.
+    // Map-space size of a texel of level 0; level l's is 2^l times it.
     finest_texel: f32,
-    // Distances along the light's axis of the depth-0 and depth-1 planes.
-    near: f32,
-    far: f32,
     levels: u32,
     pages_per_side: u32,
     page_texels: u32,
@@ -34,8 +33,6 @@ struct VirtualMap {
     // Levels finer than its footprint's that a pixel reads where their pages hold
     // its whole footprint (`virtual_lookup_visibility`).
     edge_levels: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 @group(SHADOW_GROUP) @binding(SHADOW_BINDING + 7u) var<uniform> virtual_map: VirtualMap;
@@ -50,10 +47,11 @@ struct VirtualTexel {
     exact: bool,
 }
 
-// The level a pixel at view depth `view_depth` reads: the coarsest whose texels are
-// no larger than its footprint, as the page requests chose (`page_requests.wgsl`).
-fn virtual_level(view_depth: f32) -> u32 {
-    let ratio = view_depth * virtual_map.footprint_per_depth / virtual_map.finest_texel;
+// The level a pixel at view depth `view_depth` reads, where a map unit spans
+// `world_per_map` world units (`map_point`'s w): the coarsest whose texels are no
+// larger than its footprint, as the page requests chose (`page_requests.wgsl`).
+fn virtual_level(view_depth: f32, world_per_map: f32) -> u32 {
+    let ratio = view_depth * virtual_map.footprint_per_depth / world_per_map / virtual_map.finest_texel;
     if (ratio < 1.0) {
         return 0u;
     }
@@ -64,12 +62,12 @@ fn virtual_level(view_depth: f32) -> u32 {
 // level, or the finest coarser one whose window holds the point, as its page requests
 // chose (`window_level` in page_requests.wgsl); the coarsest where none does.
 fn virtual_window_level(world: vec3<f32>, level: u32) -> u32 {
-    let xy = (virtual_map.light_from_world * vec4<f32>(world, 1.0)).xy;
+    let xy = virtual_map_point(world).xy;
     let side = i32(virtual_map.pages_per_side);
     var l = level;
     while l + 1u < virtual_map.levels {
-        let page_world = virtual_texel_size(l) * f32(virtual_map.page_texels);
-        let page = vec2<i32>(floor(xy / page_world)) - virtual_origin(l);
+        let page_size = virtual_texel_size(l) * f32(virtual_map.page_texels);
+        let page = vec2<i32>(floor(xy / page_size)) - virtual_origin(l);
         if all(page >= vec2<i32>(0)) && all(page < vec2<i32>(side)) {
             break;
         }
@@ -78,12 +76,12 @@ fn virtual_window_level(world: vec3<f32>, level: u32) -> u32 {
     return l;
 }
 
-// World size of a texel of `level`.
+// Map-space size of a texel of `level`.
 fn virtual_texel_size(level: u32) -> f32 {
     return virtual_map.finest_texel * exp2(f32(level));
 }
 
-// The level in whose texels a search `radius` world units wide round a pixel of
+// The level in whose texels a search `radius` map units wide round a pixel of
 // `level` spans at most `cap` texels (PCSS's `max_search_texels`, which a 2D map's
 // coarser texels stretch as far): `level` itself, or as many levels coarser as it
 // takes (`search_level` in page_requests.wgsl, which asks for its pages).
@@ -98,7 +96,7 @@ fn virtual_origin(level: u32) -> vec2<i32> {
     return select(pair.zw, pair.xy, level % 2u == 0u);
 }
 
-// The table's entry for page `page` of `level` (in pages from the light-space
+// The table's entry for page `page` of `level` (in pages from the map-space
 // origin): 0, no page, outside the level's window.
 fn virtual_page_entry(level: u32, page: vec2<i32>) -> u32 {
     let side = i32(virtual_map.pages_per_side);
@@ -109,7 +107,7 @@ fn virtual_page_entry(level: u32, page: vec2<i32>) -> u32 {
     return page_table[level * u32(side * side) + u32(relative.y * side + relative.x)];
 }
 
-// Texel `texel` of `level` (in texels from the light-space origin, y up) through
+// Texel `texel` of `level` (in texels from the map-space origin, y up) through
 // the page table; the far plane (lit) where no page holds it, itself or coarser.
 fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     let size = i32(virtual_map.page_texels);
@@ -125,7 +123,7 @@ fn virtual_texel(level: u32, texel: vec2<i32>) -> VirtualTexel {
     let read = vec2<i32>(floor(vec2<f32>(texel) / scale));
     let within = read - vec2<i32>(floor(vec2<f32>(read) / f32(size))) * size;
     let tile = virtual_slot_tile(slot);
-    // Texture rows run down, light-space y up.
+    // Texture rows run down, map-space y up.
     let depth = textureLoad(shadow_map, tile.xy + vec2<i32>(within.x, size - 1 - within.y), tile.z, 0);
     return VirtualTexel(depth, coarser == 0u);
 }
@@ -140,7 +138,7 @@ fn virtual_slot_tile(slot: u32) -> vec3<i32> {
     return vec3<i32>(vec2<i32>(first), i32(row / rows));
 }
 
-// Where page `page` of `level` (in pages from the light-space origin) lies in the
+// Where page `page` of `level` (in pages from the map-space origin) lies in the
 // pool when its own level's page is resident: its tile's first texel in xy, its
 // layer in z, and 1 in w; w is 0 where a coarser page stands in for it, or none.
 fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec4<i32> {
@@ -152,9 +150,9 @@ fn virtual_exact_tile(level: u32, page: vec2<i32>) -> vec4<i32> {
 }
 
 // The 2×2 block of texels from `corner` (its lower left, in texels of a level,
-// light-space y up) up and right, from the tile at `tile` (the xyz of
+// map-space y up) up and right, from the tile at `tile` (the xyz of
 // [`virtual_exact_tile`]) in one gather, in the order (x, y+1), (x+1, y+1), (x+1, y),
-// (x, y): the block must lie in the tile's page. Texture rows run down, light-space
+// (x, y): the block must lie in the tile's page. Texture rows run down, map-space
 // y up: the block's rows are texture rows `row − 1` (y + 1) and `row` (y), which
 // gather at their shared corner returns as (x, row), (x+1, row), (x+1, row−1),
 // (x, row−1).
@@ -179,7 +177,7 @@ struct VirtualBlock {
     exact: bool,
 }
 
-// The block of `level` from texel `corner` (its lower left, light-space y up) up and
+// The block of `level` from texel `corner` (its lower left, map-space y up) up and
 // right. Most blocks lie in one page: its tile from the table once, the four texels
 // in one gather where the page is resident at its own level; through the table
 // texel by texel otherwise (a block across a page border, or a page a coarser one
@@ -201,11 +199,11 @@ fn virtual_block(level: u32, corner: vec2<i32>) -> VirtualBlock {
     return VirtualBlock(vec4<f32>(a.depth, b.depth, c.depth, d.depth), a.exact && b.exact && c.exact && d.exact);
 }
 
-// The light's view of a world point: light-space x and y, and the depth the map
-// stores for it (0 at the near plane, 1 at the far one).
-fn virtual_light_point(world: vec3<f32>) -> vec3<f32> {
-    let light = (virtual_map.light_from_world * vec4<f32>(world, 1.0)).xyz;
-    return vec3<f32>(light.xy, (-light.z - virtual_map.near) / (virtual_map.far - virtual_map.near));
+// A world point on the map: x and y in map units, the depth the map stores for it
+// (0 at the near plane, 1 at the far one), and in w the world units per map unit
+// there (`map_point`).
+fn virtual_map_point(world: vec3<f32>) -> vec4<f32> {
+    return map_point(virtual_map.map, world);
 }
 
 // The fraction of a 2×2 bilinear footprint of `level` round the world point that
@@ -213,11 +211,11 @@ fn virtual_light_point(world: vec3<f32>) -> vec3<f32> {
 // the results weighted bilinearly (percentage-closer filtering, Reeves, Salesin and
 // Cook 1987), whatever pages the taps fall in.
 fn virtual_pcf2x2(world: vec3<f32>, level: u32) -> f32 {
-    let point = virtual_light_point(world);
+    let point = virtual_map_point(world);
     return virtual_pcf2x2_at(point.xy / virtual_texel_size(level), point.z, level);
 }
 
-// [`virtual_pcf2x2`] at `texels`, a point in texels of `level` from the light-space
+// [`virtual_pcf2x2`] at `texels`, a point in texels of `level` from the map-space
 // origin (texel (i, j) spans [i, i + 1) × [j, j + 1)), against depth `depth`: the tap
 // every filter of a virtual map is made of (techniques/virtual_query.wgsl).
 fn virtual_pcf2x2_at(texels: vec2<f32>, depth: f32, level: u32) -> f32 {
@@ -235,7 +233,7 @@ fn virtual_pcf2x2_at(texels: vec2<f32>, depth: f32, level: u32) -> f32 {
     return mix(bottom, top, weight.y);
 }
 
-// The pages debug view's flags for a lookup of `level` at light-space `xy`: 1 where
+// The pages debug view's flags for a lookup of `level` at map-space `xy`: 1 where
 // its page was drawn this frame (the table's bit 28), 2 where a coarser page stands
 // in for it or none does, 4 within a texel of its page's border.
 fn virtual_page_flags(level: u32, xy: vec2<f32>) -> u32 {

@@ -1,4 +1,4 @@
-// The shadow lookup of a sun's virtual map (`--partition virtual`): the pixel reads
+// The shadow lookup of a virtual map (`--partition virtual`): the pixel reads
 // the clipmap level that matches its footprint (the level its page requests asked
 // for), or a finer one along shadow edges, at its point pushed along its normal by
 // the normal-offset bias in texels of that level, through the page table with the
@@ -10,27 +10,30 @@ import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
 import package::techniques::common::MAX_RECEIVER_SLOPE_PER_TEXEL;
 import package::techniques::virtual_query::VirtualQuery;
 import package::variant::sample_shadow_virtual;
-import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_level, virtual_window_level, virtual_light_point, virtual_map, virtual_page_flags, virtual_texel_size};
+import package::virtual_map::map_space::map_delta;
+import package::virtual_map::page_lookup::{virtual_exact_tile, virtual_level, virtual_map, virtual_map_point, virtual_page_flags, virtual_texel_size, virtual_window_level};
 
 // The receiver's point as its lookup reads it: pushed along its unit normal `n`,
-// lit from `l`, by the normal offset in texels of `level`, times 1 − N·L (as
-// `shadow_coords` does in map_visibility.wgsl).
+// lit from `l`, by the normal offset in texels of `level` (their world size there),
+// times 1 − N·L (as `shadow_coords` does in map_visibility.wgsl).
 fn virtual_offset_point(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>, level: u32) -> vec3<f32> {
     let slope = max(1.0 - clamp(dot(n, l), 0.0, 1.0), MIN_NORMAL_OFFSET_SCALE);
-    return world + n * (light.bias.normal_offset * virtual_texel_size(level) * slope);
+    let texel = virtual_texel_size(level) * virtual_map_point(world).w;
+    return world + n * (light.bias.normal_offset * texel * slope);
 }
 
-// ∂depth/∂(texel x, y) of the receiver's plane in a level of texels `texel` wide, from
-// the world point's screen derivatives, or 0 when receiver-plane bias is off: the
-// same 2×2 solve as `receiver_depth_gradient` (common.wgsl) in the map's texels.
-fn virtual_receiver_gradient(world_dx: vec3<f32>, world_dy: vec3<f32>, texel: f32) -> vec2<f32> {
+// ∂depth/∂(texel x, y) of the receiver's plane at world point `world` in a level of
+// texels `texel` map units wide, from the point's screen derivatives, or 0 when
+// receiver-plane bias is off: the same 2×2 solve as `receiver_depth_gradient`
+// (common.wgsl) in the map's texels, the derivatives carried into map space by the
+// projection's own there (`map_delta`).
+fn virtual_receiver_gradient(world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>, texel: f32) -> vec2<f32> {
     if light.bias.receiver_plane == 0u {
         return vec2<f32>(0.0);
     }
-    // Light space looks down −z; the map's depth is (−z − near) / range.
-    let scale = vec3<f32>(1.0 / texel, 1.0 / texel, -1.0 / (virtual_map.far - virtual_map.near));
-    let a = (virtual_map.light_from_world * vec4<f32>(world_dx, 0.0)).xyz * scale;
-    let b = (virtual_map.light_from_world * vec4<f32>(world_dy, 0.0)).xyz * scale;
+    let scale = vec3<f32>(1.0 / texel, 1.0 / texel, 1.0);
+    let a = map_delta(virtual_map.map, world, world_dx) * scale;
+    let b = map_delta(virtual_map.map, world, world_dy) * scale;
     let det = a.x * b.y - a.y * b.x;
     if abs(det) < 1e-24 {
         return vec2<f32>(0.0);
@@ -47,7 +50,7 @@ fn virtual_receiver_gradient(world_dx: vec3<f32>, world_dy: vec3<f32>, texel: f3
 // and the refinement's footprint test read there: the bilinear 2×2 and a ring of
 // UNSURE_RING_TEXELS texels round it (`virtual_map_unsure`, refine_virtual.wgsl).
 fn virtual_footprint_resident(point: vec3<f32>, level: u32) -> bool {
-    let p = virtual_light_point(point).xy / virtual_texel_size(level) - vec2<f32>(0.5);
+    let p = virtual_map_point(point).xy / virtual_texel_size(level) - vec2<f32>(0.5);
     let base = vec2<i32>(floor(p));
     let size = f32(virtual_map.page_texels);
     let first = vec2<i32>(floor(vec2<f32>(base - vec2<i32>(UNSURE_RING_TEXELS)) / size));
@@ -91,17 +94,18 @@ fn virtual_lookup_visibility(
     pixel: vec2<f32>,
     view_depth: f32,
 ) -> vec2<f32> {
-    let level = virtual_read_level(world, n, l, virtual_window_level(world, virtual_level(view_depth)));
+    let surface = virtual_map_point(world);
+    let level = virtual_read_level(world, n, l, virtual_window_level(world, virtual_level(view_depth, surface.w)));
     let point = virtual_offset_point(world, n, l, level);
-    let light_point = virtual_light_point(point);
+    let map_point = virtual_map_point(point);
     let texel = virtual_texel_size(level);
-    let gradient = virtual_receiver_gradient(world_dx, world_dy, texel);
-    let offset = light_point - virtual_light_point(world);
-    let q = VirtualQuery(light_point.xy / texel, light_point.z, level, texel, pixel, gradient, offset);
+    let gradient = virtual_receiver_gradient(world, world_dx, world_dy, texel);
+    let offset = map_point.xyz - surface.xyz;
+    let q = VirtualQuery(map_point.xy / texel, map_point.z, level, texel, texel * map_point.w, pixel, gradient, offset);
     let visibility = sample_shadow_virtual(q);
     var code = level;
     if camera.debug_view == DEBUG_VIEW_PAGES {
-        code += TRACED_LAYER_FLAG * virtual_page_flags(level, virtual_light_point(point).xy);
+        code += TRACED_LAYER_FLAG * virtual_page_flags(level, map_point.xy);
     }
     return vec2<f32>(visibility, f32(code));
 }

@@ -48,7 +48,7 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
 /// (`Clipmap::search_requests`).
 #[test]
 fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
-    let search = AreaSearch { cone_tan: 5f32.to_radians().tan(), cap_texels: 32.0 };
+    let search = AreaSearch { light_size: 5f32.to_radians().tan(), cap_texels: 32.0 };
     let searches = Searches { area: Some(search), cone: None };
     let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
     // 16 measured: the coarser levels' pages round the points whose cone is widest.
@@ -62,7 +62,7 @@ fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
 #[test]
 fn the_gpu_asks_for_the_pages_of_pcss_over_a_wide_suns_cone() {
     let cone =
-        ConeReach { cone_tan: 5f32.to_radians().tan(), level_cap_texels: 32.0, reach_cap_texels: 64.0 };
+        ConeReach { light_size: 5f32.to_radians().tan(), level_cap_texels: 32.0, reach_cap_texels: 64.0 };
     let searches = Searches { area: None, cone: Some(cone) };
     let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
     assert!(asked.search_only >= 10, "{} pages only the cone asks for", asked.search_only);
@@ -123,7 +123,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         let depth = 0.5 + 39.5 * rng.next() * rng.next();
         let point = camera + direction * depth;
         let footprint = depth * reach.footprint_per_depth;
-        let xy = clipmap.light_xy(point);
+        let xy = clipmap.map_xy(point);
         let level = clipmap.level_for_point(xy, footprint).unwrap_or(0);
         let page = clipmap.page_size(level);
         let spread = reach.reach_texels * clipmap.texel_size(level);
@@ -234,9 +234,9 @@ fn search_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, search: AreaS
 /// rounding and the CPU's may differ: the boundary of its coarsest level, the cone's
 /// span in a level's texels where the cap clamps it, its squares' page edges.
 fn cone_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, cone: ConeReach, reach: f32) -> bool {
-    let radius = clipmap.cone_radius(point, cone.cone_tan);
+    let radius = clipmap.cone_radius(point, cone.light_size);
     let coarsest = clipmap.search_level(level, radius, cone.level_cap_texels);
-    let xy = clipmap.light_xy(point);
+    let xy = clipmap.map_xy(point);
     near_grid((radius / (clipmap.texel_size(level) * cone.level_cap_texels)).log2(), 1e-3)
         || (level..=coarsest).any(|l| {
             let texel = clipmap.texel_size(l);

@@ -286,7 +286,7 @@ fn lookups_through_the_page_table_read_every_tap_from_its_own_page_or_its_fallba
         let Some(expected) = pcf2x2(&lookup, p, level) else { continue };
         compared += 1;
         shadowed += usize::from(expected < 0.5);
-        let page = clipmap.page_at(level, clipmap.light_xy(p)).expect("in the window");
+        let page = clipmap.page_at(level, clipmap.map_xy(p)).expect("in the window");
         fallbacks += usize::from(allocation.refused.contains(&page));
         assert!(
             (gpu_visibility[k] - expected).abs() < 1e-4,
