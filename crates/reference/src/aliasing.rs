@@ -14,6 +14,7 @@
 //! is exact for warped (projective) maps as well as for orthographic ones.
 
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
+use gnomon_math::virtual_map::Clipmap;
 use gnomon_scene::{
     Camera, Light,
     lights::{Origin, ShadowView},
@@ -36,14 +37,30 @@ pub struct AliasingInput<'a> {
     pub camera: &'a Camera,
     /// The light, for the direction of its rays.
     pub light: &'a Light,
-    /// Every shadow-map layer's clip_from_world (one per cascade).
+    /// Every shadow-map layer's clip_from_world (one per cascade, or per virtual level).
     pub layers: &'a [Mat4],
-    /// The view depths bounding the cascades (one more than the layers).
-    pub splits: &'a [f32],
-    /// Cascades chosen by projection (the first layer that holds the point), not depth.
-    pub select_by_projection: bool,
+    /// Which layer shades each pixel.
+    pub choice: LayerChoice<'a>,
     /// Texels along a side of each layer.
     pub resolution: u32,
+}
+
+/// How a frame picks the layer that shades a pixel.
+#[derive(Clone, Copy)]
+pub enum LayerChoice<'a> {
+    /// By view depth, between these splits (one more than the layers): cascades.
+    Splits(&'a [f32]),
+    /// The first layer whose projection holds the point: cascades chosen by projection.
+    Projection,
+    /// A virtual map's level, as its page requests and lookup choose it
+    /// ([`Clipmap::level_for_point`] of the pixel's footprint, `footprint_per_depth`
+    /// times its view depth): the layers are its levels' windows.
+    Clipmap {
+        /// The frame's clipmap.
+        clipmap: &'a Clipmap,
+        /// A pixel's footprint in world units per unit of view depth.
+        footprint_per_depth: f32,
+    },
 }
 
 /// m per pixel, and its summary over the pixels where it is defined.
@@ -77,19 +94,26 @@ pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usi
         };
     }
     let count = input.layers.len();
-    if !input.select_by_projection {
-        return (1..count).rfind(|&i| view_depth > input.splits[i]).unwrap_or(0);
+    match input.choice {
+        LayerChoice::Splits(splits) => (1..count).rfind(|&i| view_depth > splits[i]).unwrap_or(0),
+        LayerChoice::Clipmap { clipmap, footprint_per_depth } => {
+            let footprint = clipmap.map_footprint(world, view_depth * footprint_per_depth);
+            let level = clipmap.level_for_point(clipmap.map_xy(world), footprint);
+            level.map_or(count - 1, |l| l as usize)
+        }
+        LayerChoice::Projection => {
+            let margin = 4.0 / input.resolution as f32;
+            (0..count.saturating_sub(1))
+                .find(|&i| {
+                    texture_coords(input.layers[i], world).is_some_and(|(uv, z)| {
+                        uv.cmpgt(Vec2::splat(margin)).all()
+                            && uv.cmplt(Vec2::splat(1.0 - margin)).all()
+                            && (0.0..=1.0).contains(&z)
+                    })
+                })
+                .unwrap_or(count - 1)
+        }
     }
-    let margin = 4.0 / input.resolution as f32;
-    (0..count.saturating_sub(1))
-        .find(|&i| {
-            texture_coords(input.layers[i], world).is_some_and(|(uv, z)| {
-                uv.cmpgt(Vec2::splat(margin)).all()
-                    && uv.cmplt(Vec2::splat(1.0 - margin)).all()
-                    && (0.0..=1.0).contains(&z)
-            })
-        })
-        .unwrap_or(count - 1)
 }
 
 /// Shadow-map texture coordinates (u right, v down, both in [0, 1] inside the map) and
@@ -280,8 +304,7 @@ mod tests {
             camera: &camera,
             light: &sun_along(-Vec3::Z),
             layers: &layers,
-            splits: &[0.0, f32::INFINITY],
-            select_by_projection: false,
+            choice: LayerChoice::Splits(&[0.0, f32::INFINITY]),
             resolution,
         };
         let image = measure(&input);
@@ -325,13 +348,12 @@ mod tests {
             camera: &camera,
             light: &sun_along(-Vec3::Z),
             layers: &layers,
-            splits: &[0.1, 5.0, 100.0],
-            select_by_projection: false,
+            choice: LayerChoice::Splits(&[0.1, 5.0, 100.0]),
             resolution: 64,
         };
         assert_eq!(shading_layer(&input, Vec3::ZERO, 4.0), 0);
         assert_eq!(shading_layer(&input, Vec3::ZERO, 6.0), 1);
-        let by_projection = AliasingInput { select_by_projection: true, ..input };
+        let by_projection = AliasingInput { choice: LayerChoice::Projection, ..input };
         assert_eq!(shading_layer(&by_projection, Vec3::ZERO, 6.0), 0, "inside the small map");
         assert_eq!(shading_layer(&by_projection, Vec3::new(3.0, 0.0, 0.0), 4.0), 1, "outside it");
     }

@@ -11,7 +11,7 @@ use std::sync::{
 
 use gnomon_reference::{
     aliasing,
-    aliasing::{AliasingImage, AliasingInput},
+    aliasing::{AliasingImage, AliasingInput, LayerChoice},
     drawn::{DrawnSurfaces, DrawnTruth, measure_drawn},
     heatmap,
 };
@@ -22,14 +22,22 @@ use gnomon_scene::{Settings, settings::CascadeSelection};
 /// map's levels, each pixel at the level its footprint picks (finer along shadow
 /// edges: `shadow.virtual_map.edge_levels`).
 pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
-    let (projections, splits, select_by_projection, resolution) = match &frame.virtual_levels {
-        Some(levels) => (&levels.projections, &levels.splits, false, levels.resolution),
-        None => (
-            &frame.cascades,
-            &frame.cascade_splits,
-            settings.shadow.cascades.cascade_selection == CascadeSelection::Projection,
-            frame.shadow_resolution,
+    let (projections, choice, resolution) = match &frame.virtual_levels {
+        Some(levels) => (
+            &levels.projections,
+            LayerChoice::Clipmap {
+                clipmap: &levels.clipmap,
+                footprint_per_depth: levels.footprint_per_depth,
+            },
+            levels.resolution,
         ),
+        None => {
+            let choice = match settings.shadow.cascades.cascade_selection {
+                CascadeSelection::Projection => LayerChoice::Projection,
+                CascadeSelection::Depth => LayerChoice::Splits(&frame.cascade_splits),
+            };
+            (&frame.cascades, choice, frame.shadow_resolution)
+        }
     };
     let layers: Vec<glam::Mat4> = projections.iter().map(|p| p.clip_from_world()).collect();
     aliasing::measure(&AliasingInput {
@@ -41,8 +49,7 @@ pub fn measure_aliasing(frame: &Frame, settings: &Settings) -> AliasingImage {
         camera: &frame.camera,
         light: &frame.light,
         layers: &layers,
-        splits,
-        select_by_projection,
+        choice,
         resolution,
     })
 }

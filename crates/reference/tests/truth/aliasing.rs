@@ -9,7 +9,7 @@ use glam::Vec3;
 use gnomon_math::ProjectionKind;
 use gnomon_reference::{
     TracedScene,
-    aliasing::{self, AliasingInput},
+    aliasing::{self, AliasingInput, LayerChoice},
     flicker::{Flicker, FlickerCounter, PathFrame},
     metrics::RasterView,
     reference_visibility,
@@ -26,11 +26,11 @@ use gnomon_scene::{
 };
 
 /// What Lloyd's m is measured from over `frame`: its pixels against the layers
-/// `layers` (each a map of `resolution`²), a pixel picking its layer by `splits`.
+/// `layers` (each a map of `resolution`²), a pixel picking its layer by `choice`.
 fn frame_input<'a>(
     frame: &'a Frame,
     layers: &'a [glam::Mat4],
-    splits: &'a [f32],
+    choice: LayerChoice<'a>,
     resolution: u32,
 ) -> AliasingInput<'a> {
     AliasingInput {
@@ -42,18 +42,18 @@ fn frame_input<'a>(
         camera: &frame.camera,
         light: &frame.light,
         layers,
-        splits,
-        select_by_projection: false,
+        choice,
         resolution,
     }
 }
 
 fn mean_m(frame: &Frame, s: &Settings) -> f32 {
     let layers: Vec<glam::Mat4> = frame.cascades.iter().map(|p| p.clip_from_world()).collect();
-    let image = aliasing::measure(&AliasingInput {
-        select_by_projection: s.shadow.cascades.cascade_selection == CascadeSelection::Projection,
-        ..frame_input(frame, &layers, &frame.cascade_splits, frame.shadow_resolution)
-    });
+    let choice = match s.shadow.cascades.cascade_selection {
+        CascadeSelection::Projection => LayerChoice::Projection,
+        CascadeSelection::Depth => LayerChoice::Splits(&frame.cascade_splits),
+    };
+    let image = aliasing::measure(&frame_input(frame, &layers, choice, frame.shadow_resolution));
     assert!(image.measured > frame.pixel_count() / 2, "m measured over {} pixels", image.measured);
     image.mean
 }
@@ -427,8 +427,8 @@ fn pancaking_keeps_every_shadow_in_a_shorter_depth_range() {
     assert!(e_clamped < 0.005, "the box's shadow is kept: mismatch {e_clamped}");
 }
 
-/// A virtual map reports its levels (`Frame::virtual_levels`) as layers split where
-/// a pixel's footprint moves to the next level. A level's texels are the coarsest no
+/// A virtual map reports its levels (`Frame::virtual_levels`) as layers, each pixel
+/// reading the one its footprint picks. A level's texels are the coarsest no
 /// larger than the footprint along the camera's axis at the pixel's view depth, so
 /// they span between half a pixel and one there; off the axis, a pixel at the same
 /// view depth is nearer along its ray and narrower by up to cos θ at the image's
@@ -441,11 +441,7 @@ fn a_virtual_maps_levels_give_texels_between_half_a_pixel_and_one() {
     s.shadow.partition = Partition::Virtual;
     s.screen.refine = Refine::Off;
     let frame = render(&builtin::columns(), &s);
-    let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
-    assert_eq!(levels.splits.len(), levels.projections.len() + 1);
-    assert!(levels.splits.windows(2).all(|w| w[0] < w[1]), "{:?}", levels.splits);
-    let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
-    let image = aliasing::measure(&frame_input(&frame, &layers, &levels.splits, levels.resolution));
+    let image = virtual_aliasing(&frame);
     let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
     assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
     let aspect = frame.width as f32 / frame.height as f32;
@@ -453,5 +449,48 @@ fn a_virtual_maps_levels_give_texels_between_half_a_pixel_and_one() {
     let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
     let outside = defined.iter().filter(|&&m| !(0.5 * cos..=1.0 / cos).contains(&m)).count();
     assert_eq!(outside, 0, "m from {} to {}: mean {}, max {}", 0.5 * cos, 1.0 / cos, image.mean, image.max);
+    assert!(image.mean > 0.5 && image.mean <= 1.0, "mean m {}", image.mean);
+}
+
+/// Lloyd's m over a frame of a virtual map, each pixel at the level its footprint
+/// picks.
+fn virtual_aliasing(frame: &Frame) -> aliasing::AliasingImage {
+    let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
+    let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
+    let choice =
+        LayerChoice::Clipmap { clipmap: &levels.clipmap, footprint_per_depth: levels.footprint_per_depth };
+    aliasing::measure(&frame_input(frame, &layers, choice, levels.resolution))
+}
+
+/// A spot's virtual map: its levels' texels grow with the distance from the spot, and
+/// a pixel reads the coarsest level whose texels at its own distance are no larger
+/// than its footprint, so its texels span between half a pixel and one (m within
+/// [cos θ / 2, 1 / cos θ], as a sun's levels, above). A level off by one halves or
+/// doubles m. (A pixel whose footprint is wider than the coarsest level's texels,
+/// 256 across the frustum, would read finer texels than it needs, m below a half;
+/// none is here.)
+#[test]
+fn a_spots_virtual_levels_give_texels_between_half_a_pixel_and_one() {
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (320, 180);
+    s.light.kind = gnomon_scene::settings::LightKind::Spot;
+    s.shadow.partition = Partition::Virtual;
+    s.screen.refine = Refine::Off;
+    let frame = render(&builtin::spheres(), &s);
+    let image = virtual_aliasing(&frame);
+    let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
+    assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
+    let aspect = frame.width as f32 / frame.height as f32;
+    let tan_diagonal = (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() * (aspect * aspect + 1.0).sqrt();
+    let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
+    let coarse = defined.iter().filter(|&&m| m < 0.5 * cos).count();
+    eprintln!(
+        "figure: spheres under a spot, virtual map: m mean {:.3}, max {:.3}, {coarse} of {} pixels below cos θ / 2",
+        image.mean,
+        image.max,
+        defined.len()
+    );
+    assert!(image.max <= 1.0 / cos, "m up to {}: texels wider than a pixel", image.max);
+    assert_eq!(coarse, 0, "texels narrower than half a pixel: mean m {}", image.mean);
     assert!(image.mean > 0.5 && image.mean <= 1.0, "mean m {}", image.mean);
 }

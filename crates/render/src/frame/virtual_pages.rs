@@ -155,17 +155,20 @@ pub(crate) struct VirtualPlan {
 }
 
 /// A virtual map's clipmap levels as a frame reports them
-/// ([`crate::Frame::virtual_levels`]): each level's whole window as a layer, and the
-/// view depths where a pixel's footprint moves to the next level, as cascades report
-/// theirs, so that what measures a cascade's texels per pixel measures a level's.
+/// ([`crate::Frame::virtual_levels`]): each level's whole window as a layer, and what
+/// picks a pixel's level, so that what measures a cascade's texels per pixel
+/// measures a level's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VirtualLevels {
     /// Each level's window, finest first: its own projection.
     pub projections: Vec<gnomon_math::LightProjection>,
-    /// The view depths bounding the levels a pixel's footprint picks (one more than
-    /// the levels, from 0 to infinity). Along shadow edges pixels may read up to
-    /// `shadow.virtual_map.edge_levels` finer.
-    pub splits: Vec<f32>,
+    /// The frame's clipmap: a pixel reads the level [`Clipmap::level_for_point`]
+    /// gives its footprint (along shadow edges, up to
+    /// `shadow.virtual_map.edge_levels` finer).
+    pub clipmap: Clipmap,
+    /// A pixel's footprint in world units per unit of view depth, as the page
+    /// requests take it (the lod bias included).
+    pub footprint_per_depth: f32,
     /// Texels per side of each level's window.
     pub resolution: u32,
 }
@@ -178,12 +181,12 @@ impl VirtualPlan {
         let projections = (0..clipmap.shape.levels)
             .map(|level| clipmap.rect_projection(&clipmap.level_window(level)))
             .collect();
-        // Level l from the footprint ratio 2^l on (`virtual_level`), the last to infinity.
-        let per_depth = self.uniform.footprint_per_depth.max(f32::MIN_POSITIVE);
-        let mut splits = vec![0.0];
-        splits.extend((1..clipmap.shape.levels).map(|l| clipmap.texel_size(l) / per_depth));
-        splits.push(f32::INFINITY);
-        VirtualLevels { projections, splits, resolution: side * clipmap.shape.page_size }
+        VirtualLevels {
+            projections,
+            clipmap: clipmap.clone(),
+            footprint_per_depth: self.uniform.footprint_per_depth,
+            resolution: side * clipmap.shape.page_size,
+        }
     }
 }
 
