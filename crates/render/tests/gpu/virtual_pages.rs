@@ -1,6 +1,7 @@
 //! Virtual shadow maps' page requests on the GPU (`virtual_map/page_requests.wgsl`)
 //! against the clipmap's own arithmetic (`gnomon_math::virtual_map`): the pass must
-//! ask for exactly the pages that `Clipmap::request` names for every pixel.
+//! ask for exactly the pages that `Clipmap::request` names for every pixel, under a
+//! sun and under a spot.
 
 use std::collections::BTreeSet;
 
@@ -35,11 +36,25 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
     // Unreal's levels, and levels of 1024² read at texels 8× finer than the pixels,
     // whose windows leave many of the points to coarser levels
     // (`Clipmap::level_for_point`).
-    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, Searches::NONE);
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(sun(ClipmapShape::DEFAULT, 1.0), Searches::NONE);
     assert_eq!(asked.fell_back, 0);
     let small = ClipmapShape { virtual_resolution: 1024, ..ClipmapShape::DEFAULT };
-    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(small, 0.125, Searches::NONE).fell_back;
+    let fell_back = asks_for_exactly_the_pages_the_clipmap_names(sun(small, 0.125), Searches::NONE).fell_back;
     assert!(fell_back > 500, "{fell_back} points read a coarser level than their footprint's");
+}
+
+/// Under a spot, whose levels' texels grow with the distance from it, each pixel
+/// asks for the level whose texels match its footprint at its own distance, and the
+/// points outside its frustum ask for nothing (`Clipmap::sees`); under PCSS for a
+/// spot of radius 0.3, for the cone to its disk measured on its near plane.
+#[test]
+fn the_gpu_asks_for_exactly_the_pages_of_a_spots_clipmap() {
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(spot(), Searches::NONE);
+    assert!(asked.unseen > 500, "{} points outside the spot's frustum", asked.unseen);
+    let cone = ConeReach { light_size: 0.3, level_cap_texels: 32.0, reach_cap_texels: 64.0 };
+    let asked =
+        asks_for_exactly_the_pages_the_clipmap_names(spot(), Searches { area: None, cone: Some(cone) });
+    assert!(asked.search_only >= 10, "{} pages only the cone asks for", asked.search_only);
 }
 
 /// Under a sun 10° wide whose penumbrae rays refine, each pixel also asks for the
@@ -50,7 +65,7 @@ fn the_gpu_asks_for_exactly_the_pages_the_clipmap_names() {
 fn the_gpu_asks_for_the_pages_of_the_search_over_a_wide_suns_cone() {
     let search = AreaSearch { light_size: 5f32.to_radians().tan(), cap_texels: 32.0 };
     let searches = Searches { area: Some(search), cone: None };
-    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(sun(ClipmapShape::DEFAULT, 1.0), searches);
     // 16 measured: the coarser levels' pages round the points whose cone is widest.
     assert!(asked.search_only >= 10, "{} pages only the search asks for", asked.search_only);
 }
@@ -64,7 +79,7 @@ fn the_gpu_asks_for_the_pages_of_pcss_over_a_wide_suns_cone() {
     let cone =
         ConeReach { light_size: 5f32.to_radians().tan(), level_cap_texels: 32.0, reach_cap_texels: 64.0 };
     let searches = Searches { area: None, cone: Some(cone) };
-    let asked = asks_for_exactly_the_pages_the_clipmap_names(ClipmapShape::DEFAULT, 1.0, searches);
+    let asked = asks_for_exactly_the_pages_the_clipmap_names(sun(ClipmapShape::DEFAULT, 1.0), searches);
     assert!(asked.search_only >= 10, "{} pages only the cone asks for", asked.search_only);
 }
 
@@ -87,35 +102,56 @@ struct Asked {
     fell_back: usize,
     /// Pages that only the searches over a sun's cone asked for.
     search_only: usize,
+    /// Points the map does not see (outside a spot's frustum).
+    unseen: usize,
 }
 
-/// Checks the GPU's requests against the clipmap's for surfaces whose footprint is
-/// `footprint_scale` times a 240-pixel-high camera's, and the pages of `searches`
-/// over a sun's cone.
+/// The camera every request test looks from.
+const CAMERA: Vec3 = Vec3::new(2.0, 6.0, 9.0);
+
+/// A 60° camera 240 pixels high: a pixel's footprint per unit of view depth.
+fn footprint_per_depth() -> f32 {
+    2.0 * (30f32.to_radians()).tan() / 240.0
+}
+
+/// A sun's clipmap of `shape` round [`CAMERA`], for surfaces whose footprint is
+/// `footprint_scale` times the camera's, and that scale.
+fn sun(shape: ClipmapShape, footprint_scale: f32) -> (Clipmap, f32) {
+    let bounds = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 12.0, 30.0));
+    let farthest = 40.0 * footprint_scale * footprint_per_depth();
+    (Clipmap::new(shape, Vec3::new(-0.4, -1.0, 0.3), CAMERA, &bounds, farthest), footprint_scale)
+}
+
+/// A spot 14 units up, 50° from its axis to its frustum's side, looking down and
+/// a little toward the camera: most points lie in its frustum, some outside.
+fn spot() -> (Clipmap, f32) {
+    let position = Vec3::new(0.0, 14.0, 0.0);
+    let view = gnomon_math::view_from_world_look_at(position, Vec3::new(1.0, 0.0, 3.0), Vec3::Y);
+    (Clipmap::spot(ClipmapShape::DEFAULT, view, 50f32.to_radians().tan(), 0.2, 60.0), 1.0)
+}
+
+/// Checks the GPU's requests against `clipmap`'s for surfaces seen from [`CAMERA`]
+/// whose footprint is `footprint_scale` times its pixels', and the pages of
+/// `searches` over the light's cone.
 fn asks_for_exactly_the_pages_the_clipmap_names(
-    shape: ClipmapShape,
-    footprint_scale: f32,
+    (clipmap, footprint_scale): (Clipmap, f32),
     searches: Searches,
 ) -> Asked {
     let gpu = gpu();
-    let camera = Vec3::new(2.0, 6.0, 9.0);
-    let bounds = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 12.0, 30.0));
-    // A 60° camera 240 pixels high, seeing up to 40 units away; the filter reaches
-    // 2.5 texels.
+    let camera = CAMERA;
+    // Surfaces up to 40 units away; the filter reaches 2.5 texels.
     let reach = PixelReach {
-        footprint_per_depth: footprint_scale * 2.0 * (30f32.to_radians()).tan() / 240.0,
+        footprint_per_depth: footprint_scale * footprint_per_depth(),
         reach_texels: 2.5,
         area_search: searches.area,
         cone: searches.cone,
     };
-    let travel = Vec3::new(-0.4, -1.0, 0.3);
-    let clipmap = Clipmap::new(shape, travel, camera, &bounds, 40.0 * reach.footprint_per_depth);
     let (width, height) = (96u32, 64u32);
     let mut rng = Lcg(17);
     let mut texels = Vec::with_capacity((width * height) as usize);
     let mut expected = BTreeSet::new();
     let mut searched_pages = BTreeSet::new();
-    let mut fell_back = 0;
+    let (mut fell_back, mut unseen) = (0, 0);
     for _ in 0..width * height {
         // Surfaces from 0.5 to 40 units away, in every direction round the camera.
         let direction =
@@ -123,18 +159,32 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
         let depth = 0.5 + 39.5 * rng.next() * rng.next();
         let point = camera + direction * depth;
         let footprint = depth * reach.footprint_per_depth;
+        if !clipmap.sees(point) {
+            // Asks for nothing, however near the frustum's side: a pixel there asks
+            // for no page round it either.
+            let light = clipmap.light_from_world.transform_point3(point);
+            let side = clipmap.map_xy(point).abs().max_element();
+            if light.z < 0.0 && (side - 1.0).abs() < 1e-3 {
+                texels.push(Vec4::ZERO);
+                continue;
+            }
+            unseen += 1;
+            texels.push(point.extend(depth));
+            continue;
+        }
         let xy = clipmap.map_xy(point);
-        let level = clipmap.level_for_point(xy, footprint).unwrap_or(0);
+        let map_footprint = clipmap.map_footprint(point, footprint);
+        let level = clipmap.level_for_point(xy, map_footprint).unwrap_or(0);
         let page = clipmap.page_size(level);
         let spread = reach.reach_texels * clipmap.texel_size(level);
         // Pixels on a boundary of levels or pages are left out (as background): the
         // two sides' rounding may differ there by an ulp.
         // So are points on the edge of a window the level search passed over.
-        let on_window_edge = (clipmap.level_for_footprint(footprint)..level).any(|l| {
+        let on_window_edge = (clipmap.level_for_footprint(map_footprint)..level).any(|l| {
             let size = clipmap.page_size(l);
             near_grid(xy.x / size, 1e-3) || near_grid(xy.y / size, 1e-3)
         });
-        let ambiguous = near_grid((footprint / clipmap.finest_texel).log2(), 1e-3)
+        let ambiguous = near_grid((map_footprint / clipmap.finest_texel).log2(), 1e-3)
             || on_window_edge
             || searches.area.is_some_and(|search| {
                 search_is_ambiguous(&clipmap, point, level, search, reach.reach_texels)
@@ -149,7 +199,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
             texels.push(Vec4::ZERO);
             continue;
         }
-        fell_back += usize::from(level > clipmap.level_for_footprint(footprint));
+        fell_back += usize::from(level > clipmap.level_for_footprint(map_footprint));
         texels.push(point.extend(depth));
         if let Some(rect) = clipmap.request(point, footprint, reach.reach_texels) {
             expected.extend(rect.pages());
@@ -177,7 +227,7 @@ fn asks_for_exactly_the_pages_the_clipmap_names(
     let missing: Vec<_> = expected.difference(&asked).take(5).collect();
     let extra: Vec<_> = asked.difference(&expected).take(5).collect();
     assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
-    Asked { fell_back, search_only }
+    Asked { fell_back, search_only, unseen }
 }
 
 /// The prepass's surface as the request pass reads it: `texels` (world point, view
@@ -242,7 +292,9 @@ fn cone_is_ambiguous(clipmap: &Clipmap, point: Vec3, level: u32, cone: ConeReach
             let texel = clipmap.texel_size(l);
             let spans = (radius / texel).clamp(1.0, cone.reach_cap_texels);
             let (page, spread) = (clipmap.page_size(l), Vec2::splat((spans + 1.0 + reach) * texel));
-            near_grid(spans, 1e-3)
+            // Where the cap clamps the span, both sides clamp it to the same.
+            let clamped = radius / texel >= cone.reach_cap_texels * 1.001;
+            (near_grid(spans, 1e-3) && !clamped)
                 || [xy - spread, xy, xy + spread]
                     .iter()
                     .any(|p| near_grid(p.x / page, 1e-3) || near_grid(p.y / page, 1e-3))
