@@ -59,45 +59,45 @@ fn a_spots_virtual_map_is_wrong_only_along_edges_and_exact_refined() {
     }
 }
 
-/// PCSS under a spot of radius 0.5 on its virtual map: refined by rays, as right as on
-/// its 2D map; alone, its penumbrae are there (well under pcf2x2's error). Alone it
-/// is less right than on the 2D map (all-pixel MAE 0.0049 read two levels finer,
-/// against 0.0036; docs/virtual-maps.md): its search spans the whole cone in a
-/// coarser level, where the 2D map's stops at its cap, and the floor the spot
-/// grazes finds itself farther out.
+/// PCSS under a spot of radius 0.5 on its virtual map. Alone, within 1.25× the
+/// error of the spot's 2D map alone (the bound a sun's virtual map meets,
+/// virtual_maps.rs): its blocker search is narrowed to the cone at the nearest
+/// blocker's depth (`pcss_virtual.wgsl`), without which it spans the cone at the
+/// spot's near plane, ten times the map here (0.0059 against the 2D map's 0.0036;
+/// narrowed, 0.0037). Alone, its penumbrae are there (well under pcf2x2's error).
+/// Refined by rays, as right as on the 2D map.
 #[test]
-fn pcss_on_a_spots_virtual_map_refined_is_as_right_as_on_its_2d_map() {
+fn pcss_on_a_spots_virtual_map_is_as_right_as_on_its_2d_map() {
     let scene = builtin::contact();
-    let mut s = virtual_spot(Refine::Rays);
+    let mut s = virtual_spot(Refine::Off);
     (s.image.width, s.image.height) = (320, 180);
     s.light.spot_radius = Some(0.5);
     s.reference.samples = 128;
     s.shadow.filter.technique = Technique::PCSS;
     let truth = reference(&scene, &s);
-    let on_virtual = compare(&render(&scene, &s), &truth);
-    let single = Settings {
-        shadow: gnomon_scene::settings::ShadowSettings { partition: Partition::Single, ..s.shadow.clone() },
-        ..s.clone()
+    let on_2d = |s: &Settings| {
+        let mut s = s.clone();
+        s.shadow.partition = Partition::Single;
+        compare(&render(&scene, &s), &truth)
     };
-    let on_single = compare(&render(&scene, &single), &truth);
-    let mut alone = s.clone();
-    alone.screen.refine = Refine::Off;
-    let alone = compare(&render(&scene, &alone), &truth);
-    alone_hard(&scene, &s, &truth, alone.mae);
+    let (alone, alone_2d) = (compare(&render(&scene, &s), &truth), on_2d(&s));
+    let mut hard = s.clone();
+    hard.shadow.filter.technique = Technique::PCF2X2;
+    let hard = compare(&render(&scene, &hard), &truth);
+    let mut refined = s.clone();
+    refined.screen.refine = Refine::Rays;
+    let (on_virtual, on_single) = (compare(&render(&scene, &refined), &truth), on_2d(&refined));
     figure(
-        "contact, spot r 0.5, PCSS refined by rays: MAE on a virtual map (on a 2D map; virtual alone)",
-        format!("{:.4} ({:.4}; {:.4})", on_virtual.mae, on_single.mae, alone.mae),
+        "contact, spot r 0.5, PCSS alone: all-pixel MAE on a virtual map (on its 2D map)",
+        format!("{:.4} ({:.4})", alone.mae, alone_2d.mae),
+        format!("≤ 1.25 × {:.4}", alone_2d.mae),
+    );
+    figure(
+        "contact, spot r 0.5, PCSS refined by rays: all-pixel MAE on a virtual map (on its 2D map)",
+        format!("{:.4} ({:.4})", on_virtual.mae, on_single.mae),
         format!("≤ 1.1 × {:.4}", on_single.mae),
     );
+    assert!(alone.mae <= 1.25 * alone_2d.mae, "{alone:?} against {alone_2d:?}");
+    assert!(alone.mae < 0.5 * hard.mae, "PCSS alone {alone:?} against pcf2x2's {hard:?}");
     assert!(on_virtual.mae <= 1.1 * on_single.mae, "{on_virtual:?} against {on_single:?}");
-}
-
-/// PCSS alone on the virtual map, `mae`, well under pcf2x2's there: its penumbrae
-/// are drawn.
-fn alone_hard(scene: &gnomon_scene::Scene, s: &Settings, truth: &gnomon_reference::ReferenceImage, mae: f64) {
-    let mut hard = s.clone();
-    hard.screen.refine = Refine::Off;
-    hard.shadow.filter.technique = Technique::PCF2X2;
-    let hard = compare(&render(scene, &hard), truth);
-    assert!(mae < 0.5 * hard.mae, "PCSS alone {mae} against pcf2x2's {hard:?}");
 }
