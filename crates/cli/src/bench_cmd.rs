@@ -10,13 +10,14 @@ use std::{collections::BTreeMap, path::PathBuf, time::Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use glam::Vec3;
 use gnomon_math::solar::DayArc;
 use gnomon_render::{
     DepthBaselineScene, FrameCost, Gpu, GpuScene, LayerCache, Renderer,
     timing::{ClockChoice, TimingSource},
 };
 use gnomon_scene::{
-    Scene, Settings,
+    Light, Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
     settings::{LightKind, Technique},
 };
@@ -77,6 +78,12 @@ pub struct BenchArgs {
     /// Needs the sun (`--light sun`).
     #[arg(long, value_enum, help_heading = "Benchmark")]
     pub sun_path: Option<SunPathKind>,
+    /// Move the spot every frame along this path over the warm-up and timed frames
+    /// (overriding --spot-target), so that no kept map is valid: `sweep` swings its
+    /// aim 30° across, about the vertical through it, as a flashlight's. Needs the
+    /// spot (`--light spot`).
+    #[arg(long, value_enum, help_heading = "Benchmark")]
+    pub spot_path: Option<SpotPathKind>,
     /// How to time passes: GPU timestamps where the adapter has them (else the CPU
     /// wall clock), or the CPU wall clock always.
     #[arg(long, value_enum, default_value_t = ClockArg::Auto, help_heading = "Benchmark")]
@@ -102,6 +109,27 @@ impl SunPathKind {
     fn arc(self) -> DayArc {
         match self {
             SunPathKind::Day => DayArc::EQUINOX_45_NORTH,
+        }
+    }
+}
+
+/// How `--spot-path` moves the spot.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SpotPathKind {
+    /// Its aim swung 30° across, about the vertical through it, from 15° one side
+    /// of the scene's aim to 15° the other.
+    Sweep,
+}
+
+impl SpotPathKind {
+    /// The point frame `fraction` of the path (0 to 1) aims the spot at, for a spot
+    /// at `position` that the scene aims along `direction`.
+    fn target(self, position: Vec3, direction: Vec3, fraction: f32) -> Vec3 {
+        match self {
+            SpotPathKind::Sweep => {
+                let angle = (fraction - 0.5) * 30f32.to_radians();
+                position + glam::Quat::from_rotation_y(angle) * direction
+            }
         }
     }
 }
@@ -137,6 +165,10 @@ fn check_args(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.sun_path.is_none() || args.settings.light.kind == LightKind::Sun,
         "--sun-path moves the sun: give it with --light sun (the default), not another light"
+    );
+    anyhow::ensure!(
+        args.spot_path.is_none() || args.settings.light.kind == LightKind::Spot,
+        "--spot-path moves the spot: give it with --light spot, not another light"
     );
     Ok(())
 }
@@ -283,7 +315,14 @@ impl Bench<'_> {
         let path = self.args.camera_path;
         let travel = self.args.path_travel;
         let sun_arc = self.args.sun_path.map(SunPathKind::arc);
-        // The camera and the sun of frame `i` of the warm-up and timed frames together.
+        let spot = match (self.args.spot_path, settings.resolve_lights(&self.scene)?.first()) {
+            (Some(kind), Some(resolved)) => match resolved.light {
+                Light::Spot(spot) => Some((kind, spot.position, spot.direction)),
+                Light::Directional(_) | Light::Point(_) => None,
+            },
+            (None, _) | (Some(_), None) => None,
+        };
+        // The camera and the light of frame `i` of the warm-up and timed frames together.
         let place = |settings: &mut Settings, i: u32| {
             let fraction = i as f32 / (frames - 1).max(1) as f32;
             if let Some(kind) = path {
@@ -295,6 +334,9 @@ impl Bench<'_> {
                 let sun = arc.at(fraction);
                 settings.light.sun_elevation = Some(sun.elevation);
                 settings.light.sun_azimuth = Some(sun.azimuth);
+            }
+            if let Some((kind, position, direction)) = spot {
+                settings.light.spot_target = Some(kind.target(position, direction, fraction));
             }
         };
         let settings = &mut settings;

@@ -1,5 +1,6 @@
-//! `bench --sun-path day`: a sun that moves every frame leaves no kept map valid, so
-//! every layer is drawn and its texels counted; a still sun with kept maps draws none.
+//! `bench --sun-path day` and `--spot-path sweep`: a light that moves every frame
+//! leaves no kept map valid, so every layer is drawn and its texels counted; a still
+//! light with kept maps draws none.
 
 use crate::support::{gnomon, stderr, temp_dir};
 
@@ -40,5 +41,22 @@ fn a_moving_sun_draws_every_frame_and_a_still_one_keeps_its_map() {
     // Only the sun moves along a day.
     let out = gnomon(dir, &["bench", "spheres", "--sun-path", "day", "--light", "spot", "--out", "bad"]);
     assert!(!out.status.success() && stderr(&out).contains("--sun-path"), "{}", stderr(&out));
+    assert!(!dir.join("bad").exists());
+}
+
+/// `bench --spot-path sweep`: a spot whose aim swings every frame leaves no kept map
+/// valid, as a moving sun does; only the spot sweeps.
+#[test]
+fn a_sweeping_spot_draws_every_frame() {
+    let temp = temp_dir("bench-spot");
+    let dir = temp.path();
+    let moving = bench(dir, "moving", &["--light", "spot", "--spot-path", "sweep"]);
+    assert_eq!(median(&moving, "layers drawn"), 1.0, "{moving}");
+    assert_eq!(median(&moving, "layers kept"), 0.0, "{moving}");
+    let still = bench(dir, "still", &["--light", "spot"]);
+    assert_eq!(median(&still, "layers kept"), 1.0, "{still}");
+
+    let out = gnomon(dir, &["bench", "spheres", "--spot-path", "sweep", "--out", "bad"]);
+    assert!(!out.status.success() && stderr(&out).contains("--spot-path"), "{}", stderr(&out));
     assert!(!dir.join("bad").exists());
 }
