@@ -28,7 +28,9 @@
 #   7. `lamps:N`: lighting per light with the light list;
 #   8. virtual maps against cascades (`scripts/virtual-vs-cascades.sh`, its own
 #      limit of VIRTUAL_SECONDS, default 240): error, traced share, moving and
-#      still sun at the three views of issue 53.
+#      still sun at the three views of issue 53;
+#   9. a sweeping spot (`bench --spot-path sweep`): its 2D map against its virtual
+#      map, the shadow passes' time and texels.
 set -u
 gnomon=${1:-target/release/gnomon}
 shared=${2:-../shared/scenes}
@@ -205,4 +207,8 @@ if [ "$(date +%s)" -lt "$deadline" ]; then
 else
   printf 'skipped: the run is out of time.\n\n' >> "$md"
 fi
+echo "## 9. A sweeping spot: its 2D map against its virtual map (contact)" >> "$md"
+step spot-sweep "$gnomon" bench contact --light spot --spot-path sweep --techniques pcf2x2 \
+  --frames 60 --warmup 10 --width 1280 --height 720 --sweep partition=single,virtual --out "$out/spot-sweep"
+bench_md spot-sweep
 echo "done: $md"
