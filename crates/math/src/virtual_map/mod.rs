@@ -362,7 +362,7 @@ impl Clipmap {
 
     /// The square that the refinement's search over a sun's cone reads for a pixel
     /// of `level` at world point `point` whose own lookup reaches `reach_texels` of
-    /// `level`: the cone from the point to the sun's disk at the near plane, in the
+    /// `level`: the cone from the point to the light's area at the near plane, in the
     /// search's level ([`Clipmap::search_level`]), a texel more for the taps'
     /// rounding, and the lookup's reach in that level's texels.
     pub fn search_square(

@@ -107,7 +107,7 @@ pub(super) struct LightPlan {
     /// Which of its pixels trace a shadow ray (on the mask path; off for a light with
     /// an area).
     pub refine: Refine,
-    /// A sun's virtual map's pages this frame (`--partition virtual`).
+    /// A sun's or a spot's virtual map's pages this frame (`--partition virtual`).
     pub virtual_map: Option<super::virtual_pages::VirtualPlan>,
 }
 
@@ -180,8 +180,8 @@ fn virtual_lookup_reach(
     technique.virtual_reach(filter, kernel)
 }
 
-/// The refinement's search over a virtual sun's cone, which its page requests ask
-/// for: where rays refine the penumbrae of a sun with an angular size (the
+/// The refinement's search over the cone to a virtual light's area, which its page
+/// requests ask for: where rays refine the penumbrae of a light with a size (the
 /// classification's `REFINE_PENUMBRAE`), none otherwise.
 fn virtual_area_search(refine: Refine, light: &Light, filter: &FilterSettings) -> Option<AreaSearch> {
     let searched = match refine {

@@ -233,7 +233,7 @@ impl Renderer {
         let (filter_reach_texels, cone) = match reach {
             VirtualReach::Texels(texels) => (texels, None),
             // A search over a cone reaches at least a texel round the receiver, even
-            // where the sun has no size and its cone none.
+            // where the light has no size and its cone none.
             VirtualReach::Cone { level_cap, reach_cap } => {
                 let light_size = light.emission().area.size();
                 let cone = (light_size > 0.0).then_some(ConeReach {

@@ -111,7 +111,7 @@ pub enum VirtualReach {
     /// Texels of the pixel's own level round its texel (beyond the bilinear
     /// footprint).
     Texels(f32),
-    /// The sun's cone from the receiver, read in the levels from the pixel's own up
+    /// The light's cone from the receiver, read in the levels from the pixel's own up
     /// to the one whose texels the cone spans in at most `level_cap` texels, and in
     /// each as many texels as it spans there, at most `reach_cap`
     /// ([`gnomon_math::virtual_map::ConeReach`]).
@@ -180,7 +180,7 @@ pub trait ShadowTechnique: Sync {
     }
     /// WGSL sources implementing `fn sample_shadow_virtual(q: VirtualQuery) -> f32`
     /// (as `<module>_sample_shadow_virtual`, or under the contract's own name), the
-    /// lookup in a sun's virtual map through its page table (see
+    /// lookup in a sun's or a spot's virtual map through its page table (see
     /// `virtual_query.wgsl`), for the techniques that can read one; `None` for the
     /// others, which the settings' checks then refuse with `shadow.partition`
     /// virtual.
@@ -193,9 +193,9 @@ pub trait ShadowTechnique: Sync {
     /// (beyond the bilinear footprint): a sample-fitted cascade keeps this margin
     /// around its samples. `kernel_texels` is the PCF kernel's width in texels.
     fn filter_reach_texels(&self, settings: &FilterSettings, kernel_texels: f32) -> f32;
-    /// How far its lookup on a sun's virtual map reads (which pages each pixel asks
-    /// for): the filter's reach in the pixel's own level
-    /// ([`ShadowTechnique::filter_reach_texels`]), unless it reads the sun's cone in
+    /// How far its lookup on a virtual map reads (which pages each pixel asks for):
+    /// the filter's reach in the pixel's own level
+    /// ([`ShadowTechnique::filter_reach_texels`]), unless it reads the light's cone in
     /// coarser levels, as PCSS does.
     fn virtual_reach(&self, settings: &FilterSettings, kernel_texels: f32) -> VirtualReach {
         VirtualReach::Texels(self.filter_reach_texels(settings, kernel_texels))

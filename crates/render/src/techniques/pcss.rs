@@ -60,7 +60,7 @@ mod tests {
 
     /// A sample-fitted cascade keeps a margin as wide as the reach: the blocker
     /// search's taps and the filter's both read there, whichever cap is the larger.
-    /// On a virtual map each reads the sun's cone in the level where it spans at most
+    /// On a virtual map each reads the light's cone in the level where it spans at most
     /// its cap: the coarsest level read is the smaller cap's, and no read reaches
     /// further than the larger cap.
     #[test]

@@ -189,11 +189,11 @@ pub struct PixelReach {
     /// Texels of its level that the pixel's filter reaches from its point: the
     /// kernel's radius, the normal offset's and a texel for bilinear taps.
     pub reach_texels: f32,
-    /// Under a sun with an angular size whose penumbrae rays refine, the search of
-    /// the refinement's footprint test over the sun's cone (`virtual_area_unsure`,
+    /// Under a light with a size whose penumbrae rays refine, the search of the
+    /// refinement's footprint test over the cone to its area (`virtual_area_unsure`,
     /// refine_virtual.wgsl), whose pages each pixel asks for too.
     pub area_search: Option<AreaSearch>,
-    /// Under a technique that reads the sun's cone in coarser levels (PCSS), that
+    /// Under a technique that reads the light's cone in coarser levels (PCSS), that
     /// cone, whose pages each pixel asks for in every level it may read
     /// ([`gnomon_math::virtual_map::Clipmap::cone_requests`]).
     pub cone: Option<ConeReach>,
