@@ -440,35 +440,15 @@ fn a_virtual_maps_levels_give_texels_between_half_a_pixel_and_one() {
     (s.image.width, s.image.height) = (320, 180);
     s.shadow.partition = Partition::Virtual;
     s.screen.refine = Refine::Off;
-    let frame = render(&builtin::columns(), &s);
-    let image = virtual_aliasing(&frame);
-    let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
-    assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
-    let aspect = frame.width as f32 / frame.height as f32;
-    let tan_diagonal = (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() * (aspect * aspect + 1.0).sqrt();
-    let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
-    let outside = defined.iter().filter(|&&m| !(0.5 * cos..=1.0 / cos).contains(&m)).count();
-    assert_eq!(outside, 0, "m from {} to {}: mean {}, max {}", 0.5 * cos, 1.0 / cos, image.mean, image.max);
-    assert!(image.mean > 0.5 && image.mean <= 1.0, "mean m {}", image.mean);
-}
-
-/// Lloyd's m over a frame of a virtual map, each pixel at the level its footprint
-/// picks.
-fn virtual_aliasing(frame: &Frame) -> aliasing::AliasingImage {
-    let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
-    let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
-    let choice =
-        LayerChoice::Clipmap { clipmap: &levels.clipmap, footprint_per_depth: levels.footprint_per_depth };
-    aliasing::measure(&frame_input(frame, &layers, choice, levels.resolution))
+    assert_levels_span_half_a_pixel_to_one(&render(&builtin::columns(), &s), "columns under a sun");
 }
 
 /// A spot's virtual map: its levels' texels grow with the distance from the spot, and
 /// a pixel reads the coarsest level whose texels at its own distance are no larger
-/// than its footprint, so its texels span between half a pixel and one (m within
-/// [cos θ / 2, 1 / cos θ], as a sun's levels, above). A level off by one halves or
-/// doubles m. (A pixel whose footprint is wider than the coarsest level's texels,
-/// 256 across the frustum, would read finer texels than it needs, m below a half;
-/// none is here.)
+/// than its footprint, so its texels span between half a pixel and one, as a sun's
+/// levels' do (above). A level off by one halves or doubles m. (A pixel whose
+/// footprint is wider than the coarsest level's texels, 256 across the frustum, would
+/// read finer texels than it needs, m below a half; none is here.)
 #[test]
 fn a_spots_virtual_levels_give_texels_between_half_a_pixel_and_one() {
     let mut s = Settings::default();
@@ -476,21 +456,40 @@ fn a_spots_virtual_levels_give_texels_between_half_a_pixel_and_one() {
     s.light.kind = gnomon_scene::settings::LightKind::Spot;
     s.shadow.partition = Partition::Virtual;
     s.screen.refine = Refine::Off;
-    let frame = render(&builtin::spheres(), &s);
-    let image = virtual_aliasing(&frame);
+    assert_levels_span_half_a_pixel_to_one(&render(&builtin::spheres(), &s), "spheres under a spot");
+}
+
+/// Lloyd's m over `frame` (a virtual map), each pixel at the level its footprint
+/// picks, lies within [cos θ / 2, 1 / cos θ] at every pixel (θ half the image's
+/// diagonal field of view), and between a half and one on average.
+fn assert_levels_span_half_a_pixel_to_one(frame: &Frame, view: &str) {
+    let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
+    let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
+    let choice =
+        LayerChoice::Clipmap { clipmap: &levels.clipmap, footprint_per_depth: levels.footprint_per_depth };
+    let image = aliasing::measure(&frame_input(frame, &layers, choice, levels.resolution));
     let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
-    assert!(defined.len() > 20_000, "{} pixels measured", defined.len());
+    assert!(defined.len() > 20_000, "{view}: {} pixels measured", defined.len());
     let aspect = frame.width as f32 / frame.height as f32;
     let tan_diagonal = (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() * (aspect * aspect + 1.0).sqrt();
     let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
-    let coarse = defined.iter().filter(|&&m| m < 0.5 * cos).count();
+    let outside = defined.iter().filter(|&&m| !(0.5 * cos..=1.0 / cos).contains(&m)).count();
     eprintln!(
-        "figure: spheres under a spot, virtual map: m mean {:.3}, max {:.3}, {coarse} of {} pixels below cos θ / 2",
+        "figure: {view}, virtual map: m mean {:.3}, max {:.3}, {outside} of {} pixels outside [{:.3}, {:.3}]",
         image.mean,
         image.max,
-        defined.len()
+        defined.len(),
+        0.5 * cos,
+        1.0 / cos
     );
-    assert!(image.max <= 1.0 / cos, "m up to {}: texels wider than a pixel", image.max);
-    assert_eq!(coarse, 0, "texels narrower than half a pixel: mean m {}", image.mean);
-    assert!(image.mean > 0.5 && image.mean <= 1.0, "mean m {}", image.mean);
+    assert_eq!(
+        outside,
+        0,
+        "{view}: m from {} to {}: mean {}, max {}",
+        0.5 * cos,
+        1.0 / cos,
+        image.mean,
+        image.max
+    );
+    assert!(image.mean > 0.5 && image.mean <= 1.0, "{view}: mean m {}", image.mean);
 }
