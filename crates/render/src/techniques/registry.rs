@@ -423,6 +423,23 @@ mod tests {
                 );
             }
         }
+        // A spot takes a virtual map as a sun does; a point light is refused, by name.
+        virtual_sun.filter.technique = Technique::PCF2X2;
+        let spot = Light::Spot(gnomon_scene::SpotLight {
+            position: glam::Vec3::Y,
+            direction: glam::Vec3::NEG_Y,
+            inner_angle_degrees: 20.0,
+            outer_angle_degrees: 30.0,
+            range: 5.0,
+            color: glam::Vec3::ONE,
+            intensity: 1.0,
+            falloff: gnomon_scene::Falloff::Constant,
+            radius: 0.0,
+        });
+        assert!(registry.check_light(&virtual_sun, &spot, "spot").is_ok());
+        let e = registry.check_light(&virtual_sun, &point(), "lamp").unwrap_err();
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.partition", "virtual"));
+        assert!(e.valid.contains("point light `lamp`"), "{}", e.valid);
     }
 
     #[test]
