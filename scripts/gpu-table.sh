@@ -30,7 +30,9 @@
 #      limit of VIRTUAL_SECONDS, default 240): error, traced share, moving and
 #      still sun at the three views of issue 53;
 #   9. a sweeping spot (`bench --spot-path sweep`): its 2D map against its virtual
-#      map, the shadow passes' time and texels.
+#      map, the shadow passes' time and texels;
+#  10. a swaying point light (`bench --point-path sway`): its cube map against its
+#      virtual map, the same.
 set -u
 gnomon=${1:-target/release/gnomon}
 shared=${2:-../shared/scenes}
@@ -211,4 +213,8 @@ echo "## 9. A sweeping spot: its 2D map against its virtual map (contact)" >> "$
 step spot-sweep "$gnomon" bench contact --light spot --spot-path sweep --techniques pcf2x2 \
   --frames 60 --warmup 10 --width 1280 --height 720 --sweep partition=single,virtual --out "$out/spot-sweep"
 bench_md spot-sweep
+echo "## 10. A swaying point light: its cube map against its virtual map (contact)" >> "$md"
+step point-sway "$gnomon" bench contact --light point --point-path sway --techniques pcf2x2 \
+  --frames 60 --warmup 10 --width 1280 --height 720 --sweep partition=single,virtual --out "$out/point-sway"
+bench_md point-sway
 echo "done: $md"

@@ -10,14 +10,12 @@ use std::{collections::BTreeMap, path::PathBuf, time::Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use glam::Vec3;
-use gnomon_math::solar::DayArc;
 use gnomon_render::{
     DepthBaselineScene, FrameCost, Gpu, GpuScene, LayerCache, Renderer,
     timing::{ClockChoice, TimingSource},
 };
 use gnomon_scene::{
-    Light, Scene, Settings,
+    Scene, Settings,
     camera_path::{CameraPathKind, camera_on_path},
     settings::{LightKind, Technique},
 };
@@ -25,6 +23,7 @@ use gnomon_viewer::settings_form::SettingsForm;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::{
+    bench_lights::{LightPaths, PointPathKind, SpotPathKind, SunPathKind},
     bench_report::{ConfigReport, LayerDrawn, Report, Summary, markdown, summarize},
     output::{self, Staged},
 };
@@ -84,6 +83,12 @@ pub struct BenchArgs {
     /// spot (`--light spot`).
     #[arg(long, value_enum, help_heading = "Benchmark")]
     pub spot_path: Option<SpotPathKind>,
+    /// Move the point light every frame along this path over the warm-up and timed
+    /// frames (overriding --point-position), so that no kept map is valid: `sway`
+    /// carries it across a twentieth of its range along x, as a hanging lantern
+    /// swings. Needs the point light (`--light point`).
+    #[arg(long, value_enum, help_heading = "Benchmark")]
+    pub point_path: Option<PointPathKind>,
     /// How to time passes: GPU timestamps where the adapter has them (else the CPU
     /// wall clock), or the CPU wall clock always.
     #[arg(long, value_enum, default_value_t = ClockArg::Auto, help_heading = "Benchmark")]
@@ -96,42 +101,6 @@ pub struct BenchArgs {
     pub verbose: bool,
     #[command(flatten)]
     pub settings: Settings,
-}
-
-/// How `--sun-path` moves the sun.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum SunPathKind {
-    /// A day's arc ([`DayArc::EQUINOX_45_NORTH`]).
-    Day,
-}
-
-impl SunPathKind {
-    fn arc(self) -> DayArc {
-        match self {
-            SunPathKind::Day => DayArc::EQUINOX_45_NORTH,
-        }
-    }
-}
-
-/// How `--spot-path` moves the spot.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum SpotPathKind {
-    /// Its aim swung 30° across, about the vertical through it, from 15° one side
-    /// of the scene's aim to 15° the other.
-    Sweep,
-}
-
-impl SpotPathKind {
-    /// The point frame `fraction` of the path (0 to 1) aims the spot at, for a spot
-    /// at `position` that the scene aims along `direction`.
-    fn target(self, position: Vec3, direction: Vec3, fraction: f32) -> Vec3 {
-        match self {
-            SpotPathKind::Sweep => {
-                let angle = (fraction - 0.5) * 30f32.to_radians();
-                position + glam::Quat::from_rotation_y(angle) * direction
-            }
-        }
-    }
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -149,6 +118,17 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
         return Err(invalid());
     }
     Ok((w, h))
+}
+
+impl BenchArgs {
+    /// The paths its flags move the light along.
+    fn light_paths(&self) -> crate::bench_lights::LightPathArgs {
+        crate::bench_lights::LightPathArgs {
+            sun: self.sun_path,
+            spot: self.spot_path,
+            point: self.point_path,
+        }
+    }
 }
 
 /// Refuses values of the bench's own flags out of their ranges, naming the flag and
@@ -169,6 +149,10 @@ fn check_args(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.spot_path.is_none() || args.settings.light.kind == LightKind::Spot,
         "--spot-path moves the spot: give it with --light spot, not another light"
+    );
+    anyhow::ensure!(
+        args.point_path.is_none() || args.settings.light.kind == LightKind::Point,
+        "--point-path moves the point light: give it with --light point, not another light"
     );
     Ok(())
 }
@@ -314,14 +298,8 @@ impl Bench<'_> {
         let frames = self.args.warmup + self.args.frames;
         let path = self.args.camera_path;
         let travel = self.args.path_travel;
-        let sun_arc = self.args.sun_path.map(SunPathKind::arc);
-        let spot = match (self.args.spot_path, settings.resolve_lights(&self.scene)?.first()) {
-            (Some(kind), Some(resolved)) => match resolved.light {
-                Light::Spot(spot) => Some((kind, spot.position, spot.direction)),
-                Light::Directional(_) | Light::Point(_) => None,
-            },
-            (None, _) | (Some(_), None) => None,
-        };
+        let first = settings.resolve_lights(&self.scene)?.first().map(|resolved| resolved.light);
+        let lights = LightPaths::new(self.args.light_paths(), first);
         // The camera and the light of frame `i` of the warm-up and timed frames together.
         let place = |settings: &mut Settings, i: u32| {
             let fraction = i as f32 / (frames - 1).max(1) as f32;
@@ -330,14 +308,7 @@ impl Bench<'_> {
                 settings.camera.eye = Some(camera.eye);
                 settings.camera.target = Some(camera.target);
             }
-            if let Some(arc) = sun_arc {
-                let sun = arc.at(fraction);
-                settings.light.sun_elevation = Some(sun.elevation);
-                settings.light.sun_azimuth = Some(sun.azimuth);
-            }
-            if let Some((kind, position, direction)) = spot {
-                settings.light.spot_target = Some(kind.target(position, direction, fraction));
-            }
+            lights.place(settings, fraction);
         };
         let settings = &mut settings;
         let mut frame = 0;

@@ -120,7 +120,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         width: reference.width,
         height: reference.height,
         shadow_resolution: virtual_levels.map_or(settings.shadow.map.resolution, |l| l.resolution),
-        virtual_levels: virtual_levels.map(|l| l.projections.len() as u32),
+        virtual_levels: virtual_levels.map(|l| l.clipmap.shape.levels),
         light: format!("{:?}", settings.resolve_light(&scene)?),
         reference_samples: reference.samples,
         adapter: gpu.info.adapter.clone(),

@@ -2,6 +2,7 @@
 //! settings in `gnomon-scene`), runs the renderer, and writes images and float outputs.
 
 mod bench_cmd;
+mod bench_lights;
 mod bench_moving;
 mod bench_report;
 mod cache;

@@ -54,7 +54,8 @@ pub enum LayerChoice<'a> {
     Projection,
     /// A virtual map's level, as its page requests and lookup choose it
     /// ([`Clipmap::level_for_point`] of the pixel's footprint, `footprint_per_depth`
-    /// times its view depth): the layers are its levels' windows.
+    /// times its view depth): the layers are its levels' windows, or for a point
+    /// light each level's faces ([`Clipmap::layer_of`]).
     Clipmap {
         /// The frame's clipmap.
         clipmap: &'a Clipmap,
@@ -83,25 +84,19 @@ pub struct AliasingImage {
 
 /// The layer that shades a point, chosen as the lighting pass does (see
 /// `select_cascade` in the renderer's `map_visibility.wgsl`; the normal offset is
-/// ignored): for a point light, the cube face its direction falls on.
+/// ignored): for a point light's 2D maps, the cube face its direction falls on (or
+/// the paraboloid); for a virtual map, its level's layer.
 pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usize {
-    if let ShadowView::Omni { position, .. } = input.light.shadow_view() {
-        let d = world - position;
-        return match input.layers.len() {
-            // Dual paraboloids: the lower hemisphere is layer 0.
-            2 => usize::from(d.y > 0.0),
-            _ => gnomon_math::omni::CubeFace::of_direction(d).layer() as usize,
-        };
-    }
     let count = input.layers.len();
-    match input.choice {
-        LayerChoice::Splits(splits) => (1..count).rfind(|&i| view_depth > splits[i]).unwrap_or(0),
-        LayerChoice::Clipmap { clipmap, footprint_per_depth } => {
+    match (input.choice, omni_layer(input, world)) {
+        (LayerChoice::Clipmap { clipmap, footprint_per_depth }, _) => {
             let footprint = clipmap.map_footprint(world, view_depth * footprint_per_depth);
             let level = clipmap.level_for_point(clipmap.map_xy(world), footprint);
-            level.map_or(count - 1, |l| l as usize)
+            level.map_or(count - 1, |l| clipmap.layer_of(l, world))
         }
-        LayerChoice::Projection => {
+        (LayerChoice::Splits(_) | LayerChoice::Projection, Some(layer)) => layer,
+        (LayerChoice::Splits(splits), None) => (1..count).rfind(|&i| view_depth > splits[i]).unwrap_or(0),
+        (LayerChoice::Projection, None) => {
             let margin = 4.0 / input.resolution as f32;
             (0..count.saturating_sub(1))
                 .find(|&i| {
@@ -114,6 +109,20 @@ pub fn shading_layer(input: &AliasingInput, world: Vec3, view_depth: f32) -> usi
                 .unwrap_or(count - 1)
         }
     }
+}
+
+/// A point light's 2D maps' layer for `world`: the cube face its direction falls on,
+/// or of dual paraboloids (two layers) the lower hemisphere's 0; None for a sun or a
+/// spot.
+fn omni_layer(input: &AliasingInput, world: Vec3) -> Option<usize> {
+    let ShadowView::Omni { position, .. } = input.light.shadow_view() else {
+        return None;
+    };
+    let d = world - position;
+    Some(match input.layers.len() {
+        2 => usize::from(d.y > 0.0),
+        _ => gnomon_math::omni::CubeFace::of_direction(d).layer() as usize,
+    })
 }
 
 /// Shadow-map texture coordinates (u right, v down, both in [0, 1] inside the map) and

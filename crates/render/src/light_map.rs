@@ -19,22 +19,25 @@ pub(crate) enum MapLookup {
     Cube,
     /// Through a point light's dual paraboloids, into two 2D layers.
     Paraboloid,
-    /// Through a sun's or a spot's virtual map: the clipmap level of the receiver's
-    /// footprint, its page found in the page table (`virtual_map/page_lookup.wgsl`).
+    /// Through a virtual map (a sun's, a spot's or a point light's): the clipmap
+    /// level of the receiver's footprint, its page found in the page table
+    /// (`virtual_map/page_lookup.wgsl`).
     Virtual,
 }
 
 impl MapLookup {
-    /// The map `light` draws under `shadow`: `shadow.map.omni` for an
-    /// omnidirectional view, `shadow.partition` for a sun's or a spot's (a virtual
-    /// partition of a point light is refused by the technique registry's
-    /// `check_light`).
+    /// The map `light` draws under `shadow`: a virtual map where `shadow.partition`
+    /// says so, whatever the light; otherwise `shadow.map.omni` for an
+    /// omnidirectional view, and a 2D map (single or cascades) for a sun's or a
+    /// spot's.
     pub fn of(light: &Light, shadow: &ShadowSettings) -> MapLookup {
         match (light.shadow_view(), shadow.map.omni, shadow.partition) {
-            (ShadowView::Omni { .. }, OmniMap::Cube, _) => MapLookup::Cube,
-            (ShadowView::Omni { .. }, OmniMap::Paraboloid, _) => MapLookup::Paraboloid,
-            (ShadowView::Parallel { .. } | ShadowView::Frustum { .. }, _, Partition::Virtual) => {
-                MapLookup::Virtual
+            (_, _, Partition::Virtual) => MapLookup::Virtual,
+            (ShadowView::Omni { .. }, OmniMap::Cube, Partition::Single | Partition::Cascades) => {
+                MapLookup::Cube
+            }
+            (ShadowView::Omni { .. }, OmniMap::Paraboloid, Partition::Single | Partition::Cascades) => {
+                MapLookup::Paraboloid
             }
             (
                 ShadowView::Parallel { .. } | ShadowView::Frustum { .. },

@@ -1,6 +1,6 @@
-//! `bench --sun-path day` and `--spot-path sweep`: a light that moves every frame
-//! leaves no kept map valid, so every layer is drawn and its texels counted; a still
-//! light with kept maps draws none.
+//! `bench --sun-path day`, `--spot-path sweep` and `--point-path sway`: a light
+//! that moves every frame leaves no kept map valid, so every layer is drawn and its
+//! texels counted; a still light with kept maps draws none.
 
 use crate::support::{gnomon, stderr, temp_dir};
 
@@ -58,5 +58,28 @@ fn a_sweeping_spot_draws_every_frame() {
 
     let out = gnomon(dir, &["bench", "spheres", "--spot-path", "sweep", "--out", "bad"]);
     assert!(!out.status.success() && stderr(&out).contains("--spot-path"), "{}", stderr(&out));
+    assert!(!dir.join("bad").exists());
+}
+
+/// `bench --point-path sway`: a point light carried across every frame redraws all
+/// six faces of its cube map, and every page its virtual map's pixels read; still,
+/// it keeps them; only the point light sways.
+#[test]
+fn a_swaying_point_light_draws_every_frame() {
+    let temp = temp_dir("bench-point");
+    let dir = temp.path();
+    let moving = bench(dir, "moving", &["--light", "point", "--point-path", "sway"]);
+    assert_eq!(median(&moving, "layers drawn"), 6.0, "{moving}");
+    assert_eq!(median(&moving, "layers kept"), 0.0, "{moving}");
+    let still = bench(dir, "still", &["--light", "point"]);
+    assert_eq!(median(&still, "layers kept"), 6.0, "{still}");
+    let virtual_map = ["--light", "point", "--partition", "virtual"];
+    let moving = bench(dir, "moving-virtual", &[&virtual_map[..], &["--point-path", "sway"]].concat());
+    assert!(median(&moving, "pages drawn") > 0.0, "{moving}");
+    let still = bench(dir, "still-virtual", &virtual_map);
+    assert_eq!(median(&still, "pages drawn"), 0.0, "{still}");
+
+    let out = gnomon(dir, &["bench", "spheres", "--point-path", "sway", "--out", "bad"]);
+    assert!(!out.status.success() && stderr(&out).contains("--point-path"), "{}", stderr(&out));
     assert!(!dir.join("bad").exists());
 }

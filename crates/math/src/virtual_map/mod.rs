@@ -1,5 +1,5 @@
-//! Virtual shadow maps for a sun or a spot: the clipmap's geometry and the pages a
-//! pixel needs.
+//! Virtual shadow maps for a sun, a spot or a point light: the clipmap's geometry
+//! and the pages a pixel needs.
 //!
 //! A virtual map replaces the few large textures of cascades with a clipmap of
 //! *virtual* levels around the camera, each [`ClipmapShape::virtual_resolution`]²
@@ -14,7 +14,8 @@
 //!   in map units, and the depth the map stores. A sun's is orthographic along its rigid
 //!   `light_from_world`, so its map units are world units; a spot's is its perspective
 //!   frustum, so its map units are its normalized device coordinates and a texel's
-//!   world size grows with the distance from the light ([`Clipmap::world_per_map`]).
+//!   world size grows with the distance from the light ([`Clipmap::world_per_map`]);
+//!   a point light's is six such frusta round a cube's faces, side by side ([`cube`]).
 //!   Either way a plane in the world stays a plane in map space, so depth is affine
 //!   in texels over a receiver's plane.
 //! - Level `l`'s texels are `2^l` times level 0's, and level 0's are a power of two in
@@ -24,16 +25,18 @@
 //!   its coordinates halved ([`PageKey::coarser`]).
 //! - A sun's level windows of `pages_per_side`² pages are centred on the camera,
 //!   snapped to whole pages ([`Clipmap::new`]). A spot's are fixed on its axis, level
-//!   0's over its whole frustum: a mip chain ([`Clipmap::spot`]).
+//!   0's over its whole frustum: a mip chain ([`Clipmap::spot`]); a point light's hold
+//!   its six faces' chains ([`Clipmap::point`]).
 //! - A pixel asks for the finest level whose texels are no smaller than its footprint
 //!   (about one texel per pixel), and for every page its filter and normal offset may
 //!   reach ([`Clipmap::request`]).
 
+pub mod cube;
 mod map_space;
 pub mod pages;
 pub mod runs;
 
-pub use map_space::MapProjection;
+pub use map_space::{MapFrame, MapProjection};
 
 use glam::{IVec2, Mat4, Vec2, Vec3};
 
@@ -166,7 +169,7 @@ pub struct SearchSquare {
     pub reach: f32,
 }
 
-/// One frame's clipmap for a sun or a spot: where each level lies, and its depth range.
+/// One frame's clipmap for a sun, a spot or a point light: where each level lies, and its depth range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
     /// Its levels' size and paging.
@@ -304,23 +307,25 @@ impl Clipmap {
     /// The pages of `level` that a caster within `bounds` can write: those over its
     /// shadow in map space, the rectangle its corners cover seen from the light (for
     /// a spot, the whole window where a corner lies before its near plane, where the
-    /// projection stops bounding it). A caster that moves dirties these pages where
+    /// projection stops bounding it; for a point light, such a rectangle in each face,
+    /// [`Clipmap::cube_pages_under`]). A caster that moves dirties these pages where
     /// it was and where it is.
-    pub fn pages_under(&self, level: u32, bounds: &Aabb) -> Option<PageRect> {
+    pub fn pages_under(&self, level: u32, bounds: &Aabb) -> Vec<PageRect> {
         let in_light = bounds.transformed(self.light_from_world);
         match self.projection {
             MapProjection::Orthographic => {
-                self.pages_over(level, in_light.min.truncate(), in_light.max.truncate())
+                self.pages_over(level, in_light.min.truncate(), in_light.max.truncate()).into_iter().collect()
             }
             MapProjection::Perspective { .. } if -in_light.max.z < self.near => {
-                Some(self.level_window(level))
+                vec![self.level_window(level)]
             }
             MapProjection::Perspective { .. } => {
                 let corners = bounds.corners().map(|c| self.map_xy(c));
                 let low = corners.iter().copied().fold(Vec2::INFINITY, Vec2::min);
                 let high = corners.iter().copied().fold(Vec2::NEG_INFINITY, Vec2::max);
-                self.pages_over(level, low, high)
+                self.pages_over(level, low, high).into_iter().collect()
             }
+            MapProjection::Cube => self.cube_pages_under(level, bounds),
         }
     }
 
@@ -347,8 +352,7 @@ impl Clipmap {
         }
         let xy = self.map_xy(point);
         let level = self.level_for_point(xy, self.map_footprint(point, footprint))?;
-        let reach = reach_texels * self.texel_size(level);
-        self.pages_over(level, xy - Vec2::splat(reach), xy + Vec2::splat(reach))
+        self.pages_around(level, xy, reach_texels * self.texel_size(level))
     }
 
     /// The level in whose texels a search `radius` map units wide round a pixel of
@@ -418,8 +422,7 @@ impl Clipmap {
             .iter()
             .filter_map(|square| {
                 self.page_at(square.level, square.centre)?;
-                let half = Vec2::splat(square.reach);
-                self.pages_over(square.level, square.centre - half, square.centre + half)
+                self.pages_around(square.level, square.centre, square.reach)
             })
             .collect()
     }
@@ -446,8 +449,7 @@ impl Clipmap {
                 self.page_at(l, centre)?;
                 let texel = self.texel_size(l);
                 let spans = (radius / texel).clamp(1.0, cone.reach_cap_texels);
-                let half = Vec2::splat((spans + 1.0 + reach_texels) * texel);
-                self.pages_over(l, centre - half, centre + half)
+                self.pages_around(l, centre, (spans + 1.0 + reach_texels) * texel)
             })
             .collect()
     }
@@ -480,17 +482,21 @@ impl Clipmap {
     }
 
     /// The projection of the pages of `rect` over the clipmap's depth range: a sun's
-    /// orthographic one of their light-space window; a spot's perspective, followed by
-    /// the scale and offset of their window in its normalized device coordinates onto
-    /// [−1, 1]². Page `(x, y)` of it covers its columns `(x − min.x) · page_size …`
+    /// orthographic one of their light-space window; a spot's or a cube face's
+    /// perspective, followed by the scale and offset of their window in its
+    /// normalized device coordinates onto [−1, 1]² (a point light's `rect` lies in one
+    /// face's slot). Page `(x, y)` of it covers its columns `(x − min.x) · page_size …`
     /// and, v down, its rows `(max.y − y) · page_size …`.
     pub fn rect_projection(&self, rect: &PageRect) -> LightProjection {
         let size = self.page_size(rect.level);
-        let (left, bottom) = (rect.min.x as f32 * size, rect.min.y as f32 * size);
-        let (right, top) = ((rect.max.x + 1) as f32 * size, (rect.max.y + 1) as f32 * size);
-        let MapProjection::Perspective { tan_half_fov } = self.projection else {
+        let frame = self.rect_frame(rect);
+        let (left, bottom) =
+            (rect.min.x as f32 * size - frame.slot.x, rect.min.y as f32 * size - frame.slot.y);
+        let (right, top) =
+            ((rect.max.x + 1) as f32 * size - frame.slot.x, (rect.max.y + 1) as f32 * size - frame.slot.y);
+        let Some(tan_half_fov) = self.tan_half_fov() else {
             return LightProjection::orthographic(
-                self.light_from_world,
+                frame.view_from_world,
                 (left, right, bottom, top),
                 self.near,
                 self.far,
@@ -505,8 +511,8 @@ impl Clipmap {
             glam::Vec4::new(-(left + right) / width, -(bottom + top) / height, 0.0, 1.0),
         );
         LightProjection {
-            light_from_world: self.light_from_world,
-            clip_from_light: window_from_map * self.map_from_light(),
+            light_from_world: frame.view_from_world,
+            clip_from_light: window_from_map * self.map_from_view(),
             // A texel's world size, 2 d tan(fov / 2) / resolution, is the window's
             // width over its texels at distance d.
             kind: ProjectionKind::Perspective { fov: 2.0 * (tan_half_fov * 0.5 * width.max(height)).atan() },
@@ -533,3 +539,6 @@ mod tests;
 
 #[cfg(test)]
 mod spot_tests;
+
+#[cfg(test)]
+mod point_tests;

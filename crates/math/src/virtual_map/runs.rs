@@ -9,7 +9,7 @@
 //! moved) is laid out so that runs are long ([`PagePool::pack`](super::pages::PagePool::pack)):
 //! its pages take slots in the order of their level, row and column.
 
-use super::pages::PageGrant;
+use super::{PageKey, pages::PageGrant};
 
 /// Pages side by side in a level's row, from `first` rightwards, whose tiles lie side
 /// by side in one row of the pool from `first.physical` rightwards.
@@ -35,8 +35,10 @@ impl PageRun {
 /// `drawn` (grants with distinct slots) joined into the fewest runs that slot order
 /// allows, in the order of their first slot: a grant extends the run before it when
 /// its page is that run's right neighbour and its slot the next one in the same row
-/// of a pool `tiles_per_row` tiles wide.
-pub fn runs(drawn: &[PageGrant], tiles_per_row: u32) -> Vec<PageRun> {
+/// of a pool `tiles_per_row` tiles wide, unless its page `starts_layer`: a run is
+/// drawn through one projection, which a point light's faces do not share
+/// ([`Clipmap::starts_layer`](super::Clipmap::starts_layer)).
+pub fn runs(drawn: &[PageGrant], tiles_per_row: u32, starts_layer: impl Fn(PageKey) -> bool) -> Vec<PageRun> {
     let mut sorted = drawn.to_vec();
     sorted.sort_unstable_by_key(|g| g.physical);
     let mut runs: Vec<PageRun> = Vec::new();
@@ -46,7 +48,8 @@ pub fn runs(drawn: &[PageGrant], tiles_per_row: u32) -> Vec<PageRun> {
             let same_row = grant.physical == end && end % tiles_per_row != 0;
             let neighbour = grant.page.level == run.first.page.level
                 && grant.page.y == run.first.page.y
-                && grant.page.x == run.first.page.x + run.len as i32;
+                && grant.page.x == run.first.page.x + run.len as i32
+                && !starts_layer(grant.page);
             if same_row && neighbour {
                 run.len += 1;
                 continue;
@@ -86,7 +89,7 @@ mod tests {
         check_invariant(&pool, &allocation);
         let drawn: Vec<_> = allocation.to_draw().copied().collect();
         assert_eq!(drawn.len(), requests.len());
-        let found = runs(&drawn, 4);
+        let found = runs(&drawn, 4, |_| false);
         let spans: Vec<(PageKey, u32, u32)> =
             found.iter().map(|r| (r.first.page, r.first.physical, r.len)).collect();
         assert_eq!(
@@ -105,6 +108,12 @@ mod tests {
         let mut expected = drawn.clone();
         expected.sort_unstable_by_key(|g| g.physical);
         assert_eq!(back, expected);
+        // A page that starts a layer (a point light's face) starts a run.
+        let split = runs(&drawn, 4, |p| p == page(0, 2, 0));
+        assert_eq!(
+            split.iter().map(|r| (r.first.page, r.len)).take(3).collect::<Vec<_>>(),
+            vec![(page(0, 0, 0), 2), (page(0, 2, 0), 2), (page(0, 4, 0), 1)]
+        );
     }
 
     #[test]
@@ -139,7 +148,7 @@ mod tests {
             // Slots in order of level, row and column: every run's pages are
             // neighbours, and no run could be longer.
             let drawn: Vec<_> = allocation.to_draw().copied().collect();
-            let found = runs(&drawn, 5);
+            let found = runs(&drawn, 5, |_| false);
             assert_eq!(found.iter().map(|r| r.len as usize).sum::<usize>(), drawn.len());
             for pair in found.windows(2) {
                 let (a, b) = (pair[0], pair[1]);

@@ -137,7 +137,9 @@ fn a_caster_dirties_exactly_the_pages_under_its_shadow() {
         let caster = Aabb::new(centre - rng.vec(0.05, 1.0), centre + rng.vec(0.05, 1.0));
         // Levels whose windows (32 world units and more) hold every caster whole.
         let level = 12 + (rng.next() * 4.0) as u32;
-        let rect = map.pages_under(level, &caster).expect("the caster is near the camera");
+        let [rect] = map.pages_under(level, &caster)[..] else {
+            panic!("one rectangle: the caster is near the camera")
+        };
         let in_light = caster.transformed(map.light_from_world);
         let size = map.page_size(level);
         // Every page near the caster: dirtied exactly when its window meets the

@@ -459,33 +459,72 @@ fn a_spots_virtual_levels_give_texels_between_half_a_pixel_and_one() {
     assert_levels_span_half_a_pixel_to_one(&render(&builtin::spheres(), &s), "spheres under a spot");
 }
 
+/// The same under a point light: each pixel at its level of its cube face's chain
+/// (`LayerChoice::Clipmap` picks the face's layer of the level).
+#[test]
+fn a_point_lights_virtual_levels_give_texels_between_half_a_pixel_and_one() {
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (320, 180);
+    s.light.kind = gnomon_scene::settings::LightKind::Point;
+    s.shadow.partition = Partition::Virtual;
+    s.screen.refine = Refine::Off;
+    assert_levels_span_half_a_pixel_to_one(&render(&builtin::spheres(), &s), "spheres under a point light");
+}
+
 /// Lloyd's m over `frame` (a virtual map), each pixel at the level its footprint
-/// picks, lies within [cos θ / 2, 1 / cos θ] at every pixel (θ half the image's
-/// diagonal field of view), and between a half and one on average.
+/// picks, lies within [cos θ cos φ / 2, 1 / cos θ] at every pixel (θ half the
+/// image's diagonal field of view; φ the angle between the light's ray to the pixel
+/// and its map's axis, 0 for a sun: a spot's or a cube face's texel is as wide as the
+/// footprint the level matches in the plane across the axis, cos φ as wide across
+/// the ray), and between a half and one on average. A pixel whose footprint is wider
+/// than two of the coarsest level's texels (a spot's or a face's chain stops at 2 × 2
+/// pages) reads finer texels than it needs: its m is only held below 1 / cos θ.
 fn assert_levels_span_half_a_pixel_to_one(frame: &Frame, view: &str) {
     let levels = frame.virtual_levels.as_ref().expect("a virtual map reports its levels");
+    let clipmap = &levels.clipmap;
     let layers: Vec<glam::Mat4> = levels.projections.iter().map(|p| p.clip_from_world()).collect();
-    let choice =
-        LayerChoice::Clipmap { clipmap: &levels.clipmap, footprint_per_depth: levels.footprint_per_depth };
+    let choice = LayerChoice::Clipmap { clipmap, footprint_per_depth: levels.footprint_per_depth };
     let image = aliasing::measure(&frame_input(frame, &layers, choice, levels.resolution));
-    let defined: Vec<f32> = image.m.iter().copied().filter(|m| m.is_finite()).collect();
-    assert!(defined.len() > 20_000, "{view}: {} pixels measured", defined.len());
     let aspect = frame.width as f32 / frame.height as f32;
     let tan_diagonal = (0.5 * frame.camera.fov_y_degrees.to_radians()).tan() * (aspect * aspect + 1.0).sqrt();
     let cos = 1.0 / (1.0 + tan_diagonal * tan_diagonal).sqrt();
-    let outside = defined.iter().filter(|&&m| !(0.5 * cos..=1.0 / cos).contains(&m)).count();
+    let off_axis = |world: glam::Vec3| match clipmap.tan_half_fov() {
+        None => 1.0,
+        Some(_) => {
+            let view = clipmap.frame(world).view_from_world.transform_point3(world);
+            -view.z / view.length()
+        }
+    };
+    let coarsest = clipmap.texel_size(clipmap.shape.levels - 1);
+    let past_the_chain = |world: glam::Vec3, depth: f32| {
+        clipmap.map_footprint(world, depth * levels.footprint_per_depth) >= 2.0 * coarsest
+    };
+    let (mut defined, mut outside, mut clamped) = (0, 0, 0);
+    for ((&m, &world), &depth) in image.m.iter().zip(&frame.position).zip(&frame.depth) {
+        if !m.is_finite() {
+            continue;
+        }
+        defined += 1;
+        let low = if past_the_chain(world, depth) {
+            clamped += 1;
+            0.0
+        } else {
+            0.5 * cos * off_axis(world)
+        };
+        outside += usize::from(!(low..=1.0 / cos).contains(&m));
+    }
+    assert!(defined > 20_000, "{view}: {defined} pixels measured");
     eprintln!(
-        "figure: {view}, virtual map: m mean {:.3}, max {:.3}, {outside} of {} pixels outside [{:.3}, {:.3}]",
+        "figure: {view}, virtual map: m mean {:.3}, max {:.3}, {outside} of {defined} pixels outside [{:.3} cos φ, {:.3}] ({clamped} past the coarsest level)",
         image.mean,
         image.max,
-        defined.len(),
         0.5 * cos,
         1.0 / cos
     );
     assert_eq!(
         outside,
         0,
-        "{view}: m from {} to {}: mean {}, max {}",
+        "{view}: m from {} cos φ to {}: mean {}, max {}",
         0.5 * cos,
         1.0 / cos,
         image.mean,

@@ -23,5 +23,5 @@ mod refine_forward;
 mod refine_soft;
 mod screen_space;
 mod soft_shadows;
+mod virtual_local_lights;
 mod virtual_maps;
-mod virtual_spots;

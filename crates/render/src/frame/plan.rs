@@ -107,7 +107,7 @@ pub(super) struct LightPlan {
     /// Which of its pixels trace a shadow ray (on the mask path; off for a light with
     /// an area).
     pub refine: Refine,
-    /// A sun's or a spot's virtual map's pages this frame (`--partition virtual`).
+    /// Its virtual map's pages this frame (`--partition virtual`).
     pub virtual_map: Option<super::virtual_pages::VirtualPlan>,
 }
 

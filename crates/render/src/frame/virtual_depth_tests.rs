@@ -1,8 +1,9 @@
 //! The frame's own pages (laid out anew, drawn in runs into the pool's layers with
 //! the shadow pass's pipelines, culled per run) hold the depth that a full-resolution
 //! map of their level holds at every texel: the same pass over the bounding rectangle
-//! of the level's pages, drawn whole. On the spheres under a sun and a spot, and on
-//! Sponza where the shared scenes are present.
+//! of the level's pages (of a point light's face's), drawn whole. On the spheres
+//! under a sun, a spot and a point light, and on Sponza where the shared scenes are
+//! present.
 
 use std::collections::BTreeMap;
 
@@ -55,16 +56,21 @@ fn compare_pages(scene: &Scene, settings: &Settings) -> Compared {
     let clipmap = &light.virtual_map.as_ref().expect("a virtual plan").clipmap;
     let pages = renderer.virtual_lights.pages(0);
     let (size, pool_texture) = (pages.size(), pages.texture().clone());
-    let mut levels: BTreeMap<u32, Vec<(PageKey, u32)>> = BTreeMap::new();
+    // The pages of each layer (a level, or a point light's face of one): one
+    // projection draws them.
+    let layers = clipmap.layers();
+    let mut grouped: BTreeMap<usize, Vec<(PageKey, u32)>> = BTreeMap::new();
     for (page, slot) in pages.pages().resident_pages() {
-        levels.entry(page.level).or_default().push((page, slot));
+        let layer = layers.iter().position(|l| l.contains(page)).expect("every page lies in a layer");
+        grouped.entry(layer).or_default().push((page, slot));
     }
-    assert_eq!(levels.values().map(Vec::len).sum::<usize>(), stats.drawn as usize);
+    assert_eq!(grouped.values().map(Vec::len).sum::<usize>(), stats.drawn as usize);
     let pool = depth_of(&gpu, &pool_texture);
     let page = size.page_size as usize;
     let row_texels = size.texels_per_side() as usize;
     let mut seen = Compared::default();
-    for (&level, resident) in &levels {
+    for (&layer, resident) in &grouped {
+        let level = layers[layer].level;
         let min = resident.iter().fold(IVec2::MAX, |m, (p, _)| m.min(IVec2::new(p.x, p.y)));
         let max = resident.iter().fold(IVec2::MIN, |m, (p, _)| m.max(IVec2::new(p.x, p.y)));
         let rect = PageRect { level, min, max };
@@ -153,6 +159,17 @@ fn the_frames_pages_hold_a_full_resolution_maps_depth_on_the_spheres() {
 fn the_frames_pages_hold_a_full_resolution_maps_depth_under_a_spot() {
     let mut s = virtual_sun(320, 180);
     s.light.kind = LightKind::Spot;
+    let seen = compare_pages(&builtin::spheres(), &s);
+    assert!(seen.covered > seen.texels / 10, "the pages hold casters: {seen:?}");
+    assert_holds(&seen);
+}
+
+/// A point light's pages: each face's drawn through its own view, as the full map
+/// of the face's pages of a level is; none crossing a face's slot.
+#[test]
+fn the_frames_pages_hold_a_full_resolution_maps_depth_under_a_point_light() {
+    let mut s = virtual_sun(320, 180);
+    s.light.kind = LightKind::Point;
     let seen = compare_pages(&builtin::spheres(), &s);
     assert!(seen.covered > seen.texels / 10, "the pages hold casters: {seen:?}");
     assert_holds(&seen);

@@ -1,4 +1,5 @@
-//! A sun's or a spot's virtual shadow map in the frame (`--partition virtual`, issue 53).
+//! A light's virtual shadow map in the frame (`--partition virtual`, issue 53): a
+//! sun's, a spot's or a point light's.
 //!
 //! Before recording, [`Renderer::plan_virtual`] draws a depth prepass from the
 //! camera, asks the GPU which pages of the clipmap its pixels read
@@ -160,7 +161,9 @@ pub(crate) struct VirtualPlan {
 /// measures a level's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VirtualLevels {
-    /// Each level's window, finest first: its own projection.
+    /// The projection of the window of each of the clipmap's layers
+    /// ([`Clipmap::layer_window`]): each level's window, finest first; for a point
+    /// light, each level's six faces.
     pub projections: Vec<gnomon_math::LightProjection>,
     /// The frame's clipmap: a pixel reads the level [`Clipmap::level_for_point`]
     /// gives its footprint (along shadow edges, up to
@@ -169,7 +172,7 @@ pub struct VirtualLevels {
     /// A pixel's footprint in world units per unit of view depth, as the page
     /// requests take it (the lod bias included).
     pub footprint_per_depth: f32,
-    /// Texels per side of each level's window.
+    /// Texels per side of each layer.
     pub resolution: u32,
 }
 
@@ -178,8 +181,10 @@ impl VirtualPlan {
     pub fn levels(&self) -> VirtualLevels {
         let clipmap = &self.clipmap;
         let side = clipmap.shape.pages_per_side();
-        let projections = (0..clipmap.shape.levels)
-            .map(|level| clipmap.rect_projection(&clipmap.level_window(level)))
+        let projections = clipmap
+            .layers()
+            .iter()
+            .map(|layer| clipmap.rect_projection(&clipmap.layer_window(layer)))
             .collect();
         VirtualLevels {
             projections,
@@ -226,9 +231,8 @@ impl Renderer {
                 let frustum = spot_light_projection(position, axis, half_angle, near, far);
                 Clipmap::spot(shape, frustum.light_from_world, half_angle.tan(), near, far)
             }
-            ShadowView::Omni { .. } => {
-                unreachable!("the technique registry refuses a virtual map for a point light")
-            }
+            // Six spot-like chains round the cube map's faces, from the same range.
+            ShadowView::Omni { position, near, far } => Clipmap::point(shape, position, near, far),
         };
         let (filter_reach_texels, cone) = match reach {
             VirtualReach::Texels(texels) => (texels, None),
@@ -303,7 +307,7 @@ impl Renderer {
         let edge_params =
             (edge_levels > 0).then(|| PageRequestParams::new(&clipmap, reach, (width, height), edge_levels));
         let to_draw: Vec<_> = allocation.to_draw().copied().collect();
-        let runs = runs(&to_draw, size.pages_per_side);
+        let runs = runs(&to_draw, size.pages_per_side, |page| clipmap.starts_layer(page));
         let drawn = to_draw.len() as u32;
         let stats = PageStats {
             requested: asked,
@@ -408,7 +412,7 @@ impl KeptPages {
         let stale: Vec<_> = moving
             .iter()
             .chain(&self.moving_before)
-            .flat_map(|bounds| (0..levels).filter_map(|level| clipmap.pages_under(level, bounds)))
+            .flat_map(|bounds| (0..levels).flat_map(|level| clipmap.pages_under(level, bounds)))
             .collect();
         if !stale.is_empty() {
             self.pages.invalidate(|page| stale.iter().any(|rect| rect.contains(page)));

@@ -91,7 +91,7 @@ fn struct_layouts() -> Vec<StructLayout> {
         }),
         struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
         struct_layout!(crate::virtual_map::MapSpaceGpu as "MapSpace" {
-            light_from_world, near, far, tan_half_fov, perspective,
+            light_from_world, near, far, tan_half_fov, kind,
         }),
         struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
             map, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,

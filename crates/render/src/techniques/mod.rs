@@ -180,7 +180,8 @@ pub trait ShadowTechnique: Sync {
     }
     /// WGSL sources implementing `fn sample_shadow_virtual(q: VirtualQuery) -> f32`
     /// (as `<module>_sample_shadow_virtual`, or under the contract's own name), the
-    /// lookup in a sun's or a spot's virtual map through its page table (see
+    /// lookup in a virtual map (a sun's, a spot's or a point light's) through its
+    /// page table (see
     /// `virtual_query.wgsl`), for the techniques that can read one; `None` for the
     /// others, which the settings' checks then refuse with `shadow.partition`
     /// virtual.

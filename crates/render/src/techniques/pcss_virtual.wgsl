@@ -1,5 +1,5 @@
-// pcss on a virtual map: pcss.wgsl's three steps (Fernando 2005) for a sun or a
-// spot, with every tap through the page table. Each step reads the level where its
+// pcss on a virtual map: pcss.wgsl's three steps (Fernando 2005) for a sun, a spot
+// or a point light, with every tap through the page table. Each step reads the level where its
 // width spans at most its cap, as a mip chain is read: the pixel's own level, or a
 // coarser one where the cone or the penumbra is wider than the cap in the pixel's
 // texels. So a wide light's search sees its whole cone and a wide penumbra is not
@@ -13,6 +13,7 @@
 // 3. a Poisson disk of bilinear taps that wide, in the level where it spans at most
 //    `max_penumbra_texels` and where the receiver's plane may be trusted that far
 //    (`pcss_virtual_filter_level`).
+import package::constants::MAP_ORTHOGRAPHIC;
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::common::{MAX_RECEIVER_SLOPE_PER_TEXEL, disk_rotation};
@@ -87,7 +88,7 @@ fn pcss_sample_shadow_virtual(q: VirtualQuery) -> f32 {
     if found.count == 0.0 {
         return 1.0;
     }
-    if virtual_map.map.perspective == 1u {
+    if virtual_map.map.kind != MAP_ORTHOGRAPHIC {
         // No blocker lies nearer than the nearest found, so the cone at its depth
         // bounds where a caster can hide the light: searched again over that cone,
         // narrower, so in a finer level. A spot's near plane lies where its settings

@@ -8,8 +8,7 @@ use std::hash::{Hash, Hasher};
 
 use gnomon_scene::{
     Light, Scene, Settings,
-    lights::ShadowView,
-    settings::{Partition, ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
+    settings::{ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
 };
 
 use super::{BUILTIN, ShadowTechnique};
@@ -191,19 +190,6 @@ impl TechniqueRegistry {
             value: technique.technique().to_string(),
             valid: format!("for point light `{name}` {map}: {}", self.names(fits)),
         };
-        match (light.shadow_view(), shadow.partition) {
-            (ShadowView::Omni { .. }, Partition::Virtual) => {
-                return Err(SettingsError {
-                    setting: "shadow.partition",
-                    value: "virtual".into(),
-                    valid: format!(
-                        "single or cascades for point light `{name}`: a virtual map is a sun's or a spot's so far"
-                    ),
-                });
-            }
-            (ShadowView::Parallel { .. } | ShadowView::Frustum { .. }, _)
-            | (ShadowView::Omni { .. }, Partition::Single | Partition::Cascades) => {}
-        }
         match MapLookup::of(light, shadow) {
             MapLookup::Cube if technique.cube_wgsl().is_none() => {
                 Err(refuse("(a cube map)", &|t| t.cube_wgsl().is_some()))
@@ -423,7 +409,9 @@ mod tests {
                 );
             }
         }
-        // A spot takes a virtual map as a sun does; a point light is refused, by name.
+        // A spot and a point light take a virtual map as a sun does, whatever the
+        // point light's `shadow.map.omni`; a technique without a virtual lookup is
+        // refused for them by name.
         virtual_sun.filter.technique = Technique::PCF2X2;
         let spot = Light::Spot(gnomon_scene::SpotLight {
             position: glam::Vec3::Y,
@@ -437,9 +425,13 @@ mod tests {
             radius: 0.0,
         });
         assert!(registry.check_light(&virtual_sun, &spot, "spot").is_ok());
+        assert!(registry.check_light(&virtual_sun, &point(), "lamp").is_ok());
+        virtual_sun.map.omni = gnomon_scene::settings::OmniMap::Paraboloid;
+        assert!(registry.check_light(&virtual_sun, &point(), "lamp").is_ok());
+        virtual_sun.filter.technique = Technique::ESM;
         let e = registry.check_light(&virtual_sun, &point(), "lamp").unwrap_err();
-        assert_eq!((e.setting, e.value.as_str()), ("shadow.partition", "virtual"));
-        assert!(e.valid.contains("point light `lamp`"), "{}", e.valid);
+        assert_eq!((e.setting, e.value.as_str()), ("shadow.filter.technique", "esm"));
+        assert!(e.valid.starts_with("for light `lamp` with `shadow.partition` virtual"), "{}", e.valid);
     }
 
     #[test]

@@ -42,25 +42,56 @@ pub(crate) struct MapSpaceGpu {
     pub light_from_world: Mat4,
     pub near: f32,
     pub far: f32,
-    /// A spot's frustum's half-angle's tangent; 0 for a sun.
+    /// The tangent of a spot's or each cube face's frustum's half-angle; 0 for a sun.
     pub tan_half_fov: f32,
-    /// 1 for a spot's perspective map space, 0 for a sun's orthographic one.
-    pub perspective: u32,
+    /// Its [`MapKindGpu`].
+    pub kind: u32,
+}
+
+/// How a map space projects, as `MapSpace::kind` says it (`MAP_ORTHOGRAPHIC`,
+/// `MAP_PERSPECTIVE` and `MAP_CUBE` in the generated constants).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub(crate) enum MapKindGpu {
+    /// A sun's.
+    Orthographic = 0,
+    /// A spot's.
+    Perspective = 1,
+    /// A point light's cube faces, side by side.
+    Cube = 2,
+}
+
+impl MapKindGpu {
+    /// Every kind, for the generated constants.
+    pub const ALL: [MapKindGpu; 3] = [MapKindGpu::Orthographic, MapKindGpu::Perspective, MapKindGpu::Cube];
+
+    /// Its constant's name in WGSL.
+    pub fn wgsl_name(self) -> &'static str {
+        match self {
+            MapKindGpu::Orthographic => "MAP_ORTHOGRAPHIC",
+            MapKindGpu::Perspective => "MAP_PERSPECTIVE",
+            MapKindGpu::Cube => "MAP_CUBE",
+        }
+    }
+
+    fn of(projection: MapProjection) -> MapKindGpu {
+        match projection {
+            MapProjection::Orthographic => MapKindGpu::Orthographic,
+            MapProjection::Perspective { .. } => MapKindGpu::Perspective,
+            MapProjection::Cube => MapKindGpu::Cube,
+        }
+    }
 }
 
 impl MapSpaceGpu {
     /// `clipmap`'s map space.
     pub fn of(clipmap: &Clipmap) -> Self {
-        let (tan_half_fov, perspective) = match clipmap.projection {
-            MapProjection::Orthographic => (0.0, 0),
-            MapProjection::Perspective { tan_half_fov } => (tan_half_fov, 1),
-        };
         MapSpaceGpu {
             light_from_world: clipmap.light_from_world,
             near: clipmap.near,
             far: clipmap.far,
-            tan_half_fov,
-            perspective,
+            tan_half_fov: clipmap.tan_half_fov().unwrap_or(0.0),
+            kind: MapKindGpu::of(clipmap.projection) as u32,
         }
     }
 }

@@ -4,7 +4,7 @@
 // Many pixels share a page; atomicOr keeps one bit for all of them. The same
 // arithmetic as `Clipmap::request` in gnomon-math, which the tests hold it to.
 
-import package::constants::{AREA_SEARCH_FINER_LEVELS, VIRTUAL_ORIGIN_VECTORS};
+import package::constants::{AREA_SEARCH_FINER_LEVELS, MAP_CUBE, MAP_ORTHOGRAPHIC, VIRTUAL_ORIGIN_VECTORS};
 import package::virtual_map::map_space::{MapSpace, map_axis_distance, map_near_radius, map_point, map_sees};
 
 struct PageRequestParams {
@@ -89,8 +89,9 @@ fn window_level(world: vec3<f32>, level: u32) -> u32 {
 }
 
 // Marks the pages of `level` that a lookup of that level at world point `world` may
-// read: the square `reach_texels` of its texels reach round the point. Nothing where
-// the point lies outside the level's window.
+// read: the square `reach_texels` of its texels reach round the point, within the
+// level's window and, for a point light, its face's slot (`Clipmap::pages_around`).
+// Nothing where the point lies outside the level's window.
 fn request_level_pages(world: vec3<f32>, level: u32, reach_texels: f32) {
     let texel = request_params.finest_texel * exp2(f32(level));
     let page_size = texel * f32(request_params.page_texels);
@@ -102,8 +103,14 @@ fn request_level_pages(world: vec3<f32>, level: u32, reach_texels: f32) {
         return;
     }
     let reach = reach_texels * texel;
-    let low = max(vec2<i32>(floor((xy - reach) / page_size)) - origin, vec2<i32>(0));
-    let high = min(vec2<i32>(floor((xy + reach) / page_size)) - origin, vec2<i32>(side - 1));
+    var low = max(vec2<i32>(floor((xy - reach) / page_size)) - origin, vec2<i32>(0));
+    var high = min(vec2<i32>(floor((xy + reach) / page_size)) - origin, vec2<i32>(side - 1));
+    if request_params.map.kind == MAP_CUBE {
+        // The slot, 2 map units wide, whose borders are whole pages at every level.
+        let slot = floor(xy / 2.0) * 2.0;
+        low = max(low, vec2<i32>(round(slot / page_size)) - origin);
+        high = min(high, vec2<i32>(round((slot + 2.0) / page_size)) - origin - vec2<i32>(1));
+    }
     for (var y = low.y; y <= high.y; y++) {
         for (var x = low.x; x <= high.x; x++) {
             let bit = level * u32(side * side) + u32(y * side + x);
@@ -128,7 +135,7 @@ fn cone_radius(world: vec3<f32>, size: f32) -> f32 {
     let m = request_params.map;
     let distance = map_axis_distance(m, world);
     let reach = size * max(distance - m.near, 0.0);
-    return map_near_radius(m, select(reach / distance, reach, m.perspective == 0u));
+    return map_near_radius(m, select(reach / distance, reach, m.kind == MAP_ORTHOGRAPHIC));
 }
 
 // Marks the pages that the refinement's search over the light's cone reads for a pixel

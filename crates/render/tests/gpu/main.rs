@@ -20,4 +20,5 @@ mod map_cache;
 mod persistence;
 mod submission;
 mod techniques;
+mod virtual_frames;
 mod virtual_pages;

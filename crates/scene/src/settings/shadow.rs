@@ -313,9 +313,10 @@ pub enum Partition {
     /// Cascaded shadow maps for a sun: the view frustum split along its depth, one
     /// --shadow-res map per slice, in a depth texture array (a spot keeps one map).
     Cascades,
-    /// A virtual shadow map for a sun or a spot (issue 53): for a sun, a clipmap of
-    /// 16384² levels in 128² pages around the camera, each level twice the area of the
-    /// one before; for a spot, a mip chain of such levels over its frustum. Only the
+    /// A virtual shadow map (issue 53): for a sun, a clipmap of 16384² levels in 128²
+    /// pages around the camera, each level twice the area of the one before; for a
+    /// spot, a mip chain of such levels over its frustum; for a point light, one over
+    /// each of its cube's faces (whatever --omni says). Only the
     /// pages that visible pixels read, at their own footprint, are drawn, into a pool
     /// of tiles (--page-pool), and kept until the light or a caster over them moves.
     /// Filtered by pcf2x2, a PCF kernel (pcf, pcf-tent, pcf-poisson) or pcss, each
