@@ -92,14 +92,18 @@ impl Clipmap {
     }
 
     /// The frame that draws the pages of `rect` (which lie in one face's slot for a
-    /// point light): the face's, or the light's for a sun or a spot.
+    /// point light: the face whose slot's centre is nearest theirs), or the light's
+    /// for a sun or a spot.
     pub(super) fn rect_frame(&self, rect: &PageRect) -> MapFrame {
         match self.projection {
             MapProjection::Cube => {
                 let size = self.page_size(rect.level);
                 let centre = (rect.min + rect.max + IVec2::ONE).as_vec2() * 0.5 * size;
-                let face = CubeFace::ALL.into_iter().find(|&f| face_slot(f) == slot_of(centre));
-                self.face_frame(face.expect("a point light's pages lie in its faces' slots"))
+                let nearest = |f: &CubeFace| face_slot(*f).distance_squared(centre);
+                let faces = CubeFace::ALL.into_iter();
+                self.face_frame(
+                    faces.min_by(|a, b| nearest(a).total_cmp(&nearest(b))).unwrap_or(CubeFace::PositiveX),
+                )
             }
             MapProjection::Orthographic | MapProjection::Perspective { .. } => {
                 MapFrame { view_from_world: self.light_from_world, slot: Vec2::ZERO }

@@ -275,7 +275,7 @@ impl Renderer {
         // drawing fallbacks nobody reads would cost as much as the pages read.)
         let capacity = size.pages_per_side * size.pages_per_side;
         let requested = if requested.len() > capacity as usize {
-            with_fallbacks(requested, shape.levels)
+            with_fallbacks(requested, clipmap.shape.levels)
         } else {
             requested
         };
@@ -287,7 +287,7 @@ impl Renderer {
             light_from_world: clipmap.light_from_world,
             projection: clipmap.projection,
             finest_texel: clipmap.finest_texel,
-            levels: shape.levels,
+            levels: clipmap.shape.levels,
             near: clipmap.near,
             far: clipmap.far,
             bias: settings.shadow.bias.clone(),

@@ -11,7 +11,7 @@ mod in_the_frame {
     use gnomon_render::{Frame, OutputRequest, PageStats, Renderer};
     use gnomon_scene::{
         Motion, Settings, builtin,
-        settings::{Partition, Refine},
+        settings::{LightKind, Partition, Refine},
     };
 
     use crate::support;
@@ -66,20 +66,37 @@ mod in_the_frame {
         assert_eq!((p.drawn, p.kept), (p.requested - p.refused, 0), "{p:?}");
     }
 
+    /// Under a sun, a spot and a point light: the fallbacks asked for are pages of the
+    /// light's own levels (a spot's chain has 7, a point light's 5). A sun's or a
+    /// spot's view fits under the 4 tiles of a pool 2 a side; a point light's spans
+    /// five of its faces, each of whose coarsest levels is 2 × 2 pages: a pool 4 a
+    /// side (16 tiles, half the 32 pages its pixels ask for here) holds a coarse page
+    /// over each.
     #[test]
     fn an_overfull_pool_refuses_pages_counts_them_and_falls_back_to_coarser_ones() {
         let scene = builtin::spheres();
         let mut renderer = Renderer::new(support::gpu()).unwrap();
-        let ample = renderer.render(&scene, &virtual_sun(24), &OutputRequest::default()).unwrap();
-        let full = renderer.render(&scene, &virtual_sun(2), &OutputRequest::default()).unwrap();
-        let (a, f) = (pages(&ample), pages(&full));
-        assert_eq!(a.refused, 0, "{a:?}");
-        assert_eq!((f.capacity, f.resident), (4, 4), "{f:?}");
-        assert_eq!(f.refused, f.requested - 4, "{f:?}");
-        // The refused pages' pixels read the coarse resident pages: the spheres'
-        // shadows are still there, blurrier, not lost to lit pixels.
-        let (sa, sf) = (shadowed(&ample), shadowed(&full));
-        assert!(sa > 0.02 && sf > 0.5 * sa, "shadowed: {sa} with room, {sf} with 4 tiles");
+        for (kind, full_side) in [(LightKind::Sun, 2), (LightKind::Spot, 2), (LightKind::Point, 4)] {
+            let of = |pool_side| {
+                let mut s = virtual_sun(pool_side);
+                s.light.kind = kind;
+                s
+            };
+            let ample = renderer.render(&scene, &of(24), &OutputRequest::default()).unwrap();
+            let full = renderer.render(&scene, &of(full_side), &OutputRequest::default()).unwrap();
+            let (a, f) = (pages(&ample), pages(&full));
+            let tiles = full_side * full_side;
+            assert_eq!(a.refused, 0, "{kind:?}: {a:?}");
+            assert_eq!((f.capacity, f.resident), (tiles, tiles), "{kind:?}: {f:?}");
+            assert_eq!(f.refused, f.requested - tiles, "{kind:?}: {f:?}");
+            // The refused pages' pixels read the coarse resident pages: the spheres'
+            // shadows are still there, blurrier, not lost to lit pixels.
+            let (sa, sf) = (shadowed(&ample), shadowed(&full));
+            assert!(
+                sa > 0.02 && sf > 0.5 * sa,
+                "{kind:?}: shadowed: {sa} with room, {sf} with {tiles} tiles"
+            );
+        }
     }
 
     /// Pixels whose visibility differs between two frames of one view.
