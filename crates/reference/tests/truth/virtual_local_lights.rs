@@ -158,3 +158,57 @@ fn pcss_on_a_point_lights_virtual_map_is_no_worse_than_on_its_cube_map() {
     assert!(alone.mae <= cube.mae, "{alone:?} against {cube:?}");
     assert!(alone.mae < 0.5 * hard.mae, "PCSS alone {alone:?} against pcf2x2's {hard:?}");
 }
+
+/// PCSS under a point light of radius 1 on `contact`: its blocker search's cone
+/// reaches past a face's guard band, where the next slot of the map holds another
+/// face's directions. Its taps are held in their own face's slot
+/// (`virtual_tap_offset`), so the pixels whose direction from the light lies in the
+/// outer tenth of its face (its second largest component over 0.9 of its largest)
+/// are no more wrong than the rest: their all-pixel MAE is at most the others'.
+/// Reading the next slot drew a seam along the borders.
+#[test]
+fn pcss_on_a_point_lights_virtual_map_has_no_seam_at_its_faces_borders() {
+    let scene = builtin::contact();
+    let mut s = virtual_light(LightKind::Point, Refine::Off);
+    (s.image.width, s.image.height) = (320, 180);
+    s.light.point_radius = Some(1.0);
+    s.reference.samples = 128;
+    s.shadow.filter.technique = Technique::PCSS;
+    let truth = reference(&scene, &s);
+    let frame = render(&scene, &s);
+    let position = s.resolve_light(&scene).unwrap().emission().origin;
+    let gnomon_scene::lights::Origin::Local { position, .. } = position else { panic!("a point light") };
+    let raster = gnomon_reference::metrics::RasterView {
+        visibility: &frame.visibility,
+        object_id: &frame.object_id,
+        depth: &frame.depth,
+    };
+    let classes = gnomon_reference::metrics::classify(raster, &truth);
+    // The direction's place across its face toward the nearest border: its second
+    // largest component over its largest, 1 on the border.
+    let near_border = |world: glam::Vec3| {
+        let mut a = (world - position).abs().to_array();
+        a.sort_by(f32::total_cmp);
+        a[1] > 0.9 * a[2]
+    };
+    let (mut band, mut rest) = ((0.0, 0usize), (0.0, 0usize));
+    for (i, class) in classes.iter().enumerate() {
+        if *class != gnomon_reference::metrics::PixelClass::Compared {
+            continue;
+        }
+        let error = f64::from((frame.visibility[i] - truth.visibility[i]).abs());
+        let sum = if near_border(frame.position[i]) { &mut band } else { &mut rest };
+        (sum.0, sum.1) = (sum.0 + error, sum.1 + 1);
+    }
+    let (band_mae, rest_mae) = (band.0 / band.1.max(1) as f64, rest.0 / rest.1.max(1) as f64);
+    figure(
+        &format!(
+            "contact, point r 1, PCSS alone: MAE in the outer tenth of a face ({} pixels), elsewhere",
+            band.1
+        ),
+        format!("{band_mae:.4}, {rest_mae:.4}"),
+        format!("≤ {rest_mae:.4}"),
+    );
+    assert!(band.1 > 1000, "{} pixels near a border", band.1);
+    assert!(band_mae <= rest_mae, "{band_mae} near the faces' borders against {rest_mae}");
+}

@@ -17,7 +17,7 @@ import package::constants::MAP_ORTHOGRAPHIC;
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_cone_radius, emitter_penumbra_radius};
 import package::techniques::common::{MAX_RECEIVER_SLOPE_PER_TEXEL, disk_rotation};
-import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson, virtual_query_in_level};
+import package::techniques::virtual_query::{VirtualQuery, virtual_distance, virtual_pcf_poisson, virtual_query_in_level, virtual_tap_offset};
 import package::variant::POISSON_DISK;
 import package::virtual_map::map_space::{map_near_radius, map_radius_at};
 import package::virtual_map::page_lookup::{virtual_map, virtual_search_level, virtual_texel_depth};
@@ -37,7 +37,7 @@ fn pcss_virtual_blockers(q: VirtualQuery, radius: f32) -> PcssBlockers {
     let rotation = disk_rotation(q.pixel);
     var found = PcssBlockers(0.0, 0.0, 3.0e38);
     for (var i = 0u; i < light.pcss.blocker_taps; i++) {
-        let offset = rotation * POISSON_DISK[i] * radius;
+        let offset = virtual_tap_offset(q, rotation * POISSON_DISK[i] * radius);
         let stored = virtual_texel_depth(q.level, vec2<i32>(floor(q.texels + offset)));
         if stored < q.depth + dot(q.gradient, offset) {
             let at = virtual_distance(stored);

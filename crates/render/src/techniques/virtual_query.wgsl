@@ -5,7 +5,7 @@
 // its level or stood in for by a coarser one. A tap is a point in texels of the
 // level the pixel reads; the kernels are the 2D maps' (pcf.wgsl, common.wgsl) with
 // their taps moved there.
-import package::constants::MAX_KERNEL_TEXELS;
+import package::constants::{MAP_CUBE, MAX_KERNEL_TEXELS};
 import package::passes::light_binding::light;
 import package::techniques::common::disk_rotation;
 import package::techniques::pcf::{kernel_grid, kernel_grid_x, kernel_grid_y};
@@ -56,10 +56,28 @@ fn virtual_distance(depth: f32) -> f32 {
     return map_distance(virtual_map.map, depth);
 }
 
-// One bilinear comparison tap `offset` texels from the lookup, with the compared
-// depth moved along the receiver's plane.
+// A tap `offset` texels from the lookup, as an offset that stays in the map the
+// receiver lies in: under a point light, within its cube face's slot (2 map units
+// wide, `virtual_map::cube`), the bilinear 2×2 included. The slot's guard band holds
+// its own face's depths round the face; past it lies another face's slot, other
+// directions, so a wider filter (a PCSS cone, a wide kernel at a coarse level) is
+// held at the band's edge, as a cube map without seamless filtering clamps to its
+// face's edge. Unchanged for a sun or a spot.
+fn virtual_tap_offset(q: VirtualQuery, offset: vec2<f32>) -> vec2<f32> {
+    if virtual_map.map.kind != MAP_CUBE {
+        return offset;
+    }
+    let slot = floor(q.texels * q.texel_map / 2.0) * 2.0;
+    let low = slot / q.texel_map + vec2<f32>(0.5);
+    let high = (slot + 2.0) / q.texel_map - vec2<f32>(0.5);
+    return clamp(q.texels + offset, low, high) - q.texels;
+}
+
+// One bilinear comparison tap `offset` texels from the lookup (within its map:
+// `virtual_tap_offset`), with the compared depth moved along the receiver's plane.
 fn virtual_compare_tap(q: VirtualQuery, offset: vec2<f32>) -> f32 {
-    return virtual_pcf2x2_at(q.texels + offset, q.depth + dot(q.gradient, offset), q.level);
+    let tap = virtual_tap_offset(q, offset);
+    return virtual_pcf2x2_at(q.texels + tap, q.depth + dot(q.gradient, tap), q.level);
 }
 
 // The kernel width in texels of the level read (kernel_width_texels for a virtual
