@@ -169,7 +169,8 @@ pub struct SearchSquare {
     pub reach: f32,
 }
 
-/// One frame's clipmap for a sun, a spot or a point light: where each level lies, and its depth range.
+/// One frame's clipmap for a sun, a spot or a point light: where each level lies,
+/// and its depth range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
     /// Its levels' size and paging.
@@ -308,7 +309,7 @@ impl Clipmap {
     /// shadow in map space, the rectangle its corners cover seen from the light (for
     /// a spot, the whole window where a corner lies before its near plane, where the
     /// projection stops bounding it; for a point light, such a rectangle in each face,
-    /// [`Clipmap::cube_pages_under`]). A caster that moves dirties these pages where
+    /// `cube_pages_under` in `cube.rs`). A caster that moves dirties these pages where
     /// it was and where it is.
     pub fn pages_under(&self, level: u32, bounds: &Aabb) -> Vec<PageRect> {
         let in_light = bounds.transformed(self.light_from_world);

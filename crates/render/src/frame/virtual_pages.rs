@@ -172,7 +172,7 @@ pub struct VirtualLevels {
     /// A pixel's footprint in world units per unit of view depth, as the page
     /// requests take it (the lod bias included).
     pub footprint_per_depth: f32,
-    /// Texels per side of each layer.
+    /// Texels per side of each layer's window.
     pub resolution: u32,
 }
 
