@@ -24,6 +24,8 @@ pub(crate) struct FixedBindings {
     /// Bound in place of a virtual map's uniform and page table for the lights
     /// without one.
     placeholder_virtual: VirtualBuffers,
+    /// Bound in place of a depth pyramid where the mask pass reads none.
+    placeholder_pyramid: wgpu::TextureView,
 }
 
 /// A virtual map's uniform and page table, as a light's shadow group binds them.
@@ -44,6 +46,9 @@ pub(crate) struct ShadowViews<'a> {
     pub mask: Option<&'a wgpu::TextureView>,
     /// A sun's virtual map (whose page pool is `map`).
     pub virtual_map: Option<&'a VirtualBuffers>,
+    /// The depth map's min-max pyramid, for the mask pass of a light whose
+    /// penumbrae it classifies.
+    pub pyramid: Option<&'a wgpu::TextureView>,
 }
 
 fn placeholder(
@@ -127,6 +132,10 @@ impl FixedBindings {
                 placeholder(device, "no shadow mask", screen_space::MASK_FORMAT, 1),
                 wgpu::TextureViewDimension::D2,
             ),
+            placeholder_pyramid: view_as(
+                placeholder(device, "no depth pyramid", crate::rays::PYRAMID_FORMAT, 1),
+                wgpu::TextureViewDimension::D2Array,
+            ),
             placeholder_virtual: VirtualBuffers {
                 uniform: placeholder_buffer(
                     device,
@@ -142,8 +151,9 @@ impl FixedBindings {
     /// Group 2 of the lighting and mask passes: a light's maps and their samplers.
     pub fn shadow_group(&self, pool: &mut Pool, layouts: &Layouts, views: ShadowViews) -> wgpu::BindGroup {
         let mask = Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone());
-        // The mask after the shadow resources (`passes::Layouts::shadow`).
-        let bindings = [self.map_bindings(&views), vec![mask]].concat();
+        let pyramid = Binding::View(views.pyramid.unwrap_or(&self.placeholder_pyramid).clone());
+        // The mask and the pyramid after the shadow resources (`passes::Layouts::shadow`).
+        let bindings = [self.map_bindings(&views), vec![mask, pyramid]].concat();
         pool.bind_group("shadow map", &layouts.shadow, &bindings)
     }
 

@@ -12,6 +12,7 @@ mod host_target;
 mod late;
 mod light_passes;
 mod map_cache;
+mod pyramid_cache;
 mod moment_cache;
 mod outputs;
 mod plan;
@@ -47,7 +48,7 @@ use crate::{
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
-    rays::TracePasses,
+    rays::{PyramidPass, TracePasses},
     techniques::TechniqueRegistry,
     timing::ClockChoice,
 };
@@ -63,6 +64,7 @@ struct Passes {
     screen_space: ScreenSpacePass,
     trace: TracePasses,
     moments: MomentPass,
+    pyramid: PyramidPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
     map_scroll: MapScrollPass,
@@ -110,6 +112,7 @@ impl Renderer {
                 screen_space: ScreenSpacePass::new(device, &layouts),
                 trace: TracePasses::default(),
                 moments: MomentPass::new(device, &gpu.queue),
+                pyramid: PyramidPass::new(device),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
                 map_scroll: MapScrollPass::new(device),

@@ -126,6 +126,12 @@ impl LightPlan {
         MapLookup::of(&self.light, &self.settings.shadow)
     }
 
+    /// Whether its mask pass, on the mask path, classifies its penumbrae by its map's
+    /// min-max pyramid, which the frame then builds (`rays::classifies_penumbrae`).
+    pub fn classifies_penumbrae(&self) -> bool {
+        rays::classifies_penumbrae(self.refine, self.lookup(), rays::LightSize::of(&self.light))
+    }
+
     /// Layers of its map.
     pub fn layers(&self) -> u32 {
         self.layout.projections.len() as u32

@@ -17,6 +17,7 @@ use super::{
     cull::Culled,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
+    pyramid_cache::PyramidPlan,
     outputs::{Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
     recording::{DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, Recorded, Recording},
@@ -30,7 +31,7 @@ use crate::{
         moments::{MomentInput, MomentLayout, MomentTarget},
     },
     pool::{Binding, ViewKey},
-    rays::{self, RefineLists},
+    rays::{self, PyramidLayout, RefineLists},
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::CameraGpu,
@@ -126,9 +127,9 @@ impl Renderer {
         request: &SubmitRequest,
     ) -> Recorded {
         let gpu = self.gpu.clone();
-        // Every layer of every light, each light's filter, mask, trace, penumbra filter
-        // and lighting, and the prepass.
-        let timed_passes = plan.lights.iter().map(|p| p.layers() + 5).sum::<u32>() + 1;
+        // Every layer of every light, each light's filter, depth pyramid, mask, trace,
+        // penumbra filter and lighting, and the prepass.
+        let timed_passes = plan.lights.iter().map(|p| p.layers() + 6).sum::<u32>() + 1;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut rec = Recording {
             encoder: &mut encoder,
@@ -280,6 +281,7 @@ impl Renderer {
         light: &LightPlan,
         index: u32,
         map: &wgpu::Texture,
+        classified: PenumbraClassification,
     ) -> LightMaps {
         let gpu = self.gpu.clone();
         let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
@@ -327,7 +329,44 @@ impl Renderer {
             .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
         let virtual_map =
             light.virtual_map.as_ref().map(|plan| Self::virtual_buffers(&mut self.pool, &gpu.queue, plan));
-        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, lookup }
+        let pyramid = match classified {
+            PenumbraClassification::Pyramid => Some(self.depth_pyramid(rec, light, index, &map_view)),
+            PenumbraClassification::None => {
+                self.map_cache.pyramids.forget(index as usize);
+                None
+            }
+        };
+        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, pyramid, lookup }
+    }
+
+    /// Light `index`'s depth pyramid, built from `map` (`rays/pyramid.rs`), or kept
+    /// where its depth map was kept whole and still casters keep maps.
+    fn depth_pyramid(
+        &mut self,
+        rec: &mut Recording,
+        light: &LightPlan,
+        index: u32,
+        map: &wgpu::TextureView,
+    ) -> wgpu::TextureView {
+        let gpu = self.gpu.clone();
+        let layout = PyramidLayout::of(light.map_resolution(), light.layers());
+        let kept = light.settings.shadow.map.cache == MapCacheSetting::StillCasters
+            && self.map_cache.kept_whole(index as usize);
+        let texture = match self.map_cache.pyramids.plan(&gpu.device, index as usize, layout, kept) {
+            PyramidPlan::Keep(texture) => texture,
+            PyramidPlan::Build(texture) => {
+                let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
+                let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("depth pyramid"),
+                    timestamp_writes: rec.clock.compute_writes(slot),
+                });
+                self.passes.pyramid.record(&mut self.pool, &mut pass, map, &texture, layout);
+                drop(pass);
+                rec.clock.end(&gpu, rec.encoder, slot);
+                texture
+            }
+        };
+        self.pool.view(&texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array))
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes
@@ -341,7 +380,11 @@ impl Renderer {
         map: &wgpu::Texture,
         mask_layer: Option<&wgpu::TextureView>,
     ) -> LightBindings {
-        let maps = self.light_maps(rec, light, index, map);
+        let classified = match mask_layer {
+            Some(_) if light.classifies_penumbrae() => PenumbraClassification::Pyramid,
+            Some(_) | None => PenumbraClassification::None,
+        };
+        let maps = self.light_maps(rec, light, index, map, classified);
         let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
         let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(mask_layer));
@@ -349,6 +392,17 @@ impl Renderer {
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
+}
+
+/// How a light's mask pass classifies its penumbrae, and so whether the frame builds
+/// its map's depth pyramid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PenumbraClassification {
+    /// By the pyramid (`rays::classifies_penumbrae`).
+    Pyramid,
+    /// Not by it: a hard light, a light drawn unrefined or on the forward path, a
+    /// cube, paraboloid or virtual map.
+    None,
 }
 
 /// Each light's bindings for the passes from the camera, and the reported light's map.

@@ -121,6 +121,9 @@ pub(super) struct LightMaps {
     pub cube: Option<wgpu::TextureView>,
     /// A sun's virtual map's uniform and page table (its pool is `map`).
     pub virtual_map: Option<VirtualBuffers>,
+    /// The min-max pyramid of the depth map, for a light whose penumbrae the mask
+    /// pass classifies (`rays/pyramid.rs`).
+    pub pyramid: Option<wgpu::TextureView>,
     pub lookup: MapLookup,
 }
 
@@ -133,6 +136,7 @@ impl LightMaps {
             cube: self.cube.as_ref(),
             mask,
             virtual_map: self.virtual_map.as_ref(),
+            pyramid: self.pyramid.as_ref(),
         }
     }
 }

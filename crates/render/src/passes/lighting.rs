@@ -138,6 +138,23 @@ pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -
     parts
 }
 
+/// `pixel_visibility` of the mask pass of a light whose penumbrae it classifies
+/// (`rays::classifies_penumbrae`): the classification of its 2D map
+/// (rays/penumbra_classify.wgsl: lit, umbra or unsure, no technique's estimate) and
+/// the rules of resolve_visibility.wgsl. The technique is linked for the 2D lookup's
+/// cascade choice, which the classification shares.
+pub(crate) fn penumbra_lookup_wgsl(technique: TechniqueRef) -> Vec<String> {
+    let mut parts = vec![techniques::shadow_bindings_wgsl(techniques::OWN_SHADOW_BINDINGS)];
+    parts.extend(techniques::helper_wgsl());
+    parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+    parts.push(include_str!("map_visibility.wgsl").to_owned());
+    parts.push(include_str!("../rays/penumbra_classify.wgsl").to_owned());
+    parts.push(LOOKUP_VISIBILITY.bind("penumbra_map_lookup"));
+    parts.push(include_str!("resolve_visibility.wgsl").to_owned());
+    parts.push(PIXEL_VISIBILITY.bind("resolved_pixel_visibility"));
+    parts
+}
+
 /// The start of every module that shades from the camera: the light, the scene's
 /// declarations, the camera and the shared shading helpers.
 pub(crate) fn camera_shading_wgsl() -> Vec<String> {

@@ -99,6 +99,7 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     #[cfg(not(test))]
     let naming = link::Naming::AsWritten;
     link::link(&all, naming).unwrap_or_else(|error| {
+        eprintln!("LINK ERROR: {error}");
         let comment: String = error.lines().map(|line| format!("// {line}\n")).collect();
         format!(
             "// WESL could not link this shader:\n{comment}const wesl_link_failed: u32 = wesl_link_error;\n"
@@ -175,8 +176,9 @@ pub(crate) struct Layouts {
     pub screen: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the
     /// filterable techniques' moment map and its sampler, a point light's cube with
-    /// its nearest comparison and gathering samplers, and on the mask path the light's
-    /// layer of the shadow mask.
+    /// its nearest comparison and gathering samplers, on the mask path the light's
+    /// layer of the shadow mask, and in the mask pass of a light whose penumbrae it
+    /// classifies the map's min-max pyramid (`rays/pyramid.rs`).
     pub shadow: wgpu::BindGroupLayout,
     /// The shadow receiver's one group, in the host's shader: the light's and the
     /// camera's uniforms, then the shadow resources in the order of `shadow`.
@@ -222,7 +224,23 @@ impl Layouts {
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
             forward_rays: crate::rays::forward_layouts(device),
-            shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(9)]].concat()),
+            shadow: layout(
+                "shadow map",
+                &[
+                    shadow_entries(0),
+                    vec![
+                        unfilterable_texture_entry(9),
+                        fragment_entry(
+                            10,
+                            texture(
+                                wgpu::TextureSampleType::Float { filterable: false },
+                                wgpu::TextureViewDimension::D2Array,
+                            ),
+                        ),
+                    ],
+                ]
+                .concat(),
+            ),
             receiver: layout(
                 "shadow receiver",
                 &[vec![uniform_entry(0, fragment), uniform_entry(1, fragment)], shadow_entries(2)].concat(),

@@ -53,7 +53,11 @@ pub(crate) fn prepass_wgsl() -> String {
 /// The shadow-mask pass's WGSL for `key`, composed.
 pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     let mut parts = lighting::camera_shading_wgsl();
-    parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
+    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+        parts.extend(lighting::penumbra_lookup_wgsl(key.technique));
+    } else {
+        parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
+    }
     parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());

@@ -5,7 +5,7 @@
 //! (`refine_trace.wgsl`). Only listed pixels pay for a ray, and a group of the trace
 //! pass holds listed pixels only, so no lane waits on a neighbour's ray.
 
-use crate::passes::wgsl_interfaces::{DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES};
+use crate::passes::wgsl_interfaces::{AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES};
 use gnomon_scene::settings::Refine;
 
 use std::collections::HashMap;
@@ -45,7 +45,17 @@ pub(crate) fn list_wgsl() -> String {
 /// with each pixel's map answer: never, when `refine` is off; otherwise the
 /// classification ([`classify_wgsl`]) and the list it appends to.
 pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) -> Vec<String> {
-    let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
+    let classified = classifies_penumbrae(refine, lookup, size).then(|| {
+        // The lookup classified the pixel already (`penumbra_map_lookup`): what it
+        // left unsure it said by its visibility.
+        vec![
+            "const REFINE_EVERY_PIXEL: bool = false;\nconst REFINE_PENUMBRAE: bool = true;\n".to_owned(),
+            include_str!("refine_classify.wgsl").to_owned(),
+            RAY_DECIDES.bind("classified_ray_decides"),
+            MAP_UNSURE.bind("classified_map_unsure"),
+        ]
+    });
+    let Some(mut parts) = classified.or_else(|| classify_wgsl(refine, lookup, size)) else {
         return vec![
             include_str!("refine_off.wgsl").to_owned(),
             RAY_DECIDES.bind("unrefined_ray_decides"),
@@ -74,6 +84,23 @@ impl LightSize {
     pub fn of(light: &gnomon_scene::Light) -> Self {
         if light.is_hard() { LightSize::Hard } else { LightSize::Area }
     }
+}
+
+/// Whether the mask pass of a light of `size` refined by `refine` and looked up by
+/// `lookup` classifies its penumbrae by the map's min-max pyramid
+/// (`penumbra_classify.wgsl`): a light with an area whose rays run where the map is
+/// unsure, on a 2D map. Its lookup is then the classification alone, lit, umbra or
+/// unsure, and no technique's estimate.
+pub(crate) fn classifies_penumbrae(refine: Refine, lookup: MapLookup, size: LightSize) -> bool {
+    let traced = match refine {
+        Refine::Auto | Refine::Rays => true,
+        Refine::Off | Refine::EveryPixel => false,
+    };
+    let pyramid = match lookup {
+        MapLookup::Map => true,
+        MapLookup::Cube | MapLookup::Paraboloid | MapLookup::Virtual => false,
+    };
+    traced && pyramid && size == LightSize::Area
 }
 
 /// The WGSL of `ray_decides`, which says whether a ray decides a pixel: the
@@ -127,11 +154,19 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
 /// The shadow rays from surface points (surface_rays.wgsl) with what they need: the
 /// tracer of `traversal`, its bindings in `group`, and the light's samples.
 pub(crate) fn surface_rays_wgsl(group: u32, traversal: Traversal) -> Vec<String> {
-    vec![
+    let mut parts = vec![
         super::trace_wgsl(group, traversal),
         include_str!("light_sample.wgsl").to_owned(),
         include_str!("surface_rays.wgsl").to_owned(),
-    ]
+    ];
+    match traversal {
+        Traversal::Shader => {
+            parts.push(include_str!("penumbra_beam.wgsl").to_owned());
+            parts.push(AREA_VISIBILITY.bind("beam_area_visibility"));
+        }
+        Traversal::RayQuery => parts.push(AREA_VISIBILITY.bind("ray_area_visibility")),
+    }
+    parts
 }
 
 /// The trace pass's WGSL for `traversal` and a light of `size`, composed.

@@ -21,8 +21,8 @@ import package::passes::octahedron::octahedron_decode;
 import package::passes::screen_common::{prepass_normals, prepass_surface};
 import package::passes::shading::light_geometry;
 import package::rays::refine_list::unsure_pixels;
-import package::rays::surface_rays::{area_visibility, centre_ray_blocked, surface_ray_origin};
-import package::variant::{REFINE_GROUP_SIZE, REFINE_PENUMBRAE};
+import package::rays::surface_rays::{centre_ray_blocked, surface_ray_origin};
+import package::variant::{REFINE_GROUP_SIZE, REFINE_PENUMBRAE, area_visibility};
 
 // The light's counters, read only: they are also the pass's indirect dispatch, which
 // no pass may write while it reads them so.
@@ -238,6 +238,7 @@ fn penumbra_across(near: ptr<function, array<f32, 9>>) -> vec2<f32> {
 
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn cs_filter_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    if true { return; }
     let count = listed.count;
     for (var index = id.x; index < count; index += groups.x * REFINE_GROUP_SIZE) {
         let entry = unsure_pixels[index];

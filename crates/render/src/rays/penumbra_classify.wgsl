@@ -1,0 +1,364 @@
+// The mask pass's answer for a light with an area on a 2D map (a sun's map or
+// cascades, a spot's map), when its penumbrae are traced: lit, where no caster the
+// map holds can hide any part of the light from the receiver; in umbra, where one
+// caster the map holds hides all of it; unsure everywhere else, which the trace
+// pass then answers with a penumbra beam (penumbra_beam.wgsl). No technique's
+// estimate is made: under a light with an area the rays decide every pixel the map
+// cannot, so the map only has to say where they need not run.
+//
+// It reads the map's min-max pyramid (depth_pyramid.wgsl) in squares that double
+// around the receiver, so that a search over the cone's whole reach costs a load per
+// level, and a square's least depth bounds every caster in it: the answer "no
+// caster" is never given where the map holds one (a test holds the pyramid to
+// that).
+//
+// A caster at stored depth s, r texels to the side of the receiver, can hide part of
+// the light only if the cone from the receiver to the light is at least r texels wide
+// at the caster's distance: the cone narrows from `emitter_cone_radius(d, 0)` at the
+// light to nothing at the receiver, linearly, and a texel widens linearly with
+// distance (`texel_world_size_at`), so the farthest a caster r texels aside may
+// stand from the light is one division (`farthest_reaching`), and the deepest depth
+// it may store one conversion (`deepest_reaching`).
+//
+// Umbra, when the map's surface over a square that holds the cone's whole cross-
+// section at the surface's nearest depth lies within a thin slab in front of the
+// receiver: each ray of the cone then starts behind that surface and leaves the
+// slab in front of it, inside the square, so it crosses the surface. A slab thin
+// for its square (`UMBRA_SLOPE`) keeps out the silhouettes where a ray could pass
+// beside a caster, not through it: a caster's edge seen over what lies behind it is
+// a jump in depth as deep as the gap between them.
+import package::passes::light_binding::{light, light_depth_from_distance, light_distance_from_depth, texel_shape};
+import package::passes::light_kinds::{emitter_above_plane, emitter_cone_radius};
+import package::passes::map_visibility::select_cascade;
+import package::rays::map_step::map_step;
+import package::techniques::bindings::shadow_map;
+
+// The pyramid of `shadow_map` (rays/pyramid.rs), in the light's shadow group beside
+// the mask.
+@group(2) @binding(10) var depth_pyramid: texture_2d_array<f32>;
+
+// Map texels a side of one texel of the pyramid's first level
+// (`pyramid::FIRST_LEVEL_TEXELS`).
+const PYRAMID_FIRST_TEXELS: f32 = 4.0;
+
+// What the classification answers, as the visibility it stores: lit and umbra are
+// the map's answers; a visibility strictly between 0 and 1 is what
+// refine_classify.wgsl lists for the trace pass.
+const CLASSIFIED_LIT: f32 = 1.0;
+const CLASSIFIED_UMBRA: f32 = 0.0;
+const CLASSIFIED_UNSURE: f32 = 0.5;
+
+// The steepest a caster's surface over an umbra's square may be, as depth along the
+// light over distance across it: up to 63° from facing the light.
+const UMBRA_SLOPE: f32 = 2.0;
+
+// A receiver as the classification sees it, in texels of its layer: where it lies
+// (texel centres at whole numbers), its own depth, and its plane's depth gradient.
+struct Receiver {
+    texel: vec2<f32>,
+    depth: f32,
+    gradient: vec2<f32>,
+    // Its distance from the light along the light's axis.
+    distance: f32,
+    layer: u32,
+};
+
+// How far to the side of the receiver a caster can reach the cone:
+// `emitter_cone_radius` is `cone_at_light` × (1 − at / distance), a texel is
+// `texel_at_light` + `texel_growth` × at wide (the smaller of its two sides).
+struct Reach {
+    cone_at_light: f32,
+    distance: f32,
+    texel_at_light: f32,
+    texel_growth: f32,
+};
+
+fn receiver_reach(r: Receiver) -> Reach {
+    let smaller = min(texel_shape(r.layer).x, texel_shape(r.layer).y);
+    return Reach(
+        emitter_cone_radius(light.emitter, r.distance, 0.0),
+        r.distance,
+        light.cascades[r.layer].texel_world * smaller,
+        light.map.texel_per_distance * smaller,
+    );
+}
+
+// The farthest from the light a caster `texels` to the side may stand and still
+// reach the cone (negative where none can): A (1 − at / d) ≥ texels × (t0 + k at).
+fn farthest_reaching(reach: Reach, texels: f32) -> f32 {
+    let r = max(texels, 0.0);
+    return (reach.cone_at_light - r * reach.texel_at_light)
+        / (reach.cone_at_light / reach.distance + r * reach.texel_growth);
+}
+
+// The deepest stored depth of a caster `texels` to the side that can reach the cone
+// (below every depth where none can).
+fn deepest_reaching(reach: Reach, texels: f32) -> f32 {
+    let at = farthest_reaching(reach, texels);
+    if at <= light.map.near {
+        return -1.0;
+    }
+    return light_depth_from_distance(at);
+}
+
+// The cone's radius in texels at light distance `at`.
+fn cone_texels(reach: Reach, at: f32) -> f32 {
+    let cone = reach.cone_at_light * max(1.0 - at / reach.distance, 0.0);
+    return cone / (reach.texel_at_light + reach.texel_growth * at);
+}
+
+// The receiver at `world` (its plane through the screen derivatives `world_dx`,
+// `world_dy`) in layer `layer`; w of the texel is 0 where it lies outside the layer.
+fn classified_receiver(world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>, layer: u32) -> Receiver {
+    let clip_from_world = light.cascade_clip_from_world[layer];
+    let clip = clip_from_world * vec4<f32>(world, 1.0);
+    let size = light.map.resolution;
+    let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
+    var r = Receiver(vec2<f32>(-1e9), 0.0, vec2<f32>(0.0), distance, layer);
+    if clip.w <= 0.0 {
+        return r;
+    }
+    let ndc = clip.xyz / clip.w;
+    r.texel = (ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5)) * size - vec2<f32>(0.5);
+    r.depth = ndc.z;
+    // The plane's depth gradient per texel, from its two screen tangents.
+    let a = map_step(clip_from_world, ndc, clip.w, world_dx);
+    let b = map_step(clip_from_world, ndc, clip.w, world_dy);
+    let det = a.x * b.y - a.y * b.x;
+    if abs(det) > 1e-20 {
+        r.gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
+    } else {
+        // Seen edge-on from the light: its plane holds no depth to follow.
+        r.gradient = vec2<f32>(1e9);
+    }
+    return r;
+}
+
+// Whether a texel at `offset` from the receiver storing `stored` may hide part of
+// the light: in front of the receiver's plane by more than `tolerance`, and near
+// enough the light to reach the cone from there (a texel's geometry may lie up to a
+// texel nearer the receiver than its centre).
+fn may_hide(r: Receiver, reach: Reach, offset: vec2<f32>, stored: f32, tolerance: f32) -> bool {
+    let plane = r.depth + dot(r.gradient, offset);
+    let aside = max(abs(offset.x), abs(offset.y)) - 1.0;
+    return stored < plane - tolerance && stored <= deepest_reaching(reach, aside);
+}
+
+// One square of the pyramid's level `level`, in map texels (texel centres at whole
+// numbers): its edges, and its least and greatest depth.
+struct Square {
+    lo: vec2<f32>,
+    hi: vec2<f32>,
+    range: vec2<f32>,
+};
+
+fn pyramid_square(layer: u32, level: u32, texel: vec2<i32>) -> Square {
+    let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
+    let lo = vec2<f32>(texel) * side - vec2<f32>(0.5);
+    let range = textureLoad(depth_pyramid, texel, layer, i32(level)).xy;
+    return Square(lo, lo + vec2<f32>(side), range);
+}
+
+// The pyramid's texel of level `level` that holds map texel position `p`.
+fn pyramid_texel(p: vec2<f32>, level: u32) -> vec2<i32> {
+    let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
+    return vec2<i32>(floor((p + vec2<f32>(0.5)) / side));
+}
+
+// What a square says of the casters that may hide part of the light from the
+// receiver.
+const SQUARE_CLEAR: u32 = 0u;
+const SQUARE_HIDES: u32 = 1u;
+const SQUARE_SPLIT: u32 = 2u;
+
+// Whether square `q` holds no caster that can reach the cone (its least depth is
+// deeper than any caster as near the receiver as its nearest edge may reach from),
+// surely holds one (its least depth is in front of the receiver's plane everywhere
+// over it, and near enough the light to reach from its farthest corner), or must be
+// looked at in finer squares.
+fn weigh_square(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> u32 {
+    let near_edge = max(q.lo - r.texel, r.texel - q.hi);
+    let aside = max(max(near_edge.x, near_edge.y), 0.0);
+    if q.range.x > deepest_reaching(reach, aside - 0.5) {
+        return SQUARE_CLEAR;
+    }
+    let corner = max(abs(q.lo - r.texel), abs(q.hi - r.texel));
+    let far = max(corner.x, corner.y);
+    // The receiver's plane is least over the square at one of its corners.
+    let plane_low = r.depth + min(r.gradient.x * (q.lo.x - r.texel.x), r.gradient.x * (q.hi.x - r.texel.x))
+        + min(r.gradient.y * (q.lo.y - r.texel.y), r.gradient.y * (q.hi.y - r.texel.y));
+    if q.range.x < plane_low - tolerance && q.range.x <= deepest_reaching(reach, far) {
+        return SQUARE_HIDES;
+    }
+    return SQUARE_SPLIT;
+}
+
+// Whether any of the 4 × 4 map texels of a first-level square `q` may hide part of
+// the light, each against its own plane depth.
+fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bool {
+    let base = vec2<i32>(q.lo + vec2<f32>(0.5));
+    for (var k = 0; k < 16; k++) {
+        let texel = base + vec2<i32>(k % 4, k / 4);
+        let stored = textureLoad(shadow_map, texel, r.layer, 0);
+        if may_hide(r, reach, vec2<f32>(texel) - r.texel, stored, tolerance) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The deepest the descent of `casters_reach` goes: three squares waiting per level
+// and the four it starts from.
+const DESCENT_STACK: u32 = 48u;
+
+// Whether any caster the map holds may hide part of the light from receiver `r`: a
+// descent of the pyramid from the squares that hold every caster's reach, each
+// square cleared, found to hide, or split into its four (`weigh_square`); a first-
+// level square that cannot be cleared is read texel by texel. A tilted receiver's
+// own surface spans depths in front of it, so the squares round it do not clear at
+// once; they split until they are small for their distance, or are read texel by
+// texel, where each texel is weighed against the plane.
+fn casters_reach(r: Receiver, reach: Reach, widest: f32, tolerance: f32, levels: u32) -> bool {
+    var top = 0u;
+    while top + 1u < levels && PYRAMID_FIRST_TEXELS * f32(1u << top) < widest + 2.0 {
+        top++;
+    }
+    var stack: array<u32, DESCENT_STACK>;
+    var count = 0u;
+    let first = pyramid_texel(r.texel - vec2<f32>(0.5 * PYRAMID_FIRST_TEXELS * f32(1u << top)), top);
+    let dims = vec2<i32>(textureDimensions(depth_pyramid, top));
+    for (var k = 0; k < 4; k++) {
+        let texel = first + vec2<i32>(k % 2, k / 2);
+        // Past the pyramid's edge lies nothing of the map.
+        if all(texel >= vec2<i32>(0)) && all(texel < dims) {
+            stack[count] = pack_square(top, texel);
+            count++;
+        }
+    }
+    while count > 0u {
+        count--;
+        let level = stack[count] >> 28u;
+        let texel = vec2<i32>(vec2<u32>(stack[count] & 0x3fffu, (stack[count] >> 14u) & 0x3fffu));
+        let q = pyramid_square(r.layer, level, texel);
+        let verdict = weigh_square(r, reach, q, tolerance);
+        if verdict == SQUARE_HIDES {
+            return true;
+        }
+        if verdict == SQUARE_CLEAR {
+            continue;
+        }
+        if level == 0u {
+            if first_level_hides(r, reach, q, tolerance) {
+                return true;
+            }
+            continue;
+        }
+        if count + 4u > DESCENT_STACK {
+            // Deeper than the stack: nothing proves the light reaches.
+            return true;
+        }
+        for (var k = 0; k < 4; k++) {
+            stack[count] = pack_square(level - 1u, texel * 2 + vec2<i32>(k % 2, k / 2));
+            count++;
+        }
+    }
+    return false;
+}
+
+// A square as the descent's stack holds it: its level in the top 4 bits, its texel
+// in 14 bits each (a pyramid's first level is at most 2048 texels a side).
+fn pack_square(level: u32, texel: vec2<i32>) -> u32 {
+    let t = vec2<u32>(texel);
+    return (level << 28u) | (t.y << 14u) | t.x;
+}
+
+// The classification of receiver `r` (`CLASSIFIED_*`).
+fn classify_receiver(r: Receiver, seen_normal: vec3<f32>, world: vec3<f32>) -> f32 {
+    let size = light.map.resolution;
+    let reach = receiver_reach(r);
+    let tolerance = 0.5 * (abs(r.gradient.x) + abs(r.gradient.y)) + 4.0 * 1.1920929e-7;
+    // The farthest any caster can reach: from the map's nearest depth.
+    let levels = textureNumLevels(depth_pyramid);
+    let nearest = textureLoad(depth_pyramid, vec2<i32>(0), r.layer, i32(levels) - 1).x;
+    let widest = max(cone_texels(reach, max(light_distance_from_depth(nearest), light.map.near)) + 1.0, 2.5);
+    // What lies past the map's edge is unknown.
+    if any(r.texel - vec2<f32>(widest) < vec2<f32>(-0.5)) || any(r.texel + vec2<f32>(widest) > vec2<f32>(size - 0.5)) {
+        return CLASSIFIED_UNSURE;
+    }
+    if !casters_reach(r, reach, widest, tolerance, levels) {
+        return select(CLASSIFIED_UNSURE, CLASSIFIED_LIT, emitter_above_plane(light.emitter, world, seen_normal));
+    }
+    return select(CLASSIFIED_UNSURE, CLASSIFIED_UMBRA, covered_by_one_caster(r, reach, tolerance, levels));
+}
+
+// Whether one caster the map holds hides all of the light from receiver `r` (the
+// umbra's proof at the top of this file): over a window of radius R round the
+// receiver, for R doubling from a first-level square, the map's depths lie in a
+// slab in front of the receiver, thin for the window, whose nearest depth's cone
+// fits in the window. Each window is read from the coarsest level whose squares are
+// no wider than R (at most 3 × 3 of them), so each holds the one before: its slab
+// only deepens, and once it reaches the receiver or thickens past the bound no wider
+// window can pass.
+fn covered_by_one_caster(r: Receiver, reach: Reach, tolerance: f32, levels: u32) -> bool {
+    let receiver_texel = reach.texel_at_light + reach.texel_growth * r.distance;
+    // In front of the receiver by more than its plane's tolerance and two texels
+    // along the light.
+    let front = light_depth_from_distance(r.distance - 2.0 * receiver_texel) - tolerance;
+    for (var level = 0u; level < levels; level++) {
+        let radius = PYRAMID_FIRST_TEXELS * f32(1u << level);
+        let lo = pyramid_texel(r.texel - vec2<f32>(radius), level);
+        let hi = pyramid_texel(r.texel + vec2<f32>(radius), level);
+        let dims = vec2<i32>(textureDimensions(depth_pyramid, level));
+        if any(lo < vec2<i32>(0)) || any(hi >= dims) {
+            return false;
+        }
+        var range = vec2<f32>(2.0, -1.0);
+        for (var y = lo.y; y <= hi.y; y++) {
+            for (var x = lo.x; x <= hi.x; x++) {
+                let square = pyramid_square(r.layer, level, vec2<i32>(x, y));
+                range = vec2<f32>(min(range.x, square.range.x), max(range.y, square.range.y));
+            }
+        }
+        if range.y >= front {
+            return false;
+        }
+        let near_at = light_distance_from_depth(range.x);
+        let far_at = light_distance_from_depth(range.y);
+        let texel = reach.texel_at_light + reach.texel_growth * near_at;
+        // The window spans at most 2R + 2 squares of R: 4R across.
+        if far_at - near_at > UMBRA_SLOPE * 4.0 * radius * texel {
+            return false;
+        }
+        if cone_texels(reach, near_at) + 1.0 <= radius {
+            return true;
+        }
+    }
+    return false;
+}
+
+// `lookup_visibility` for a light with an area whose penumbrae are traced, on a 2D
+// map: (`CLASSIFIED_*`, the layer that holds the receiver).
+fn penumbra_map_lookup(
+    world: vec3<f32>,
+    n: vec3<f32>,
+    l: vec3<f32>,
+    world_dx: vec3<f32>,
+    world_dy: vec3<f32>,
+    pixel: vec2<f32>,
+    view_depth: f32,
+) -> vec2<f32> {
+    let layer = select_cascade(view_depth, world, n, l);
+    let r = classified_receiver(world, world_dx, world_dy, layer);
+    let plane = cross(world_dx, world_dy);
+    var seen_normal = n;
+    if dot(plane, plane) > 0.0 {
+        seen_normal = normalize(plane) * select(-1.0, 1.0, dot(plane, n) >= 0.0);
+    }
+    return vec2<f32>(classify_receiver(r, seen_normal, world), f32(layer));
+}
+
+// The map is never unsure past the classification: `penumbra_map_lookup` answered
+// unsure by a visibility of one half, which refine_classify.wgsl lists.
+fn classified_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {
+    return false;
+}

@@ -1,0 +1,176 @@
+//! The min-max depth pyramid of a light's shadow map (`depth_pyramid.wgsl`): what
+//! the penumbra classification of a light with an area reads
+//! (`penumbra_classify.wgsl`), to bound in a few loads which casters the map holds
+//! near a receiver's cone to the light. Level m of the pyramid covers the map in
+//! squares of 2^(m+2) texels, every layer (a cascade, a cube face), down to one
+//! texel; its side is a power of two, so that every level halves the one before
+//! and a square of any level lies in one texel of every coarser one.
+
+use crate::pool::{Binding, Pool, ViewKey};
+
+/// The pyramid's format: the least depth in red, the greatest in green.
+pub(crate) const PYRAMID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+
+/// Map texels along each side of one texel of the pyramid's first level.
+pub(crate) const FIRST_LEVEL_TEXELS: u32 = 4;
+
+/// The shape of a map's pyramid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct PyramidLayout {
+    /// The first level's side, in its texels: the least power of two covering the
+    /// map's side over [`FIRST_LEVEL_TEXELS`].
+    pub side: u32,
+    /// Levels, down to one texel.
+    pub levels: u32,
+    /// The map's layers.
+    pub layers: u32,
+}
+
+impl PyramidLayout {
+    /// The pyramid of a map `resolution` texels a side with `layers` layers.
+    pub fn of(resolution: u32, layers: u32) -> Self {
+        let side = resolution.div_ceil(FIRST_LEVEL_TEXELS).next_power_of_two();
+        Self { side, levels: side.ilog2() + 1, layers }
+    }
+
+    /// The texture's size.
+    pub fn size(&self) -> wgpu::Extent3d {
+        wgpu::Extent3d { width: self.side, height: self.side, depth_or_array_layers: self.layers }
+    }
+
+    /// Its usage: written level by level as storage, read by the mask pass.
+    pub const USAGE: wgpu::TextureUsages =
+        wgpu::TextureUsages::STORAGE_BINDING.union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+    /// A texture for it, with every level.
+    pub fn create(&self, device: &wgpu::Device) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth pyramid"),
+            size: self.size(),
+            mip_level_count: self.levels,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: PYRAMID_FORMAT,
+            usage: Self::USAGE,
+            view_formats: &[],
+        })
+    }
+}
+
+/// The pyramid's two pipelines: the first level from the map, each next from the
+/// one before.
+pub(crate) struct PyramidPass {
+    first_layout: wgpu::BindGroupLayout,
+    next_layout: wgpu::BindGroupLayout,
+    first: wgpu::ComputePipeline,
+    next: wgpu::ComputePipeline,
+}
+
+/// Invocations of a workgroup along x and y (`@workgroup_size(8, 8, 1)`).
+const GROUP_SIDE: u32 = 8;
+
+impl PyramidPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry { binding, visibility: compute, ty, count: None };
+        let array = wgpu::TextureViewDimension::D2Array;
+        let written = entry(
+            2,
+            wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: PYRAMID_FORMAT,
+                view_dimension: array,
+            },
+        );
+        let read = |binding, sample_type| {
+            entry(binding, wgpu::BindingType::Texture { sample_type, view_dimension: array, multisampled: false })
+        };
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+        };
+        let first_layout = layout("depth pyramid, first level", &[read(0, wgpu::TextureSampleType::Depth), written]);
+        let next_layout = layout(
+            "depth pyramid, next level",
+            &[read(1, wgpu::TextureSampleType::Float { filterable: false }), written],
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("depth pyramid"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("depth_pyramid.wgsl").into()),
+        });
+        let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry_point),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let first = pipeline(&first_layout, "cs_pyramid_first");
+        let next = pipeline(&next_layout, "cs_pyramid_next");
+        Self { first_layout, next_layout, first, next }
+    }
+
+    /// Records every level of `pyramid` (of `layout`) from the depth map `map` (all
+    /// its layers, as a 2D array) into one compute pass.
+    pub fn record(
+        &self,
+        pool: &mut Pool,
+        pass: &mut wgpu::ComputePass,
+        map: &wgpu::TextureView,
+        pyramid: &wgpu::Texture,
+        layout: PyramidLayout,
+    ) {
+        let level_view = |pool: &mut Pool, level| {
+            pool.view(
+                pyramid,
+                ViewKey {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    base_mip: level,
+                    mips: Some(1),
+                    ..Default::default()
+                },
+            )
+        };
+        for level in 0..layout.levels {
+            let written = Binding::View(level_view(pool, level));
+            let group = if level == 0 {
+                pass.set_pipeline(&self.first);
+                pool.bind_group_numbered(
+                    "depth pyramid, first level",
+                    &self.first_layout,
+                    vec![(0, Binding::View(map.clone())), (2, written)],
+                )
+            } else {
+                pass.set_pipeline(&self.next);
+                let finer = Binding::View(level_view(pool, level - 1));
+                pool.bind_group_numbered("depth pyramid, next level", &self.next_layout, vec![(1, finer), (2, written)])
+            };
+            pass.set_bind_group(0, &group, &[]);
+            let side = (layout.side >> level).max(1);
+            let groups = side.div_ceil(GROUP_SIDE);
+            pass.dispatch_workgroups(groups, groups, layout.layers);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pyramid_covers_its_map_in_levels_that_halve_down_to_one_texel() {
+        for (resolution, side, levels) in [(2048, 512, 10), (256, 64, 7), (1000, 256, 9), (8192, 2048, 12)] {
+            let layout = PyramidLayout::of(resolution, 6);
+            assert_eq!((layout.side, layout.levels), (side, levels), "{resolution}");
+            assert!(layout.side * FIRST_LEVEL_TEXELS >= resolution);
+            assert_eq!(layout.side >> (layout.levels - 1), 1);
+        }
+    }
+}
