@@ -4,12 +4,12 @@
 //! and the frame records no pyramid pass for it. Anything else builds it again, into
 //! the same texture while the map's shape stays.
 
-use crate::rays::PyramidLayout;
+use crate::rays::{Pyramid, PyramidLayout};
 
 /// One light's kept pyramid.
 struct KeptPyramid {
     layout: PyramidLayout,
-    texture: wgpu::Texture,
+    pyramid: Pyramid,
 }
 
 /// Every light's kept pyramid, by the light's index in the frame.
@@ -23,26 +23,26 @@ pub(super) struct PyramidCache {
 /// What a frame does with a light's pyramid.
 pub(super) enum PyramidPlan {
     /// Keep it: built from the depths the map holds now.
-    Keep(wgpu::Texture),
+    Keep(Pyramid),
     /// Build it into this texture.
-    Build(wgpu::Texture),
+    Build(Pyramid),
 }
 
 impl PyramidCache {
     /// Light `index`'s pyramid of `layout`: the kept one where `depths_kept` (its
-    /// depth map is the one it was built from), else a texture to build it into.
+    /// depth map is the one it was built from), else textures to build it into.
     pub fn plan(&mut self, device: &wgpu::Device, index: usize, layout: PyramidLayout, depths_kept: bool) -> PyramidPlan {
         if self.lights.len() <= index {
             self.lights.resize_with(index + 1, || None);
         }
         match &self.lights[index] {
-            Some(kept) if kept.layout == layout && depths_kept => PyramidPlan::Keep(kept.texture.clone()),
-            Some(kept) if kept.layout == layout => PyramidPlan::Build(kept.texture.clone()),
+            Some(kept) if kept.layout == layout && depths_kept => PyramidPlan::Keep(kept.pyramid.clone()),
+            Some(kept) if kept.layout == layout => PyramidPlan::Build(kept.pyramid.clone()),
             Some(_) | None => {
-                self.created += 1;
-                let texture = layout.create(device);
-                self.lights[index] = Some(KeptPyramid { layout, texture: texture.clone() });
-                PyramidPlan::Build(texture)
+                self.created += 2;
+                let pyramid = layout.create(device);
+                self.lights[index] = Some(KeptPyramid { layout, pyramid: pyramid.clone() });
+                PyramidPlan::Build(pyramid)
             }
         }
     }

@@ -20,7 +20,9 @@ use super::{
     pyramid_cache::PyramidPlan,
     outputs::{Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
-    recording::{DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, Recorded, Recording},
+    recording::{
+        DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, PyramidViews, Recorded, Recording,
+    },
     screen::MaskStart,
 };
 use crate::{
@@ -347,26 +349,27 @@ impl Renderer {
         light: &LightPlan,
         index: u32,
         map: &wgpu::TextureView,
-    ) -> wgpu::TextureView {
+    ) -> PyramidViews {
         let gpu = self.gpu.clone();
         let layout = PyramidLayout::of(light.map_resolution(), light.layers());
         let kept = light.settings.shadow.map.cache == MapCacheSetting::StillCasters
             && self.map_cache.kept_whole(index as usize);
-        let texture = match self.map_cache.pyramids.plan(&gpu.device, index as usize, layout, kept) {
-            PyramidPlan::Keep(texture) => texture,
-            PyramidPlan::Build(texture) => {
+        let pyramid = match self.map_cache.pyramids.plan(&gpu.device, index as usize, layout, kept) {
+            PyramidPlan::Keep(pyramid) => pyramid,
+            PyramidPlan::Build(pyramid) => {
                 let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
                 let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("depth pyramid"),
                     timestamp_writes: rec.clock.compute_writes(slot),
                 });
-                self.passes.pyramid.record(&mut self.pool, &mut pass, map, &texture, layout);
+                self.passes.pyramid.record(&mut self.pool, &mut pass, map, &pyramid, layout);
                 drop(pass);
                 rec.clock.end(&gpu, rec.encoder, slot);
-                texture
+                pyramid
             }
         };
-        self.pool.view(&texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array))
+        let whole = ViewKey::whole(wgpu::TextureViewDimension::D2Array);
+        PyramidViews { planes: self.pool.view(&pyramid.planes, whole), ranges: self.pool.view(&pyramid.ranges, whole) }
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes

@@ -121,9 +121,9 @@ pub(super) struct LightMaps {
     pub cube: Option<wgpu::TextureView>,
     /// A sun's virtual map's uniform and page table (its pool is `map`).
     pub virtual_map: Option<VirtualBuffers>,
-    /// The min-max pyramid of the depth map, for a light whose penumbrae the mask
-    /// pass classifies (`rays/pyramid.rs`).
-    pub pyramid: Option<wgpu::TextureView>,
+    /// The depth map's pyramid, for a light whose penumbrae the mask pass
+    /// classifies (`rays/pyramid.rs`).
+    pub pyramid: Option<PyramidViews>,
     pub lookup: MapLookup,
 }
 
@@ -139,6 +139,12 @@ impl LightMaps {
             pyramid: self.pyramid.as_ref(),
         }
     }
+}
+
+/// The views of a depth pyramid's two textures, every level and layer.
+pub(super) struct PyramidViews {
+    pub planes: wgpu::TextureView,
+    pub ranges: wgpu::TextureView,
 }
 
 /// The copies a frame recorded, waiting for its submission.

@@ -228,16 +228,13 @@ impl Layouts {
                 "shadow map",
                 &[
                     shadow_entries(0),
-                    vec![
-                        unfilterable_texture_entry(9),
-                        fragment_entry(
-                            10,
-                            texture(
-                                wgpu::TextureSampleType::Float { filterable: false },
-                                wgpu::TextureViewDimension::D2Array,
-                            ),
-                        ),
-                    ],
+                    vec![unfilterable_texture_entry(9)],
+                    (10..12)
+                        .map(|binding| {
+                            let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+                            fragment_entry(binding, texture(unfiltered, wgpu::TextureViewDimension::D2Array))
+                        })
+                        .collect(),
                 ]
                 .concat(),
             ),

@@ -15,7 +15,7 @@ pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
-pub(crate) use pyramid::{PYRAMID_FORMAT, PyramidLayout, PyramidPass};
+pub(crate) use pyramid::{PLANES_FORMAT, Pyramid, PyramidLayout, PyramidPass, RANGES_FORMAT};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;

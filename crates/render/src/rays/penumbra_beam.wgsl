@@ -58,9 +58,15 @@ struct Beam {
 // cone's widening, for `beam_enters`.
 struct BeamAxis {
     origin: vec3<f32>,
+    direction: vec3<f32>,
+    // cos and sin of the cone's half-angle.
+    cos_half: f32,
+    sin_half: f32,
     inv_plus: vec3<f32>,
     inv_minus: vec3<f32>,
     length: f32,
+    // The receiver's geometric normal: a box wholly below its plane is not entered.
+    normal: vec3<f32>,
 };
 
 fn beam_axis(beam: Beam) -> BeamAxis {
@@ -71,11 +77,16 @@ fn beam_axis(beam: Beam) -> BeamAxis {
     let plus = a + vec3<f32>(k);
     let minus = a - vec3<f32>(k);
     let tiny = vec3<f32>(1e-30);
+    let cos_half = inverseSqrt(1.0 + k * k);
     return BeamAxis(
         beam.origin,
+        a,
+        cos_half,
+        k * cos_half,
         1.0 / select(plus, tiny, abs(plus) < tiny),
         1.0 / select(minus, -tiny, abs(minus) < tiny),
         beam.plane.axis_length,
+        beam.normal,
     );
 }
 
@@ -86,6 +97,11 @@ fn beam_axis(beam: Beam) -> BeamAxis {
 // o + t a ≥ lo − k t and o + t a ≤ hi + k t: a slab test whose two sides have their
 // own slopes, a ± k, exact for the growing cube.
 fn beam_enters(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    // The box's corner farthest along the normal, over the receiver's plane.
+    let above = select(lo, hi, axis.normal > vec3<f32>(0.0)) - axis.origin;
+    if dot(above, axis.normal) <= 0.0 {
+        return false;
+    }
     // t (a + k) ≥ lo − o: a lower bound on t where a + k > 0, an upper one where not.
     let low = (lo - axis.origin) * axis.inv_plus;
     let high = (hi - axis.origin) * axis.inv_minus;
@@ -101,7 +117,17 @@ fn beam_enters(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let t_max = min(min(from_lo_max, from_hi_max), vec3<f32>(axis.length));
     let near = max(t_min.x, max(t_min.y, t_min.z));
     let far = min(t_max.x, min(t_max.y, t_max.z));
-    return near <= far * 1.000001 + 1e-30;
+    if near > far * 1.000001 + 1e-30 {
+        return false;
+    }
+    // And the box's bounding sphere against the cone itself: its centre no farther
+    // outside the cone's surface than its radius (the cube bound above is √3 loose
+    // across an oblique axis).
+    let centre = 0.5 * (lo + hi) - axis.origin;
+    let radius = 0.5 * length(hi - lo);
+    let along = dot(centre, axis.direction);
+    let across = length(centre - along * axis.direction);
+    return across * axis.cos_half - along * axis.sin_half <= radius * 1.000001;
 }
 
 // The samples on the inner side of the plane through the origin with normal `m`:
@@ -170,28 +196,52 @@ fn clip_polygon(beam: Beam, w: ptr<function, array<vec3<f32>, 5>>, count: u32, a
     return n;
 }
 
-// The samples triangle may hide from the beam's origin (before any alpha
-// test).
-fn triangle_mask(beam: Beam, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<u32> {
-    var w = array<vec3<f32>, 5>(v0 - beam.origin, v1 - beam.origin, v2 - beam.origin, vec3<f32>(0.0), vec3<f32>(0.0));
+// The samples the triangle `v0`, `v1`, `v2` may hide from the beam's origin
+// (before any alpha test), of those not yet hidden (`open`): the AND of its three
+// edges' planes through the origin, read one at a time so that a triangle whose first
+// edge leaves nothing open costs one read. A triangle that crosses the receiver's
+// plane across the beam, or the light's, is clipped first (`clipped_mask`).
+fn triangle_mask(beam: Beam, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, open: vec4<u32>) -> vec4<u32> {
+    let w0 = v0 - beam.origin;
+    let w1 = v1 - beam.origin;
+    let w2 = v2 - beam.origin;
     // Wholly below the receiver's plane: it meets no ray that leaves above it.
-    let above = vec3<f32>(dot(w[0], beam.normal), dot(w[1], beam.normal), dot(w[2], beam.normal));
+    let above = vec3<f32>(dot(w0, beam.normal), dot(w1, beam.normal), dot(w2, beam.normal));
     if all(above <= vec3<f32>(0.0)) {
         return vec4<u32>(0u);
     }
     let axis = beam.plane.depth_axis;
-    let depth = vec3<f32>(dot(w[0], axis), dot(w[1], axis), dot(w[2], axis));
+    let depth = vec3<f32>(dot(w0, axis), dot(w1, axis), dot(w2, axis));
     let far = vec3<f32>(beam.plane.far);
     if all(depth <= vec3<f32>(0.0)) || all(depth >= far) {
         return vec4<u32>(0u);
     }
-    var count = 3u;
-    if any(depth <= vec3<f32>(0.0)) {
-        count = clip_polygon(beam, &w, count, 0.0, true);
+    if any(depth <= vec3<f32>(0.0)) || any(depth >= far) {
+        return clipped_mask(beam, w0, w1, w2) & open;
     }
-    if any(depth >= far) {
-        count = clip_polygon(beam, &w, count, beam.plane.far, false);
+    let e01 = cross(w0, w1);
+    let winding = dot(e01, w2);
+    if winding == 0.0 {
+        return vec4<u32>(0u);
     }
+    let side = sign(winding);
+    var mask = plane_mask(beam, side * e01) & open;
+    if all(mask == vec4<u32>(0u)) {
+        return mask;
+    }
+    mask &= plane_mask(beam, side * cross(w1, w2));
+    if all(mask == vec4<u32>(0u)) {
+        return mask;
+    }
+    return mask & plane_mask(beam, side * cross(w2, w0));
+}
+
+// `triangle_mask` of a triangle (`w0`, `w1`, `w2` from the origin) clipped to the
+// depths in front of the receiver and short of the light.
+fn clipped_mask(beam: Beam, w0: vec3<f32>, w1: vec3<f32>, w2: vec3<f32>) -> vec4<u32> {
+    var w = array<vec3<f32>, 5>(w0, w1, w2, vec3<f32>(0.0), vec3<f32>(0.0));
+    var count = clip_polygon(beam, &w, 3u, 0.0, true);
+    count = clip_polygon(beam, &w, count, beam.plane.far, false);
     if count < 3u {
         return vec4<u32>(0u);
     }
@@ -275,7 +325,13 @@ fn walk_beam(beam: Beam) -> BeamHits {
         steps++;
         for (var i = node.first; i < node.first + node.count; i++) {
             let tri = bvh_triangles[i];
-            var hidden = triangle_mask(beam, tri.v0, tri.v1, tri.v2) & ~hits.hidden;
+            // Of a closed mesh, the faces turned one way from the origin alone: a
+            // segment that meets the mesh from outside enters and leaves it, crossing a
+            // face turned each way.
+            if tri.closed == 1u && dot(cross(tri.v1 - tri.v0, tri.v2 - tri.v0), tri.v0 - beam.origin) < 0.0 {
+                continue;
+            }
+            var hidden = triangle_mask(beam, tri.v0, tri.v1, tri.v2, ~hits.hidden);
             if any(hidden != vec4<u32>(0u)) && tri.alpha != NO_ALPHA {
                 hidden = alpha_tested_mask(beam, i, hidden);
             }

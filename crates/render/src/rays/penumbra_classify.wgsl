@@ -33,9 +33,11 @@ import package::passes::map_visibility::select_cascade;
 import package::rays::map_step::map_step;
 import package::techniques::bindings::shadow_map;
 
-// The pyramid of `shadow_map` (rays/pyramid.rs), in the light's shadow group beside
-// the mask.
-@group(2) @binding(10) var depth_pyramid: texture_2d_array<f32>;
+// The pyramid of `shadow_map` (rays/pyramid.rs, depth_pyramid.wgsl), in the light's
+// shadow group beside the mask: each square's plane and least residual, and its
+// least and greatest depth.
+@group(2) @binding(10) var pyramid_planes_read: texture_2d_array<f32>;
+@group(2) @binding(11) var pyramid_ranges_read: texture_2d_array<f32>;
 
 // Map texels a side of one texel of the pyramid's first level
 // (`pyramid::FIRST_LEVEL_TEXELS`).
@@ -145,18 +147,21 @@ fn may_hide(r: Receiver, reach: Reach, offset: vec2<f32>, stored: f32, tolerance
 }
 
 // One square of the pyramid's level `level`, in map texels (texel centres at whole
-// numbers): its edges, and its least and greatest depth.
+// numbers): its edges, its plane (depth at its centre, per texel along x and y, least
+// residual) and its least and greatest depth.
 struct Square {
     lo: vec2<f32>,
     hi: vec2<f32>,
+    plane: vec4<f32>,
     range: vec2<f32>,
 };
 
 fn pyramid_square(layer: u32, level: u32, texel: vec2<i32>) -> Square {
     let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
     let lo = vec2<f32>(texel) * side - vec2<f32>(0.5);
-    let range = textureLoad(depth_pyramid, texel, layer, i32(level)).xy;
-    return Square(lo, lo + vec2<f32>(side), range);
+    let plane = textureLoad(pyramid_planes_read, texel, layer, i32(level));
+    let range = textureLoad(pyramid_ranges_read, texel, layer, i32(level)).xy;
+    return Square(lo, lo + vec2<f32>(side), plane, range);
 }
 
 // The pyramid's texel of level `level` that holds map texel position `p`.
@@ -169,28 +174,37 @@ fn pyramid_texel(p: vec2<f32>, level: u32) -> vec2<i32> {
 // receiver.
 const SQUARE_CLEAR: u32 = 0u;
 const SQUARE_HIDES: u32 = 1u;
-const SQUARE_SPLIT: u32 = 2u;
+const SQUARE_UNDECIDED: u32 = 2u;
 
-// Whether square `q` holds no caster that can reach the cone (its least depth is
-// deeper than any caster as near the receiver as its nearest edge may reach from),
-// surely holds one (its least depth is in front of the receiver's plane everywhere
-// over it, and near enough the light to reach from its farthest corner), or must be
-// looked at in finer squares.
-fn weigh_square(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> u32 {
+// Whether square `q` holds no caster that can reach the cone, holds one, or cannot
+// say. Clear where nothing it holds lies in front of the receiver's plane (its
+// plane, lowered by its least residual, lies behind the receiver's everywhere over
+// it: a tilted floor's own squares, however wide), or where its least depth is deeper
+// than any caster as near the receiver as its nearest edge, or the edge of what was
+// weighed before (`covered`), may reach from. Hides where its least depth is in front
+// of the receiver's plane everywhere over it and near enough the light to reach from
+// its farthest corner.
+fn weigh_square(r: Receiver, reach: Reach, q: Square, tolerance: f32, covered: f32) -> u32 {
+    let centre = 0.5 * (q.lo + q.hi);
+    let half = 0.5 * (q.hi.x - q.lo.x);
+    let receiver_at_centre = r.depth + dot(r.gradient, centre - r.texel);
+    let tilt = abs(q.plane.y - r.gradient.x) + abs(q.plane.z - r.gradient.y);
+    if q.plane.w + q.plane.x - receiver_at_centre - tilt * half >= -tolerance {
+        return SQUARE_CLEAR;
+    }
     let near_edge = max(q.lo - r.texel, r.texel - q.hi);
     let aside = max(max(near_edge.x, near_edge.y), 0.0);
-    if q.range.x > deepest_reaching(reach, aside - 0.5) {
+    if q.range.x > deepest_reaching(reach, max(aside - 0.5, covered - 1.0)) {
         return SQUARE_CLEAR;
     }
     let corner = max(abs(q.lo - r.texel), abs(q.hi - r.texel));
     let far = max(corner.x, corner.y);
     // The receiver's plane is least over the square at one of its corners.
-    let plane_low = r.depth + min(r.gradient.x * (q.lo.x - r.texel.x), r.gradient.x * (q.hi.x - r.texel.x))
-        + min(r.gradient.y * (q.lo.y - r.texel.y), r.gradient.y * (q.hi.y - r.texel.y));
+    let plane_low = receiver_at_centre - (abs(r.gradient.x) + abs(r.gradient.y)) * half;
     if q.range.x < plane_low - tolerance && q.range.x <= deepest_reaching(reach, far) {
         return SQUARE_HIDES;
     }
-    return SQUARE_SPLIT;
+    return SQUARE_UNDECIDED;
 }
 
 // Whether any of the 4 × 4 map texels of a first-level square `q` may hide part of
@@ -207,69 +221,98 @@ fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bo
     return false;
 }
 
-// The deepest the descent of `casters_reach` goes: three squares waiting per level
-// and the four it starts from.
-const DESCENT_STACK: u32 = 48u;
-
-// Whether any caster the map holds may hide part of the light from receiver `r`: a
-// descent of the pyramid from the squares that hold every caster's reach, each
-// square cleared, found to hide, or split into its four (`weigh_square`); a first-
-// level square that cannot be cleared is read texel by texel. A tilted receiver's
-// own surface spans depths in front of it, so the squares round it do not clear at
-// once; they split until they are small for their distance, or are read texel by
-// texel, where each texel is weighed against the plane.
-fn casters_reach(r: Receiver, reach: Reach, widest: f32, tolerance: f32, levels: u32) -> bool {
-    var top = 0u;
-    while top + 1u < levels && PYRAMID_FIRST_TEXELS * f32(1u << top) < widest + 2.0 {
-        top++;
+// Whether a square of level `level` that `weigh_square` could not decide holds a
+// caster, looked at in its four squares of the level below (`split_once`), and theirs
+// again where they cannot say either; a first-level square that cannot say is read
+// texel by texel, and one still undecided `SPLIT_LEVELS` levels down counts as
+// hiding.
+fn split_square_hides(r: Receiver, reach: Reach, level: u32, texel: vec2<i32>, tolerance: f32, covered: f32) -> bool {
+    var undecided: array<u32, 4>;
+    var count = split_once(r, reach, level, texel, tolerance, covered, &undecided);
+    if count > 4u {
+        return true;
     }
-    var stack: array<u32, DESCENT_STACK>;
-    var count = 0u;
-    let first = pyramid_texel(r.texel - vec2<f32>(0.5 * PYRAMID_FIRST_TEXELS * f32(1u << top)), top);
-    let dims = vec2<i32>(textureDimensions(depth_pyramid, top));
-    for (var k = 0; k < 4; k++) {
-        let texel = first + vec2<i32>(k % 2, k / 2);
-        // Past the pyramid's edge lies nothing of the map.
-        if all(texel >= vec2<i32>(0)) && all(texel < dims) {
-            stack[count] = pack_square(top, texel);
-            count++;
-        }
-    }
-    while count > 0u {
-        count--;
-        let level = stack[count] >> 28u;
-        let texel = vec2<i32>(vec2<u32>(stack[count] & 0x3fffu, (stack[count] >> 14u) & 0x3fffu));
-        let q = pyramid_square(r.layer, level, texel);
-        let verdict = weigh_square(r, reach, q, tolerance);
-        if verdict == SQUARE_HIDES {
+    for (var k = 0u; k < count; k++) {
+        var finer: array<u32, 4>;
+        let child = vec2<i32>(vec2<u32>(undecided[k] & 0xffffu, undecided[k] >> 16u));
+        if split_once(r, reach, level - 1u, child, tolerance, covered, &finer) != 0u {
             return true;
-        }
-        if verdict == SQUARE_CLEAR {
-            continue;
-        }
-        if level == 0u {
-            if first_level_hides(r, reach, q, tolerance) {
-                return true;
-            }
-            continue;
-        }
-        if count + 4u > DESCENT_STACK {
-            // Deeper than the stack: nothing proves the light reaches.
-            return true;
-        }
-        for (var k = 0; k < 4; k++) {
-            stack[count] = pack_square(level - 1u, texel * 2 + vec2<i32>(k % 2, k / 2));
-            count++;
         }
     }
     return false;
 }
 
-// A square as the descent's stack holds it: its level in the top 4 bits, its texel
-// in 14 bits each (a pyramid's first level is at most 2048 texels a side).
-fn pack_square(level: u32, texel: vec2<i32>) -> u32 {
-    let t = vec2<u32>(texel);
-    return (level << 28u) | (t.y << 14u) | t.x;
+// Weighs the four squares under square `texel` of level `level`: returns how many
+// cannot say, each into `undecided` (x | y << 16), or more than 4 where one hides. At
+// the first level, a square that cannot say is read texel by texel.
+fn split_once(
+    r: Receiver,
+    reach: Reach,
+    level: u32,
+    texel: vec2<i32>,
+    tolerance: f32,
+    covered: f32,
+    undecided: ptr<function, array<u32, 4>>,
+) -> u32 {
+    if level == 0u {
+        return select(0u, 5u, first_level_hides(r, reach, pyramid_square(r.layer, 0u, texel), tolerance));
+    }
+    var count = 0u;
+    for (var k = 0; k < 4; k++) {
+        let child = texel * 2 + vec2<i32>(k % 2, k / 2);
+        let q = pyramid_square(r.layer, level - 1u, child);
+        let verdict = weigh_square(r, reach, q, tolerance, covered);
+        if verdict == SQUARE_HIDES {
+            return 5u;
+        }
+        if verdict == SQUARE_UNDECIDED {
+            if level == 1u {
+                if first_level_hides(r, reach, q, tolerance) {
+                    return 5u;
+                }
+            } else {
+                (*undecided)[count] = u32(child.x) | (u32(child.y) << 16u);
+                count++;
+            }
+        }
+    }
+    return count;
+}
+
+// Whether any caster the map holds may hide part of the light from receiver `r`:
+// squares that double (the 2 × 2 of each level that hold it), each weighed
+// (`weigh_square`) against what a caster beyond the squares weighed before may
+// reach from, one that cannot say looked at in finer squares
+// (`split_square_hides`), until no caster deeper than the map's nearest can reach
+// farther.
+fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels: u32) -> bool {
+    // Texel centres within this (Chebyshev) distance of the receiver are weighed.
+    var covered = 0.0;
+    for (var level = 0u; level < levels; level++) {
+        if level > 0u && deepest_reaching(reach, covered - 1.0) < nearest {
+            break;
+        }
+        let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
+        let first = pyramid_texel(r.texel - vec2<f32>(0.5 * side), level);
+        for (var k = 0; k < 4; k++) {
+            let texel = first + vec2<i32>(k % 2, k / 2);
+            let verdict = weigh_square(r, reach, pyramid_square(r.layer, level, texel), tolerance, covered);
+            if verdict == SQUARE_HIDES {
+                return true;
+            }
+            if verdict == SQUARE_UNDECIDED {
+                if level == 0u {
+                    if first_level_hides(r, reach, pyramid_square(r.layer, 0u, texel), tolerance) {
+                        return true;
+                    }
+                } else {
+                    return true;
+                }
+            }
+        }
+        covered = 0.5 * side - 0.5;
+    }
+    return false;
 }
 
 // The classification of receiver `r` (`CLASSIFIED_*`).
@@ -278,14 +321,14 @@ fn classify_receiver(r: Receiver, seen_normal: vec3<f32>, world: vec3<f32>) -> f
     let reach = receiver_reach(r);
     let tolerance = 0.5 * (abs(r.gradient.x) + abs(r.gradient.y)) + 4.0 * 1.1920929e-7;
     // The farthest any caster can reach: from the map's nearest depth.
-    let levels = textureNumLevels(depth_pyramid);
-    let nearest = textureLoad(depth_pyramid, vec2<i32>(0), r.layer, i32(levels) - 1).x;
+    let levels = textureNumLevels(pyramid_ranges_read);
+    let nearest = textureLoad(pyramid_ranges_read, vec2<i32>(0), r.layer, i32(levels) - 1).x;
     let widest = max(cone_texels(reach, max(light_distance_from_depth(nearest), light.map.near)) + 1.0, 2.5);
     // What lies past the map's edge is unknown.
     if any(r.texel - vec2<f32>(widest) < vec2<f32>(-0.5)) || any(r.texel + vec2<f32>(widest) > vec2<f32>(size - 0.5)) {
         return CLASSIFIED_UNSURE;
     }
-    if !casters_reach(r, reach, widest, tolerance, levels) {
+    if !casters_reach(r, reach, nearest, tolerance, levels) {
         return select(CLASSIFIED_UNSURE, CLASSIFIED_LIT, emitter_above_plane(light.emitter, world, seen_normal));
     }
     return select(CLASSIFIED_UNSURE, CLASSIFIED_UMBRA, covered_by_one_caster(r, reach, tolerance, levels));
@@ -308,7 +351,7 @@ fn covered_by_one_caster(r: Receiver, reach: Reach, tolerance: f32, levels: u32)
         let radius = PYRAMID_FIRST_TEXELS * f32(1u << level);
         let lo = pyramid_texel(r.texel - vec2<f32>(radius), level);
         let hi = pyramid_texel(r.texel + vec2<f32>(radius), level);
-        let dims = vec2<i32>(textureDimensions(depth_pyramid, level));
+        let dims = vec2<i32>(textureDimensions(pyramid_ranges_read, level));
         if any(lo < vec2<i32>(0)) || any(hi >= dims) {
             return false;
         }

@@ -1,4 +1,4 @@
-//! The min-max depth pyramid of a light's shadow map (`depth_pyramid.wgsl`): what
+//! The depth pyramid of a light's shadow map (`depth_pyramid.wgsl`): what
 //! the penumbra classification of a light with an area reads
 //! (`penumbra_classify.wgsl`), to bound in a few loads which casters the map holds
 //! near a receiver's cone to the light. Level m of the pyramid covers the map in
@@ -8,8 +8,11 @@
 
 use crate::pool::{Binding, Pool, ViewKey};
 
-/// The pyramid's format: the least depth in red, the greatest in green.
-pub(crate) const PYRAMID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+/// The format of the pyramid's planes: a square's depth at its centre, its depth
+/// per map texel along x and y, and the least residual below that plane.
+pub(crate) const PLANES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The format of the pyramid's ranges: a square's least and greatest depth.
+pub(crate) const RANGES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 
 /// Map texels along each side of one texel of the pyramid's first level.
 pub(crate) const FIRST_LEVEL_TEXELS: u32 = 4;
@@ -42,19 +45,33 @@ impl PyramidLayout {
     pub const USAGE: wgpu::TextureUsages =
         wgpu::TextureUsages::STORAGE_BINDING.union(wgpu::TextureUsages::TEXTURE_BINDING);
 
-    /// A texture for it, with every level.
-    pub fn create(&self, device: &wgpu::Device) -> wgpu::Texture {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("depth pyramid"),
-            size: self.size(),
-            mip_level_count: self.levels,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: PYRAMID_FORMAT,
-            usage: Self::USAGE,
-            view_formats: &[],
-        })
+    /// Its two textures, with every level.
+    pub fn create(&self, device: &wgpu::Device) -> Pyramid {
+        let texture = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: self.size(),
+                mip_level_count: self.levels,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: Self::USAGE,
+                view_formats: &[],
+            })
+        };
+        Pyramid {
+            planes: texture("depth pyramid, planes", PLANES_FORMAT),
+            ranges: texture("depth pyramid, ranges", RANGES_FORMAT),
+        }
     }
+}
+
+/// A pyramid's textures (`depth_pyramid.wgsl`): per square, its plane and least
+/// residual, and its range of depths.
+#[derive(Clone, Debug)]
+pub(crate) struct Pyramid {
+    pub planes: wgpu::Texture,
+    pub ranges: wgpu::Texture,
 }
 
 /// The pyramid's two pipelines: the first level from the map, each next from the
@@ -74,24 +91,29 @@ impl PyramidPass {
         let compute = wgpu::ShaderStages::COMPUTE;
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry { binding, visibility: compute, ty, count: None };
         let array = wgpu::TextureViewDimension::D2Array;
-        let written = entry(
-            2,
-            wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: PYRAMID_FORMAT,
-                view_dimension: array,
-            },
-        );
+        let written = |binding, format| {
+            entry(
+                binding,
+                wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format,
+                    view_dimension: array,
+                },
+            )
+        };
         let read = |binding, sample_type| {
             entry(binding, wgpu::BindingType::Texture { sample_type, view_dimension: array, multisampled: false })
         };
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
         };
-        let first_layout = layout("depth pyramid, first level", &[read(0, wgpu::TextureSampleType::Depth), written]);
+        let outputs = [written(3, PLANES_FORMAT), written(4, RANGES_FORMAT)];
+        let first_layout =
+            layout("depth pyramid, first level", &[vec![read(0, wgpu::TextureSampleType::Depth)], outputs.to_vec()].concat());
+        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
         let next_layout = layout(
             "depth pyramid, next level",
-            &[read(1, wgpu::TextureSampleType::Float { filterable: false }), written],
+            &[vec![read(1, unfiltered), read(2, unfiltered)], outputs.to_vec()].concat(),
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("depth pyramid"),
@@ -124,33 +146,35 @@ impl PyramidPass {
         pool: &mut Pool,
         pass: &mut wgpu::ComputePass,
         map: &wgpu::TextureView,
-        pyramid: &wgpu::Texture,
+        pyramid: &Pyramid,
         layout: PyramidLayout,
     ) {
-        let level_view = |pool: &mut Pool, level| {
-            pool.view(
-                pyramid,
+        let levels_view = |pool: &mut Pool, texture: &wgpu::Texture, base_mip, mips| {
+            Binding::View(pool.view(
+                texture,
                 ViewKey {
                     dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    base_mip: level,
-                    mips: Some(1),
+                    base_mip,
+                    mips: Some(mips),
                     ..Default::default()
                 },
-            )
+            ))
         };
         for level in 0..layout.levels {
-            let written = Binding::View(level_view(pool, level));
+            let mut bindings = vec![
+                (3, levels_view(pool, &pyramid.planes, level, 1)),
+                (4, levels_view(pool, &pyramid.ranges, level, 1)),
+            ];
             let group = if level == 0 {
                 pass.set_pipeline(&self.first);
-                pool.bind_group_numbered(
-                    "depth pyramid, first level",
-                    &self.first_layout,
-                    vec![(0, Binding::View(map.clone())), (2, written)],
-                )
+                bindings.push((0, Binding::View(map.clone())));
+                pool.bind_group_numbered("depth pyramid, first level", &self.first_layout, bindings)
             } else {
                 pass.set_pipeline(&self.next);
-                let finer = Binding::View(level_view(pool, level - 1));
-                pool.bind_group_numbered("depth pyramid, next level", &self.next_layout, vec![(1, finer), (2, written)])
+                // Every finer level, so that the shader knows which is the last.
+                bindings.push((1, levels_view(pool, &pyramid.planes, 0, level)));
+                bindings.push((2, levels_view(pool, &pyramid.ranges, 0, level)));
+                pool.bind_group_numbered("depth pyramid, next level", &self.next_layout, bindings)
             };
             pass.set_bind_group(0, &group, &[]);
             let side = (layout.side >> level).max(1);
