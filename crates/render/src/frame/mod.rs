@@ -12,6 +12,7 @@ mod host_target;
 mod late;
 mod light_passes;
 mod map_cache;
+mod penumbra_history;
 mod pyramid_cache;
 mod moment_cache;
 mod outputs;
@@ -88,6 +89,8 @@ pub struct Renderer {
     techniques: TechniqueRegistry,
     /// Each light's map as its still casters drew it, kept across frames.
     map_cache: map_cache::MapCache,
+    /// Each light's penumbra history, kept across frames where nothing moved.
+    penumbra_histories: penumbra_history::PenumbraHistories,
     /// Each virtual light's pool of pages, kept across frames.
     virtual_lights: virtual_pages::VirtualLights,
 }
@@ -126,6 +129,7 @@ impl Renderer {
                 pool: Pool::new(device),
                 late_times: LateTimes::default(),
                 map_cache: map_cache::MapCache::default(),
+                penumbra_histories: penumbra_history::PenumbraHistories::default(),
                 virtual_lights: virtual_pages::VirtualLights::default(),
                 techniques,
                 layouts,
@@ -150,7 +154,7 @@ impl Renderer {
         let mut creations = self.pool.creations();
         // The kept maps' textures (depths and moments) live outside the pool, made
         // again only when a map's size changes (`map_cache.rs`, `moment_cache.rs`).
-        creations.textures += self.map_cache.created();
+        creations.textures += self.map_cache.created() + self.penumbra_histories.created();
         creations
     }
 
@@ -294,7 +298,9 @@ impl Renderer {
         // pixels ask for the pages along shadow edges one level finer, which the
         // next frame draws (`shadow.virtual_map.edge_levels`, `virtual_map/edges.rs`).
         // The first frame whose pages were settled already, or the frame after the
-        // last level's, is the one returned.
+        // last level's, is the one returned. A still view's penumbrae gather their
+        // beams over frames too (`screen.penumbra_frames`, rays/penumbra_mask.wgsl):
+        // the frame returned is the first whose history holds that many.
         let levels = self.settling_frames(scene, settings)?;
         let mut frames = 0;
         let submitted = loop {
@@ -305,7 +311,9 @@ impl Renderer {
                 times: TimesWanted::Now,
             };
             let submitted = self.submit(uploaded, scene, settings, submit).await?;
-            if frames == levels || submitted.edges_settled() {
+            let penumbrae = settings.screen.penumbra_frames;
+            let gathered = submitted.penumbrae_gathered(penumbrae) || frames >= levels + penumbrae;
+            if (frames >= levels || submitted.edges_settled()) && gathered {
                 break submitted;
             }
             frames += 1;

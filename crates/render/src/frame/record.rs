@@ -17,6 +17,7 @@ use super::{
     cull::Culled,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
+    penumbra_history::{HistoryFrame, HistoryKey},
     pyramid_cache::PyramidPlan,
     outputs::{Submitted, TimedLights},
     plan::{FramePlan, LightPlan},
@@ -100,7 +101,10 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        let untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
+        let mut untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
+        for (stats, frames) in untimed.lights.iter_mut().zip(&recorded.penumbra_frames) {
+            stats.penumbra_frames = *frames;
+        }
         let times = recorded.times.take().map(PendingTimes::submitted);
         let mut timed = match (request.times, times) {
             (_, None) => untimed,
@@ -151,6 +155,7 @@ impl Renderer {
             layer_commands,
             color: drawn.color,
             shadow_map: drawn.shadow_map,
+            penumbra_frames: drawn.penumbra_frames,
             submitted_at: Instant::now(),
         }
     }
@@ -175,8 +180,9 @@ impl Renderer {
             self.pool.bind_group("camera", &self.layouts.camera, &[Binding::Buffer(camera_buffer.clone())]);
         // On the mask path, one layer of the mask per light.
         let mask_layers = if plan.mask_path { self.mask_layers(plan, width, height) } else { vec![] };
-        let LitLights { lit, shown_map, shown_map_readback } =
-            self.record_light_maps(rec, uploaded, plan, culled, &mask_layers, readback);
+        let histories = self.penumbra_histories(uploaded, plan, &camera_gpu, [width, height]);
+        let maps = LightMapInputs { culled, mask_layers: &mask_layers, histories: &histories, readback };
+        let LitLights { lit, shown_map, shown_map_readback } = self.record_light_maps(rec, uploaded, plan, maps);
         let mut readbacks = FrameReadbacks { shadow_map: shown_map_readback, ..Default::default() };
         let targets = self.lighting_targets(width, height);
         let viewport = Viewport { width, height };
@@ -199,6 +205,7 @@ impl Renderer {
                 depth: &targets.depth,
                 mask_layers: &mask_layers,
                 mask_rects,
+                histories: &histories,
                 mask_start: match plan.lighting {
                     Lighting::LightList => MaskStart::Keep,
                     Lighting::PerLight => MaskStart::Clear,
@@ -243,7 +250,33 @@ impl Renderer {
                 .map(|t| readback::record(&mut self.pool, rec.encoder, t, wgpu::TextureAspect::All))
                 .collect();
         }
-        Drawn { readbacks, color: targets.textures[0].clone(), shadow_map: shown_map }
+        let penumbra_frames = histories.iter().map(|h| h.as_ref().map(|h| h.frame)).collect();
+        Drawn { readbacks, color: targets.textures[0].clone(), shadow_map: shown_map, penumbra_frames }
+    }
+
+    /// Each light's penumbra history this frame: one for each light whose mask pass
+    /// classifies its penumbrae (`frame/penumbra_history.rs`), none for the others,
+    /// which keep none.
+    fn penumbra_histories(
+        &mut self,
+        uploaded: &GpuScene,
+        plan: &FramePlan,
+        camera: &CameraGpu,
+        size: [u32; 2],
+    ) -> Vec<Option<HistoryFrame>> {
+        let device = self.gpu.device.clone();
+        (0..plan.lights.len())
+            .map(|index| {
+                let light = &plan.lights[index];
+                if plan.mask_path && light.classifies_penumbrae() {
+                    let key = HistoryKey::of(light, camera, uploaded.caster_generation);
+                    Some(self.penumbra_histories.begin(&device, index, key, size))
+                } else {
+                    self.penumbra_histories.forget(index);
+                    None
+                }
+            })
+            .collect()
     }
 
     /// The first passes: each light's shadow maps (and moment map), and its bindings
@@ -253,23 +286,23 @@ impl Renderer {
         rec: &mut Recording,
         uploaded: &GpuScene,
         plan: &FramePlan,
-        culled: &Culled,
-        mask_layers: &[wgpu::TextureView],
-        readback: Readback,
+        inputs: LightMapInputs,
     ) -> LitLights {
         let mut lit = Vec::with_capacity(plan.lights.len());
         let mut shown_map = None;
         let mut shown_map_readback = None;
         for (index, light) in plan.lights.iter().enumerate() {
-            let map = self.record_shadow_maps(rec, uploaded, light, &culled.layers[index], index as u32);
+            let map = self.record_shadow_maps(rec, uploaded, light, &inputs.culled.layers[index], index as u32);
             if index == plan.shown {
-                if readback.shadow_map {
+                if inputs.readback.shadow_map {
                     let aspect = wgpu::TextureAspect::DepthOnly;
                     shown_map_readback = Some(readback::record(&mut self.pool, rec.encoder, &map, aspect));
                 }
                 shown_map = Some(map.clone());
             }
-            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
+            let mask = inputs.mask_layers.get(index);
+            let history = inputs.histories[index].as_ref();
+            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask, history));
         }
         let shown_map = shown_map.expect("the reported light is one of the lights");
         LitLights { lit, shown_map, shown_map_readback }
@@ -283,10 +316,16 @@ impl Renderer {
         light: &LightPlan,
         index: u32,
         map: &wgpu::Texture,
-        classified: PenumbraClassification,
+        history: Option<&HistoryFrame>,
     ) -> LightMaps {
         let gpu = self.gpu.clone();
-        let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
+        // The history's state this frame, which the penumbra passes read.
+        let mut uniform = light.light_gpu;
+        if let Some(history) = history {
+            uniform.rays.history = u32::from(history.held);
+            uniform.rays.frame = history.frame;
+        }
+        let light_buffer = self.pool.uniform(&gpu.queue, "light", &uniform);
         let map_view = self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
         let shadow = &light.settings.shadow;
         let moments = light.filterable_map.map(|filterable| {
@@ -331,9 +370,9 @@ impl Renderer {
             .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
         let virtual_map =
             light.virtual_map.as_ref().map(|plan| Self::virtual_buffers(&mut self.pool, &gpu.queue, plan));
-        let pyramid = match classified {
-            PenumbraClassification::Pyramid => Some(self.depth_pyramid(rec, light, index, &map_view)),
-            PenumbraClassification::None => {
+        let pyramid = match history {
+            Some(_) => Some(self.depth_pyramid(rec, light, index, &map_view)),
+            None => {
                 self.map_cache.pyramids.forget(index as usize);
                 None
             }
@@ -382,12 +421,9 @@ impl Renderer {
         index: u32,
         map: &wgpu::Texture,
         mask_layer: Option<&wgpu::TextureView>,
+        history: Option<&HistoryFrame>,
     ) -> LightBindings {
-        let classified = match mask_layer {
-            Some(_) if light.classifies_penumbrae() => PenumbraClassification::Pyramid,
-            Some(_) | None => PenumbraClassification::None,
-        };
-        let maps = self.light_maps(rec, light, index, map, classified);
+        let maps = self.light_maps(rec, light, index, map, history);
         let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
         let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(mask_layer));
@@ -397,15 +433,13 @@ impl Renderer {
     }
 }
 
-/// How a light's mask pass classifies its penumbrae, and so whether the frame builds
-/// its map's depth pyramid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum PenumbraClassification {
-    /// By the pyramid (`rays::classifies_penumbrae`).
-    Pyramid,
-    /// Not by it: a hard light, a light drawn unrefined or on the forward path, a
-    /// cube, paraboloid or virtual map.
-    None,
+/// What the first passes read besides the plan: the culled layers, the mask's layers,
+/// each light's penumbra history, and what to copy out.
+struct LightMapInputs<'a> {
+    culled: &'a Culled,
+    mask_layers: &'a [wgpu::TextureView],
+    histories: &'a [Option<HistoryFrame>],
+    readback: Readback,
 }
 
 /// Each light's bindings for the passes from the camera, and the reported light's map.
@@ -423,4 +457,6 @@ pub(super) struct Drawn {
     pub color: wgpu::Texture,
     /// The reported light's shadow map.
     pub shadow_map: wgpu::Texture,
+    /// Frames each light's penumbra history holds.
+    pub penumbra_frames: Vec<Option<u32>>,
 }

@@ -167,5 +167,8 @@ pub(super) struct Recorded {
     pub layer_commands: LayerCommands,
     pub color: wgpu::Texture,
     pub shadow_map: wgpu::Texture,
+    /// Frames each light's penumbra history holds, this one counted (None: it keeps
+    /// none).
+    pub penumbra_frames: Vec<Option<u32>>,
     pub submitted_at: Instant,
 }

@@ -99,9 +99,9 @@ struct Contact {
 // Refinement by rays (screen).
 struct Rays {
     penumbra_rays: u32,  // rays per pixel over the light's area (0: hard, one ray)
+    history: u32,        // 1 where the penumbra history holds last frame's answers
+    frame: u32,          // frames the history holds, this one counted
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 };
 
 // One layer (cascade) of the map.

@@ -196,6 +196,9 @@ pub(crate) struct Layouts {
     pub trace_screen: wgpu::BindGroupLayout,
     /// Group 2 of the trace pass: the light's layer of the mask, written.
     pub refined_mask: wgpu::BindGroupLayout,
+    /// Group 3 of the mask pass of a light whose penumbrae it classifies: its
+    /// penumbra history, read and written.
+    pub penumbra_history: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -256,6 +259,7 @@ impl Layouts {
             refine_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Append),
             trace_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Read),
             refined_mask: crate::rays::refined_mask_layout(device),
+            penumbra_history: crate::rays::history_layout(device),
         }
     }
 }

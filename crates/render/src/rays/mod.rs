@@ -22,7 +22,7 @@ pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
     LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, classifies_penumbrae,
     mask_refine_wgsl,
-    refined_mask_layout, screen_layout as refine_screen_layout,
+    HISTORY_FORMAT, history_layout, refined_mask_layout, screen_layout as refine_screen_layout,
 };
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};

@@ -400,6 +400,12 @@ fn penumbra_map_lookup(
     return vec2<f32>(classify_receiver(r, seen_normal, world), f32(layer));
 }
 
+// The layer that holds the receiver at `world` (`select_cascade`), for a pixel whose
+// classification the penumbra history kept (penumbra_mask.wgsl).
+fn penumbra_layer(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>, view_depth: f32) -> f32 {
+    return f32(select_cascade(view_depth, world, n, l));
+}
+
 // The map is never unsure past the classification: `penumbra_map_lookup` answered
 // unsure by a visibility of one half, which refine_classify.wgsl lists.
 fn classified_map_unsure(world: vec3<f32>, n: vec3<f32>, geometric_n: vec3<f32>, l: vec3<f32>, layer: u32) -> bool {

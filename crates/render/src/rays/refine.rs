@@ -26,14 +26,18 @@ pub(crate) const MAX_GROUPS: u32 = 65_535;
 /// `min_storage_buffer_offset_alignment` WebGPU allows, so every device accepts the
 /// dynamic offset.
 pub(crate) const COUNTER_STRIDE: u64 = 256;
-/// Bytes of one light's counters (`RefineCounters` in refine_list.wgsl): the three
-/// workgroup counts of the indirect dispatch, then the pixels listed.
-const COUNTER_BYTES: u64 = 16;
+/// Bytes of one light's counters (`RefineCounters` in refine_append.wgsl): the three
+/// workgroup counts of the trace pass's indirect dispatch, then the pixels listed;
+/// then the same for the pixels listed to be filled.
+const COUNTER_BYTES: u64 = 32;
+/// Bytes from a light's counters to those of its fill pass.
+const FILL_COUNTERS: u64 = 16;
 /// Texels of the ring around a lookup's bilinear 2×2 that the footprint test reads
 /// (`refine_footprint.wgsl`): a virtual map's pixels ask for the pages it reaches.
 pub(crate) const UNSURE_RING_TEXELS: i32 = 2;
-/// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
-pub(crate) const PIXEL_BYTES: u64 = 8;
+/// Bytes of one listed pixel (`UnsurePixel`): its position, its map layer, and the
+/// mean and count of the beams its penumbra history holds.
+pub(crate) const PIXEL_BYTES: u64 = 16;
 
 /// The constants the list (`refine_list.wgsl` and the passes that import it) shares
 /// with Rust.
@@ -226,8 +230,9 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
     })
 }
 
-/// Group 2 of the trace and filter passes: the light's layer of the mask, written
-/// (0), and a copy of it as the trace pass left it, read by the filter pass (1).
+/// Group 2 of the trace and fill passes: the light's layer of the mask, written (0),
+/// a copy of it as the trace pass left it, read by the fill pass (1), and the light's
+/// penumbra history as this frame leaves it, written (2).
 pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
@@ -235,17 +240,15 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
         ty,
         count: None,
     };
+    let written = |format| wgpu::BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format,
+        view_dimension: wgpu::TextureViewDimension::D2,
+    };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("refined shadow mask"),
         entries: &[
-            entry(
-                0,
-                wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: passes::screen_space::MASK_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-            ),
+            entry(0, written(passes::screen_space::MASK_FORMAT)),
             entry(
                 1,
                 wgpu::BindingType::Texture {
@@ -254,6 +257,43 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
                     multisampled: false,
                 },
             ),
+            entry(2, written(HISTORY_FORMAT)),
+        ],
+    })
+}
+
+/// The format of a light's penumbra history (penumbra_mask.wgsl): per pixel, its
+/// value and the beams behind it.
+pub(crate) const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+
+/// Group 3 of the mask pass of a light whose penumbrae it classifies: its penumbra
+/// history as the last frame left it, read (0), and as this frame leaves it, written
+/// (1).
+pub(crate) fn history_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let fragment = wgpu::ShaderStages::FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("penumbra history"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: fragment,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: fragment,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: HISTORY_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
         ],
     })
 }
@@ -279,11 +319,11 @@ impl TracePasses {
     }
 }
 
-/// The trace pass's pipeline, and the penumbra filter's that follows it under a
-/// light with an area (`cs_filter_penumbra` in refine_trace.wgsl).
+/// The trace pass's pipeline, and the penumbra fill's that follows it under a light
+/// with an area (`cs_fill_penumbra` in refine_trace.wgsl).
 pub(crate) struct TracePass {
     trace: wgpu::ComputePipeline,
-    filter: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
 }
 
 impl TracePass {
@@ -312,31 +352,22 @@ impl TracePass {
                 cache: None,
             })
         };
-        Self { trace: pipeline("cs_trace"), filter: pipeline("cs_filter_penumbra") }
+        Self { trace: pipeline("cs_trace"), fill: pipeline("cs_fill_penumbra") }
     }
 
     /// Records `stage` of light `light` over its listed pixels.
     pub fn record(&self, pass: &mut wgpu::ComputePass, stage: TraceStage, groups: &TraceGroups, light: u32) {
-        let pipeline = match stage {
-            TraceStage::Trace => &self.trace,
-            TraceStage::PenumbraFilter => &self.filter,
+        let (pipeline, arguments) = match stage {
+            TraceStage::Trace => (&self.trace, 0),
+            TraceStage::PenumbraFill => (&self.fill, FILL_COUNTERS),
         };
-        self.dispatch(pipeline, pass, groups, light);
-    }
-
-    fn dispatch(
-        &self,
-        pipeline: &wgpu::ComputePipeline,
-        pass: &mut wgpu::ComputePass,
-        groups: &TraceGroups,
-        light: u32,
-    ) {
+        let counters = RefineLists::counter_offset(light);
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, groups.scene, &[]);
-        pass.set_bind_group(1, groups.screen, &[RefineLists::counter_offset(light)]);
+        pass.set_bind_group(1, groups.screen, &[counters]);
         pass.set_bind_group(2, groups.mask, &[]);
         pass.set_bind_group(super::GROUP, groups.bvh, &[]);
-        pass.dispatch_workgroups_indirect(groups.counters, u64::from(RefineLists::counter_offset(light)));
+        pass.dispatch_workgroups_indirect(groups.counters, u64::from(counters) + arguments);
     }
 }
 
@@ -347,9 +378,9 @@ pub(crate) enum TraceStage {
     /// (`groups.mask`).
     Trace,
     /// After the trace and a copy of the light's layer of the mask into the group's
-    /// `traced_mask`, under a light with an area: each listed pixel becomes an
-    /// edge-aware average of its neighbours.
-    PenumbraFilter,
+    /// `traced_mask`, under a light with an area: each unsure pixel no beam answered
+    /// takes the mean of its answered neighbours.
+    PenumbraFill,
 }
 
 impl TraceStage {
@@ -357,7 +388,7 @@ impl TraceStage {
     pub fn label(self) -> &'static str {
         match self {
             TraceStage::Trace => "shadow mask ray trace",
-            TraceStage::PenumbraFilter => "penumbra filter",
+            TraceStage::PenumbraFill => "penumbra fill",
         }
     }
 }
@@ -449,18 +480,20 @@ impl RefineLists {
         )
     }
 
-    /// The trace and filter passes' group 2: `mask_layer`, written, and `traced`, the
-    /// copy of it that the filter reads.
+    /// The trace and fill passes' group 2: `mask_layer`, written, `traced`, the copy
+    /// of it that the fill reads, and `history`, the light's penumbra history as this
+    /// frame leaves it.
     pub fn mask_group(
         pool: &mut Pool,
         layouts: &Layouts,
         mask_layer: &wgpu::TextureView,
         traced: &wgpu::TextureView,
+        history: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
         pool.bind_group(
             "refined shadow mask",
             &layouts.refined_mask,
-            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone())],
+            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone()), Binding::View(history.clone())],
         )
     }
 

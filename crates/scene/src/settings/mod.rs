@@ -226,6 +226,7 @@ impl Settings {
         check_limit(l.point_radius, "light.point_radius", &limits::LIGHT_RADIUS)?;
         self.shadow.validate()?;
         PENUMBRA_RAYS_RANGE.check(self.screen.penumbra_rays)?;
+        PENUMBRA_FRAMES_RANGE.check(self.screen.penumbra_frames)?;
         REFERENCE_SAMPLES_RANGE.check(self.reference.samples)?;
         Ok(())
     }
