@@ -79,14 +79,17 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 }
 
 // The fill pass, after the trace pass under a light with an area: each unsure pixel
-// that no beam answered, this frame or before (listed from the list's far end),
-// takes the mean of its answered neighbours on the same surface, read from the copy
-// `traced_mask`: those within one pixel, or two where none is, each weighed by the
-// inverse square of its distance. A quarter of the unsure pixels are beamed, one of
-// each 2 × 2 block, so every pixel has beamed or decided neighbours within one pixel
-// on its surface unless the block lies across an edge. The fill is the interpolation
-// of a penumbra sampled every other pixel, no estimate of its own: the history keeps
-// it with no beam, and the pixel is beamed in its turn.
+// that no beam answered, this frame or before (listed from the list's far end), is
+// answered from its neighbours' answers on the same surface within one pixel, read
+// from the copy `traced_mask`: their mean, each weighed by the inverse square of its
+// distance, where they differ by at most `FILL_SPREAD`; or by a beam of its own where
+// they differ more, or where none is answered. A quarter of the unsure pixels are
+// beamed, one of each 2 × 2 block, so every pixel has beamed or decided neighbours
+// within one pixel on its surface unless the block lies across an edge; where the
+// penumbra is wide they differ little, and its mean is its interpolation, within a
+// few hundredths; where it is narrow (a contact, a small light) they differ by much
+// more, and the mean would smear it. The mean is no estimate of the pixel's own: the
+// history keeps it with no beam, and the pixel is beamed in its turn.
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let count = listed.fill_count;
@@ -98,19 +101,28 @@ fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
         let n = octahedron_decode(textureLoad(prepass_normals, texel, 0).zw);
         let pixel_world = 2.0 * surface.w / (camera.scale_y * camera.height);
         let centre = FillCentre(texel, surface.xyz, n, pixel_world, surface.w);
-        var filled = neighbours_mean(centre, 1);
-        if filled.y == 0.0 {
-            filled = neighbours_mean(centre, 2);
+        let near = neighbours(centre);
+        var visibility: f32;
+        var beams = 0.0;
+        if near.weight > 0.0 && near.highest - near.lowest <= FILL_SPREAD {
+            visibility = near.sum / near.weight;
+        } else {
+            let origin = surface_ray_origin(centre.world, n, surface.w);
+            let pattern = entry.pixel ^ lowbias32(light.rays.frame + 0x68e31da4u);
+            visibility = area_visibility(origin, centre.world, n, pattern).x;
+            beams = 1.0;
         }
-        // None on its surface within two pixels: the light's centre decides.
-        let visibility = select(select(0.0, 1.0, centre_lit(centre)), filled.x / filled.y, filled.y > 0.0);
         textureStore(refined_mask, texel, vec4<f32>(2.0 * f32(entry.layer) + visibility, 0.0, 0.0, 0.0));
-        textureStore(traced_history, texel, vec4<f32>(visibility, 0.0, 0.0, 0.0));
+        textureStore(traced_history, texel, vec4<f32>(visibility, beams, 0.0, 0.0));
     }
 }
 
-// The centre of a fill: its pixel, surface point and normal, a pixel's width in world
-// units at its depth, and that depth.
+// The most the answered neighbours of a pixel may differ for the fill to take their
+// mean rather than beam it.
+const FILL_SPREAD: f32 = 0.25;
+
+// The centre of a fill: its pixel, surface point and geometric normal, a pixel's
+// width in world units at its depth, and that depth.
 struct FillCentre {
     texel: vec2<i32>,
     world: vec3<f32>,
@@ -124,43 +136,48 @@ struct FillCentre {
 const SURFACE_PIXELS: f32 = 2.0;
 const SURFACE_COS: f32 = 0.9;
 
-// The weighted sum and the weight of the answered neighbours within `radius` pixels
-// of `c` on its surface (`cs_fill_penumbra`).
-fn neighbours_mean(c: FillCentre, radius: i32) -> vec2<f32> {
-    let size = vec2<i32>(textureDimensions(traced_mask));
-    var sum = vec2<f32>(0.0);
-    for (var dy = -radius; dy <= radius; dy++) {
-        for (var dx = -radius; dx <= radius; dx++) {
-            let q = c.texel + vec2<i32>(dx, dy);
-            if (dx == 0 && dy == 0) || any(q < vec2<i32>(0)) || any(q >= size) {
-                continue;
-            }
-            let packed = textureLoad(traced_mask, q, 0).x;
-            // Not answered yet (PENUMBRA_PENDING), or the background.
-            let q_surface = textureLoad(prepass_surface, q, 0);
-            if packed < 0.0 || q_surface.w <= 0.0 {
-                continue;
-            }
-            let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
-            if abs(dot(c.n, q_surface.xyz - c.world)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
-                continue;
-            }
-            // A neighbour facing away from the light or outside its cone is dark by
-            // definition, not by a caster: it says nothing of this pixel's penumbra.
-            let q_light = light_geometry(q_surface.xyz);
-            if dot(q_n, q_light.xyz) <= 0.0 || q_light.w <= 0.0 {
-                continue;
-            }
-            let w = 1.0 / f32(dx * dx + dy * dy);
-            sum += vec2<f32>(w * (packed - 2.0 * floor(packed * 0.5)), w);
-        }
-    }
-    return sum;
-}
+// What a fill's answered neighbours say: their weighted sum and weight, and their
+// least and greatest answer.
+struct Neighbours {
+    sum: f32,
+    weight: f32,
+    lowest: f32,
+    highest: f32,
+};
 
-// Whether the ray from the centre to the light's centre arrives: the fill's last
-// resort, for a pixel with no answered neighbour on its surface.
-fn centre_lit(c: FillCentre) -> bool {
-    let origin = surface_ray_origin(c.world, c.n, c.view_depth);
-    return !centre_ray_blocked(origin, c.world, light_geometry(c.world).xyz);
+// The answered neighbours within one pixel of `c` on its surface
+// (`cs_fill_penumbra`).
+fn neighbours(c: FillCentre) -> Neighbours {
+    let size = vec2<i32>(textureDimensions(traced_mask));
+    var near = Neighbours(0.0, 0.0, 1.0, 0.0);
+    for (var k = 0; k < 9; k++) {
+        let d = vec2<i32>(k % 3 - 1, k / 3 - 1);
+        let q = c.texel + d;
+        if k == 4 || any(q < vec2<i32>(0)) || any(q >= size) {
+            continue;
+        }
+        let packed = textureLoad(traced_mask, q, 0).x;
+        // Not answered yet (PENUMBRA_PENDING), or the background.
+        let q_surface = textureLoad(prepass_surface, q, 0);
+        if packed < 0.0 || q_surface.w <= 0.0 {
+            continue;
+        }
+        let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
+        if abs(dot(c.n, q_surface.xyz - c.world)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+            continue;
+        }
+        // A neighbour facing away from the light or outside its cone is dark by
+        // definition, not by a caster: it says nothing of this pixel's penumbra.
+        let q_light = light_geometry(q_surface.xyz);
+        if dot(q_n, q_light.xyz) <= 0.0 || q_light.w <= 0.0 {
+            continue;
+        }
+        let visibility = packed - 2.0 * floor(packed * 0.5);
+        let w = 1.0 / f32(dot(d, d));
+        near.sum += w * visibility;
+        near.weight += w;
+        near.lowest = min(near.lowest, visibility);
+        near.highest = max(near.highest, visibility);
+    }
+    return near;
 }
