@@ -206,7 +206,7 @@ impl Renderer {
         let resolved = self.techniques.resolve_lights(settings, scene)?;
         let mask_path = settings.uses_shadow_mask(&resolved)?;
         let levels = resolved.iter().filter(|r| r.shadow.partition == Partition::Virtual).map(|r| {
-            let refine = rays::light_refine(settings.light_refine(r), &r.light);
+            let refine = rays::light_refine(settings.light_refine(r));
             edge_levels(mask_path, refine, &r.shadow)
         });
         Ok(levels.max().unwrap_or(0))
@@ -256,7 +256,7 @@ impl Renderer {
                 light_gpu.ambient = Vec3::ZERO;
             }
             let refine = if mask_path {
-                rays::light_refine(settings.light_refine(&r), &r.light)
+                rays::light_refine(settings.light_refine(&r))
             } else {
                 rays::forward_light_refine(settings.light_refine(&r))
             };

@@ -34,7 +34,7 @@ use crate::{
         moments::{MomentInput, MomentLayout, MomentTarget},
     },
     pool::{Binding, ViewKey},
-    rays::{self, PyramidLayout, RefineLists},
+    rays::{self, PyramidInput, PyramidLayout, PyramidParams, RefineLists},
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::CameraGpu,
@@ -401,7 +401,15 @@ impl Renderer {
                     label: Some("depth pyramid"),
                     timestamp_writes: rec.clock.compute_writes(slot),
                 });
-                self.passes.pyramid.record(&mut self.pool, &mut pass, map, &pyramid, layout);
+                let cube = light.lookup() == MapLookup::Cube;
+                let params = PyramidParams {
+                    cube: u32::from(cube),
+                    range: light.light_gpu.emitter.range,
+                    near: light.light_gpu.map.near,
+                    _pad: 0,
+                };
+                let input = PyramidInput { map, params, queue: &gpu.queue, layout };
+                self.passes.pyramid.record(&mut self.pool, &mut pass, input, &pyramid);
                 drop(pass);
                 rec.clock.end(&gpu, rec.encoder, slot);
                 pyramid

@@ -54,7 +54,7 @@ pub(crate) fn prepass_wgsl() -> String {
 pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     let mut parts = lighting::camera_shading_wgsl();
     if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
-        parts.extend(lighting::penumbra_lookup_wgsl(key.technique));
+        parts.extend(lighting::penumbra_lookup_wgsl(key.technique, key.lookup));
     } else {
         parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
     }

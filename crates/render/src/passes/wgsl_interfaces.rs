@@ -108,6 +108,16 @@ pub(crate) const AREA_VISIBILITY: WgslInterface = WgslInterface {
     returns: Some("vec2<f32>"),
 };
 
+/// The layer that holds a receiver, for the mask pass of a light whose penumbrae it
+/// classifies where its history kept the classification: `map_penumbra_layer`
+/// (rays/penumbra_map.wgsl, the cascade the lookup reads) or `cube_penumbra_layer`
+/// (rays/penumbra_cube.wgsl, the face), by `MapLookup`.
+pub(crate) const PENUMBRA_LAYER: WgslInterface = WgslInterface {
+    name: "penumbra_layer",
+    params: &[("world", "vec3<f32>"), ("n", "vec3<f32>"), ("l", "vec3<f32>"), ("view_depth", "f32")],
+    returns: Some("f32"),
+};
+
 /// Whether a ray decides a pixel the map answered: `classified_ray_decides`
 /// (refine_classify.wgsl) or `unrefined_ray_decides` (refine_off.wgsl: never), by
 /// `Refine`.

@@ -28,6 +28,28 @@
 @group(0) @binding(3) var pyramid_planes: texture_storage_2d_array<rgba32float, write>;
 @group(0) @binding(4) var pyramid_ranges: texture_storage_2d_array<rg32float, write>;
 
+// How level 0 reads the map's depths (`PyramidParams` in pyramid.rs): a cube face's
+// distance over range becomes 1 − near / z, z its distance along the face's axis
+// (`cube_depth` in penumbra_classify.wgsl), affine across a plane as a 2D map's
+// depth is.
+struct PyramidParams {
+    cube: u32,
+    range: f32,
+    near: f32,
+    _pad: u32,
+};
+@group(0) @binding(5) var<uniform> pyramid_params: PyramidParams;
+
+// The depth the pyramid holds of map texel `texel` storing `stored`.
+fn pyramid_depth(texel: vec2<u32>, stored: f32, resolution: f32) -> f32 {
+    if pyramid_params.cube == 0u {
+        return stored;
+    }
+    let ndc = (vec2<f32>(texel) + vec2<f32>(0.5)) / resolution * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
+    let z = stored * pyramid_params.range * inverseSqrt(1.0 + dot(ndc, ndc));
+    return 1.0 - pyramid_params.near / z;
+}
+
 // What a texel holding no depth stores.
 const PYRAMID_EMPTY_PLANE: vec4<f32> = vec4<f32>(2.0, 0.0, 0.0, 0.0);
 const PYRAMID_EMPTY_RANGE: vec2<f32> = vec2<f32>(2.0, -1.0);
@@ -49,7 +71,7 @@ fn cs_pyramid_first(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var k = 0u; k < 16u; k++) {
         let texel = id.xy * FIRST_SIDE + vec2<u32>(k % 4u, k / 4u);
         if all(texel < map) {
-            let d = textureLoad(map_depths, texel, id.z, 0);
+            let d = pyramid_depth(texel, textureLoad(map_depths, texel, id.z, 0), f32(map.x));
             depths[k] = d;
             valid |= 1u << k;
             sum += d;

@@ -15,7 +15,7 @@ pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
-pub(crate) use pyramid::{PLANES_FORMAT, Pyramid, PyramidLayout, PyramidPass, RANGES_FORMAT};
+pub(crate) use pyramid::{PLANES_FORMAT, Pyramid, PyramidInput, PyramidLayout, PyramidParams, PyramidPass, RANGES_FORMAT};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
@@ -27,7 +27,7 @@ pub(crate) use refine::{
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};
 
-use gnomon_scene::{Light, settings::Refine};
+use gnomon_scene::settings::Refine;
 use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
@@ -40,12 +40,12 @@ use traversal::FIRST_BINDING;
 pub(crate) const GROUP: u32 = 3;
 
 /// The refinement a light gets on the mask path: `refine`, with `auto` resolved to
-/// `rays` for a hard light and to `off` for a light with an area, whose refined
-/// pixels cost `penumbra_rays` rays each: asked for by name only.
-pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
+/// `rays`, for a hard light (a ray where the map is unsure) and for a light with an
+/// area alike (a penumbra beam where the map cannot say the pixel is lit or in umbra,
+/// a quarter of them a frame: `penumbra_mask.wgsl`).
+pub(crate) fn light_refine(refine: Refine) -> Refine {
     match refine {
-        Refine::Auto if light.is_hard() => Refine::Rays,
-        Refine::Auto => Refine::Off,
+        Refine::Auto => Refine::Rays,
         Refine::Off | Refine::Rays | Refine::EveryPixel => refine,
     }
 }

@@ -1,5 +1,5 @@
 // The mask pass's answer for a light with an area on a 2D map (a sun's map or
-// cascades, a spot's map), when its penumbrae are traced: lit, where no caster the
+// cascades, a spot's map) or a point light's cube, when its penumbrae are traced: lit, where no caster the
 // map holds can hide any part of the light from the receiver; in umbra, where one
 // caster the map holds hides all of it; unsure everywhere else, which the trace
 // pass then answers with a penumbra beam (penumbra_beam.wgsl). No technique's
@@ -29,8 +29,6 @@
 // a jump in depth as deep as the gap between them.
 import package::passes::light_binding::{light, light_depth_from_distance, light_distance_from_depth, texel_shape};
 import package::passes::light_kinds::{emitter_above_plane, emitter_cone_radius};
-import package::passes::map_visibility::select_cascade;
-import package::rays::map_step::map_step;
 import package::techniques::bindings::shadow_map;
 
 // The pyramid of `shadow_map` (rays/pyramid.rs, depth_pyramid.wgsl), in the light's
@@ -60,29 +58,90 @@ struct Receiver {
     texel: vec2<f32>,
     depth: f32,
     gradient: vec2<f32>,
-    // Its distance from the light along the light's axis.
+    // Its distance from the light along the layer's axis.
     distance: f32,
     layer: u32,
+    // Whether the layer is a cube face, whose depths the pyramid holds as
+    // `cube_depth` (depth_pyramid.wgsl) rather than as the face stores them.
+    cube: bool,
 };
 
-// How far to the side of the receiver a caster can reach the cone:
-// `emitter_cone_radius` is `cone_at_light` × (1 − at / distance), a texel is
-// `texel_at_light` + `texel_growth` × at wide (the smaller of its two sides).
+// A receiver outside its layer, or seen edge-on from the light: the map cannot say.
+fn unplaced_receiver(layer: u32, cube: bool) -> Receiver {
+    return Receiver(vec2<f32>(-1e9), 0.0, vec2<f32>(0.0), 1.0, layer, cube);
+}
+
+// A cube face's depth at distance `z` along its axis: 1 − near / z, which like a
+// perspective map's depth is affine across a plane seen from the light (the distance
+// over range the face stores is not), and grows with distance.
+fn cube_depth(z: f32) -> f32 {
+    return 1.0 - light.map.near / z;
+}
+
+// The depth the classification weighs for a point at distance `at` along its
+// layer's axis, and the inverse.
+fn layer_depth(cube: bool, at: f32) -> f32 {
+    if cube {
+        return cube_depth(at);
+    }
+    return light_depth_from_distance(at);
+}
+
+fn layer_distance(cube: bool, depth: f32) -> f32 {
+    if cube {
+        return light.map.near / max(1.0 - depth, 1e-30);
+    }
+    return light_distance_from_depth(depth);
+}
+
+// Map texel `texel`'s depth as the classification weighs it: a cube face's distance
+// over range made `cube_depth` along the texel's centre ray.
+fn stored_depth(r: Receiver, texel: vec2<i32>) -> f32 {
+    let stored = textureLoad(shadow_map, texel, r.layer, 0);
+    if !r.cube {
+        return stored;
+    }
+    let ndc = (vec2<f32>(texel) + vec2<f32>(0.5)) / light.map.resolution * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
+    return cube_depth(stored * light.emitter.range * inverseSqrt(1.0 + dot(ndc, ndc)));
+}
+
+// How far to the side of the receiver a caster can reach the cone: its radius is
+// `cone_at_light` × (1 − at / distance) at distance `at` along the layer's axis, and
+// a texel there is `texel_at_light` + `texel_growth` × at wide (the smaller of its
+// two sides).
 struct Reach {
     cone_at_light: f32,
     distance: f32,
     texel_at_light: f32,
     texel_growth: f32,
+    cube: bool,
 };
 
-fn receiver_reach(r: Receiver) -> Reach {
+// A 2D layer's reach: the cone is `emitter_cone_radius`'s.
+fn map_reach(r: Receiver) -> Reach {
     let smaller = min(texel_shape(r.layer).x, texel_shape(r.layer).y);
     return Reach(
         emitter_cone_radius(light.emitter, r.distance, 0.0),
         r.distance,
         light.cascades[r.layer].texel_world * smaller,
         light.map.texel_per_distance * smaller,
+        false,
     );
+}
+
+// A cube face's reach, for a receiver `offset` from the light: a face texel at
+// distance `at` along its axis is 2 at / resolution wide across it, and the cone
+// from the receiver to the sphere (radius `size`) lies, where it crosses the plane
+// at `at`, within size (1 + tan θ) (d − at) / (d − size) of the line to the light's
+// centre, θ the angle between the receiver's direction and the face's axis and d its
+// distance along it: the sphere's points lie within its radius of the centre across
+// the axis and along it.
+fn cube_reach(r: Receiver, offset: vec3<f32>) -> Reach {
+    let size = light.emitter.size;
+    let d = r.distance;
+    let across = sqrt(max(dot(offset, offset) - d * d, 0.0));
+    let cone = size * (1.0 + across / d) * d / max(d - size, 1e-30);
+    return Reach(cone, d, 0.0, 2.0 / light.map.resolution, true);
 }
 
 // The farthest from the light a caster `texels` to the side may stand and still
@@ -93,47 +152,31 @@ fn farthest_reaching(reach: Reach, texels: f32) -> f32 {
         / (reach.cone_at_light / reach.distance + r * reach.texel_growth);
 }
 
-// The deepest stored depth of a caster `texels` to the side that can reach the cone
-// (below every depth where none can).
+// The deepest depth of a caster `texels` to the side that can reach the cone (below
+// every depth where none can).
 fn deepest_reaching(reach: Reach, texels: f32) -> f32 {
     let at = farthest_reaching(reach, texels);
     if at <= light.map.near {
         return -1.0;
     }
-    return light_depth_from_distance(at);
+    return layer_depth(reach.cube, at);
 }
 
-// The cone's radius in texels at light distance `at`.
+// The cone's radius in texels at distance `at` along the layer's axis.
 fn cone_texels(reach: Reach, at: f32) -> f32 {
     let cone = reach.cone_at_light * max(1.0 - at / reach.distance, 0.0);
     return cone / (reach.texel_at_light + reach.texel_growth * at);
 }
 
-// The receiver at `world` (its plane through the screen derivatives `world_dx`,
-// `world_dy`) in layer `layer`; w of the texel is 0 where it lies outside the layer.
-fn classified_receiver(world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>, layer: u32) -> Receiver {
-    let clip_from_world = light.cascade_clip_from_world[layer];
-    let clip = clip_from_world * vec4<f32>(world, 1.0);
-    let size = light.map.resolution;
-    let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    var r = Receiver(vec2<f32>(-1e9), 0.0, vec2<f32>(0.0), distance, layer);
-    if clip.w <= 0.0 {
-        return r;
-    }
-    let ndc = clip.xyz / clip.w;
-    r.texel = (ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5)) * size - vec2<f32>(0.5);
-    r.depth = ndc.z;
-    // The plane's depth gradient per texel, from its two screen tangents.
-    let a = map_step(clip_from_world, ndc, clip.w, world_dx);
-    let b = map_step(clip_from_world, ndc, clip.w, world_dy);
+// The receiver plane's depth gradient per texel, from the map steps of its two
+// screen tangents `a` and `b` (u, v, depth), by the 2×2 inverse; None (a vector of
+// NaN) where the plane is seen edge-on from the light.
+fn plane_gradient(a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
     let det = a.x * b.y - a.y * b.x;
-    if abs(det) > 1e-20 {
-        r.gradient = vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / size;
-    } else {
-        // Seen edge-on from the light: its plane holds no depth to follow.
-        r.gradient = vec2<f32>(1e9);
+    if !(abs(det) > 1e-20) {
+        return vec2<f32>(0.0);
     }
-    return r;
+    return vec2<f32>(b.y * a.z - a.y * b.z, a.x * b.z - b.x * a.z) / det / light.map.resolution;
 }
 
 // Whether a texel at `offset` from the receiver storing `stored` may hide part of
@@ -213,78 +256,19 @@ fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bo
     let base = vec2<i32>(q.lo + vec2<f32>(0.5));
     for (var k = 0; k < 16; k++) {
         let texel = base + vec2<i32>(k % 4, k / 4);
-        let stored = textureLoad(shadow_map, texel, r.layer, 0);
-        if may_hide(r, reach, vec2<f32>(texel) - r.texel, stored, tolerance) {
+        if may_hide(r, reach, vec2<f32>(texel) - r.texel, stored_depth(r, texel), tolerance) {
             return true;
         }
     }
     return false;
-}
-
-// Whether a square of level `level` that `weigh_square` could not decide holds a
-// caster, looked at in its four squares of the level below (`split_once`), and theirs
-// again where they cannot say either; a first-level square that cannot say is read
-// texel by texel, and one still undecided `SPLIT_LEVELS` levels down counts as
-// hiding.
-fn split_square_hides(r: Receiver, reach: Reach, level: u32, texel: vec2<i32>, tolerance: f32, covered: f32) -> bool {
-    var undecided: array<u32, 4>;
-    var count = split_once(r, reach, level, texel, tolerance, covered, &undecided);
-    if count > 4u {
-        return true;
-    }
-    for (var k = 0u; k < count; k++) {
-        var finer: array<u32, 4>;
-        let child = vec2<i32>(vec2<u32>(undecided[k] & 0xffffu, undecided[k] >> 16u));
-        if split_once(r, reach, level - 1u, child, tolerance, covered, &finer) != 0u {
-            return true;
-        }
-    }
-    return false;
-}
-
-// Weighs the four squares under square `texel` of level `level`: returns how many
-// cannot say, each into `undecided` (x | y << 16), or more than 4 where one hides. At
-// the first level, a square that cannot say is read texel by texel.
-fn split_once(
-    r: Receiver,
-    reach: Reach,
-    level: u32,
-    texel: vec2<i32>,
-    tolerance: f32,
-    covered: f32,
-    undecided: ptr<function, array<u32, 4>>,
-) -> u32 {
-    if level == 0u {
-        return select(0u, 5u, first_level_hides(r, reach, pyramid_square(r.layer, 0u, texel), tolerance));
-    }
-    var count = 0u;
-    for (var k = 0; k < 4; k++) {
-        let child = texel * 2 + vec2<i32>(k % 2, k / 2);
-        let q = pyramid_square(r.layer, level - 1u, child);
-        let verdict = weigh_square(r, reach, q, tolerance, covered);
-        if verdict == SQUARE_HIDES {
-            return 5u;
-        }
-        if verdict == SQUARE_UNDECIDED {
-            if level == 1u {
-                if first_level_hides(r, reach, q, tolerance) {
-                    return 5u;
-                }
-            } else {
-                (*undecided)[count] = u32(child.x) | (u32(child.y) << 16u);
-                count++;
-            }
-        }
-    }
-    return count;
 }
 
 // Whether any caster the map holds may hide part of the light from receiver `r`:
 // squares that double (the 2 × 2 of each level that hold it), each weighed
 // (`weigh_square`) against what a caster beyond the squares weighed before may
-// reach from, one that cannot say looked at in finer squares
-// (`split_square_hides`), until no caster deeper than the map's nearest can reach
-// farther.
+// reach from, a first-level square that cannot say read texel by texel, until no
+// caster deeper than the layer's nearest can reach farther. A coarser square that
+// cannot say counts as hiding: the pixel is beamed.
 fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels: u32) -> bool {
     // Texel centres within this (Chebyshev) distance of the receiver are weighed.
     var covered = 0.0;
@@ -295,19 +279,10 @@ fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels
         let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
         let first = pyramid_texel(r.texel - vec2<f32>(0.5 * side), level);
         for (var k = 0; k < 4; k++) {
-            let texel = first + vec2<i32>(k % 2, k / 2);
-            let verdict = weigh_square(r, reach, pyramid_square(r.layer, level, texel), tolerance, covered);
-            if verdict == SQUARE_HIDES {
+            let q = pyramid_square(r.layer, level, first + vec2<i32>(k % 2, k / 2));
+            let verdict = weigh_square(r, reach, q, tolerance, covered);
+            if verdict == SQUARE_HIDES || (verdict == SQUARE_UNDECIDED && (level > 0u || first_level_hides(r, reach, q, tolerance))) {
                 return true;
-            }
-            if verdict == SQUARE_UNDECIDED {
-                if level == 0u {
-                    if first_level_hides(r, reach, pyramid_square(r.layer, 0u, texel), tolerance) {
-                        return true;
-                    }
-                } else {
-                    return true;
-                }
             }
         }
         covered = 0.5 * side - 0.5;
@@ -315,16 +290,15 @@ fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels
     return false;
 }
 
-// The classification of receiver `r` (`CLASSIFIED_*`).
-fn classify_receiver(r: Receiver, seen_normal: vec3<f32>, world: vec3<f32>) -> f32 {
+// The classification of receiver `r` (`CLASSIFIED_*`), whose reach is `reach`.
+fn classify_receiver(r: Receiver, reach: Reach, seen_normal: vec3<f32>, world: vec3<f32>) -> f32 {
     let size = light.map.resolution;
-    let reach = receiver_reach(r);
     let tolerance = 0.5 * (abs(r.gradient.x) + abs(r.gradient.y)) + 4.0 * 1.1920929e-7;
-    // The farthest any caster can reach: from the map's nearest depth.
+    // The farthest any caster can reach: from the layer's nearest depth.
     let levels = textureNumLevels(pyramid_ranges_read);
     let nearest = textureLoad(pyramid_ranges_read, vec2<i32>(0), r.layer, i32(levels) - 1).x;
-    let widest = max(cone_texels(reach, max(light_distance_from_depth(nearest), light.map.near)) + 1.0, 2.5);
-    // What lies past the map's edge is unknown.
+    let widest = max(cone_texels(reach, max(layer_distance(r.cube, nearest), light.map.near)) + 1.0, 2.5);
+    // What lies past the layer's edge is unknown.
     if any(r.texel - vec2<f32>(widest) < vec2<f32>(-0.5)) || any(r.texel + vec2<f32>(widest) > vec2<f32>(size - 0.5)) {
         return CLASSIFIED_UNSURE;
     }
@@ -346,7 +320,7 @@ fn covered_by_one_caster(r: Receiver, reach: Reach, tolerance: f32, levels: u32)
     let receiver_texel = reach.texel_at_light + reach.texel_growth * r.distance;
     // In front of the receiver by more than its plane's tolerance and two texels
     // along the light.
-    let front = light_depth_from_distance(r.distance - 2.0 * receiver_texel) - tolerance;
+    let front = layer_depth(r.cube, r.distance - 2.0 * receiver_texel) - tolerance;
     for (var level = 0u; level < levels; level++) {
         let radius = PYRAMID_FIRST_TEXELS * f32(1u << level);
         let lo = pyramid_texel(r.texel - vec2<f32>(radius), level);
@@ -365,8 +339,8 @@ fn covered_by_one_caster(r: Receiver, reach: Reach, tolerance: f32, levels: u32)
         if range.y >= front {
             return false;
         }
-        let near_at = light_distance_from_depth(range.x);
-        let far_at = light_distance_from_depth(range.y);
+        let near_at = layer_distance(r.cube, range.x);
+        let far_at = layer_distance(r.cube, range.y);
         let texel = reach.texel_at_light + reach.texel_growth * near_at;
         // The window spans at most 2R + 2 squares of R: 4R across.
         if far_at - near_at > UMBRA_SLOPE * 4.0 * radius * texel {
@@ -379,31 +353,14 @@ fn covered_by_one_caster(r: Receiver, reach: Reach, tolerance: f32, levels: u32)
     return false;
 }
 
-// `lookup_visibility` for a light with an area whose penumbrae are traced, on a 2D
-// map: (`CLASSIFIED_*`, the layer that holds the receiver).
-fn penumbra_map_lookup(
-    world: vec3<f32>,
-    n: vec3<f32>,
-    l: vec3<f32>,
-    world_dx: vec3<f32>,
-    world_dy: vec3<f32>,
-    pixel: vec2<f32>,
-    view_depth: f32,
-) -> vec2<f32> {
-    let layer = select_cascade(view_depth, world, n, l);
-    let r = classified_receiver(world, world_dx, world_dy, layer);
+// The camera-facing geometric normal of the plane through the screen derivatives
+// `world_dx` and `world_dy`, on the side of `n`.
+fn seen_plane_normal(n: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>) -> vec3<f32> {
     let plane = cross(world_dx, world_dy);
-    var seen_normal = n;
-    if dot(plane, plane) > 0.0 {
-        seen_normal = normalize(plane) * select(-1.0, 1.0, dot(plane, n) >= 0.0);
+    if !(dot(plane, plane) > 0.0) {
+        return n;
     }
-    return vec2<f32>(classify_receiver(r, seen_normal, world), f32(layer));
-}
-
-// The layer that holds the receiver at `world` (`select_cascade`), for a pixel whose
-// classification the penumbra history kept (penumbra_mask.wgsl).
-fn penumbra_layer(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>, view_depth: f32) -> f32 {
-    return f32(select_cascade(view_depth, world, n, l));
+    return normalize(plane) * select(-1.0, 1.0, dot(plane, n) >= 0.0);
 }
 
 // The map is never unsure past the classification: `penumbra_map_lookup` answered

@@ -21,9 +21,9 @@ import package::passes::light_binding::light;
 import package::passes::octahedron::octahedron_decode;
 import package::passes::screen_common::{plane_point, prepass_normals, prepass_surface};
 import package::passes::shading::{facing_error, light_geometry};
-import package::rays::penumbra_classify::{CLASSIFIED_UNSURE, penumbra_layer};
+import package::rays::penumbra_classify::CLASSIFIED_UNSURE;
 import package::rays::refine_append::{listed_defer_beam, listed_defer_to_fill};
-import package::variant::{pixel_visibility, ray_decides};
+import package::variant::{penumbra_layer, pixel_visibility, ray_decides};
 
 // Last frame's history, read; this frame's, written (two textures in turn,
 // `frame/penumbra_history.rs`).

@@ -74,6 +74,27 @@ pub(crate) struct Pyramid {
     pub ranges: wgpu::Texture,
 }
 
+/// How the pyramid's first level reads a map's depths (`PyramidParams` in
+/// depth_pyramid.wgsl): a cube face's distance over `range` (`cube` 1) becomes
+/// 1 − `near` / z, z along the face's axis.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct PyramidParams {
+    pub cube: u32,
+    pub range: f32,
+    pub near: f32,
+    pub _pad: u32,
+}
+
+/// What a pyramid is built from.
+pub(crate) struct PyramidInput<'a> {
+    /// The depth map, every layer.
+    pub map: &'a wgpu::TextureView,
+    pub params: PyramidParams,
+    pub queue: &'a wgpu::Queue,
+    pub layout: PyramidLayout,
+}
+
 /// The pyramid's two pipelines: the first level from the map, each next from the
 /// one before.
 pub(crate) struct PyramidPass {
@@ -108,8 +129,18 @@ impl PyramidPass {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
         };
         let outputs = [written(3, PLANES_FORMAT), written(4, RANGES_FORMAT)];
-        let first_layout =
-            layout("depth pyramid, first level", &[vec![read(0, wgpu::TextureSampleType::Depth)], outputs.to_vec()].concat());
+        let params = entry(
+            5,
+            wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+        );
+        let first_layout = layout(
+            "depth pyramid, first level",
+            &[vec![read(0, wgpu::TextureSampleType::Depth), params], outputs.to_vec()].concat(),
+        );
         let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
         let next_layout = layout(
             "depth pyramid, next level",
@@ -140,15 +171,10 @@ impl PyramidPass {
     }
 
     /// Records every level of `pyramid` (of `layout`) from the depth map `map` (all
-    /// its layers, as a 2D array) into one compute pass.
-    pub fn record(
-        &self,
-        pool: &mut Pool,
-        pass: &mut wgpu::ComputePass,
-        map: &wgpu::TextureView,
-        pyramid: &Pyramid,
-        layout: PyramidLayout,
-    ) {
+    /// its layers, as a 2D array, read as `params` says) into one compute pass.
+    pub fn record(&self, pool: &mut Pool, pass: &mut wgpu::ComputePass, input: PyramidInput, pyramid: &Pyramid) {
+        let PyramidInput { map, params, queue, layout } = input;
+        let params = pool.uniform(queue, "depth pyramid", &params);
         let levels_view = |pool: &mut Pool, texture: &wgpu::Texture, base_mip, mips| {
             Binding::View(pool.view(
                 texture,
@@ -168,6 +194,7 @@ impl PyramidPass {
             let group = if level == 0 {
                 pass.set_pipeline(&self.first);
                 bindings.push((0, Binding::View(map.clone())));
+                bindings.push((5, Binding::Buffer(params.clone())));
                 pool.bind_group_numbered("depth pyramid, first level", &self.first_layout, bindings)
             } else {
                 pass.set_pipeline(&self.next);

@@ -93,16 +93,16 @@ impl LightSize {
 /// Whether the mask pass of a light of `size` refined by `refine` and looked up by
 /// `lookup` classifies its penumbrae by the map's min-max pyramid
 /// (`penumbra_classify.wgsl`): a light with an area whose rays run where the map is
-/// unsure, on a 2D map. Its lookup is then the classification alone, lit, umbra or
-/// unsure, and no technique's estimate.
+/// unsure, on a 2D map or a point light's cube. Its lookup is then the
+/// classification alone, lit, umbra or unsure, and no technique's estimate.
 pub(crate) fn classifies_penumbrae(refine: Refine, lookup: MapLookup, size: LightSize) -> bool {
     let traced = match refine {
         Refine::Auto | Refine::Rays => true,
         Refine::Off | Refine::EveryPixel => false,
     };
     let pyramid = match lookup {
-        MapLookup::Map => true,
-        MapLookup::Cube | MapLookup::Paraboloid | MapLookup::Virtual => false,
+        MapLookup::Map | MapLookup::Cube => true,
+        MapLookup::Paraboloid | MapLookup::Virtual => false,
     };
     traced && pyramid && size == LightSize::Area
 }
