@@ -183,6 +183,13 @@ impl Renderer {
         self.render_uploaded_async(&uploaded, scene, settings, request).await
     }
 
+    /// Throws every light's penumbra history away: the next frame starts afresh, as
+    /// after a cut, though nothing it would notice moved (a host that cuts to another
+    /// shot of the same scene, or a measure of a first frame).
+    pub fn forget_penumbra_history(&mut self) {
+        self.penumbra_histories.forget_all();
+    }
+
     /// Uploads a scene's geometry, instances and textures.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene, RenderError> {
         GpuScene::upload(&self.gpu, scene, &self.layouts)

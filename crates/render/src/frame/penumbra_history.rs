@@ -96,6 +96,11 @@ impl PenumbraHistories {
         }
     }
 
+    /// Every light keeps no history: the next frame of each starts afresh.
+    pub fn forget_all(&mut self) {
+        self.lights.iter_mut().for_each(|kept| *kept = None);
+    }
+
     /// How many history textures it has created.
     pub fn created(&self) -> u64 {
         self.created
