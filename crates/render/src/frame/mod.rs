@@ -26,6 +26,8 @@ mod shadow_maps;
 mod tile_pass;
 #[cfg(test)]
 mod virtual_depth_tests;
+#[cfg(test)]
+mod penumbra_tests;
 mod virtual_pages;
 mod virtual_record;
 

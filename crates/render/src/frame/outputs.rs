@@ -194,9 +194,15 @@ pub struct LightStats {
     /// the frame was waited for (not a live frame's). The forward path traces in the
     /// lighting pass and counts nothing (`rays/refine_forward.wgsl` says why).
     pub traced_pixels: Option<u32>,
-    /// Shadow rays each refined pixel asks for: 1 under a hard light, the settings'
-    /// `penumbra_rays` under a light with an area (a sample below the surface's
-    /// horizon is counted, though not traced).
+    /// Pixels whose shadow rays decide, this frame or before, where it refines by rays
+    /// on the mask path and the frame was waited for: the traced ones, and under a
+    /// light with an area whose penumbrae its mask pass classifies, those filled from
+    /// their neighbours and those their penumbra history answered.
+    pub unsure_pixels: Option<u32>,
+    /// Shadow rays each refined pixel asks for: 1 under a hard light; under a light
+    /// with an area, a penumbra beam's samples (`gnomon_math::light_masks::SAMPLES`),
+    /// or the settings' `penumbra_rays` where ray queries trace them one by one (a
+    /// sample below the surface's horizon is counted, though not traced).
     pub rays_per_pixel: u32,
     /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
     /// device cannot trace this scene or an image this large.
@@ -534,6 +540,7 @@ impl TimedLights {
                 trace_ms: None,
                 refine: light.refine,
                 traced_pixels: None,
+                unsure_pixels: None,
                 rays_per_pixel: 1,
                 refine_fallback: None,
                 penumbra_frames: None,

@@ -54,6 +54,12 @@ impl PyramidCache {
         }
     }
 
+    /// Light `index`'s kept pyramid and its shape, for the tests that read it back.
+    #[cfg(test)]
+    pub fn kept(&self, index: usize) -> Option<(&Pyramid, PyramidLayout)> {
+        self.lights.get(index)?.as_ref().map(|kept| (&kept.pyramid, kept.layout))
+    }
+
     /// How many pyramid textures it has created.
     pub fn created(&self) -> u64 {
         self.created

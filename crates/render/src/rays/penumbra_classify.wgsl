@@ -47,6 +47,11 @@ const PYRAMID_FIRST_TEXELS: f32 = 4.0;
 const CLASSIFIED_LIT: f32 = 1.0;
 const CLASSIFIED_UMBRA: f32 = 0.0;
 const CLASSIFIED_UNSURE: f32 = 0.5;
+// Unsure because the receiver's own horizon cuts the light (a terminator), where no
+// caster the map holds reaches: a band a pixel or two wide whose visibility falls
+// fast, which a neighbour's answer would not fill; the mask pass beams it in every
+// frame it is not answered (penumbra_mask.wgsl).
+const CLASSIFIED_HORIZON: f32 = 0.25;
 
 // The steepest a caster's surface over an umbra's square may be, as depth along the
 // light over distance across it: up to 63° from facing the light.
@@ -303,7 +308,7 @@ fn classify_receiver(r: Receiver, reach: Reach, seen_normal: vec3<f32>, world: v
         return CLASSIFIED_UNSURE;
     }
     if !casters_reach(r, reach, nearest, tolerance, levels) {
-        return select(CLASSIFIED_UNSURE, CLASSIFIED_LIT, emitter_above_plane(light.emitter, world, seen_normal));
+        return select(CLASSIFIED_HORIZON, CLASSIFIED_LIT, emitter_above_plane(light.emitter, world, seen_normal));
     }
     return select(CLASSIFIED_UNSURE, CLASSIFIED_UMBRA, covered_by_one_caster(r, reach, tolerance, levels));
 }

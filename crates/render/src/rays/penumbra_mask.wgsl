@@ -22,7 +22,7 @@ import package::passes::octahedron::octahedron_decode;
 import package::passes::screen_common::{plane_point, prepass_normals, prepass_surface};
 import package::passes::shading::{facing_error, light_geometry};
 import package::rays::penumbra_classify::CLASSIFIED_UNSURE;
-import package::rays::refine_append::{listed_defer_beam, listed_defer_to_fill};
+import package::rays::refine_append::{count_kept, listed_defer_beam, listed_defer_to_fill};
 import package::variant::{penumbra_layer, pixel_visibility, ray_decides};
 
 // Last frame's history, read; this frame's, written (two textures in turn,
@@ -93,11 +93,17 @@ fn fs_penumbra_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     }
     let beams = select(0.0, past.y, kept && past.y >= 1.0);
     let texel_u = vec2<u32>(texel);
-    if beamed_this_frame(texel_u) {
+    // A pixel unsure for another reason than the casters the map holds (the
+    // horizon: `CLASSIFIED_HORIZON`; a surface within the error of its normal of
+    // edge-on, which the map called lit or dark) is beamed whenever its history has
+    // no answer: its neighbours' would not say.
+    let own = shadow.x != CLASSIFIED_UNSURE && beams == 0.0;
+    if beamed_this_frame(texel_u) || own {
         listed_defer_beam(texel_u, u32(layer), vec2<f32>(select(0.0, past.x, beams > 0.0), beams));
         return PENUMBRA_PENDING;
     }
     if beams > 0.0 {
+        count_kept();
         textureStore(penumbra_history_written, texel, vec4<f32>(past.x, beams, 0.0, 0.0));
         return past.x + 2.0 * layer;
     }

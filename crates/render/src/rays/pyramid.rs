@@ -41,9 +41,11 @@ impl PyramidLayout {
         wgpu::Extent3d { width: self.side, height: self.side, depth_or_array_layers: self.layers }
     }
 
-    /// Its usage: written level by level as storage, read by the mask pass.
-    pub const USAGE: wgpu::TextureUsages =
-        wgpu::TextureUsages::STORAGE_BINDING.union(wgpu::TextureUsages::TEXTURE_BINDING);
+    /// Its usage: written level by level as storage, read by the mask pass, and
+    /// copied out by the tests that check it.
+    pub const USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
+        .union(wgpu::TextureUsages::TEXTURE_BINDING)
+        .union(wgpu::TextureUsages::COPY_SRC);
 
     /// Its two textures, with every level.
     pub fn create(&self, device: &wgpu::Device) -> Pyramid {

@@ -28,8 +28,10 @@ pub(crate) const MAX_GROUPS: u32 = 65_535;
 pub(crate) const COUNTER_STRIDE: u64 = 256;
 /// Bytes of one light's counters (`RefineCounters` in refine_append.wgsl): the three
 /// workgroup counts of the trace pass's indirect dispatch, then the pixels listed;
-/// then the same for the pixels listed to be filled.
-const COUNTER_BYTES: u64 = 32;
+/// then the same for the pixels listed to be filled; then the unsure pixels their
+/// penumbra history answered: 36 bytes, which the trace pass reads as a struct of
+/// two `vec3<u32>` (`ListedPixels`, 16-byte aligned) of 48.
+const COUNTER_BYTES: u64 = 48;
 /// Bytes from a light's counters to those of its fill pass.
 const FILL_COUNTERS: u64 = 16;
 /// Texels of the ring around a lookup's bilinear 2×2 that the footprint test reads
@@ -414,6 +416,16 @@ pub(crate) struct TraceGroups<'a> {
     pub counters: &'a wgpu::Buffer,
 }
 
+/// What a light's counters say of its pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Listed {
+    /// Traced this frame: a ray (or a penumbra beam) each.
+    pub traced: u32,
+    /// Decided by rays, this frame or before: the traced, the filled and those their
+    /// penumbra history answered.
+    pub unsure: u32,
+}
+
 /// A frame's list of unsure pixels (room for every pixel of the screen, reused by
 /// each light in turn) and each light's counters.
 pub(crate) struct RefineLists {
@@ -511,9 +523,14 @@ impl RefineLists {
         copy
     }
 
-    /// Pixels each light listed, from a copy of the counters read back.
-    pub fn listed(counters: &[u32], lights: usize) -> Vec<u32> {
+    /// Pixels each light listed, from a copy of the counters read back: beamed (or
+    /// traced) this frame, and unsure in all (beamed, filled, or answered by their
+    /// penumbra history).
+    pub fn listed(counters: &[u32], lights: usize) -> Vec<Listed> {
         let stride = (COUNTER_STRIDE / 4) as usize;
-        (0..lights).map(|light| counters.get(light * stride + 3).copied().unwrap_or(0)).collect()
+        let word = |light: usize, k: usize| counters.get(light * stride + k).copied().unwrap_or(0);
+        (0..lights)
+            .map(|light| Listed { traced: word(light, 3), unsure: word(light, 3) + word(light, 7) + word(light, 8) })
+            .collect()
     }
 }

@@ -17,6 +17,9 @@ struct RefineCounters {
     fill_groups_y: u32,
     fill_groups_z: u32,
     fill_count: atomic<u32>,
+    // Unsure pixels answered by the beams their history holds, neither beamed nor
+    // filled this frame (penumbra_mask.wgsl).
+    kept_count: atomic<u32>,
 };
 
 @group(1) @binding(4) var<storage, read_write> refine_counters: RefineCounters;
@@ -41,6 +44,11 @@ fn listed_defer_beam(pixel: vec2<u32>, layer: u32, past: vec2<f32>) {
     // The list holds a pixel per pixel of the screen, and each pixel lists itself at
     // most once per light: the index is in bounds.
     unsure_pixels[index] = UnsurePixel(pixel.x | (pixel.y << 16u), layer, past.x, past.y);
+}
+
+// Counts an unsure pixel its history answered.
+fn count_kept() {
+    atomicAdd(&refine_counters.kept_count, 1u);
 }
 
 // Appends `pixel` to the fill list, which runs from the list's far end down, and

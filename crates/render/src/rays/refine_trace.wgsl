@@ -35,6 +35,7 @@ struct ListedPixels {
     count: u32,
     fill_groups: vec3<u32>,
     fill_count: u32,
+    kept_count: u32,
 };
 
 // The list itself is `unsure_pixels` (refine_list.wgsl); its counters are read-only
@@ -104,7 +105,7 @@ fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
         let near = neighbours(centre);
         var visibility: f32;
         var beams = 0.0;
-        if near.weight > 0.0 && near.highest - near.lowest <= FILL_SPREAD {
+        if near.across && near.highest - near.lowest <= FILL_SPREAD {
             visibility = near.sum / near.weight;
         } else {
             let origin = surface_ray_origin(centre.world, n, surface.w);
@@ -119,7 +120,7 @@ fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
 
 // The most the answered neighbours of a pixel may differ for the fill to take their
 // mean rather than beam it.
-const FILL_SPREAD: f32 = 0.25;
+const FILL_SPREAD: f32 = 0.15;
 
 // The centre of a fill: its pixel, surface point and geometric normal, a pixel's
 // width in world units at its depth, and that depth.
@@ -136,20 +137,26 @@ struct FillCentre {
 const SURFACE_PIXELS: f32 = 2.0;
 const SURFACE_COS: f32 = 0.9;
 
-// What a fill's answered neighbours say: their weighted sum and weight, and their
-// least and greatest answer.
+// What a fill's answered neighbours say: their weighted sum and weight, their least
+// and greatest answer, and whether two of them lie on either side of the pixel, so
+// that their mean interpolates between them rather than carrying one side's answer
+// over an edge the pixel may lie beyond (a penumbra a pixel or two wide, whose
+// answered neighbours all lie on its lit side).
 struct Neighbours {
     sum: f32,
     weight: f32,
     lowest: f32,
     highest: f32,
+    across: bool,
 };
 
 // The answered neighbours within one pixel of `c` on its surface
 // (`cs_fill_penumbra`).
 fn neighbours(c: FillCentre) -> Neighbours {
     let size = vec2<i32>(textureDimensions(traced_mask));
-    var near = Neighbours(0.0, 0.0, 1.0, 0.0);
+    var near = Neighbours(0.0, 0.0, 1.0, 0.0, false);
+    // Which of the 3 × 3 answered, bit k for neighbour k (row by row).
+    var answered = 0u;
     for (var k = 0; k < 9; k++) {
         let d = vec2<i32>(k % 3 - 1, k / 3 - 1);
         let q = c.texel + d;
@@ -178,6 +185,15 @@ fn neighbours(c: FillCentre) -> Neighbours {
         near.weight += w;
         near.lowest = min(near.lowest, visibility);
         near.highest = max(near.highest, visibility);
+        answered |= 1u << u32(k);
+    }
+    // Either side along a row, a column or a diagonal: neighbours 3 and 5, 1 and 7,
+    // 0 and 8, 2 and 6.
+    for (var pair = 0u; pair < 4u; pair++) {
+        let sides = (1u << FILL_OPPOSITE[pair].x) | (1u << FILL_OPPOSITE[pair].y);
+        near.across = near.across || (answered & sides) == sides;
     }
     return near;
 }
+
+const FILL_OPPOSITE: array<vec2<u32>, 4> = array<vec2<u32>, 4>(vec2<u32>(3u, 5u), vec2<u32>(1u, 7u), vec2<u32>(0u, 8u), vec2<u32>(2u, 6u));
