@@ -131,7 +131,8 @@ pub fn measure(
         series.push(MotionSeries { technique: technique.name().to_owned(), frames });
     }
     bar.finish_and_clear();
-    let (last, reference) = last.ok_or_else(|| anyhow::anyhow!("--techniques is empty: name at least one"))?;
+    let (last, reference) =
+        last.ok_or_else(|| anyhow::anyhow!("--techniques is empty: name at least one"))?;
     Ok(Measured { series, last, reference })
 }
 
@@ -147,7 +148,8 @@ fn light_paths(motion: Motion) -> LightPathArgs {
 }
 
 fn measure_frame(index: u32, frame: &Frame, reference: &ReferenceImage) -> MotionFrame {
-    let raster = RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
     let classes = metrics::classify(raster, reference);
     let m = metrics::measure(raster, reference, &classes);
     MotionFrame {

@@ -107,7 +107,8 @@ pub(crate) fn stage_motion(
     frame: &gnomon_render::Frame,
     reference: &ReferenceImage,
 ) -> anyhow::Result<()> {
-    let raster = RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
     let classes = metrics::classify(raster, reference);
     let error = if reference.samples > 1 {
         heatmap::soft(&frame.visibility, reference, &classes)

@@ -134,7 +134,10 @@ impl FixedBindings {
                 wgpu::TextureViewDimension::D2,
             ),
             placeholder_pyramid: [crate::rays::PLANES_FORMAT, crate::rays::RANGES_FORMAT].map(|format| {
-                view_as(placeholder(device, "no depth pyramid", format, 1), wgpu::TextureViewDimension::D2Array)
+                view_as(
+                    placeholder(device, "no depth pyramid", format, 1),
+                    wgpu::TextureViewDimension::D2Array,
+                )
             }),
             placeholder_virtual: VirtualBuffers {
                 uniform: placeholder_buffer(

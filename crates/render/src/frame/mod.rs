@@ -12,11 +12,13 @@ mod host_target;
 mod late;
 mod light_passes;
 mod map_cache;
-mod penumbra_history;
-mod pyramid_cache;
 mod moment_cache;
 mod outputs;
+mod penumbra_history;
+#[cfg(test)]
+mod penumbra_tests;
 mod plan;
+mod pyramid_cache;
 mod receiver;
 mod record;
 mod recording;
@@ -26,8 +28,6 @@ mod shadow_maps;
 mod tile_pass;
 #[cfg(test)]
 mod virtual_depth_tests;
-#[cfg(test)]
-mod penumbra_tests;
 mod virtual_pages;
 mod virtual_record;
 

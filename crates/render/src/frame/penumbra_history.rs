@@ -62,7 +62,13 @@ pub(super) struct HistoryFrame {
 
 impl PenumbraHistories {
     /// Light `index`'s history for a frame of `key` on a `width` × `height` screen.
-    pub fn begin(&mut self, device: &wgpu::Device, index: usize, key: HistoryKey, [width, height]: [u32; 2]) -> HistoryFrame {
+    pub fn begin(
+        &mut self,
+        device: &wgpu::Device,
+        index: usize,
+        key: HistoryKey,
+        [width, height]: [u32; 2],
+    ) -> HistoryFrame {
         if self.lights.len() <= index {
             self.lights.resize_with(index + 1, || None);
         }
@@ -77,7 +83,8 @@ impl PenumbraHistories {
             Some(_) | None => {
                 self.created += 2;
                 let texture = |label| create_history(device, label, width, height);
-                let textures = [texture("penumbra history, even frames"), texture("penumbra history, odd frames")];
+                let textures =
+                    [texture("penumbra history, even frames"), texture("penumbra history, odd frames")];
                 (LightHistory { textures, key, frames: 1 }, false)
             }
         };

@@ -50,7 +50,8 @@ impl ReadPyramid {
         let level = |texture: &wgpu::Texture, level: u32| {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let mut pool = Pool::new(&gpu.device);
-            let pending = readback::record_level(&mut pool, &mut encoder, texture, wgpu::TextureAspect::All, level);
+            let pending =
+                readback::record_level(&mut pool, &mut encoder, texture, wgpu::TextureAspect::All, level);
             gpu.queue.submit([encoder.finish()]);
             pollster::block_on(pending.read::<f32>(gpu)).expect("read back")
         };
@@ -98,17 +99,27 @@ fn first_fault(pyramid: &ReadPyramid, depths: &[f32], resolution: u32, slack: f3
     for level in 0..pyramid.layout.levels as usize {
         let (span, width) = (4usize << level, (side >> level).max(1));
         for layer in 0..pyramid.layout.layers as usize {
-            for (k, (plane, range)) in
-                pyramid.planes[level].iter().zip(&pyramid.ranges[level]).skip(layer * width * width).take(width * width).enumerate()
+            for (k, (plane, range)) in pyramid.planes[level]
+                .iter()
+                .zip(&pyramid.ranges[level])
+                .skip(layer * width * width)
+                .take(width * width)
+                .enumerate()
             {
                 let (i, j) = (k % width, k / width);
-                let centre = [(i * span) as f32 + (span as f32 - 1.0) / 2.0, (j * span) as f32 + (span as f32 - 1.0) / 2.0];
+                let centre = [
+                    (i * span) as f32 + (span as f32 - 1.0) / 2.0,
+                    (j * span) as f32 + (span as f32 - 1.0) / 2.0,
+                ];
                 let (mut least, mut greatest) = (f32::INFINITY, f32::NEG_INFINITY);
                 for y in (j * span).min(n)..((j + 1) * span).min(n) {
                     for x in (i * span).min(n)..((i + 1) * span).min(n) {
                         let d = depths[layer * n * n + y * n + x];
                         (least, greatest) = (least.min(d), greatest.max(d));
-                        let below = plane[0] + plane[1] * (x as f32 - centre[0]) + plane[2] * (y as f32 - centre[1]) + plane[3];
+                        let below = plane[0]
+                            + plane[1] * (x as f32 - centre[0])
+                            + plane[2] * (y as f32 - centre[1])
+                            + plane[3];
                         if below > d + ROUNDING * (1.0 + plane[1].abs() + plane[2].abs()) * span as f32 {
                             return Some(format!(
                                 "level {level} layer {layer} square ({i}, {j}): plane less residual {below} above texel ({x}, {y})'s {d}"
@@ -136,7 +147,13 @@ fn first_fault(pyramid: &ReadPyramid, depths: &[f32], resolution: u32, slack: f3
 /// lies behind the receiver's plane everywhere over it (`weigh_square`'s first rule),
 /// mirrored here: the receiver's plane of depth `depth` at map position `at`, changing
 /// by `gradient` per texel.
-fn clears_by_plane(plane: [f32; 4], centre: [f32; 2], half: f32, receiver: ([f32; 2], f32, [f32; 2]), tolerance: f32) -> bool {
+fn clears_by_plane(
+    plane: [f32; 4],
+    centre: [f32; 2],
+    half: f32,
+    receiver: ([f32; 2], f32, [f32; 2]),
+    tolerance: f32,
+) -> bool {
     let (at, depth, gradient) = receiver;
     let receiver_at_centre = depth + gradient[0] * (centre[0] - at[0]) + gradient[1] * (centre[1] - at[1]);
     let tilt = (plane[1] - gradient[0]).abs() + (plane[2] - gradient[1]).abs();
@@ -164,12 +181,28 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
         // The check sees a square that lies: a least depth raised past its least
         // texel, and a residual raised past its lowest texel.
         let occupied = pyramid.ranges[0].iter().position(|r| r[0] < r[1]).expect("a square with depths");
-        let mut raised = ReadPyramid { layout: pyramid.layout, planes: pyramid.planes.clone(), ranges: pyramid.ranges.clone() };
+        let mut raised = ReadPyramid {
+            layout: pyramid.layout,
+            planes: pyramid.planes.clone(),
+            ranges: pyramid.ranges.clone(),
+        };
         raised.ranges[0][occupied][0] += 1e-4;
-        assert!(first_fault(&raised, &depths, map.resolution, slack).is_some(), "{}: a raised least depth passed", scene.name);
-        let mut raised = ReadPyramid { layout: pyramid.layout, planes: pyramid.planes.clone(), ranges: pyramid.ranges.clone() };
+        assert!(
+            first_fault(&raised, &depths, map.resolution, slack).is_some(),
+            "{}: a raised least depth passed",
+            scene.name
+        );
+        let mut raised = ReadPyramid {
+            layout: pyramid.layout,
+            planes: pyramid.planes.clone(),
+            ranges: pyramid.ranges.clone(),
+        };
         raised.planes[0][occupied][3] += 1e-4;
-        assert!(first_fault(&raised, &depths, map.resolution, slack).is_some(), "{}: a raised residual passed", scene.name);
+        assert!(
+            first_fault(&raised, &depths, map.resolution, slack).is_some(),
+            "{}: a raised residual passed",
+            scene.name
+        );
 
         // So a square the plane rule clears holds no texel in front of the receiver's
         // plane: tried for planes through every first- and second-level square's
@@ -183,8 +216,13 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
                 if i * span >= n || j * span >= n {
                     continue;
                 }
-                let centre = [(i * span) as f32 + (span as f32 - 1.0) / 2.0, (j * span) as f32 + (span as f32 - 1.0) / 2.0];
-                for (tilt, lift) in [([0.0, 0.0], 0.0), ([plane[1], plane[2]], 1e-5), ([2.0 * plane[1], -plane[2]], -1e-5)] {
+                let centre = [
+                    (i * span) as f32 + (span as f32 - 1.0) / 2.0,
+                    (j * span) as f32 + (span as f32 - 1.0) / 2.0,
+                ];
+                for (tilt, lift) in
+                    [([0.0, 0.0], 0.0), ([plane[1], plane[2]], 1e-5), ([2.0 * plane[1], -plane[2]], -1e-5)]
+                {
                     let at = [centre[0] + 3.0, centre[1] - 2.0];
                     let depth = plane[0] + plane[1] * 3.0 - plane[2] * 2.0 + lift;
                     let tolerance = 0.5 * (tilt[0].abs() + tilt[1].abs());
@@ -194,7 +232,8 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
                     cleared += 1;
                     for y in j * span..((j + 1) * span).min(n) {
                         for x in i * span..((i + 1) * span).min(n) {
-                            let receiver = depth + tilt[0] * (x as f32 - at[0]) + tilt[1] * (y as f32 - at[1]);
+                            let receiver =
+                                depth + tilt[0] * (x as f32 - at[0]) + tilt[1] * (y as f32 - at[1]);
                             let d = depths[y * n + x];
                             assert!(
                                 d >= receiver - tolerance - ROUNDING,
@@ -230,7 +269,8 @@ fn the_penumbra_history_follows_on_only_where_nothing_it_depends_on_moved() {
     let render = |renderer: &mut Renderer, uploaded: &crate::GpuScene, scene: &Scene, s: &Settings| {
         renderer.render_uploaded(uploaded, scene, s, &OutputRequest::default()).unwrap()
     };
-    let frames: Vec<Option<u32>> = (0..3).map(|_| held(&render(&mut renderer, &uploaded, &scene, &settings))).collect();
+    let frames: Vec<Option<u32>> =
+        (0..3).map(|_| held(&render(&mut renderer, &uploaded, &scene, &settings))).collect();
     assert_eq!(frames, [Some(1), Some(2), Some(3)], "a still view gathers");
 
     // The light moves: the frame starts afresh, and is the very frame a renderer that
@@ -240,7 +280,8 @@ fn the_penumbra_history_follows_on_only_where_nothing_it_depends_on_moved() {
     let after = render(&mut renderer, &uploaded, &scene, &moved);
     assert_eq!(held(&after), Some(1), "the history outlived the light's move");
     let fresh = Renderer::new(&gpu).unwrap().render(&scene, &moved, &OutputRequest::default()).unwrap();
-    let differ = after.visibility.iter().zip(&fresh.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    let differ =
+        after.visibility.iter().zip(&fresh.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
     assert_eq!(differ, 0, "{differ} pixels differ from a first frame under the moved light");
     assert_eq!(held(&render(&mut renderer, &uploaded, &scene, &moved)), Some(2));
 
@@ -250,7 +291,8 @@ fn the_penumbra_history_follows_on_only_where_nothing_it_depends_on_moved() {
     assert_eq!(held(&render(&mut renderer, &uploaded, &scene, &turned)), Some(1), "after the camera moved");
     assert_eq!(held(&render(&mut renderer, &uploaded, &scene, &turned)), Some(2));
     let caster = scene.instances.len() - 1;
-    scene.instances[caster].world_from_object = glam::Mat4::from_translation(glam::Vec3::X * 0.01) * scene.instances[caster].world_from_object;
+    scene.instances[caster].world_from_object =
+        glam::Mat4::from_translation(glam::Vec3::X * 0.01) * scene.instances[caster].world_from_object;
     renderer.move_instances(&mut uploaded, &scene, &[caster]).unwrap();
     assert_eq!(held(&render(&mut renderer, &uploaded, &scene, &turned)), Some(1), "after a caster moved");
     renderer.forget_penumbra_history();

@@ -31,7 +31,13 @@ pub(super) enum PyramidPlan {
 impl PyramidCache {
     /// Light `index`'s pyramid of `layout`: the kept one where `depths_kept` (its
     /// depth map is the one it was built from), else textures to build it into.
-    pub fn plan(&mut self, device: &wgpu::Device, index: usize, layout: PyramidLayout, depths_kept: bool) -> PyramidPlan {
+    pub fn plan(
+        &mut self,
+        device: &wgpu::Device,
+        index: usize,
+        layout: PyramidLayout,
+        depths_kept: bool,
+    ) -> PyramidPlan {
         if self.lights.len() <= index {
             self.lights.resize_with(index + 1, || None);
         }

@@ -17,10 +17,10 @@ use super::{
     cull::Culled,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
-    penumbra_history::{HistoryFrame, HistoryKey},
-    pyramid_cache::PyramidPlan,
     outputs::{Submitted, TimedLights},
+    penumbra_history::{HistoryFrame, HistoryKey},
     plan::{FramePlan, LightPlan},
+    pyramid_cache::PyramidPlan,
     recording::{
         DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, PyramidViews, Recorded, Recording,
     },
@@ -101,7 +101,8 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        let mut untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
+        let mut untimed =
+            TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
         for (stats, frames) in untimed.lights.iter_mut().zip(&recorded.penumbra_frames) {
             stats.penumbra_frames = *frames;
         }
@@ -182,7 +183,8 @@ impl Renderer {
         let mask_layers = if plan.mask_path { self.mask_layers(plan, width, height) } else { vec![] };
         let histories = self.penumbra_histories(uploaded, plan, &camera_gpu, [width, height]);
         let maps = LightMapInputs { culled, mask_layers: &mask_layers, histories: &histories, readback };
-        let LitLights { lit, shown_map, shown_map_readback } = self.record_light_maps(rec, uploaded, plan, maps);
+        let LitLights { lit, shown_map, shown_map_readback } =
+            self.record_light_maps(rec, uploaded, plan, maps);
         let mut readbacks = FrameReadbacks { shadow_map: shown_map_readback, ..Default::default() };
         let targets = self.lighting_targets(width, height);
         let viewport = Viewport { width, height };
@@ -292,7 +294,8 @@ impl Renderer {
         let mut shown_map = None;
         let mut shown_map_readback = None;
         for (index, light) in plan.lights.iter().enumerate() {
-            let map = self.record_shadow_maps(rec, uploaded, light, &inputs.culled.layers[index], index as u32);
+            let map =
+                self.record_shadow_maps(rec, uploaded, light, &inputs.culled.layers[index], index as u32);
             if index == plan.shown {
                 if inputs.readback.shadow_map {
                     let aspect = wgpu::TextureAspect::DepthOnly;
@@ -302,7 +305,8 @@ impl Renderer {
             }
             let mask = inputs.mask_layers.get(index);
             let history = inputs.histories[index].as_ref();
-            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask, history));
+            let drawn = DrawnLight { index: index as u32, map: &map, mask_layer: mask, history };
+            lit.push(self.light_bindings(rec, uploaded, light, drawn));
         }
         let shown_map = shown_map.expect("the reported light is one of the lights");
         LitLights { lit, shown_map, shown_map_readback }
@@ -416,7 +420,10 @@ impl Renderer {
             }
         };
         let whole = ViewKey::whole(wgpu::TextureViewDimension::D2Array);
-        PyramidViews { planes: self.pool.view(&pyramid.planes, whole), ranges: self.pool.view(&pyramid.ranges, whole) }
+        PyramidViews {
+            planes: self.pool.view(&pyramid.planes, whole),
+            ranges: self.pool.view(&pyramid.ranges, whole),
+        }
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes
@@ -426,11 +433,9 @@ impl Renderer {
         rec: &mut Recording,
         uploaded: &GpuScene,
         light: &LightPlan,
-        index: u32,
-        map: &wgpu::Texture,
-        mask_layer: Option<&wgpu::TextureView>,
-        history: Option<&HistoryFrame>,
+        drawn: DrawnLight,
     ) -> LightBindings {
+        let DrawnLight { index, map, mask_layer, history } = drawn;
         let maps = self.light_maps(rec, light, index, map, history);
         let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
@@ -439,6 +444,15 @@ impl Renderer {
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
+}
+
+/// One light as its maps were drawn: its index, its map, the mask layer its lighting
+/// pass reads (on the mask path) and its penumbra history.
+struct DrawnLight<'a> {
+    index: u32,
+    map: &'a wgpu::Texture,
+    mask_layer: Option<&'a wgpu::TextureView>,
+    history: Option<&'a HistoryFrame>,
 }
 
 /// What the first passes read besides the plan: the culled layers, the mask's layers,

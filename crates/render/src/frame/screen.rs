@@ -6,9 +6,9 @@
 use super::{
     Renderer,
     bindings::CameraDraws,
+    penumbra_history::HistoryFrame,
     plan::{FramePlan, LightPlan},
     recording::{LightBindings, Recording},
-    penumbra_history::HistoryFrame,
     virtual_record::EdgeList,
 };
 use crate::{
@@ -142,22 +142,10 @@ impl Renderer {
         );
         // The list of unsure pixels and each light's counters, cleared: zero
         // workgroups until a mask pass lists a pixel.
-        let refining = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
-            let lists = RefineLists::new(&mut self.pool, width, height, plan.lights.len());
-            rec.encoder.clear_buffer(&lists.counters, 0, None);
-            let prepass = [&surface, &normals];
-            let camera = inputs.camera_buffer;
-            let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
-            let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
-            let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-            let traced = self.pool.texture("traced shadow mask", size, screen_space::MASK_FORMAT, usage);
-            let traced = self.pool.view(&traced, ViewKey::default());
-            let one = wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 };
-            let no_history =
-                self.pool.texture("no penumbra history", one, HISTORY_FORMAT, wgpu::TextureUsages::STORAGE_BINDING);
-            let no_history = self.pool.view(&no_history, ViewKey::default());
-            Refining { lists, append, read, traced, no_history }
-        });
+        let refining =
+            plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
+                self.refining(rec, size, plan.lights.len(), inputs.camera_buffer, [&surface, &normals])
+            });
         for (index, ((light, bindings), layer)) in
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
         {
@@ -166,9 +154,8 @@ impl Renderer {
                 (Some(refining), Refine::Auto | Refine::Rays | Refine::EveryPixel) => Some(refining),
             };
             let history = inputs.histories[index].as_ref();
-            let history_views = history.map(|h| {
-                [&h.read, &h.write].map(|texture| self.pool.view(texture, ViewKey::default()))
-            });
+            let history_views = history
+                .map(|h| [&h.read, &h.write].map(|texture| self.pool.view(texture, ViewKey::default())));
             let screen = match refined {
                 Some(refining) => MaskScreen {
                     group: &refining.append,
@@ -222,6 +209,35 @@ impl Renderer {
             }
         }
         ScreenOutputs { lists: refining.map(|refining| refining.lists), surface_group: screen_group }
+    }
+
+    /// The list of unsure pixels and each light's counters, cleared (zero workgroups
+    /// until a mask pass lists a pixel), their groups over the camera and the
+    /// prepass's `surface` and `normals`, and the traced mask.
+    fn refining(
+        &mut self,
+        rec: &mut Recording,
+        size: wgpu::Extent3d,
+        lights: usize,
+        camera: &wgpu::Buffer,
+        prepass: [&wgpu::TextureView; 2],
+    ) -> Refining {
+        let lists = RefineLists::new(&mut self.pool, size.width, size.height, lights);
+        rec.encoder.clear_buffer(&lists.counters, 0, None);
+        let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
+        let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let traced = self.pool.texture("traced shadow mask", size, screen_space::MASK_FORMAT, usage);
+        let traced = self.pool.view(&traced, ViewKey::default());
+        let one = wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 };
+        let no_history = self.pool.texture(
+            "no penumbra history",
+            one,
+            HISTORY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+        );
+        let no_history = self.pool.view(&no_history, ViewKey::default());
+        Refining { lists, append, read, traced, no_history }
     }
 
     /// Light `index`'s mask pass into its `target` layer of the mask, with group 1

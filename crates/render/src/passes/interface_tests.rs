@@ -221,6 +221,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("page clear".into(), crate::virtual_map::draw::page_clear_wgsl()));
     out.push(("surface from depth".into(), crate::virtual_map::surface_from_depth_wgsl()));
     out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));
+    out.push(("depth pyramid".into(), crate::rays::pyramid::depth_pyramid_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);

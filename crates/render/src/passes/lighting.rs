@@ -7,7 +7,9 @@
 
 use std::collections::HashMap;
 
-use super::wgsl_interfaces::{IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PENUMBRA_LAYER, PIXEL_VISIBILITY, SEEN_SURFACE};
+use super::wgsl_interfaces::{
+    IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PENUMBRA_LAYER, PIXEL_VISIBILITY, SEEN_SURFACE,
+};
 use super::{
     CAMERA_MATERIAL_BINDINGS, CAMERA_STRUCT_WGSL, LIGHT_WGSL, Layouts, OWN_CAMERA_BINDING, OWN_LIGHT_BINDING,
     SCENE_COMMON_WGSL, SHADING_WGSL, camera_binding_wgsl, compose_wgsl, light_binding_wgsl,

@@ -99,7 +99,6 @@ pub(crate) fn compose_wgsl(parts: &[&str]) -> String {
     #[cfg(not(test))]
     let naming = link::Naming::AsWritten;
     link::link(&all, naming).unwrap_or_else(|error| {
-        eprintln!("LINK ERROR: {error}");
         let comment: String = error.lines().map(|line| format!("// {line}\n")).collect();
         format!(
             "// WESL could not link this shader:\n{comment}const wesl_link_failed: u32 = wesl_link_error;\n"

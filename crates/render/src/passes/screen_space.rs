@@ -81,7 +81,11 @@ fn mask_module(key: MaskKey) -> &'static str {
 
 /// The fragment entry point of [`mask_module`].
 fn mask_entry(key: MaskKey) -> &'static str {
-    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) { "fs_penumbra_mask" } else { "fs_mask" }
+    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+        "fs_penumbra_mask"
+    } else {
+        "fs_mask"
+    }
 }
 
 pub(crate) struct ScreenSpacePass {
@@ -125,7 +129,14 @@ impl ScreenSpacePass {
             ],
             immediate_size: 0,
         });
-        Self { prepass_layout, prepass: None, mask_layout, refine_layout, penumbra_layout, masks: HashMap::new() }
+        Self {
+            prepass_layout,
+            prepass: None,
+            mask_layout,
+            refine_layout,
+            penumbra_layout,
+            masks: HashMap::new(),
+        }
     }
 
     /// The prepass pipeline: groups 0 (scene), 1 (camera) and 3 (material).

@@ -171,8 +171,14 @@ impl CasterBvh {
         let pad = 1e-6 * scene_size;
         if gathered.triangles.is_empty() {
             let leaf = NodeGpu { min: [0.0; 3], count: 1, max: [0.0; 3], first: 0 };
-            let point =
-                TriangleGpu { v0: [0.0; 3], alpha: NO_ALPHA, v1: [0.0; 3], closed: 0, v2: [0.0; 3], _pad2: 0 };
+            let point = TriangleGpu {
+                v0: [0.0; 3],
+                alpha: NO_ALPHA,
+                v1: [0.0; 3],
+                closed: 0,
+                v2: [0.0; 3],
+                _pad2: 0,
+            };
             return Self {
                 nodes: vec![leaf],
                 triangles: vec![point],
@@ -212,7 +218,14 @@ impl CasterBvh {
                     alpha.push(a);
                     alpha.len() as u32 - 1
                 });
-                TriangleGpu { v0, alpha: test, v1, closed: u32::from(gathered.closed[k as usize]), v2, _pad2: 0 }
+                TriangleGpu {
+                    v0,
+                    alpha: test,
+                    v1,
+                    closed: u32::from(gathered.closed[k as usize]),
+                    v2,
+                    _pad2: 0,
+                }
             })
             .collect();
         let nodes: Vec<NodeGpu> = bvh
@@ -405,8 +418,12 @@ fn runs(sorted: &[u32]) -> Vec<Range<u32>> {
 
 /// Every casting instance's triangles in world space, with their alpha tests.
 fn gather(scene: &Scene, texture_slots: &[Option<u32>]) -> Gathered {
-    let mut out =
-        Gathered { triangles: Vec::new(), alpha: Vec::new(), closed: Vec::new(), instance_triangles: Vec::new() };
+    let mut out = Gathered {
+        triangles: Vec::new(),
+        alpha: Vec::new(),
+        closed: Vec::new(),
+        instance_triangles: Vec::new(),
+    };
     let closed_meshes = scene.closed_meshes();
     for inst in &scene.instances {
         let first = out.triangles.len() as u32;

@@ -9,20 +9,22 @@
 mod accel;
 mod bvh;
 mod forward;
-mod pyramid;
+pub(crate) mod pyramid;
 pub(crate) mod query;
 pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
-pub(crate) use pyramid::{PLANES_FORMAT, Pyramid, PyramidInput, PyramidLayout, PyramidParams, PyramidPass, RANGES_FORMAT};
+pub(crate) use pyramid::{
+    PLANES_FORMAT, Pyramid, PyramidInput, PyramidLayout, PyramidParams, PyramidPass, RANGES_FORMAT,
+};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, classifies_penumbrae,
-    mask_refine_wgsl,
-    HISTORY_FORMAT, history_layout, refined_mask_layout, screen_layout as refine_screen_layout,
+    HISTORY_FORMAT, LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage,
+    classifies_penumbrae, history_layout, mask_refine_wgsl, refined_mask_layout,
+    screen_layout as refine_screen_layout,
 };
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};

@@ -20,7 +20,7 @@
 //
 // Cut-out casters are alpha-tested per sample, by a ray to each of the samples the
 // triangle may hide.
-import package::constants::{LIGHT_MASK_ANGLE_BINS, LIGHT_MASK_OFFSET_BINS, LIGHT_MASK_SAMPLES};
+import package::constants::{LIGHT_MASK_ANGLE_BINS, LIGHT_MASK_OFFSET_BINS, LIGHT_MASK_SAMPLES, PI};
 import package::passes::light::SamplePlane;
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_plane_weight, emitter_sample_plane};
@@ -35,7 +35,6 @@ import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
 const SAMPLE_ELEMENTS: u32 = LIGHT_MASK_SAMPLES / 2u;
 const ALL_SAMPLES: vec4<u32> = vec4<u32>(0xffffffffu);
-const PI: f32 = 3.141592653589793;
 
 // The light's sample k, in the unit disk.
 fn light_mask_sample(k: u32) -> vec2<f32> {

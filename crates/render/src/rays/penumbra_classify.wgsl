@@ -27,6 +27,7 @@
 // for its square (`UMBRA_SLOPE`) keeps out the silhouettes where a ray could pass
 // beside a caster, not through it: a caster's edge seen over what lies behind it is
 // a jump in depth as deep as the gap between them.
+import package::constants::MAP_CLEARED;
 import package::passes::light_binding::{light, light_depth_from_distance, light_distance_from_depth, texel_shape};
 import package::passes::light_kinds::{emitter_above_plane, emitter_cone_radius};
 import package::techniques::bindings::shadow_map;
@@ -36,6 +37,7 @@ import package::techniques::bindings::shadow_map;
 // least and greatest depth.
 @group(2) @binding(10) var pyramid_planes_read: texture_2d_array<f32>;
 @group(2) @binding(11) var pyramid_ranges_read: texture_2d_array<f32>;
+
 
 // Map texels a side of one texel of the pyramid's first level
 // (`pyramid::FIRST_LEVEL_TEXELS`).
@@ -69,11 +71,13 @@ struct Receiver {
     // Whether the layer is a cube face, whose depths the pyramid holds as
     // `cube_depth` (depth_pyramid.wgsl) rather than as the face stores them.
     cube: bool,
+    // Where it lies in the world.
+    world: vec3<f32>,
 };
 
 // A receiver outside its layer, or seen edge-on from the light: the map cannot say.
-fn unplaced_receiver(layer: u32, cube: bool) -> Receiver {
-    return Receiver(vec2<f32>(-1e9), 0.0, vec2<f32>(0.0), 1.0, layer, cube);
+fn unplaced_receiver(layer: u32, cube: bool, world: vec3<f32>) -> Receiver {
+    return Receiver(vec2<f32>(-1e9), 0.0, vec2<f32>(0.0), 1.0, layer, cube, world);
 }
 
 // A cube face's depth at distance `z` along its axis: 1 − near / z, which like a
@@ -242,6 +246,9 @@ fn weigh_square(r: Receiver, reach: Reach, q: Square, tolerance: f32, covered: f
     }
     let near_edge = max(q.lo - r.texel, r.texel - q.hi);
     let aside = max(max(near_edge.x, near_edge.y), 0.0);
+    if plane_spares_light(r, reach, q, tolerance, aside) {
+        return SQUARE_CLEAR;
+    }
     if q.range.x > deepest_reaching(reach, max(aside - 0.5, covered - 1.0)) {
         return SQUARE_CLEAR;
     }
@@ -255,12 +262,81 @@ fn weigh_square(r: Receiver, reach: Reach, q: Square, tolerance: f32, covered: f
     return SQUARE_UNDECIDED;
 }
 
+// Whether square `q`'s plane, lowered by its least residual (every depth it holds
+// lies on it or behind it), has the whole light above its horizon and lets no ray
+// from the receiver to the light meet what lies behind it over the square: then
+// nothing the square holds can hide the light. Where the receiver's own plane bounds
+// the square too loosely (a floor's far squares under a low, wide sun, whose slope
+// from the receiver's screen derivatives is a little off), the floor's own plane
+// still clears them.
+//
+// A receiver at or in front of the plane (within `tolerance` in depth) is spared
+// outright: its rays only rise away from the plane. Under a sun, one `behind` it by a
+// little (the plane's residual bound, summed over the pyramid's levels, and the
+// depths' rounding) is spared by a square `aside` texels to its side too: every ray
+// to the sun's disk rises above the plane by at least `rise` per unit of length (the
+// sine of the disk's lowest point's elevation over it), so it leaves the plane's back
+// within behind / rise of the receiver, and moves no farther to the side than that
+// (a sun's map is orthographic).
+//
+// The map's depth is affine over a plane in the world (clip z / w, or a cube face's
+// `cube_depth`), so a plane in the map is one in the world: the layer's clip-space
+// plane, depth = α + β x + γ y over its normalized device coordinates, is the row
+// vector π with π · clip = 0, and the world's is π times clip_from_world.
+fn plane_spares_light(r: Receiver, reach: Reach, q: Square, tolerance: f32, aside: f32) -> bool {
+    let centre = 0.5 * (q.lo + q.hi);
+    let lowered = q.plane.x + q.plane.w;
+    let in_front = lowered + dot(q.plane.yz, r.texel - centre) >= r.depth - tolerance;
+    if !in_front && light.emitter.kind != LIGHT_SUN {
+        return false;
+    }
+    // Texel position p = (x + 1) res / 2 − ½ along x, (1 − y) res / 2 − ½ along y.
+    let half_res = 0.5 * light.map.resolution;
+    let beta = q.plane.y * half_res;
+    let gamma = -q.plane.z * half_res;
+    let alpha = lowered + dot(q.plane.yz, vec2<f32>(half_res - 0.5) - centre);
+    // depth − α − β x − γ y = 0 over clip coordinates (x, y, z, w) / w; a cube face's
+    // depth is 1 − near / w, and w − near·1 = (α + β x + γ y) w.
+    var clip_plane = vec4<f32>(-beta, -gamma, 1.0, -alpha);
+    var constant = 0.0;
+    if r.cube {
+        clip_plane = vec4<f32>(-beta, -gamma, 0.0, 1.0 - alpha);
+        constant = -light.map.near;
+    }
+    let world_plane = transpose(light.cascade_clip_from_world[r.layer]) * clip_plane + vec4<f32>(0.0, 0.0, 0.0, constant);
+    // Negative in front of the plane, toward the light: the free side's normal is −n.
+    let n = world_plane.xyz;
+    let length_squared = dot(n, n);
+    if !(length_squared > 0.0) {
+        return false;
+    }
+    let inverse_length = inverseSqrt(length_squared);
+    let free = -n * inverse_length;
+    let behind = (dot(n, r.world) + world_plane.w) * inverse_length;
+    let on_plane = r.world - behind * (n * inverse_length);
+    if !emitter_above_plane(light.emitter, on_plane, free) {
+        return false;
+    }
+    if in_front || behind <= 0.0 {
+        return true;
+    }
+    // The sun's disk, radius asin(s), centred asin(c) above the plane.
+    let c = dot(free, -light.emitter.direction);
+    let s = light.emitter.size * inverseSqrt(1.0 + light.emitter.size * light.emitter.size);
+    let rise = c * sqrt(max(1.0 - s * s, 0.0)) - sqrt(max(1.0 - c * c, 0.0)) * s;
+    // A caster's geometry may lie up to a texel nearer the receiver than its centre.
+    return rise > 0.0 && behind < rise * (aside - 1.0) * reach.texel_at_light;
+}
+
 // Whether any of the 4 × 4 map texels of a first-level square `q` may hide part of
-// the light, each against its own plane depth.
+// the light, each against its own plane depth; one no caster covers cannot.
 fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bool {
     let base = vec2<i32>(q.lo + vec2<f32>(0.5));
     for (var k = 0; k < 16; k++) {
         let texel = base + vec2<i32>(k % 4, k / 4);
+        if textureLoad(shadow_map, texel, r.layer, 0) >= MAP_CLEARED {
+            continue;
+        }
         if may_hide(r, reach, vec2<f32>(texel) - r.texel, stored_depth(r, texel), tolerance) {
             return true;
         }
@@ -268,12 +344,62 @@ fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bo
     return false;
 }
 
+// The most squares one search of `square_may_hide` weighs below the square it
+// starts from, and the deepest its stack of squares still to weigh grows (three a
+// level below the first, and one).
+const DESCENT_SQUARES: u32 = 64u;
+const DESCENT_STACK: i32 = 40;
+
+// Whether square `texel` of level `level` may hold a caster that hides part of the
+// light from receiver `r`: weighed whole (`weigh_square`), and where it cannot say,
+// its four children in turn, down to the map's texels (`first_level_hides`), as a
+// hierarchical Z-buffer's query descends (Greene, Kass & Miller 1993). A coarse
+// square that holds a receiver's floor and a post far behind it can say nothing of
+// either; its children each can. Squares within `covered` of the receiver were
+// weighed before. Past `DESCENT_SQUARES` the square counts as hiding: the pixel is
+// beamed.
+fn square_may_hide(r: Receiver, reach: Reach, level: u32, texel: vec2<i32>, tolerance: f32, covered: f32) -> bool {
+    var stack: array<vec3<i32>, DESCENT_STACK>;
+    stack[0] = vec3<i32>(texel, i32(level));
+    var top = 1;
+    var budget = DESCENT_SQUARES;
+    let weighed = vec2<f32>(covered + 0.5);
+    while top > 0 {
+        top -= 1;
+        let at = stack[top];
+        let q = pyramid_square(r.layer, u32(at.z), at.xy);
+        if covered > 0.0 && all(q.lo >= r.texel - weighed) && all(q.hi <= r.texel + weighed) {
+            continue;
+        }
+        let verdict = weigh_square(r, reach, q, tolerance, covered);
+        if verdict == SQUARE_HIDES {
+            return true;
+        }
+        if verdict == SQUARE_CLEAR {
+            continue;
+        }
+        if at.z == 0 {
+            if first_level_hides(r, reach, q, tolerance) {
+                return true;
+            }
+            continue;
+        }
+        if budget < 4u || top + 4 > DESCENT_STACK {
+            return true;
+        }
+        budget -= 4u;
+        for (var k = 0; k < 4; k++) {
+            stack[top] = vec3<i32>(2 * at.xy + vec2<i32>(k % 2, k / 2), at.z - 1);
+            top += 1;
+        }
+    }
+    return false;
+}
+
 // Whether any caster the map holds may hide part of the light from receiver `r`:
 // squares that double (the 2 × 2 of each level that hold it), each weighed
-// (`weigh_square`) against what a caster beyond the squares weighed before may
-// reach from, a first-level square that cannot say read texel by texel, until no
-// caster deeper than the layer's nearest can reach farther. A coarser square that
-// cannot say counts as hiding: the pixel is beamed.
+// (`square_may_hide`) against what a caster beyond the squares weighed before may
+// reach from, until no caster deeper than the layer's nearest can reach farther.
 fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels: u32) -> bool {
     // Texel centres within this (Chebyshev) distance of the receiver are weighed.
     var covered = 0.0;
@@ -284,15 +410,23 @@ fn casters_reach(r: Receiver, reach: Reach, nearest: f32, tolerance: f32, levels
         let side = PYRAMID_FIRST_TEXELS * f32(1u << level);
         let first = pyramid_texel(r.texel - vec2<f32>(0.5 * side), level);
         for (var k = 0; k < 4; k++) {
-            let q = pyramid_square(r.layer, level, first + vec2<i32>(k % 2, k / 2));
-            let verdict = weigh_square(r, reach, q, tolerance, covered);
-            if verdict == SQUARE_HIDES || (verdict == SQUARE_UNDECIDED && (level > 0u || first_level_hides(r, reach, q, tolerance))) {
+            if square_may_hide(r, reach, level, first + vec2<i32>(k % 2, k / 2), tolerance, covered) {
                 return true;
             }
         }
         covered = 0.5 * side - 0.5;
     }
     return false;
+}
+
+// A texel's smaller side over its side along each of the map's axes, for receiver
+// `r`'s layer (a cube face's texels are square).
+fn texel_sides(r: Receiver) -> vec2<f32> {
+    if r.cube {
+        return vec2<f32>(1.0);
+    }
+    let shape = texel_shape(r.layer);
+    return vec2<f32>(min(shape.x, shape.y)) / shape;
 }
 
 // The classification of receiver `r` (`CLASSIFIED_*`), whose reach is `reach`.
@@ -302,9 +436,11 @@ fn classify_receiver(r: Receiver, reach: Reach, seen_normal: vec3<f32>, world: v
     // The farthest any caster can reach: from the layer's nearest depth.
     let levels = textureNumLevels(pyramid_ranges_read);
     let nearest = textureLoad(pyramid_ranges_read, vec2<i32>(0), r.layer, i32(levels) - 1).x;
-    let widest = max(cone_texels(reach, max(layer_distance(r.cube, nearest), light.map.near)) + 1.0, 2.5);
+    // In texels along each of the map's axes: `cone_texels` counts the smaller of a
+    // texel's sides, and a low sun's map of a wide floor has long, thin texels.
+    let widest = max(cone_texels(reach, max(layer_distance(r.cube, nearest), light.map.near)) * texel_sides(r) + 1.0, vec2<f32>(2.5));
     // What lies past the layer's edge is unknown.
-    if any(r.texel - vec2<f32>(widest) < vec2<f32>(-0.5)) || any(r.texel + vec2<f32>(widest) > vec2<f32>(size - 0.5)) {
+    if any(r.texel - widest < vec2<f32>(-0.5)) || any(r.texel + widest > vec2<f32>(size - 0.5)) {
         return CLASSIFIED_UNSURE;
     }
     if !casters_reach(r, reach, nearest, tolerance, levels) {

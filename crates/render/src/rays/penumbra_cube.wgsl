@@ -19,10 +19,10 @@ fn cube_receiver(world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>) -> 
     let a = vec3<f32>(map_step(clip_from_world, ndc, clip.w, world_dx).xy, step * (clip_from_world * vec4<f32>(world_dx, 0.0)).w);
     let b = vec3<f32>(map_step(clip_from_world, ndc, clip.w, world_dy).xy, step * (clip_from_world * vec4<f32>(world_dy, 0.0)).w);
     if clip.w <= 0.0 || abs(a.x * b.y - a.y * b.x) <= 1e-20 {
-        return unplaced_receiver(face, true);
+        return unplaced_receiver(face, true, world);
     }
     let texel = (ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5)) * light.map.resolution - vec2<f32>(0.5);
-    return Receiver(texel, cube_depth(clip.w), plane_gradient(a, b), clip.w, face, true);
+    return Receiver(texel, cube_depth(clip.w), plane_gradient(a, b), clip.w, face, true, world);
 }
 
 // `lookup_visibility` for a point light with an area whose penumbrae are traced, on

@@ -112,7 +112,8 @@ const GROUP_SIDE: u32 = 8;
 impl PyramidPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let compute = wgpu::ShaderStages::COMPUTE;
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry { binding, visibility: compute, ty, count: None };
+        let entry =
+            |binding, ty| wgpu::BindGroupLayoutEntry { binding, visibility: compute, ty, count: None };
         let array = wgpu::TextureViewDimension::D2Array;
         let written = |binding, format| {
             entry(
@@ -125,7 +126,10 @@ impl PyramidPass {
             )
         };
         let read = |binding, sample_type| {
-            entry(binding, wgpu::BindingType::Texture { sample_type, view_dimension: array, multisampled: false })
+            entry(
+                binding,
+                wgpu::BindingType::Texture { sample_type, view_dimension: array, multisampled: false },
+            )
         };
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
@@ -150,7 +154,7 @@ impl PyramidPass {
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("depth pyramid"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("depth_pyramid.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(depth_pyramid_wgsl().into()),
         });
         let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -174,7 +178,13 @@ impl PyramidPass {
 
     /// Records every level of `pyramid` (of `layout`) from the depth map `map` (all
     /// its layers, as a 2D array, read as `params` says) into one compute pass.
-    pub fn record(&self, pool: &mut Pool, pass: &mut wgpu::ComputePass, input: PyramidInput, pyramid: &Pyramid) {
+    pub fn record(
+        &self,
+        pool: &mut Pool,
+        pass: &mut wgpu::ComputePass,
+        input: PyramidInput,
+        pyramid: &Pyramid,
+    ) {
         let PyramidInput { map, params, queue, layout } = input;
         let params = pool.uniform(queue, "depth pyramid", &params);
         let levels_view = |pool: &mut Pool, texture: &wgpu::Texture, base_mip, mips| {
@@ -211,6 +221,11 @@ impl PyramidPass {
             pass.dispatch_workgroups(groups, groups, layout.layers);
         }
     }
+}
+
+/// `depth_pyramid.wgsl`, composed (it imports the generated constants).
+pub(crate) fn depth_pyramid_wgsl() -> String {
+    crate::passes::compose_wgsl(&[include_str!("depth_pyramid.wgsl")])
 }
 
 #[cfg(test)]

@@ -5,7 +5,9 @@
 //! (`refine_trace.wgsl`). Only listed pixels pay for a ray, and a group of the trace
 //! pass holds listed pixels only, so no lane waits on a neighbour's ray.
 
-use crate::passes::wgsl_interfaces::{AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES};
+use crate::passes::wgsl_interfaces::{
+    AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES,
+};
 use gnomon_scene::settings::Refine;
 
 use std::collections::HashMap;
@@ -505,7 +507,11 @@ impl RefineLists {
         pool.bind_group(
             "refined shadow mask",
             &layouts.refined_mask,
-            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone()), Binding::View(history.clone())],
+            &[
+                Binding::View(mask_layer.clone()),
+                Binding::View(traced.clone()),
+                Binding::View(history.clone()),
+            ],
         )
     }
 
@@ -530,7 +536,10 @@ impl RefineLists {
         let stride = (COUNTER_STRIDE / 4) as usize;
         let word = |light: usize, k: usize| counters.get(light * stride + k).copied().unwrap_or(0);
         (0..lights)
-            .map(|light| Listed { traced: word(light, 3), unsure: word(light, 3) + word(light, 7) + word(light, 8) })
+            .map(|light| Listed {
+                traced: word(light, 3),
+                unsure: word(light, 3) + word(light, 7) + word(light, 8),
+            })
             .collect()
     }
 }

@@ -83,8 +83,8 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 // that no beam answered, this frame or before (listed from the list's far end), is
 // answered from its neighbours' answers on the same surface within one pixel, read
 // from the copy `traced_mask`: their mean, each weighed by the inverse square of its
-// distance, where they differ by at most `FILL_SPREAD`; or by a beam of its own where
-// they differ more, or where none is answered. A quarter of the unsure pixels are
+// distance, where they differ by at most `FILL_SPREAD`, lie on either side of it and
+// one lies inside a penumbra (`Neighbours`); or else by a beam of its own. A quarter of the unsure pixels are
 // beamed, one of each 2 × 2 block, so every pixel has beamed or decided neighbours
 // within one pixel on its surface unless the block lies across an edge; where the
 // penumbra is wide they differ little, and its mean is its interpolation, within a
@@ -105,7 +105,7 @@ fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
         let near = neighbours(centre);
         var visibility: f32;
         var beams = 0.0;
-        if near.across && near.highest - near.lowest <= FILL_SPREAD {
+        if near.across && near.partial && near.highest - near.lowest <= FILL_SPREAD {
             visibility = near.sum / near.weight;
         } else {
             let origin = surface_ray_origin(centre.world, n, surface.w);
@@ -148,13 +148,19 @@ struct Neighbours {
     lowest: f32,
     highest: f32,
     across: bool,
+    // Whether one of them is strictly between 0 and 1: a beam's answer inside a
+    // penumbra. Where every answer is the map's lit or umbra (or a beam's that
+    // matches one), the pixel between them is unsure because a caster reaches its
+    // cone and not theirs: a shadow a pixel wide (a wire's, a contact's first
+    // pixels), which their mean would erase.
+    partial: bool,
 };
 
 // The answered neighbours within one pixel of `c` on its surface
 // (`cs_fill_penumbra`).
 fn neighbours(c: FillCentre) -> Neighbours {
     let size = vec2<i32>(textureDimensions(traced_mask));
-    var near = Neighbours(0.0, 0.0, 1.0, 0.0, false);
+    var near = Neighbours(0.0, 0.0, 1.0, 0.0, false, false);
     // Which of the 3 × 3 answered, bit k for neighbour k (row by row).
     var answered = 0u;
     for (var k = 0; k < 9; k++) {
@@ -185,6 +191,7 @@ fn neighbours(c: FillCentre) -> Neighbours {
         near.weight += w;
         near.lowest = min(near.lowest, visibility);
         near.highest = max(near.highest, visibility);
+        near.partial = near.partial || (visibility > 0.0 && visibility < 1.0);
         answered |= 1u << u32(k);
     }
     // Either side along a row, a column or a diagonal: neighbours 3 and 5, 1 and 7,
