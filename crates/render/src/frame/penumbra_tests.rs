@@ -86,15 +86,30 @@ fn pyramid_depths(map: &ShadowMapImage, cube: Option<(f32, f32)>) -> Vec<f32> {
         .collect()
 }
 
+/// A map's depths as its pyramid holds them, and which texels a caster covers.
+struct MapDepths {
+    depths: Vec<f32>,
+    covered: Vec<bool>,
+}
+
+impl MapDepths {
+    fn of(map: &ShadowMapImage, cube: Option<(f32, f32)>) -> MapDepths {
+        let covered = map.depth.iter().map(|&d| d < crate::passes::shadow::MAP_CLEARED_DEPTH).collect();
+        MapDepths { depths: pyramid_depths(map, cube), covered }
+    }
+}
+
 /// Rounding the GPU's arithmetic may differ from the CPU's by, in depth units.
 const ROUNDING: f32 = 2e-6;
 
 /// The first square of `pyramid` that does not bound the texels of `depths` (of maps
 /// `resolution` a side) it covers: its range not their least and greatest (within
 /// `slack`: exactly where the pyramid holds the map's own depths, a cube's made on
-/// the GPU round otherwise), or its plane less its residual above one of them. None
-/// where every square does.
-fn first_fault(pyramid: &ReadPyramid, depths: &[f32], resolution: u32, slack: f32) -> Option<String> {
+/// the GPU round otherwise), or its plane less its residual above one of them that a
+/// caster covers (`covered`; the planes leave the others out). None where every
+/// square does.
+fn first_fault(pyramid: &ReadPyramid, map: &MapDepths, resolution: u32, slack: f32) -> Option<String> {
+    let MapDepths { depths, covered } = map;
     let (n, side) = (resolution as usize, pyramid.layout.side as usize);
     for level in 0..pyramid.layout.levels as usize {
         let (span, width) = (4usize << level, (side >> level).max(1));
@@ -116,6 +131,9 @@ fn first_fault(pyramid: &ReadPyramid, depths: &[f32], resolution: u32, slack: f3
                     for x in (i * span).min(n)..((i + 1) * span).min(n) {
                         let d = depths[layer * n * n + y * n + x];
                         (least, greatest) = (least.min(d), greatest.max(d));
+                        if !covered[layer * n * n + y * n + x] {
+                            continue;
+                        }
                         let below = plane[0]
                             + plane[1] * (x as f32 - centre[0])
                             + plane[2] * (y as f32 - centre[1])
@@ -172,7 +190,7 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
         let plan = pollster::block_on(renderer.plan_frame(&uploaded, &scene, &settings, None)).unwrap();
         let light = &plan.lights[0].light_gpu;
         let cube = (settings.light.kind == LightKind::Point).then_some((light.emitter.range, light.map.near));
-        let depths = pyramid_depths(map, cube);
+        let depths = MapDepths::of(map, cube);
         let pyramid = ReadPyramid::read(&gpu, &renderer, 0);
         assert_eq!(pyramid.layout.layers, map.layers, "{}", scene.name);
         let slack = if cube.is_some() { ROUNDING } else { 0.0 };
@@ -180,7 +198,17 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
 
         // The check sees a square that lies: a least depth raised past its least
         // texel, and a residual raised past its lowest texel.
-        let occupied = pyramid.ranges[0].iter().position(|r| r[0] < r[1]).expect("a square with depths");
+        // A first-level square of layer 0 whose texels a caster covers, every one.
+        let (n, width) = (map.resolution as usize, pyramid.layout.side as usize);
+        let occupied = (0..width * width)
+            .find(|k| {
+                let (i, j) = (k % width, k / width);
+                (0..16).all(|t| {
+                    let (x, y) = (4 * i + t % 4, 4 * j + t / 4);
+                    x < n && y < n && depths.covered[y * n + x]
+                }) && pyramid.ranges[0][*k][0] < pyramid.ranges[0][*k][1]
+            })
+            .expect("a square a caster covers");
         let mut raised = ReadPyramid {
             layout: pyramid.layout,
             planes: pyramid.planes.clone(),
@@ -234,7 +262,11 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
                         for x in i * span..((i + 1) * span).min(n) {
                             let receiver =
                                 depth + tilt[0] * (x as f32 - at[0]) + tilt[1] * (y as f32 - at[1]);
-                            let d = depths[y * n + x];
+                            // A texel no caster covers hides nothing.
+                            if !depths.covered[y * n + x] {
+                                continue;
+                            }
+                            let d = depths.depths[y * n + x];
                             assert!(
                                 d >= receiver - tolerance - ROUNDING,
                                 "{}: level {level} square ({i}, {j}) cleared, but texel ({x}, {y}) at {d} lies in front of the plane's {receiver}",
