@@ -199,10 +199,10 @@ pub struct LightStats {
     /// light with an area whose penumbrae its mask pass classifies, those filled from
     /// their neighbours and those their penumbra history answered.
     pub unsure_pixels: Option<u32>,
-    /// Shadow rays each refined pixel asks for: 1 under a hard light; under a light
-    /// with an area, a penumbra beam's samples (`gnomon_math::light_masks::SAMPLES`),
-    /// or the settings' `penumbra_rays` where ray queries trace them one by one (a
-    /// sample below the surface's horizon is counted, though not traced).
+    /// Shadow rays each refined pixel asks for on the mask path: 1 under a hard light;
+    /// under a light with an area, a penumbra beam's samples
+    /// (`gnomon_math::light_masks::SAMPLES`), whatever the settings' `penumbra_rays`
+    /// (which the forward path's rays follow).
     pub rays_per_pixel: u32,
     /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
     /// device cannot trace this scene or an image this large.

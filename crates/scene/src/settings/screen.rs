@@ -149,10 +149,11 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub lighting: Lighting,
-    /// Shadow rays per refined pixel under a light with an area, stratified over the
-    /// light's disk, cone or sphere as the CPU reference samples it: 1 to 256. 16
-    /// rays and an edge-aware filter take PCSS's penumbra error to 0.11–0.41× on the
-    /// measured scenes (docs/rays.md).
+    /// Shadow rays per refined pixel under a light with an area on the forward path,
+    /// stratified over the light's disk, cone or sphere as the CPU reference samples
+    /// it: 1 to 256 (docs/rays.md). The mask path beams an area light's unsure pixels
+    /// instead, over the penumbra beam's fixed 128 samples of the light, whatever this
+    /// says (docs/soft-shadows.md).
     #[cfg_attr(
         feature = "cli",
         arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_rays, help_heading = "Screen-space shadows")
