@@ -178,6 +178,21 @@ fn clears_by_plane(
     plane[3] + plane[0] - receiver_at_centre - tilt * half >= -tolerance
 }
 
+/// A first-level square of layer 0 whose texels a caster covers, every one, holding
+/// more than one depth: its index.
+fn covered_square(pyramid: &ReadPyramid, depths: &MapDepths, resolution: u32) -> usize {
+    let (n, width) = (resolution as usize, pyramid.layout.side as usize);
+    (0..width * width)
+        .find(|k| {
+            let (i, j) = (k % width, k / width);
+            (0..16).all(|t| {
+                let (x, y) = (4 * i + t % 4, 4 * j + t / 4);
+                x < n && y < n && depths.covered[y * n + x]
+            }) && pyramid.ranges[0][*k][0] < pyramid.ranges[0][*k][1]
+        })
+        .expect("a square a caster covers")
+}
+
 #[test]
 fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
     let gpu = gpu();
@@ -198,17 +213,7 @@ fn every_square_of_the_pyramid_bounds_the_texels_it_covers() {
 
         // The check sees a square that lies: a least depth raised past its least
         // texel, and a residual raised past its lowest texel.
-        // A first-level square of layer 0 whose texels a caster covers, every one.
-        let (n, width) = (map.resolution as usize, pyramid.layout.side as usize);
-        let occupied = (0..width * width)
-            .find(|k| {
-                let (i, j) = (k % width, k / width);
-                (0..16).all(|t| {
-                    let (x, y) = (4 * i + t % 4, 4 * j + t / 4);
-                    x < n && y < n && depths.covered[y * n + x]
-                }) && pyramid.ranges[0][*k][0] < pyramid.ranges[0][*k][1]
-            })
-            .expect("a square a caster covers");
+        let occupied = covered_square(&pyramid, &depths, map.resolution);
         let mut raised = ReadPyramid {
             layout: pyramid.layout,
             planes: pyramid.planes.clone(),

@@ -25,7 +25,7 @@ import package::passes::light::SamplePlane;
 import package::passes::light_binding::light;
 import package::passes::light_kinds::{emitter_plane_weight, emitter_sample_plane};
 import package::rays::light_sample::lowbias32;
-import package::rays::trace_bvh::{BvhNode, bvh_nodes, bvh_triangles, shear_ray, triangle_hit};
+import package::rays::trace_bvh::{bvh_nodes, bvh_triangles, shear_ray, triangle_hit};
 import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
 // The light's samples (LIGHT_MASK_SAMPLES points of the unit disk, two to an

@@ -29,7 +29,7 @@
 // a jump in depth as deep as the gap between them.
 import package::constants::MAP_CLEARED;
 import package::passes::light_binding::{light, light_depth_from_distance, light_distance_from_depth, texel_shape};
-import package::passes::light_kinds::{emitter_above_plane, emitter_cone_radius};
+import package::passes::light_kinds::{emitter_above_plane, emitter_cone_radius, sun_least_rise};
 import package::techniques::bindings::shadow_map;
 
 // The pyramid of `shadow_map` (rays/pyramid.rs, depth_pyramid.wgsl), in the light's
@@ -287,9 +287,6 @@ fn plane_spares_light(r: Receiver, reach: Reach, q: Square, tolerance: f32, asid
     let centre = 0.5 * (q.lo + q.hi);
     let lowered = q.plane.x + q.plane.w;
     let in_front = lowered + dot(q.plane.yz, r.texel - centre) >= r.depth - tolerance;
-    if !in_front && light.emitter.kind != LIGHT_SUN {
-        return false;
-    }
     // Texel position p = (x + 1) res / 2 − ½ along x, (1 − y) res / 2 − ½ along y.
     let half_res = 0.5 * light.map.resolution;
     let beta = q.plane.y * half_res;
@@ -320,10 +317,7 @@ fn plane_spares_light(r: Receiver, reach: Reach, q: Square, tolerance: f32, asid
     if in_front || behind <= 0.0 {
         return true;
     }
-    // The sun's disk, radius asin(s), centred asin(c) above the plane.
-    let c = dot(free, -light.emitter.direction);
-    let s = light.emitter.size * inverseSqrt(1.0 + light.emitter.size * light.emitter.size);
-    let rise = c * sqrt(max(1.0 - s * s, 0.0)) - sqrt(max(1.0 - c * c, 0.0)) * s;
+    let rise = sun_least_rise(light.emitter, free);
     // A caster's geometry may lie up to a texel nearer the receiver than its centre.
     return rise > 0.0 && behind < rise * (aside - 1.0) * reach.texel_at_light;
 }
