@@ -9,22 +9,27 @@
 mod accel;
 mod bvh;
 mod forward;
+pub(crate) mod pyramid;
 pub(crate) mod query;
 pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
+pub(crate) use pyramid::{
+    PLANES_FORMAT, Pyramid, PyramidInput, PyramidLayout, PyramidParams, PyramidPass, RANGES_FORMAT,
+};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, mask_refine_wgsl,
-    refined_mask_layout, screen_layout as refine_screen_layout,
+    HISTORY_FORMAT, LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage,
+    classifies_penumbrae, history_layout, mask_refine_wgsl, refined_mask_layout,
+    screen_layout as refine_screen_layout,
 };
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};
 
-use gnomon_scene::{Light, settings::Refine};
+use gnomon_scene::settings::Refine;
 use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
@@ -37,12 +42,12 @@ use traversal::FIRST_BINDING;
 pub(crate) const GROUP: u32 = 3;
 
 /// The refinement a light gets on the mask path: `refine`, with `auto` resolved to
-/// `rays` for a hard light and to `off` for a light with an area, whose refined
-/// pixels cost `penumbra_rays` rays each: asked for by name only.
-pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
+/// `rays`, for a hard light (a ray where the map is unsure) and for a light with an
+/// area alike (a penumbra beam where the map cannot say the pixel is lit or in umbra,
+/// a quarter of them a frame: `penumbra_mask.wgsl`).
+pub(crate) fn light_refine(refine: Refine) -> Refine {
     match refine {
-        Refine::Auto if light.is_hard() => Refine::Rays,
-        Refine::Auto => Refine::Off,
+        Refine::Auto => Refine::Rays,
         Refine::Off | Refine::Rays | Refine::EveryPixel => refine,
     }
 }
@@ -166,7 +171,8 @@ pub(crate) struct GpuBvh {
     /// The tree's nodes and triangles as uploaded (its alpha tests and textures,
     /// which no move changes, are dropped after the upload).
     tree: CasterBvh,
-    /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6.
+    /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6; the
+    /// light's masks, 7.
     buffers: Vec<wgpu::Buffer>,
     /// The acceleration structures and the ray-query tracer's group, built on first
     /// use; or why this device's structures cannot take the scene.
@@ -180,6 +186,20 @@ pub(crate) struct GpuBvh {
 struct QueryTracer {
     accel: CasterAccel,
     group: wgpu::BindGroup,
+}
+
+/// The light's samples and its half-plane masks (`gnomon_math::light_masks`) as
+/// penumbra_beam.wgsl reads them: the samples two to a 16-byte element, as f32 bits,
+/// then the table, a mask to an element. The same for every scene and light, made
+/// once.
+fn light_masks() -> &'static [u32] {
+    static WORDS: OnceLock<Vec<u32>> = OnceLock::new();
+    WORDS.get_or_init(|| {
+        use gnomon_math::light_masks;
+        let samples = light_masks::samples().into_iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]);
+        let table = light_masks::half_plane_table().into_iter().flatten();
+        samples.chain(table).collect()
+    })
 }
 
 /// Which of [`GpuBvh`]'s buffers holds what.
@@ -226,6 +246,11 @@ impl GpuBvh {
                     usage,
                 })
             })
+            .chain(std::iter::once(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("light masks"),
+                contents: bytemuck::cast_slice(light_masks()),
+                usage: wgpu::BufferUsages::STORAGE,
+            })))
             .collect();
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()

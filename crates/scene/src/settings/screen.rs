@@ -149,16 +149,32 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub lighting: Lighting,
-    /// Shadow rays per refined pixel under a light with an area, stratified over the
-    /// light's disk, cone or sphere as the CPU reference samples it: 1 to 256. 16
-    /// rays and an edge-aware filter take PCSS's penumbra error to 0.11–0.41× on the
-    /// measured scenes (docs/rays.md).
+    /// Shadow rays per refined pixel under a light with an area on the forward path,
+    /// stratified over the light's disk, cone or sphere as the CPU reference samples
+    /// it: 1 to 256 (docs/rays.md). The mask path beams an area light's unsure pixels
+    /// instead, over the penumbra beam's fixed 128 samples of the light, whatever this
+    /// says (docs/soft-shadows.md).
     #[cfg_attr(
         feature = "cli",
         arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_rays, help_heading = "Screen-space shadows")
     )]
     pub penumbra_rays: u32,
+    /// Frames a still image's penumbrae gather under a light with an area whose
+    /// unsure pixels are beamed (`render`, `compare`, Python's `render`): each frame
+    /// beams a quarter of them and keeps what the frames before found where nothing
+    /// moved, so 4 frames beam every one once and 16 four times (512 samples each). A
+    /// live view (the viewer, the lab) gathers them as it goes; 1 returns the first
+    /// frame, a quarter beamed and the rest filled from their neighbours.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_frames, help_heading = "Screen-space shadows")
+    )]
+    pub penumbra_frames: u32,
 }
+
+/// `screen.penumbra_frames`' range.
+pub const PENUMBRA_FRAMES_RANGE: SettingRange =
+    SettingRange::closed("screen.penumbra_frames", 1.0, 256.0, "frames a still image's penumbrae gather");
 
 /// The most shadow rays a refined pixel casts under a light with an area.
 pub const MAX_PENUMBRA_RAYS: u32 = 256;
@@ -187,6 +203,7 @@ impl Default for ScreenSpaceSettings {
             tracer: Tracer::Auto,
             lighting: Lighting::LightList,
             penumbra_rays: 16,
+            penumbra_frames: 16,
         }
     }
 }
