@@ -189,17 +189,47 @@ struct QueryTracer {
 }
 
 /// The light's samples and its half-plane masks (`gnomon_math::light_masks`) as
-/// penumbra_beam.wgsl reads them: the samples two to a 16-byte element, as f32 bits,
-/// then the table, a mask to an element. The same for every scene and light, made
-/// once.
-fn light_masks() -> &'static [u32] {
+/// penumbra_beam.wgsl reads them, one `Rgba32Uint` texel to four words: row 0 the
+/// samples two to a texel, as f32 bits (the rest of the row zero), then a row per
+/// angle bin of the table, a mask to each offset bin. A texture, not a storage
+/// buffer: the trace pass already binds WebGPU's default eight of those. The same
+/// for every scene and light, made once.
+fn light_mask_words() -> &'static [u32] {
+    use gnomon_math::light_masks::{ANGLE_BINS, MASK_WORDS, OFFSET_BINS, SAMPLES, half_plane_table, samples};
+    const { assert!(SAMPLES / 2 <= OFFSET_BINS && MASK_WORDS == 4) };
     static WORDS: OnceLock<Vec<u32>> = OnceLock::new();
     WORDS.get_or_init(|| {
-        use gnomon_math::light_masks;
-        let samples = light_masks::samples().into_iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]);
-        let table = light_masks::half_plane_table().into_iter().flatten();
-        samples.chain(table).collect()
+        let mut words: Vec<u32> =
+            samples().into_iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]).collect();
+        words.resize(OFFSET_BINS * MASK_WORDS, 0);
+        words.extend(half_plane_table().into_iter().flatten());
+        debug_assert_eq!(words.len(), (ANGLE_BINS + 1) * OFFSET_BINS * MASK_WORDS);
+        words
     })
+}
+
+/// The texture of [`light_mask_words`].
+fn light_mask_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
+    use gnomon_math::light_masks::{ANGLE_BINS, OFFSET_BINS};
+    device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("light masks"),
+            size: wgpu::Extent3d {
+                width: OFFSET_BINS as u32,
+                height: ANGLE_BINS as u32 + 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(light_mask_words()),
+    )
 }
 
 /// Which of [`GpuBvh`]'s buffers holds what.
@@ -246,12 +276,9 @@ impl GpuBvh {
                     usage,
                 })
             })
-            .chain(std::iter::once(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("light masks"),
-                contents: bytemuck::cast_slice(light_masks()),
-                usage: wgpu::BufferUsages::STORAGE,
-            })))
             .collect();
+            let masks =
+                light_mask_texture(device, &gpu.queue).create_view(&wgpu::TextureViewDescriptor::default());
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()
                 .zip(FIRST_BINDING..)
@@ -259,6 +286,10 @@ impl GpuBvh {
                     binding,
                     resource: buffer.as_entire_binding(),
                 })
+                .chain(std::iter::once(wgpu::BindGroupEntry {
+                    binding: traversal::LIGHT_MASKS_BINDING,
+                    resource: wgpu::BindingResource::TextureView(&masks),
+                }))
                 .collect();
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shadow rays"),

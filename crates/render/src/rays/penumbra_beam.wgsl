@@ -28,17 +28,16 @@ import package::rays::light_sample::lowbias32;
 import package::rays::trace_bvh::{bvh_nodes, bvh_triangles, shear_ray, triangle_hit};
 import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
-// The light's samples (LIGHT_MASK_SAMPLES points of the unit disk, two to an
-// element, as f32 bits), then the half-plane table, angle-major
-// (`light_masks::half_plane_table`).
-@group(TRACE_GROUP) @binding(7) var<storage, read> light_masks: array<vec4<u32>>;
+// Row 0: the light's samples (LIGHT_MASK_SAMPLES points of the unit disk, two to a
+// texel, as f32 bits); row 1 + i: the half-plane table's angle bin i, a mask to each
+// offset bin (`light_mask_words` in rays/mod.rs, `light_masks::half_plane_table`).
+@group(TRACE_GROUP) @binding(7) var light_masks: texture_2d<u32>;
 
-const SAMPLE_ELEMENTS: u32 = LIGHT_MASK_SAMPLES / 2u;
 const ALL_SAMPLES: vec4<u32> = vec4<u32>(0xffffffffu);
 
 // The light's sample k, in the unit disk.
 fn light_mask_sample(k: u32) -> vec2<f32> {
-    let pair = bitcast<vec4<f32>>(light_masks[k / 2u]);
+    let pair = bitcast<vec4<f32>>(textureLoad(light_masks, vec2<u32>(k / 2u, 0u), 0));
     return select(pair.xy, pair.zw, (k & 1u) == 1u);
 }
 
@@ -145,7 +144,7 @@ fn plane_mask(beam: Beam, m: vec3<f32>) -> vec4<u32> {
     let turns = (atan2(n.y, n.x) + PI) / (2.0 * PI);
     let i = min(u32((turns - floor(turns)) * f32(LIGHT_MASK_ANGLE_BINS)), LIGHT_MASK_ANGLE_BINS - 1u);
     let j = min(u32((d + 1.0) * 0.5 * f32(LIGHT_MASK_OFFSET_BINS)), LIGHT_MASK_OFFSET_BINS - 1u);
-    return light_masks[SAMPLE_ELEMENTS + i * LIGHT_MASK_OFFSET_BINS + j];
+    return textureLoad(light_masks, vec2<u32>(j, 1u + i), 0);
 }
 
 // Where the segment from a to b (depths da, db along the beam) crosses depth `at`.

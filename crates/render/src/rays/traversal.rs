@@ -101,7 +101,7 @@ pub(crate) fn trace_wgsl(group: u32, traversal: Traversal) -> String {
 pub(crate) const FIRST_BINDING: u32 = 2;
 
 /// The binding of the light's samples and half-plane masks (`light_masks` in
-/// penumbra_beam.wgsl), after the shader tracer's five buffers.
+/// penumbra_beam.wgsl, a texture), after the shader tracer's five buffers.
 pub(crate) const LIGHT_MASKS_BINDING: u32 = FIRST_BINDING + 5;
 
 /// The entries of the tracer's bindings, seen by `stages`: for the shader, five
@@ -120,7 +120,14 @@ pub(crate) fn entries(stages: wgpu::ShaderStages, traversal: Traversal) -> Vec<w
         Traversal::Shader => (FIRST_BINDING..FIRST_BINDING + 2)
             .map(|binding| entry(binding, buffer))
             .chain(alpha)
-            .chain(std::iter::once(entry(LIGHT_MASKS_BINDING, buffer)))
+            .chain(std::iter::once(entry(
+                LIGHT_MASKS_BINDING,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            )))
             .collect(),
         Traversal::RayQuery => std::iter::once(entry(
             FIRST_BINDING,
