@@ -171,9 +171,10 @@ pub(crate) struct GpuBvh {
     /// The tree's nodes and triangles as uploaded (its alpha tests and textures,
     /// which no move changes, are dropped after the upload).
     tree: CasterBvh,
-    /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6; the
-    /// light's masks, 7.
+    /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6.
     buffers: Vec<wgpu::Buffer>,
+    /// The light's samples and half-plane masks ([`light_mask_words`]): binding 7.
+    light_masks: wgpu::TextureView,
     /// The acceleration structures and the ray-query tracer's group, built on first
     /// use; or why this device's structures cannot take the scene.
     accel: OnceLock<Result<QueryTracer, RayQueriesUnavailable>>,
@@ -302,6 +303,7 @@ impl GpuBvh {
                 triangles: bvh.casters,
                 tree: bvh,
                 buffers,
+                light_masks: masks,
                 accel: OnceLock::new(),
                 scene: scene.name.clone(),
             }
@@ -373,9 +375,13 @@ impl GpuBvh {
     pub(crate) fn bindings(&self, traversal: Traversal) -> Vec<(u32, crate::pool::Binding)> {
         use crate::pool::Binding;
         match traversal {
-            Traversal::Shader => {
-                (FIRST_BINDING..).zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone()))).collect()
-            }
+            Traversal::Shader => (FIRST_BINDING..)
+                .zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone())))
+                .chain(std::iter::once((
+                    traversal::LIGHT_MASKS_BINDING,
+                    Binding::View(self.light_masks.clone()),
+                )))
+                .collect(),
             Traversal::RayQuery => {
                 std::iter::once((FIRST_BINDING, Binding::Tlas(self.query_tracer().accel.tlas().clone())))
                     .chain(
