@@ -55,24 +55,25 @@ pub enum Lighting {
 /// The default, `auto`, is `rays` for hard lights wherever they can run: no shadow
 /// map resolves a caster finer than its texel, and on the 36 measured glTF cases the
 /// map alone left up to 2 % of light-facing pixels wrong where the rays leave at most
-/// 0.06 % (docs/defaults.md). Area lights are refined only when asked (`rays`): a
-/// penumbra pixel costs `penumbra_rays` rays. Pass `off` to see a technique's own
-/// answer.
+/// 0.06 % (docs/defaults.md). A light with an area is refined too: the map's pyramid
+/// finds its unsure penumbra pixels and they are beamed over the light's area
+/// (docs/soft-shadows.md). Pass `off` to see a technique's own answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Refine {
-    /// `rays` for every hard light when the frame takes the mask path (under
-    /// --shadow-path auto, which then takes it for them, or mask); `off` for lights
-    /// with an area, and for every light with --shadow-path forward (ask for `rays`
-    /// by name to trace there).
+    /// `rays` for every light, hard or with an area, when the frame takes the mask
+    /// path (under --shadow-path auto, which then takes it for them, or mask); `off`
+    /// with --shadow-path forward (ask for `rays` by name to trace there).
     #[default]
     Auto,
     /// Every pixel keeps its shadow map's answer.
     Off,
     /// Pixels the map is unsure of (taps that disagree, a receiver within a few
-    /// texels' depth of the stored depth) trace one ray, or `penumbra_rays` under a
-    /// light with an area; the rest keep the map's answer.
+    /// texels' depth of the stored depth) trace one ray; under a light with an area,
+    /// those the map's pyramid cannot classify are beamed over 128 samples of it on
+    /// the mask path, or trace `penumbra_rays` rays on the forward path. The rest keep
+    /// the map's answer.
     Rays,
     /// Every pixel that faces the light traces its rays: exact (up to the penumbra's
     /// sampling noise), and the upper baseline of cost.
