@@ -35,6 +35,30 @@ impl Mover {
         Ok(Self { chosen, original, amplitude })
     }
 
+    /// Every instance with triangles but the one whose bounds are largest (a scene's
+    /// ground, as a rule): the casters `compare --motion casters` sways. Refuses a
+    /// scene with fewer than two such instances.
+    pub fn all_but_the_largest(scene: &Scene) -> anyhow::Result<Self> {
+        let candidates: Vec<usize> = (0..scene.instances.len())
+            .filter(|&i| !scene.meshes[scene.instances[i].mesh].indices.is_empty())
+            .collect();
+        let size = |i: usize| {
+            let inst = &scene.instances[i];
+            scene.meshes[inst.mesh].bounds().transformed(inst.world_from_object).extent().length()
+        };
+        let largest = candidates.iter().copied().max_by(|&a, &b| size(a).total_cmp(&size(b)));
+        let chosen: Vec<usize> = candidates.iter().copied().filter(|&i| Some(i) != largest).collect();
+        anyhow::ensure!(
+            !chosen.is_empty(),
+            "--motion casters: scene `{}` has {} instance(s) with triangles; it needs a caster besides its largest",
+            scene.name,
+            candidates.len()
+        );
+        let original = chosen.iter().map(|&i| scene.instances[i].world_from_object).collect();
+        let amplitude = 0.01 * scene.bounds().extent().max_element();
+        Ok(Self { chosen, original, amplitude })
+    }
+
     /// Marks the instances it moves as moving (`Motion::Dynamic`) in `scene`, before
     /// the scene is uploaded.
     pub fn declare_dynamic(&self, scene: &mut Scene) {

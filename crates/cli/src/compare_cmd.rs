@@ -56,6 +56,13 @@ pub struct CompareArgs {
     /// the target (an orbit's arc: that angle in radians); in (0, 1].
     #[arg(long, value_name = "FRACTION", default_value_t = 0.05, help_heading = "Camera path")]
     pub path_travel: f32,
+    /// Also measure each frame of a sequence of `--path-frames` live frames over which
+    /// the light moves, the casters move, or nothing does, each against its own
+    /// reference: the error of a single frame of a moving scene (every one the first
+    /// after a cut), or a still view's convergence. Writes motion.png and
+    /// motion-error.png (the last frame) and a table per frame.
+    #[arg(long, value_enum, help_heading = "Motion")]
+    pub motion: Option<crate::compare_motion::Motion>,
     #[command(flatten)]
     pub settings: Settings,
 }
@@ -99,6 +106,19 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         Some(kind) => measure_flicker(args, kind, &mut renderer, &uploaded, &scene, settings)?,
         None => vec![None; args.techniques.len()],
     };
+    let motion = match args.motion {
+        Some(motion) => {
+            let run = crate::compare_motion::MotionRun {
+                motion,
+                frames: args.path_frames,
+                techniques: &args.techniques,
+                use_cache: !args.no_cache,
+            };
+            let mut moved = scene.clone();
+            Some(crate::compare_motion::measure(&run, &mut renderer, &mut moved, settings)?)
+        }
+        None => None,
+    };
     let aliasing = gnomon_viewer::measure_aliasing(&frames[0].frame, settings);
     let virtual_levels = frames[0].frame.virtual_levels.as_ref();
     let reference = lab::reference(&scene, settings, !args.no_cache)?.image;
@@ -115,6 +135,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         drawn,
     };
     let rows = crate::compare_outputs::stage(&mut staged, &args.out, measured)?;
+    if let Some(measured) = &motion {
+        crate::compare_outputs::stage_motion(&mut staged, &args.out, &measured.last, &measured.reference)?;
+    }
     let report = Report {
         scene: &scene.name,
         width: reference.width,
@@ -134,8 +157,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         }),
         denominators: metrics::DENOMINATORS.iter().copied().collect(),
         rows,
+        motion: motion.as_ref().map(|m| m.series.clone()),
     };
-    let table = markdown_table(&report, reference.samples > 1);
+    let mut table = markdown_table(&report, reference.samples > 1);
+    if let (Some(kind), Some(measured)) = (args.motion, &motion) {
+        table.push_str(&crate::compare_motion::markdown(kind, &measured.series));
+    }
     staged.text(&args.out.join("metrics.json"), &serde_json::to_string_pretty(&report)?)?;
     staged.text(&args.out.join("metrics.md"), &table)?;
     let written = staged.commit()?;

@@ -99,6 +99,27 @@ pub(crate) fn stage(staged: &mut output::Staged, out: &Path, measured: Measured)
     Ok(rows)
 }
 
+/// Stages motion.png and motion-error.png in `out`: the last frame of `compare
+/// --motion` and its error against its own `reference`.
+pub(crate) fn stage_motion(
+    staged: &mut output::Staged,
+    out: &Path,
+    frame: &gnomon_render::Frame,
+    reference: &ReferenceImage,
+) -> anyhow::Result<()> {
+    let raster =
+        RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
+    let classes = metrics::classify(raster, reference);
+    let error = if reference.samples > 1 {
+        heatmap::soft(&frame.visibility, reference, &classes)
+    } else {
+        heatmap::hard(&frame.visibility, reference, &classes)
+    };
+    let (w, h) = (reference.width, reference.height);
+    staged.png_rgba(&out.join("motion.png"), w, h, &frame.color)?;
+    staged.png_rgba(&out.join("motion-error.png"), w, h, &error)
+}
+
 /// The heat-maps' legend: the error ramp under an area light, the classes otherwise.
 fn legend(soft: bool) -> Vec<(String, [u8; 3])> {
     if soft {

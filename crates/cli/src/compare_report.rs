@@ -63,6 +63,8 @@ pub struct Report<'a> {
     /// What each metric divides by (`metrics::DENOMINATORS`).
     pub denominators: std::collections::BTreeMap<&'static str, &'static str>,
     pub rows: Vec<Row>,
+    /// Each technique's frames over `--motion`'s sequence.
+    pub motion: Option<Vec<crate::compare_motion::MotionSeries>>,
 }
 
 /// The technique's name, with its moment map's format when that is not 32-bit float.

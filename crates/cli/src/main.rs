@@ -8,6 +8,7 @@ mod bench_report;
 mod cache;
 mod calibrate;
 mod compare_cmd;
+mod compare_motion;
 mod compare_outputs;
 mod compare_report;
 mod grid;

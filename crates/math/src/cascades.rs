@@ -117,9 +117,22 @@ pub fn fit_cascade_stable(
     slice: &Hexahedron,
     resolution: u32,
 ) -> LightProjection {
+    fit_cascade_stable_with_margin(direction, scene, slice, resolution, 0.0)
+}
+
+/// [`fit_cascade_stable`] with its window grown by `margin` on every side before it
+/// is placed on the texel grid (a margin that does not follow the camera keeps the
+/// cascade still).
+pub fn fit_cascade_stable_with_margin(
+    direction: Vec3,
+    scene: &Aabb,
+    slice: &Hexahedron,
+    resolution: u32,
+    margin: f32,
+) -> LightProjection {
     let light_from_world = directional_light_view(direction, scene);
     let centre = slice.corners.iter().copied().sum::<Vec3>() / 8.0;
-    let radius = slice.corners.iter().map(|c| c.distance(centre)).fold(0.0f32, f32::max);
+    let radius = slice.corners.iter().map(|c| c.distance(centre)).fold(0.0f32, f32::max) + margin.max(0.0);
     // Round the radius up to a fixed quantum so float noise in the corners cannot
     // change the window's size from frame to frame.
     let radius = (radius * 16.0).ceil() / 16.0;

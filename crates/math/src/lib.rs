@@ -2,7 +2,8 @@
 //! projections, and the mapping from normalized device coordinates to shadow-map
 //! texture coordinates; fitting, cascades and warps ([`fitting`], [`cascades`],
 //! [`warping`]); point lights' cube and dual-paraboloid maps ([`omni`]); and the filter
-//! kernels the shaders use ([`kernels`]); the sun's path through the day ([`solar`]);
+//! kernels the shaders use ([`kernels`]); the light's samples and half-plane masks of a
+//! penumbra beam ([`light_masks`]); the sun's path through the day ([`solar`]);
 //! whether a mesh is closed, for face culling in the shadow pass ([`topology`]); and
 //! which way a projection winds a triangle or a cluster of them ([`facing`]); and the
 //! pixels a light's range can reach on screen ([`screen_bounds`]); and a virtual shadow
@@ -25,6 +26,7 @@ pub mod facing;
 pub mod fitting;
 pub mod kernels;
 mod light;
+pub mod light_masks;
 pub mod octahedron;
 pub mod omni;
 mod projection;

@@ -112,6 +112,15 @@ impl LightProjection {
         }
     }
 
+    /// The same orthographic projection with its window grown by `margin` light-space
+    /// units on every side (its depth range kept). Perspective projections are
+    /// returned unchanged.
+    pub fn widened(&self, margin: f32) -> LightProjection {
+        let Some((left, right, bottom, top)) = self.orthographic_window() else { return *self };
+        let window = (left - margin, right + margin, bottom - margin, top + margin);
+        LightProjection::orthographic(self.light_from_world, window, self.near, self.far)
+    }
+
     /// The same orthographic projection with its near plane moved up to the nearest of
     /// `receivers` (world points), for a map drawn with depth clamping: casters in
     /// front of the plane are clamped onto it ("pancaking") and still shadow every
@@ -203,6 +212,24 @@ mod tests {
             assert!((x.truncate() - y.truncate()).length() < 1e-4);
             assert!(y.z > 0.0 && y.z < 1.0 && (q.far - q.near - (p.far - p.near) - 12.0).abs() < 1e-3);
         }
+    }
+
+    #[test]
+    fn widening_grows_the_window_on_every_side_and_keeps_depth() {
+        let bounds = Aabb::new(Vec3::new(-2.0, 0.0, -3.0), Vec3::new(2.0, 1.0, 3.0));
+        let p = directional_light_projection(Vec3::new(0.3, -1.0, 0.1), &bounds);
+        let q = p.widened(0.5);
+        let (a, b) = (p.orthographic_window().unwrap(), q.orthographic_window().unwrap());
+        let grown = [a.0 - b.0, b.1 - a.1, a.2 - b.2, b.3 - a.3];
+        assert!(grown.iter().all(|g| (g - 0.5).abs() < 1e-4), "{grown:?}");
+        assert_eq!((q.near, q.far), (p.near, p.far));
+        // A point keeps its depth, and the window's centre stays put.
+        for c in bounds.corners() {
+            let (x, y) = (project(p.clip_from_world(), c), project(q.clip_from_world(), c));
+            assert!((x.z - y.z).abs() < 1e-5 && y.x.abs() < x.x.abs() + 1e-6 && y.y.abs() < x.y.abs() + 1e-6);
+        }
+        let spot = spot_light_projection(Vec3::ZERO, Vec3::NEG_Z, 0.5, 0.1, 10.0);
+        assert_eq!(spot.widened(1.0).clip_from_light, spot.clip_from_light);
     }
 
     #[test]

@@ -55,6 +55,23 @@ pub struct MapDrawing {
     pub technique: TechniqueRef,
     /// The device can draw with unclipped depth (`DEPTH_CLIP_CONTROL`).
     pub unclipped_depth: bool,
+    /// For a sun with a size whose penumbrae the mask pass classifies from its map
+    /// (`rays::classifies_penumbrae`): the tangent of the sun's angular radius. The map
+    /// then reaches past its receivers by the cone's radius across its depth range
+    /// ([`penumbra_margin`]): a caster beyond the map's edge may shadow a receiver
+    /// that far inside, and a classification that cannot see it must trace.
+    pub penumbra_slope: Option<f32>,
+}
+
+/// How far past its receivers a sun's map reaches when its penumbrae are classified
+/// from it (`MapDrawing::penumbra_slope`): the radius of the cone from a receiver at
+/// the far end of its depth range to the sun at the near end, at most half the
+/// window's size on each side, so that a wide sun at most halves the map's
+/// resolution (receivers nearer the edge than the cone's reach are traced).
+pub fn penumbra_margin(projection: &LightProjection, slope: f32) -> f32 {
+    let Some((left, right, bottom, top)) = projection.orthographic_window() else { return 0.0 };
+    let cap = 0.5 * (right - left).max(top - bottom);
+    (slope * (projection.far - projection.near)).clamp(0.0, cap)
 }
 
 /// The shadow layout of `light` under `settings`: one map, or for a sun with
@@ -101,11 +118,13 @@ pub fn shadow_layout(
     let single = || {
         let fit = settings.shadow.map.fit;
         let clamped = pancake && fit == Fit::Receivers && matches!(view, ShadowView::Parallel { .. });
-        ShadowLayout {
-            projections: vec![light_projection(scene_bounds, light, camera, aspect, fit, clamped)],
-            splits: vec![0.0, f32::INFINITY],
-            depth_clamp: clamped,
-        }
+        let fitted = light_projection(scene_bounds, light, camera, aspect, fit, clamped);
+        let widened = match (drawing.penumbra_slope, fit) {
+            (Some(slope), Fit::Receivers) => fitted.widened(penumbra_margin(&fitted, slope)),
+            // A map of the whole scene already holds every caster.
+            (Some(_), Fit::Scene) | (None, _) => fitted,
+        };
+        ShadowLayout { projections: vec![widened], splits: vec![0.0, f32::INFINITY], depth_clamp: clamped }
     };
     if let (ShadowView::Parallel { travel }, Partition::Single, Some(warp)) =
         (view, settings.shadow.partition, warp_of(settings.shadow.map.warp))
@@ -130,38 +149,27 @@ pub fn shadow_layout(
         fov_y: camera.fov_y_degrees.to_radians(),
         aspect,
     };
-    let resolution = settings.shadow.map.resolution;
     // With selection by depth, the lighting pass blends the far end of each cascade
     // into the next one, so each slice starts at its predecessor's blend band.
     let blend = match c.cascade_selection {
         CascadeSelection::Depth => c.cascade_blend,
         CascadeSelection::Projection => 0.0,
     };
-    let samples = sampled.and_then(|s| s.light_bounds.as_ref());
+    let fitting = CascadeFitting {
+        bounds,
+        travel,
+        frustum,
+        view,
+        camera,
+        settings,
+        samples: sampled.and_then(|s| s.light_bounds.as_deref()),
+        drawing,
+        pancake,
+    };
     let fitted: Vec<LightProjection> = (0..splits.len() - 1)
         .map(|i| {
             let from = if i == 0 { splits[0] } else { splits[i] - blend * (splits[i] - splits[i - 1]) };
-            let slice = cascades::frustum_slice(&frustum, camera.near, camera.far, from, splits[i + 1]);
-            // A stable cascade's size follows its slice's: built exactly, so that it
-            // stays put while the camera moves (`cascades::view_slice`).
-            let exact_slice = || cascades::view_slice(&view, from, splits[i + 1]);
-            match c.cascade_fit {
-                CascadeFit::Tight => {
-                    let tight = cascades::fit_cascade_tight(travel, &bounds, &slice, pancake);
-                    match samples.and_then(|s| s.get(i).copied().flatten()) {
-                        Some(window) => cascades::fit_cascade_to_samples(
-                            &tight,
-                            window,
-                            filter_margin_texels(settings, drawing.technique, &tight),
-                            resolution,
-                        ),
-                        None => tight,
-                    }
-                }
-                CascadeFit::Stable => {
-                    cascades::fit_cascade_stable(travel, &bounds, &exact_slice(), resolution)
-                }
-            }
+            fitting.fit(i, from, splits[i + 1])
         })
         .collect();
     let near_plane = fitted.iter().map(|p| p.near).fold(f32::INFINITY, f32::min);
@@ -170,6 +178,66 @@ pub fn shadow_layout(
         projections: fitted.iter().map(|p| p.with_depth_range(near_plane, far_plane)).collect(),
         splits,
         depth_clamp: pancake && c.cascade_fit == CascadeFit::Tight,
+    }
+}
+
+/// What each of a sun's cascades is fitted from.
+struct CascadeFitting<'a> {
+    bounds: Aabb,
+    travel: Vec3,
+    frustum: Hexahedron,
+    view: cascades::PerspectiveView,
+    camera: &'a Camera,
+    settings: &'a Settings,
+    /// SDSM's light-space bounds of each cascade's samples (`--sdsm-bounds`).
+    samples: Option<&'a [Option<[f32; 4]>]>,
+    drawing: MapDrawing,
+    pancake: bool,
+}
+
+impl CascadeFitting<'_> {
+    /// Cascade `i`'s projection, serving view depths `from` to `to`.
+    fn fit(&self, i: usize, from: f32, to: f32) -> LightProjection {
+        let (settings, drawing) = (self.settings, self.drawing);
+        let resolution = settings.shadow.map.resolution;
+        let slice = cascades::frustum_slice(&self.frustum, self.camera.near, self.camera.far, from, to);
+        // A stable cascade's size follows its slice's: built exactly, so that it stays
+        // put while the camera moves (`cascades::view_slice`).
+        let exact_slice = || cascades::view_slice(&self.view, from, to);
+        match settings.shadow.cascades.cascade_fit {
+            CascadeFit::Tight => {
+                let tight = cascades::fit_cascade_tight(self.travel, &self.bounds, &slice, self.pancake);
+                let fitted = match self.samples.and_then(|s| s.get(i).copied().flatten()) {
+                    Some(window) => cascades::fit_cascade_to_samples(
+                        &tight,
+                        window,
+                        filter_margin_texels(settings, drawing.technique, &tight),
+                        resolution,
+                    ),
+                    None => tight,
+                };
+                match drawing.penumbra_slope {
+                    Some(slope) => fitted.widened(penumbra_margin(&fitted, slope)),
+                    None => fitted,
+                }
+            }
+            CascadeFit::Stable => {
+                // The margin grows the window before it is placed on the texel grid: its
+                // depth range spans the whole scene, so the margin stays put too.
+                let margin = drawing.penumbra_slope.map_or(0.0, |slope| {
+                    let unwidened =
+                        cascades::fit_cascade_stable(self.travel, &self.bounds, &exact_slice(), resolution);
+                    penumbra_margin(&unwidened, slope)
+                });
+                cascades::fit_cascade_stable_with_margin(
+                    self.travel,
+                    &self.bounds,
+                    &exact_slice(),
+                    resolution,
+                    margin,
+                )
+            }
+        }
     }
 }
 

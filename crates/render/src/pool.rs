@@ -387,8 +387,8 @@ mod tests {
     /// frame creates nothing only if every per-frame creation goes through the pool.
     /// Outside it, only the one-time uploads (the scene, the casters' BVH and
     /// acceleration structures, the GPU culler's shadow items), the
-    /// renderer's fixed bindings, the kept depth and moment maps (counted in
-    /// `Renderer::creations`), and `ShadowRays`' batch queries (no frame: buffers
+    /// renderer's fixed bindings, the kept depth and moment maps, their depth
+    /// pyramids and the penumbra histories (counted in `Renderer::creations`), and `ShadowRays`' batch queries (no frame: buffers
     /// sized to each batch) may create GPU resources.
     #[test]
     fn only_the_pool_creates_per_frame_resources() {
@@ -409,6 +409,11 @@ mod tests {
             "virtual_map/draw.rs",
             // Its tests' full-resolution reference maps.
             "virtual_map/draw/tests.rs",
+            // A map's depth pyramid, kept with the map it was built from
+            // (`frame/pyramid_cache.rs`), and each light's penumbra history, kept
+            // across frames: both counted in `Renderer::creations`.
+            "rays/pyramid.rs",
+            "frame/penumbra_history.rs",
         ];
         let creations =
             ["create_texture", "create_buffer", "create_bind_group(", "create_query_set", "create_view("];

@@ -111,7 +111,19 @@ pub(crate) fn record(
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
 ) -> PendingReadback {
-    let (width, height, layers) = (texture.width(), texture.height(), texture.depth_or_array_layers());
+    record_level(pool, encoder, texture, aspect, 0)
+}
+
+/// [`record`] of mip `level`.
+pub(crate) fn record_level(
+    pool: &mut Pool,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+    level: u32,
+) -> PendingReadback {
+    let layers = texture.depth_or_array_layers();
+    let (width, height) = ((texture.width() >> level).max(1), (texture.height() >> level).max(1));
     let bytes_per_texel = texture.format().block_copy_size(Some(aspect)).unwrap_or(4);
     let unpadded = width * bytes_per_texel;
     let padded_bytes_per_row =
@@ -122,7 +134,7 @@ pub(crate) fn record(
         wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
     );
     encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyTextureInfo { texture, mip_level: level, origin: wgpu::Origin3d::ZERO, aspect },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {

@@ -24,6 +24,9 @@ pub(crate) struct FixedBindings {
     /// Bound in place of a virtual map's uniform and page table for the lights
     /// without one.
     placeholder_virtual: VirtualBuffers,
+    /// Bound in place of a depth pyramid's planes and ranges where the mask pass
+    /// reads none.
+    placeholder_pyramid: [wgpu::TextureView; 2],
 }
 
 /// A virtual map's uniform and page table, as a light's shadow group binds them.
@@ -44,6 +47,9 @@ pub(crate) struct ShadowViews<'a> {
     pub mask: Option<&'a wgpu::TextureView>,
     /// A sun's virtual map (whose page pool is `map`).
     pub virtual_map: Option<&'a VirtualBuffers>,
+    /// The depth map's pyramid, for the mask pass of a light whose penumbrae it
+    /// classifies.
+    pub pyramid: Option<&'a super::recording::PyramidViews>,
 }
 
 fn placeholder(
@@ -127,6 +133,12 @@ impl FixedBindings {
                 placeholder(device, "no shadow mask", screen_space::MASK_FORMAT, 1),
                 wgpu::TextureViewDimension::D2,
             ),
+            placeholder_pyramid: [crate::rays::PLANES_FORMAT, crate::rays::RANGES_FORMAT].map(|format| {
+                view_as(
+                    placeholder(device, "no depth pyramid", format, 1),
+                    wgpu::TextureViewDimension::D2Array,
+                )
+            }),
             placeholder_virtual: VirtualBuffers {
                 uniform: placeholder_buffer(
                     device,
@@ -142,8 +154,13 @@ impl FixedBindings {
     /// Group 2 of the lighting and mask passes: a light's maps and their samplers.
     pub fn shadow_group(&self, pool: &mut Pool, layouts: &Layouts, views: ShadowViews) -> wgpu::BindGroup {
         let mask = Binding::View(views.mask.unwrap_or(&self.placeholder_mask).clone());
-        // The mask after the shadow resources (`passes::Layouts::shadow`).
-        let bindings = [self.map_bindings(&views), vec![mask]].concat();
+        let [planes, ranges] = match views.pyramid {
+            Some(pyramid) => [&pyramid.planes, &pyramid.ranges],
+            None => [&self.placeholder_pyramid[0], &self.placeholder_pyramid[1]],
+        }
+        .map(|view| Binding::View(view.clone()));
+        // The mask and the pyramid after the shadow resources (`passes::Layouts::shadow`).
+        let bindings = [self.map_bindings(&views), vec![mask, planes, ranges]].concat();
         pool.bind_group("shadow map", &layouts.shadow, &bindings)
     }
 

@@ -145,7 +145,7 @@ pub(super) enum DepthStart {
 impl DepthStart {
     pub(super) fn load(self) -> wgpu::LoadOp<f32> {
         match self {
-            DepthStart::Clear => wgpu::LoadOp::Clear(1.0),
+            DepthStart::Clear => wgpu::LoadOp::Clear(crate::passes::shadow::MAP_CLEARED_DEPTH),
             DepthStart::Keep => wgpu::LoadOp::Load,
         }
     }

@@ -16,7 +16,7 @@
 
 use gnomon_scene::settings::BiasSettings;
 
-use super::{moment_cache::MomentCache, plan::LightPlan};
+use super::{moment_cache::MomentCache, plan::LightPlan, pyramid_cache::PyramidCache};
 use crate::passes::SHADOW_FORMAT;
 
 /// Everything a layer's still casters' depth depends on: its projection, and the
@@ -145,6 +145,8 @@ pub(super) struct MapCache {
     created: u64,
     /// The moment maps filtered from the kept maps.
     pub moments: MomentCache,
+    /// The depth pyramids built from them.
+    pub pyramids: PyramidCache,
 }
 
 impl MapCache {
@@ -214,9 +216,9 @@ impl MapCache {
         &self.uses
     }
 
-    /// How many cache textures it has created, moment maps included.
+    /// How many cache textures it has created, moment maps and pyramids included.
     pub fn created(&self) -> u64 {
-        self.created + self.moments.created()
+        self.created + self.moments.created() + self.pyramids.created()
     }
 }
 

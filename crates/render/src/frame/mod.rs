@@ -14,7 +14,11 @@ mod light_passes;
 mod map_cache;
 mod moment_cache;
 mod outputs;
+mod penumbra_history;
+#[cfg(test)]
+mod penumbra_tests;
 mod plan;
+mod pyramid_cache;
 mod receiver;
 mod record;
 mod recording;
@@ -47,7 +51,7 @@ use crate::{
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
-    rays::TracePasses,
+    rays::{PyramidPass, TracePasses},
     techniques::TechniqueRegistry,
     timing::ClockChoice,
 };
@@ -63,6 +67,7 @@ struct Passes {
     screen_space: ScreenSpacePass,
     trace: TracePasses,
     moments: MomentPass,
+    pyramid: PyramidPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
     map_scroll: MapScrollPass,
@@ -86,6 +91,8 @@ pub struct Renderer {
     techniques: TechniqueRegistry,
     /// Each light's map as its still casters drew it, kept across frames.
     map_cache: map_cache::MapCache,
+    /// Each light's penumbra history, kept across frames where nothing moved.
+    penumbra_histories: penumbra_history::PenumbraHistories,
     /// Each virtual light's pool of pages, kept across frames.
     virtual_lights: virtual_pages::VirtualLights,
 }
@@ -110,6 +117,7 @@ impl Renderer {
                 screen_space: ScreenSpacePass::new(device, &layouts),
                 trace: TracePasses::default(),
                 moments: MomentPass::new(device, &gpu.queue),
+                pyramid: PyramidPass::new(device),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
                 map_scroll: MapScrollPass::new(device),
@@ -123,6 +131,7 @@ impl Renderer {
                 pool: Pool::new(device),
                 late_times: LateTimes::default(),
                 map_cache: map_cache::MapCache::default(),
+                penumbra_histories: penumbra_history::PenumbraHistories::default(),
                 virtual_lights: virtual_pages::VirtualLights::default(),
                 techniques,
                 layouts,
@@ -147,7 +156,7 @@ impl Renderer {
         let mut creations = self.pool.creations();
         // The kept maps' textures (depths and moments) live outside the pool, made
         // again only when a map's size changes (`map_cache.rs`, `moment_cache.rs`).
-        creations.textures += self.map_cache.created();
+        creations.textures += self.map_cache.created() + self.penumbra_histories.created();
         creations
     }
 
@@ -174,6 +183,13 @@ impl Renderer {
         settings.validate()?;
         let uploaded = self.upload(scene)?;
         self.render_uploaded_async(&uploaded, scene, settings, request).await
+    }
+
+    /// Throws every light's penumbra history away: the next frame starts afresh, as
+    /// after a cut, though nothing it would notice moved (a host that cuts to another
+    /// shot of the same scene, or a measure of a first frame).
+    pub fn forget_penumbra_history(&mut self) {
+        self.penumbra_histories.forget_all();
     }
 
     /// Uploads a scene's geometry, instances and textures.
@@ -291,7 +307,9 @@ impl Renderer {
         // pixels ask for the pages along shadow edges one level finer, which the
         // next frame draws (`shadow.virtual_map.edge_levels`, `virtual_map/edges.rs`).
         // The first frame whose pages were settled already, or the frame after the
-        // last level's, is the one returned.
+        // last level's, is the one returned. A still view's penumbrae gather their
+        // beams over frames too (`screen.penumbra_frames`, rays/penumbra_mask.wgsl):
+        // the frame returned is the first whose history holds that many.
         let levels = self.settling_frames(scene, settings)?;
         let mut frames = 0;
         let submitted = loop {
@@ -302,7 +320,9 @@ impl Renderer {
                 times: TimesWanted::Now,
             };
             let submitted = self.submit(uploaded, scene, settings, submit).await?;
-            if frames == levels || submitted.edges_settled() {
+            let penumbrae = settings.screen.penumbra_frames;
+            let gathered = submitted.penumbrae_gathered(penumbrae) || frames >= levels + penumbrae;
+            if (frames >= levels || submitted.edges_settled()) && gathered {
                 break submitted;
             }
             frames += 1;

@@ -194,13 +194,25 @@ pub struct LightStats {
     /// the frame was waited for (not a live frame's). The forward path traces in the
     /// lighting pass and counts nothing (`rays/refine_forward.wgsl` says why).
     pub traced_pixels: Option<u32>,
-    /// Shadow rays each refined pixel asks for: 1 under a hard light, the settings'
-    /// `penumbra_rays` under a light with an area (a sample below the surface's
-    /// horizon is counted, though not traced).
+    /// Pixels whose shadow rays decide, this frame or before, where it refines by rays
+    /// on the mask path and the frame was waited for: the traced ones, and under a
+    /// light with an area whose penumbrae its mask pass classifies, those filled from
+    /// their neighbours and those their penumbra history answered.
+    pub unsure_pixels: Option<u32>,
+    /// Shadow rays each refined pixel asks for on the mask path: 1 under a hard light;
+    /// under a light with an area, a penumbra beam's samples
+    /// (`gnomon_math::light_masks::SAMPLES`), whatever the settings' `penumbra_rays`
+    /// (which the forward path's rays follow).
     pub rays_per_pixel: u32,
     /// Why its shadow was drawn unrefined where it asked to be refined by rays: the
     /// device cannot trace this scene or an image this large.
     pub refine_fallback: Option<crate::rays::RaysUnavailable>,
+    /// Frames its penumbra history holds, this one counted, where its mask pass
+    /// classifies its penumbrae (rays/penumbra_mask.wgsl): 1 on the first frame, or
+    /// the first after the camera, the light or a caster moved; a still view's unsure
+    /// pixels have gathered a beam every fourth frame since. None for a light with no
+    /// penumbra history.
+    pub penumbra_frames: Option<u32>,
     /// Why its layers were culled on the CPU where its settings asked for the GPU
     /// (`DrawSubmission::GpuCulled`): the same maps, at the CPU's cost.
     pub cull_fallback: Option<crate::GpuCullUnavailable>,
@@ -367,6 +379,12 @@ impl Submitted {
     /// Whether every virtual light's pages along shadow edges had settled: the last
     /// frame's traced pixels asked for no page it had not drawn
     /// ([`crate::PageStats::edges_new`]).
+    /// Whether every light's penumbra history holds `frames` frames or more (a light
+    /// with none has nothing to gather).
+    pub(super) fn penumbrae_gathered(&self, frames: u32) -> bool {
+        self.lights.iter().filter_map(|light| light.penumbra_frames).all(|held| held >= frames)
+    }
+
     pub(super) fn edges_settled(&self) -> bool {
         let pages = self.lights.iter().filter_map(|light| light.pages);
         pages.filter(|p| p.edge_levels > 0).all(|p| p.edges_new == Some(0))
@@ -522,8 +540,10 @@ impl TimedLights {
                 trace_ms: None,
                 refine: light.refine,
                 traced_pixels: None,
+                unsure_pixels: None,
                 rays_per_pixel: 1,
                 refine_fallback: None,
+                penumbra_frames: None,
                 cull_fallback: culled
                     .gpu_cull_fallback
                     .clone()

@@ -111,6 +111,27 @@ pub(super) struct LightPlan {
     pub virtual_map: Option<super::virtual_pages::VirtualPlan>,
 }
 
+/// What a light's layout is fitted for (`Renderer::fit_layout`).
+struct LayoutFit<'a> {
+    light: &'a Light,
+    /// The render's settings with this light's shadow settings.
+    settings: &'a Settings,
+    technique: TechniqueRef,
+    /// [`MapDrawing::penumbra_slope`].
+    penumbra_slope: Option<f32>,
+}
+
+/// The tangent of a sun's angular radius, where it has one: how far past its
+/// receivers a map whose penumbrae are classified must reach, per unit of depth.
+fn sun_penumbra_slope(light: &Light) -> Option<f32> {
+    match light {
+        Light::Directional(sun) if sun.angular_diameter_degrees > 0.0 => {
+            Some((0.5 * sun.angular_diameter_degrees.to_radians()).tan())
+        }
+        Light::Directional(_) | Light::Spot(_) | Light::Point(_) => None,
+    }
+}
+
 impl LightPlan {
     /// What its shadow pass stores.
     pub fn depth_target(&self) -> DepthTarget {
@@ -124,6 +145,12 @@ impl LightPlan {
     /// How the lighting pass looks its map up.
     pub fn lookup(&self) -> MapLookup {
         MapLookup::of(&self.light, &self.settings.shadow)
+    }
+
+    /// Whether its mask pass, on the mask path, classifies its penumbrae by its map's
+    /// min-max pyramid, which the frame then builds (`rays::classifies_penumbrae`).
+    pub fn classifies_penumbrae(&self) -> bool {
+        rays::classifies_penumbrae(self.refine, self.lookup(), rays::LightSize::of(&self.light))
     }
 
     /// Layers of its map.
@@ -200,7 +227,7 @@ impl Renderer {
         let resolved = self.techniques.resolve_lights(settings, scene)?;
         let mask_path = settings.uses_shadow_mask(&resolved)?;
         let levels = resolved.iter().filter(|r| r.shadow.partition == Partition::Virtual).map(|r| {
-            let refine = rays::light_refine(settings.light_refine(r), &r.light);
+            let refine = rays::light_refine(settings.light_refine(r));
             edge_levels(mask_path, refine, &r.shadow)
         });
         Ok(levels.max().unwrap_or(0))
@@ -223,12 +250,38 @@ impl Renderer {
         let aspect = settings.image.width as f32 / settings.image.height as f32;
         let mut lights = Vec::with_capacity(resolved.len());
         for (index, r) in resolved.into_iter().enumerate() {
-            let light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
+            let refine = if mask_path {
+                rays::light_refine(settings.light_refine(&r))
+            } else {
+                rays::forward_light_refine(settings.light_refine(&r))
+            };
+            let mut light_settings = Settings { shadow: r.shadow.clone(), ..settings.clone() };
+            let lookup = MapLookup::of(&r.light, &r.shadow);
+            let classified = rays::classifies_penumbrae(refine, lookup, rays::LightSize::of(&r.light));
+            if classified {
+                // The classification reads where the casters are (penumbra_classify.wgsl),
+                // and no technique looks the map up: a rasterizer's bias would store a
+                // caster seen steeply from the light behind a receiver it shadows.
+                light_settings.shadow.bias = light_settings.shadow.bias.without_depth_offsets();
+                // Nor may a caster nearer the light than the map's near plane be
+                // pancaked onto it: a floor reaching toward a low sun would store its
+                // far part flat at the near plane, where no plane of the pyramid fits
+                // it, and every receiver's search through it would find a caster.
+                light_settings.shadow.map.depth_clamp = false;
+            }
             self.check_map_limits(&light_settings)?;
             let technique = self.techniques.check_light(&r.shadow, &r.light, &r.name)?;
             let layout = match fixed_layout {
                 Some(layout) if index == shown => layout.clone(),
-                _ => self.fit_layout(uploaded, &r.light, &light_settings, technique, &camera, aspect).await?,
+                _ => {
+                    let fitting = LayoutFit {
+                        light: &r.light,
+                        settings: &light_settings,
+                        technique,
+                        penumbra_slope: if classified { sun_penumbra_slope(&r.light) } else { None },
+                    };
+                    self.fit_layout(uploaded, fitting, &camera, aspect).await?
+                }
             };
             let shadow = &light_settings.shadow;
             let filterable_map = technique.filterable_map(&shadow.filter);
@@ -249,11 +302,6 @@ impl Renderer {
                 // Ambient light is added once, by the first light's pass.
                 light_gpu.ambient = Vec3::ZERO;
             }
-            let refine = if mask_path {
-                rays::light_refine(settings.light_refine(&r), &r.light)
-            } else {
-                rays::forward_light_refine(settings.light_refine(&r))
-            };
             let virtual_map = match MapLookup::of(&r.light, shadow) {
                 MapLookup::Virtual => {
                     let light = VirtualLight {
@@ -294,12 +342,11 @@ impl Renderer {
     async fn fit_layout(
         &mut self,
         uploaded: &GpuScene,
-        light: &Light,
-        settings: &Settings,
-        technique: TechniqueRef,
+        fitting: LayoutFit<'_>,
         camera: &Camera,
         aspect: f32,
     ) -> Result<ShadowLayout, RenderError> {
+        let LayoutFit { light, settings, technique, penumbra_slope } = fitting;
         let shadow = &settings.shadow;
         // SDSM fits a sun's cascades to the depths the camera sees.
         let sdsm = shadow.partition == Partition::Cascades && shadow.cascades.sdsm;
@@ -310,7 +357,7 @@ impl Renderer {
             ShadowView::Parallel { .. } | ShadowView::Frustum { .. } | ShadowView::Omni { .. } => None,
         };
         let unclipped_depth = self.gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-        let drawing = MapDrawing { technique, unclipped_depth };
+        let drawing = MapDrawing { technique, unclipped_depth, penumbra_slope };
         Ok(shadow_layout(&uploaded.bounds, light, camera, aspect, settings, sampled.as_ref(), drawing))
     }
 

@@ -18,8 +18,12 @@ use super::{
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
     outputs::{Submitted, TimedLights},
+    penumbra_history::{HistoryFrame, HistoryKey},
     plan::{FramePlan, LightPlan},
-    recording::{DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, Recorded, Recording},
+    pyramid_cache::PyramidPlan,
+    recording::{
+        DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, PyramidViews, Recorded, Recording,
+    },
     screen::MaskStart,
 };
 use crate::{
@@ -30,7 +34,7 @@ use crate::{
         moments::{MomentInput, MomentLayout, MomentTarget},
     },
     pool::{Binding, ViewKey},
-    rays::{self, RefineLists},
+    rays::{self, PyramidInput, PyramidLayout, PyramidParams, RefineLists},
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::CameraGpu,
@@ -97,7 +101,11 @@ impl Renderer {
             record_ms: (recorded.submitted_at - cull_done).as_secs_f64() * 1e3,
             submit_ms: (recorded.submitted_at - started).as_secs_f64() * 1e3,
         };
-        let untimed = TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
+        let mut untimed =
+            TimedLights::untimed(&plan, &culled, self.map_cache.uses(), &recorded.layer_commands);
+        for (stats, frames) in untimed.lights.iter_mut().zip(&recorded.penumbra_frames) {
+            stats.penumbra_frames = *frames;
+        }
         let times = recorded.times.take().map(PendingTimes::submitted);
         let mut timed = match (request.times, times) {
             (_, None) => untimed,
@@ -126,9 +134,9 @@ impl Renderer {
         request: &SubmitRequest,
     ) -> Recorded {
         let gpu = self.gpu.clone();
-        // Every layer of every light, each light's filter, mask, trace, penumbra filter
-        // and lighting, and the prepass.
-        let timed_passes = plan.lights.iter().map(|p| p.layers() + 5).sum::<u32>() + 1;
+        // Every layer of every light, each light's filter, depth pyramid, mask, trace,
+        // penumbra filter and lighting, and the prepass.
+        let timed_passes = plan.lights.iter().map(|p| p.layers() + 6).sum::<u32>() + 1;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut rec = Recording {
             encoder: &mut encoder,
@@ -148,6 +156,7 @@ impl Renderer {
             layer_commands,
             color: drawn.color,
             shadow_map: drawn.shadow_map,
+            penumbra_frames: drawn.penumbra_frames,
             submitted_at: Instant::now(),
         }
     }
@@ -172,8 +181,10 @@ impl Renderer {
             self.pool.bind_group("camera", &self.layouts.camera, &[Binding::Buffer(camera_buffer.clone())]);
         // On the mask path, one layer of the mask per light.
         let mask_layers = if plan.mask_path { self.mask_layers(plan, width, height) } else { vec![] };
+        let histories = self.penumbra_histories(uploaded, plan, &camera_gpu, [width, height]);
+        let maps = LightMapInputs { culled, mask_layers: &mask_layers, histories: &histories, readback };
         let LitLights { lit, shown_map, shown_map_readback } =
-            self.record_light_maps(rec, uploaded, plan, culled, &mask_layers, readback);
+            self.record_light_maps(rec, uploaded, plan, maps);
         let mut readbacks = FrameReadbacks { shadow_map: shown_map_readback, ..Default::default() };
         let targets = self.lighting_targets(width, height);
         let viewport = Viewport { width, height };
@@ -196,6 +207,7 @@ impl Renderer {
                 depth: &targets.depth,
                 mask_layers: &mask_layers,
                 mask_rects,
+                histories: &histories,
                 mask_start: match plan.lighting {
                     Lighting::LightList => MaskStart::Keep,
                     Lighting::PerLight => MaskStart::Clear,
@@ -240,7 +252,33 @@ impl Renderer {
                 .map(|t| readback::record(&mut self.pool, rec.encoder, t, wgpu::TextureAspect::All))
                 .collect();
         }
-        Drawn { readbacks, color: targets.textures[0].clone(), shadow_map: shown_map }
+        let penumbra_frames = histories.iter().map(|h| h.as_ref().map(|h| h.frame)).collect();
+        Drawn { readbacks, color: targets.textures[0].clone(), shadow_map: shown_map, penumbra_frames }
+    }
+
+    /// Each light's penumbra history this frame: one for each light whose mask pass
+    /// classifies its penumbrae (`frame/penumbra_history.rs`), none for the others,
+    /// which keep none.
+    fn penumbra_histories(
+        &mut self,
+        uploaded: &GpuScene,
+        plan: &FramePlan,
+        camera: &CameraGpu,
+        size: [u32; 2],
+    ) -> Vec<Option<HistoryFrame>> {
+        let device = self.gpu.device.clone();
+        (0..plan.lights.len())
+            .map(|index| {
+                let light = &plan.lights[index];
+                if plan.mask_path && light.classifies_penumbrae() {
+                    let key = HistoryKey::of(light, camera, uploaded.caster_generation);
+                    Some(self.penumbra_histories.begin(&device, index, key, size))
+                } else {
+                    self.penumbra_histories.forget(index);
+                    None
+                }
+            })
+            .collect()
     }
 
     /// The first passes: each light's shadow maps (and moment map), and its bindings
@@ -250,23 +288,25 @@ impl Renderer {
         rec: &mut Recording,
         uploaded: &GpuScene,
         plan: &FramePlan,
-        culled: &Culled,
-        mask_layers: &[wgpu::TextureView],
-        readback: Readback,
+        inputs: LightMapInputs,
     ) -> LitLights {
         let mut lit = Vec::with_capacity(plan.lights.len());
         let mut shown_map = None;
         let mut shown_map_readback = None;
         for (index, light) in plan.lights.iter().enumerate() {
-            let map = self.record_shadow_maps(rec, uploaded, light, &culled.layers[index], index as u32);
+            let map =
+                self.record_shadow_maps(rec, uploaded, light, &inputs.culled.layers[index], index as u32);
             if index == plan.shown {
-                if readback.shadow_map {
+                if inputs.readback.shadow_map {
                     let aspect = wgpu::TextureAspect::DepthOnly;
                     shown_map_readback = Some(readback::record(&mut self.pool, rec.encoder, &map, aspect));
                 }
                 shown_map = Some(map.clone());
             }
-            lit.push(self.light_bindings(rec, uploaded, light, index as u32, &map, mask_layers.get(index)));
+            let mask = inputs.mask_layers.get(index);
+            let history = inputs.histories[index].as_ref();
+            let drawn = DrawnLight { index: index as u32, map: &map, mask_layer: mask, history };
+            lit.push(self.light_bindings(rec, uploaded, light, drawn));
         }
         let shown_map = shown_map.expect("the reported light is one of the lights");
         LitLights { lit, shown_map, shown_map_readback }
@@ -280,9 +320,16 @@ impl Renderer {
         light: &LightPlan,
         index: u32,
         map: &wgpu::Texture,
+        history: Option<&HistoryFrame>,
     ) -> LightMaps {
         let gpu = self.gpu.clone();
-        let light_buffer = self.pool.uniform(&gpu.queue, "light", &light.light_gpu);
+        // The history's state this frame, which the penumbra passes read.
+        let mut uniform = light.light_gpu;
+        if let Some(history) = history {
+            uniform.rays.history = u32::from(history.held);
+            uniform.rays.frame = history.frame;
+        }
+        let light_buffer = self.pool.uniform(&gpu.queue, "light", &uniform);
         let map_view = self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::D2Array));
         let shadow = &light.settings.shadow;
         let moments = light.filterable_map.map(|filterable| {
@@ -327,7 +374,56 @@ impl Renderer {
             .then(|| self.pool.view(map, ViewKey::whole(wgpu::TextureViewDimension::Cube)));
         let virtual_map =
             light.virtual_map.as_ref().map(|plan| Self::virtual_buffers(&mut self.pool, &gpu.queue, plan));
-        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, lookup }
+        let pyramid = match history {
+            Some(_) => Some(self.depth_pyramid(rec, light, index, &map_view)),
+            None => {
+                self.map_cache.pyramids.forget(index as usize);
+                None
+            }
+        };
+        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, pyramid, lookup }
+    }
+
+    /// Light `index`'s depth pyramid, built from `map` (`rays/pyramid.rs`), or kept
+    /// where its depth map was kept whole and still casters keep maps.
+    fn depth_pyramid(
+        &mut self,
+        rec: &mut Recording,
+        light: &LightPlan,
+        index: u32,
+        map: &wgpu::TextureView,
+    ) -> PyramidViews {
+        let gpu = self.gpu.clone();
+        let layout = PyramidLayout::of(light.map_resolution(), light.layers());
+        let kept = light.settings.shadow.map.cache == MapCacheSetting::StillCasters
+            && self.map_cache.kept_whole(index as usize);
+        let pyramid = match self.map_cache.pyramids.plan(&gpu.device, index as usize, layout, kept) {
+            PyramidPlan::Keep(pyramid) => pyramid,
+            PyramidPlan::Build(pyramid) => {
+                let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
+                let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("depth pyramid"),
+                    timestamp_writes: rec.clock.compute_writes(slot),
+                });
+                let cube = light.lookup() == MapLookup::Cube;
+                let params = PyramidParams {
+                    cube: u32::from(cube),
+                    range: light.light_gpu.emitter.range,
+                    near: light.light_gpu.map.near,
+                    _pad: 0,
+                };
+                let input = PyramidInput { map, params, queue: &gpu.queue, layout };
+                self.passes.pyramid.record(&mut self.pool, &mut pass, input, &pyramid);
+                drop(pass);
+                rec.clock.end(&gpu, rec.encoder, slot);
+                pyramid
+            }
+        };
+        let whole = ViewKey::whole(wgpu::TextureViewDimension::D2Array);
+        PyramidViews {
+            planes: self.pool.view(&pyramid.planes, whole),
+            ranges: self.pool.view(&pyramid.ranges, whole),
+        }
     }
 
     /// A light's uniform, its moment map (recorded here) and its groups for the passes
@@ -337,11 +433,10 @@ impl Renderer {
         rec: &mut Recording,
         uploaded: &GpuScene,
         light: &LightPlan,
-        index: u32,
-        map: &wgpu::Texture,
-        mask_layer: Option<&wgpu::TextureView>,
+        drawn: DrawnLight,
     ) -> LightBindings {
-        let maps = self.light_maps(rec, light, index, map);
+        let DrawnLight { index, map, mask_layer, history } = drawn;
+        let maps = self.light_maps(rec, light, index, map, history);
         let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
         let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(mask_layer));
@@ -349,6 +444,24 @@ impl Renderer {
             mask_layer.map(|_| self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(None)));
         LightBindings { scene, lighting, mask, lookup: maps.lookup }
     }
+}
+
+/// One light as its maps were drawn: its index, its map, the mask layer its lighting
+/// pass reads (on the mask path) and its penumbra history.
+struct DrawnLight<'a> {
+    index: u32,
+    map: &'a wgpu::Texture,
+    mask_layer: Option<&'a wgpu::TextureView>,
+    history: Option<&'a HistoryFrame>,
+}
+
+/// What the first passes read besides the plan: the culled layers, the mask's layers,
+/// each light's penumbra history, and what to copy out.
+struct LightMapInputs<'a> {
+    culled: &'a Culled,
+    mask_layers: &'a [wgpu::TextureView],
+    histories: &'a [Option<HistoryFrame>],
+    readback: Readback,
 }
 
 /// Each light's bindings for the passes from the camera, and the reported light's map.
@@ -366,4 +479,6 @@ pub(super) struct Drawn {
     pub color: wgpu::Texture,
     /// The reported light's shadow map.
     pub shadow_map: wgpu::Texture,
+    /// Frames each light's penumbra history holds.
+    pub penumbra_frames: Vec<Option<u32>>,
 }

@@ -121,6 +121,9 @@ pub(super) struct LightMaps {
     pub cube: Option<wgpu::TextureView>,
     /// A sun's virtual map's uniform and page table (its pool is `map`).
     pub virtual_map: Option<VirtualBuffers>,
+    /// The depth map's pyramid, for a light whose penumbrae the mask pass
+    /// classifies (`rays/pyramid.rs`).
+    pub pyramid: Option<PyramidViews>,
     pub lookup: MapLookup,
 }
 
@@ -133,8 +136,15 @@ impl LightMaps {
             cube: self.cube.as_ref(),
             mask,
             virtual_map: self.virtual_map.as_ref(),
+            pyramid: self.pyramid.as_ref(),
         }
     }
+}
+
+/// The views of a depth pyramid's two textures, every level and layer.
+pub(super) struct PyramidViews {
+    pub planes: wgpu::TextureView,
+    pub ranges: wgpu::TextureView,
 }
 
 /// The copies a frame recorded, waiting for its submission.
@@ -157,5 +167,8 @@ pub(super) struct Recorded {
     pub layer_commands: LayerCommands,
     pub color: wgpu::Texture,
     pub shadow_map: wgpu::Texture,
+    /// Frames each light's penumbra history holds, this one counted (None: it keeps
+    /// none).
+    pub penumbra_frames: Vec<Option<u32>>,
     pub submitted_at: Instant,
 }

@@ -96,6 +96,16 @@ impl Renderer {
     }
 }
 
+/// The rays a pixel of `light` the mask path traced casts: one under a hard light; a
+/// penumbra beam's samples under a light with an area, which it beams through the
+/// shader's BVH whatever traverses the hard rays.
+fn rays_per_pixel(light: &super::plan::LightPlan) -> u32 {
+    match rays::LightSize::of(&light.light) {
+        rays::LightSize::Hard => 1,
+        rays::LightSize::Area => gnomon_math::light_masks::SAMPLES as u32,
+    }
+}
+
 /// Writes into each light's stats how its rays traversed the casters, why it fell
 /// back, and, given the copy of the counters (`traced`, submitted), the pixels it
 /// traced.
@@ -113,7 +123,9 @@ pub(super) async fn report(
     }
     for (stats, light) in timed.lights.iter_mut().zip(&plan.lights) {
         if light.refine != Refine::Off {
-            stats.traversal = Some(plan.traversal);
+            // The mask path beams a light with an area through the shader's BVH.
+            let beamed = plan.mask_path && rays::LightSize::of(&light.light) == rays::LightSize::Area;
+            stats.traversal = Some(if beamed { Traversal::Shader } else { plan.traversal });
             stats.tracer_fallback = fallbacks.tracer.clone();
         }
     }
@@ -122,8 +134,9 @@ pub(super) async fn report(
         let listed = RefineLists::listed(&words, plan.lights.len());
         for ((stats, light), listed) in timed.lights.iter_mut().zip(&plan.lights).zip(listed) {
             if light.refine != Refine::Off {
-                stats.traced_pixels = Some(listed);
-                stats.rays_per_pixel = light.light_gpu.rays.penumbra_rays.max(1);
+                stats.traced_pixels = Some(listed.traced);
+                stats.unsure_pixels = Some(listed.unsure);
+                stats.rays_per_pixel = rays_per_pixel(light);
             }
         }
     }

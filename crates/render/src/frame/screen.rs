@@ -6,6 +6,7 @@
 use super::{
     Renderer,
     bindings::CameraDraws,
+    penumbra_history::HistoryFrame,
     plan::{FramePlan, LightPlan},
     recording::{LightBindings, Recording},
     virtual_record::EdgeList,
@@ -14,7 +15,7 @@ use crate::{
     GpuScene,
     passes::screen_space::{self, MaskKey},
     pool::{Binding, ViewKey},
-    rays::{LightSize, ListAccess, RefineLists, TraceGroups, TraceStage},
+    rays::{HISTORY_FORMAT, LightSize, ListAccess, RefineLists, TraceGroups, TraceStage, Traversal},
     timing::PassKind,
 };
 use gnomon_math::screen_bounds::PixelRect;
@@ -41,14 +42,19 @@ pub(super) struct ScreenInputs<'a> {
     pub mask_layers: &'a [wgpu::TextureView],
     /// The pixels each light's mask pass covers; `None` for none.
     pub mask_rects: Vec<Option<PixelRect>>,
+    /// Each light's penumbra history, for those whose mask pass classifies their
+    /// penumbrae.
+    pub histories: &'a [Option<HistoryFrame>],
     pub mask_start: MaskStart,
 }
 
-/// Group 1 of a light's mask pass.
+/// Groups 1 and 3 of a light's mask pass.
 struct MaskScreen<'a> {
     group: &'a wgpu::BindGroup,
     /// The light's counters in the group of a refining pass; none in the plain one.
     counter_offset: Option<u32>,
+    /// Its penumbra history, read and written, where it classifies penumbrae.
+    history: Option<wgpu::BindGroup>,
 }
 
 /// A frame's refinement by rays: the lists, group 1 as the mask passes (which
@@ -59,6 +65,9 @@ struct Refining {
     append: wgpu::BindGroup,
     read: wgpu::BindGroup,
     traced: wgpu::TextureView,
+    /// Written in place of a penumbra history by the trace passes of lights that keep
+    /// none.
+    no_history: wgpu::TextureView,
 }
 
 /// Where a light's mask pass draws: its layer of the mask and the pixels of it that
@@ -80,7 +89,7 @@ pub(super) enum MaskStart {
     Keep,
 }
 
-/// What a penumbra filter copies: the light's layer of the mask (a view of one layer
+/// What a penumbra fill copies: the light's layer of the mask (a view of one layer
 /// of the frame's mask texture) into the frame's `traced` texture.
 struct PenumbraCopy<'a> {
     layer: &'a wgpu::TextureView,
@@ -133,18 +142,10 @@ impl Renderer {
         );
         // The list of unsure pixels and each light's counters, cleared: zero
         // workgroups until a mask pass lists a pixel.
-        let refining = plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
-            let lists = RefineLists::new(&mut self.pool, width, height, plan.lights.len());
-            rec.encoder.clear_buffer(&lists.counters, 0, None);
-            let prepass = [&surface, &normals];
-            let camera = inputs.camera_buffer;
-            let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
-            let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
-            let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-            let traced = self.pool.texture("traced shadow mask", size, screen_space::MASK_FORMAT, usage);
-            let traced = self.pool.view(&traced, ViewKey::default());
-            Refining { lists, append, read, traced }
-        });
+        let refining =
+            plan.lights.iter().any(|l| l.refine != Refine::Off).then(|| {
+                self.refining(rec, size, plan.lights.len(), inputs.camera_buffer, [&surface, &normals])
+            });
         for (index, ((light, bindings), layer)) in
             plan.lights.iter().zip(lit).zip(inputs.mask_layers).enumerate()
         {
@@ -152,36 +153,54 @@ impl Renderer {
                 (_, Refine::Off) | (None, _) => None,
                 (Some(refining), Refine::Auto | Refine::Rays | Refine::EveryPixel) => Some(refining),
             };
+            let history = inputs.histories[index].as_ref();
+            let history_views = history
+                .map(|h| [&h.read, &h.write].map(|texture| self.pool.view(texture, ViewKey::default())));
             let screen = match refined {
                 Some(refining) => MaskScreen {
                     group: &refining.append,
                     counter_offset: Some(RefineLists::counter_offset(index as u32)),
+                    history: history_views.as_ref().map(|[read, write]| {
+                        self.pool.bind_group(
+                            "penumbra history",
+                            &self.layouts.penumbra_history,
+                            &[Binding::View(read.clone()), Binding::View(write.clone())],
+                        )
+                    }),
                 },
-                None => MaskScreen { group: &screen_group, counter_offset: None },
+                None => MaskScreen { group: &screen_group, counter_offset: None, history: None },
             };
-            // A penumbra filter reads the neighbours of its pixels, which may lie
-            // outside the light's rectangle: they must hold this frame's values.
+            // A penumbra fill reads the neighbours of its pixels, which may lie outside
+            // the light's rectangle: they must hold this frame's values.
             let start = match refined {
                 Some(_) if light.light_gpu.rays.penumbra_rays > 0 => MaskStart::Clear,
                 Some(_) | None => inputs.mask_start,
             };
             let target = MaskTarget { layer, rect: inputs.mask_rects[index], start };
             self.record_mask(rec, light, bindings, target, &screen, index as u32);
-            if let Some(Refining { lists, read, traced, .. }) = refined {
-                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer, traced);
+            if let Some(Refining { lists, read, traced, no_history, .. }) = refined {
+                let written = history_views.as_ref().map_or(no_history, |[_, write]| write);
+                let mask = RefineLists::mask_group(&mut self.pool, &self.layouts, layer, traced, written);
                 let bvh = uploaded.rays().expect("the casters' BVH, built when the frame was planned");
+                let size = LightSize::of(&light.light);
+                // A light with an area is beamed, which walks the shader's BVH whatever
+                // traces the hard rays (penumbra_beam.wgsl).
+                let traversal = match size {
+                    LightSize::Hard => plan.traversal,
+                    LightSize::Area => Traversal::Shader,
+                };
                 let groups = TraceGroups {
                     scene: &bindings.scene,
                     screen: read,
                     mask: &mask,
-                    bvh: bvh.group(plan.traversal),
-                    traversal: plan.traversal,
-                    size: LightSize::of(&light.light),
+                    bvh: bvh.group(traversal),
+                    traversal,
+                    size,
                     counters: &lists.counters,
                 };
                 self.record_trace(rec, TraceStage::Trace, &groups, index as u32);
-                if light.light_gpu.rays.penumbra_rays > 0 {
-                    self.record_penumbra_filter(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
+                if history.is_some() {
+                    self.record_penumbra_fill(rec, &groups, PenumbraCopy { layer, traced }, index as u32);
                 }
                 if let Some(plan) = &light.virtual_map {
                     let list = EdgeList { screen: read, counters: &lists.counters };
@@ -190,6 +209,35 @@ impl Renderer {
             }
         }
         ScreenOutputs { lists: refining.map(|refining| refining.lists), surface_group: screen_group }
+    }
+
+    /// The list of unsure pixels and each light's counters, cleared (zero workgroups
+    /// until a mask pass lists a pixel), their groups over the camera and the
+    /// prepass's `surface` and `normals`, and the traced mask.
+    fn refining(
+        &mut self,
+        rec: &mut Recording,
+        size: wgpu::Extent3d,
+        lights: usize,
+        camera: &wgpu::Buffer,
+        prepass: [&wgpu::TextureView; 2],
+    ) -> Refining {
+        let lists = RefineLists::new(&mut self.pool, size.width, size.height, lights);
+        rec.encoder.clear_buffer(&lists.counters, 0, None);
+        let append = lists.group(&mut self.pool, &self.layouts, ListAccess::Append, camera, prepass);
+        let read = lists.group(&mut self.pool, &self.layouts, ListAccess::Read, camera, prepass);
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let traced = self.pool.texture("traced shadow mask", size, screen_space::MASK_FORMAT, usage);
+        let traced = self.pool.view(&traced, ViewKey::default());
+        let one = wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 };
+        let no_history = self.pool.texture(
+            "no penumbra history",
+            one,
+            HISTORY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+        );
+        let no_history = self.pool.view(&no_history, ViewKey::default());
+        Refining { lists, append, read, traced, no_history }
     }
 
     /// Light `index`'s mask pass into its `target` layer of the mask, with group 1
@@ -236,8 +284,11 @@ impl Renderer {
         pass.set_bind_group(0, &bindings.scene, &[]);
         pass.set_bind_group(1, screen.group, screen.counter_offset.as_slice());
         pass.set_bind_group(2, mask_group, &[]);
+        if let Some(history) = &screen.history {
+            pass.set_bind_group(3, history, &[]);
+        }
         rec.stats.pipeline_changes += 1;
-        rec.stats.bind_group_changes += 3;
+        rec.stats.bind_group_changes += 3 + u32::from(screen.history.is_some());
         if let Some(rect) = target.rect {
             pass.set_scissor_rect(rect.x, rect.y, rect.width, rect.height);
             pass.draw(0..3, 0..1);
@@ -265,10 +316,11 @@ impl Renderer {
         rec.clock.end(gpu, rec.encoder, slot);
     }
 
-    /// Light `index`'s penumbra filter, after its trace pass under a light with an
-    /// area: its layer of the mask is copied as traced, then each listed pixel is
-    /// averaged with its neighbours on the same surface from that copy.
-    fn record_penumbra_filter(
+    /// Light `index`'s penumbra fill, after its trace pass under a light with an area
+    /// whose penumbrae its mask pass classified: its layer of the mask is copied as
+    /// traced, then each unsure pixel no beam answered takes the mean of its answered
+    /// neighbours on the same surface in that copy.
+    fn record_penumbra_fill(
         &mut self,
         rec: &mut Recording,
         groups: &TraceGroups,
@@ -286,7 +338,7 @@ impl Renderer {
             traced.as_image_copy(),
             wgpu::Extent3d { width: traced.width(), height: traced.height(), depth_or_array_layers: 1 },
         );
-        self.record_trace(rec, TraceStage::PenumbraFilter, groups, index);
+        self.record_trace(rec, TraceStage::PenumbraFill, groups, index);
     }
 
     /// The camera's depth, normals, surface (world point and view depth) and object.

@@ -72,6 +72,10 @@ pub struct GpuScene {
     /// and renewed whenever one of them moves. A cached map drawn under another
     /// generation is drawn again.
     pub(crate) still_generation: u64,
+    /// Names where every caster stands: unique to this upload, and renewed whenever
+    /// any instance moves. A penumbra history kept under another generation is
+    /// thrown away (`frame/penumbra_history.rs`).
+    pub(crate) caster_generation: u64,
 }
 
 /// The next [`GpuScene::still_generation`], unique in the process.
@@ -208,6 +212,7 @@ impl GpuScene {
             mesh_bounds,
             mesh_clusters,
             still_generation: next_generation(),
+            caster_generation: next_generation(),
         })
     }
 
@@ -241,6 +246,7 @@ impl GpuScene {
                 refits[batch].push((slot - self.batches[batch].first_instance, bounds));
             }
         })?;
+        self.caster_generation = next_generation();
         // The upload's grouping decides: a batch of still casters that moved leaves
         // every cached map stale.
         if refits.iter().zip(&self.batches).any(|(moved, b)| !moved.is_empty() && b.motion == Motion::Static)

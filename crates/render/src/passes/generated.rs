@@ -28,8 +28,13 @@ pub fn wgsl_constants() -> String {
     for kind in crate::virtual_map::MapKindGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", kind.wgsl_name(), kind as u32);
     }
+    s += &format!("const LIGHT_MASK_SAMPLES: u32 = {}u;\n", gnomon_math::light_masks::SAMPLES);
+    s += &format!("const LIGHT_MASK_ANGLE_BINS: u32 = {}u;\n", gnomon_math::light_masks::ANGLE_BINS);
+    s += &format!("const LIGHT_MASK_OFFSET_BINS: u32 = {}u;\n", gnomon_math::light_masks::OFFSET_BINS);
     s += &format!("const UNSURE_RING_TEXELS: i32 = {}i;\n", crate::rays::refine::UNSURE_RING_TEXELS);
     s += &format!("const TRACED_LAYER_FLAG: u32 = {TRACED_LAYER_FLAG}u;\n");
+    s += &format!("const MAP_CLEARED: f32 = {:?};\n", super::shadow::MAP_CLEARED_DEPTH);
+    s += &format!("const PI: f32 = {:?};\n", std::f32::consts::PI);
     s += &format!("const LIGHT_TILE: u32 = {}u;\n", light_list::LIGHT_TILE);
     s += &format!("const LIGHT_WORDS: u32 = {}u;\n", light_list::LIGHT_WORDS);
     for (name, view) in [

@@ -62,7 +62,7 @@ fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
         struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, max_search_texels, _pad1 }),
         struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
-        struct_layout!(RaysGpu as "Rays" { penumbra_rays, _pad0, _pad1, _pad2 }),
+        struct_layout!(RaysGpu as "Rays" { penumbra_rays, history, frame, _pad0 }),
         struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),
         struct_layout!(techniques::variance::VarianceParams as "VarianceParams" {
             positive_exponent, negative_exponent, min_variance, bleeding_reduction, variant, _pad0, _pad1, _pad2,
@@ -221,6 +221,7 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("page clear".into(), crate::virtual_map::draw::page_clear_wgsl()));
     out.push(("surface from depth".into(), crate::virtual_map::surface_from_depth_wgsl()));
     out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));
+    out.push(("depth pyramid".into(), crate::rays::pyramid::depth_pyramid_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);

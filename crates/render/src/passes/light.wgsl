@@ -27,6 +27,19 @@ struct Emitter {
     size: f32,             // radius in world units, or tan of the sun's angular radius
 };
 
+// The plane of a light's samples as a receiver sees it (`emitter_sample_plane` in
+// light_kinds.wgsl), for a penumbra beam (rays/penumbra_beam.wgsl).
+struct SamplePlane {
+    toward: vec3<f32>,      // the direction to the disk's centre, in units of its radius
+    b0: vec3<f32>,          // the disk's axes, unit
+    b1: vec3<f32>,
+    depth_axis: vec3<f32>,  // a caster's depth along the beam is w·depth_axis
+    far: f32,               // depths in (0, far) can block
+    axis: vec3<f32>,        // the walk's axis ray, unit
+    axis_length: f32,
+    widening: f32,          // the cone's radius over its distance along the axis, at most
+};
+
 // The light's map: its layers, texel sizes and depth range.
 struct ShadowMap {
     layer_count: u32,         // layers: cascades, cube faces, paraboloids
@@ -86,9 +99,9 @@ struct Contact {
 // Refinement by rays (screen).
 struct Rays {
     penumbra_rays: u32,  // rays per pixel over the light's area (0: hard, one ray)
+    history: u32,        // 1 where the penumbra history holds last frame's answers
+    frame: u32,          // frames the history holds, this one counted
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 };
 
 // One layer (cascade) of the map.

@@ -3,7 +3,7 @@
 // group 0 binding 1 in Gnomon's own passes, beside the instances; binding 0 of the
 // host's group in the shadow receiver.
 import package::passes::light::Light;
-import package::passes::light_kinds::emitter_distance_from_depth;
+import package::passes::light_kinds::{emitter_depth_from_distance, emitter_distance_from_depth};
 import package::variant::{LIGHT_BINDING, LIGHT_GROUP};
 
 @group(LIGHT_GROUP) @binding(LIGHT_BINDING) var<uniform> light: Light;
@@ -45,6 +45,11 @@ fn texel_shape(layer: u32) -> vec2<f32> {
 // is `depth` (how each kind's map stores it: `emitter_distance_from_depth`).
 fn light_distance_from_depth(depth: f32) -> f32 {
     return emitter_distance_from_depth(light.emitter, light.map.near, light.map.far, depth);
+}
+
+// The depth a shadow map stores for a point at light distance `distance`.
+fn light_depth_from_distance(distance: f32) -> f32 {
+    return emitter_depth_from_distance(light.emitter, light.map.near, light.map.far, distance);
 }
 
 // The depth that moment maps store: light distance, linear in [0, 1] from the near

@@ -7,7 +7,7 @@
 // uniform's does. It needs only the generated constants and the sampling maps
 // (light_shapes.wgsl).
 import package::constants::{FALLOFF_INVERSE_SQUARE, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN};
-import package::passes::light::Emitter;
+import package::passes::light::{Emitter, SamplePlane};
 import package::passes::light_shapes::{concentric_disk, cone_direction, orthonormal_pair};
 
 // Distances below this count as this, so that a surface touching a light gets a
@@ -80,6 +80,45 @@ fn emitter_distance_from_depth(e: Emitter, near: f32, far: f32, depth: f32) -> f
     return near * far / (far - depth * (far - near));
 }
 
+// The inverse of `emitter_distance_from_depth`: the depth a map of `e` stores for a
+// point at light distance `distance` along its axis.
+fn emitter_depth_from_distance(e: Emitter, near: f32, far: f32, distance: f32) -> f32 {
+    if e.kind == LIGHT_SUN {
+        return (distance - near) / (far - near);
+    }
+    return far * (distance - near) / (distance * (far - near));
+}
+
+// Whether all of `e`'s area lies above the plane through `world` with unit normal
+// `normal`: no ray to it from there is below the surface's horizon. A sun's disk
+// lies within its angular radius of its direction; a spot's disk within its radius
+// of its centre, across its axis; a point light's sphere within its radius.
+fn emitter_above_plane(e: Emitter, world: vec3<f32>, normal: vec3<f32>) -> bool {
+    if e.kind == LIGHT_SUN {
+        return dot(normal, -e.direction) > e.size * inverseSqrt(1.0 + e.size * e.size);
+    }
+    let height = dot(normal, e.position - world);
+    if e.kind == LIGHT_SPOT {
+        let across = dot(normal, e.direction);
+        return height > e.size * sqrt(max(1.0 - across * across, 0.0));
+    }
+    return height > e.size;
+}
+
+// The least a ray from a point toward a sun's disk rises over a plane, per unit of
+// its length, where `normal` is the unit normal of the plane's side the point and
+// the sun lie on: the sine of the disk's lowest point's elevation over the plane (the
+// disk's centre asin(c) above it, its radius asin(s)). 0 for a spot or a point light,
+// whose rays' rise depends on where they start.
+fn sun_least_rise(e: Emitter, normal: vec3<f32>) -> f32 {
+    if e.kind != LIGHT_SUN {
+        return 0.0;
+    }
+    let c = dot(normal, -e.direction);
+    let s = e.size * inverseSqrt(1.0 + e.size * e.size);
+    return c * sqrt(max(1.0 - s * s, 0.0)) - sqrt(max(1.0 - c * c, 0.0)) * s;
+}
+
 // The radius, in world units, of the cone from a receiver at light distance
 // `receiver` to the light's area, at light distance `at`: e.size × (d − at) for a sun
 // (the tangent of its angular radius), e.size × (d − at) / d for a spot's disk or a
@@ -144,4 +183,74 @@ fn emitter_sample_weight(e: Emitter, len: f32) -> f32 {
         return 1.0;
     }
     return distance_falloff(e.falloff, e.falloff_window, len);
+}
+
+// The plane of `e`'s samples as seen from `origin` (a penumbra beam's,
+// rays/penumbra_beam.wgsl), its axes turned by `turn` radians: the unit disk's point
+// x lies in direction `toward + x.x b0 + x.y b1`. A spot's disk faces along its
+// axis, its radius the unit; a sun's and a point light's samples lie on the plane
+// a unit along the axis, where the cone of the disk or sphere has radius
+// tan(half-angle), over that radius. Along with it, where casters can block: their
+// depth along `depth_axis` in (0, far), and the axis ray and widening the walk
+// bounds the cone with.
+fn emitter_sample_plane(e: Emitter, origin: vec3<f32>, turn: f32) -> SamplePlane {
+    let rotation = vec2<f32>(cos(turn), sin(turn));
+    if e.kind == LIGHT_SPOT {
+        let basis = orthonormal_pair(e.direction);
+        let to_light = e.position - origin;
+        let distance = length(to_light);
+        let radius = e.size;
+        // As a share of the way to the disk's plane, along the spot's axis.
+        let height = dot(to_light, -e.direction);
+        return SamplePlane(
+            to_light / radius,
+            basis[0] * rotation.x + basis[1] * rotation.y,
+            basis[1] * rotation.x - basis[0] * rotation.y,
+            -e.direction / max(height, 1e-30),
+            1.0,
+            to_light / distance,
+            distance + radius,
+            // A point of the cone lies within radius / (distance − radius) of its
+            // distance along the axis from the axis.
+            select(1e6, radius / (distance - radius), distance > 1.01 * radius),
+        );
+    }
+    var axis = -e.direction;
+    var far = SUN_RAY_LENGTH;
+    var tan_half = e.size;
+    if e.kind != LIGHT_SUN {
+        let to_light = e.position - origin;
+        let distance = length(to_light);
+        axis = to_light / distance;
+        let radius = min(e.size, 0.999 * distance);
+        tan_half = radius / sqrt(distance * distance - radius * radius);
+        // The sphere's nearest point: a caster nearer the light than that, beside
+        // the rays to its rim, is missed.
+        far = distance - radius;
+    }
+    let basis = orthonormal_pair(axis);
+    return SamplePlane(
+        axis / tan_half,
+        basis[0] * rotation.x + basis[1] * rotation.y,
+        basis[1] * rotation.x - basis[0] * rotation.y,
+        axis,
+        far,
+        axis,
+        far,
+        tan_half,
+    );
+}
+
+// The weight of the sample in direction `d` from the receiver (`emitter_sample_plane`'s
+// `toward + x.x b0 + x.y b1`) among `e`'s samples, so that they weigh as the
+// reference's rays: over a spot's disk, uniform in area, the falloff of the
+// distance to the sample's point (`emitter_sample_weight`); over a sun's or point
+// light's cone, the density of directions uniform in solid angle on the plane,
+// cos³θ.
+fn emitter_plane_weight(e: Emitter, plane: SamplePlane, d: vec3<f32>) -> f32 {
+    if e.kind == LIGHT_SPOT {
+        return distance_falloff(e.falloff, e.falloff_window, length(d) * e.size);
+    }
+    let c = inverseSqrt(dot(d, d) / dot(plane.toward, plane.toward));
+    return c * c * c;
 }

@@ -7,7 +7,9 @@
 
 use std::collections::HashMap;
 
-use super::wgsl_interfaces::{IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PIXEL_VISIBILITY, SEEN_SURFACE};
+use super::wgsl_interfaces::{
+    IS_SEEN_SURFACE, LOOKUP_VISIBILITY, PENUMBRA_LAYER, PIXEL_VISIBILITY, SEEN_SURFACE,
+};
 use super::{
     CAMERA_MATERIAL_BINDINGS, CAMERA_STRUCT_WGSL, LIGHT_WGSL, Layouts, OWN_CAMERA_BINDING, OWN_LIGHT_BINDING,
     SCENE_COMMON_WGSL, SHADING_WGSL, camera_binding_wgsl, compose_wgsl, light_binding_wgsl,
@@ -133,6 +135,42 @@ pub(crate) fn resolved_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -
     };
     parts.push(visibility.to_owned());
     parts.push(LOOKUP_VISIBILITY.bind(implementation));
+    parts.push(include_str!("resolve_visibility.wgsl").to_owned());
+    parts.push(PIXEL_VISIBILITY.bind("resolved_pixel_visibility"));
+    parts
+}
+
+/// `pixel_visibility` of the mask pass of a light whose penumbrae it classifies
+/// (`rays::classifies_penumbrae`) on its 2D map or cube: the classification
+/// (rays/penumbra_classify.wgsl: lit, umbra or unsure, no technique's estimate) and
+/// the rules of resolve_visibility.wgsl, with `penumbra_layer`. The technique is
+/// linked for the lookup's choice of layer, which the classification shares.
+pub(crate) fn penumbra_lookup_wgsl(technique: TechniqueRef, lookup: MapLookup) -> Vec<String> {
+    let mut parts = vec![techniques::shadow_bindings_wgsl(techniques::OWN_SHADOW_BINDINGS)];
+    parts.extend(techniques::helper_wgsl());
+    let (layout, names) = match lookup {
+        MapLookup::Map => {
+            parts.extend(techniques::technique_wgsl(technique.get(), technique.wgsl()));
+            parts.push(include_str!("map_visibility.wgsl").to_owned());
+            (include_str!("../rays/penumbra_map.wgsl"), ["penumbra_map_lookup", "map_penumbra_layer"])
+        }
+        MapLookup::Cube => {
+            parts.push(techniques::CUBE_WGSL.to_owned());
+            let cube = technique.cube_wgsl().unwrap_or_else(|| {
+                unreachable!("{technique:?} has no cube lookup; the registry refuses it for point lights")
+            });
+            parts.extend(techniques::technique_wgsl(technique.get(), cube));
+            parts.push(include_str!("cube_visibility.wgsl").to_owned());
+            (include_str!("../rays/penumbra_cube.wgsl"), ["penumbra_cube_lookup", "cube_penumbra_layer"])
+        }
+        MapLookup::Paraboloid | MapLookup::Virtual => {
+            unreachable!("{lookup:?}: `rays::classifies_penumbrae` classifies 2D maps and cubes alone")
+        }
+    };
+    parts.push(include_str!("../rays/penumbra_classify.wgsl").to_owned());
+    parts.push(layout.to_owned());
+    parts.push(LOOKUP_VISIBILITY.bind(names[0]));
+    parts.push(PENUMBRA_LAYER.bind(names[1]));
     parts.push(include_str!("resolve_visibility.wgsl").to_owned());
     parts.push(PIXEL_VISIBILITY.bind("resolved_pixel_visibility"));
     parts

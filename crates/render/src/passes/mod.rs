@@ -175,8 +175,9 @@ pub(crate) struct Layouts {
     pub screen: wgpu::BindGroupLayout,
     /// Group 2 of the lighting pass: the shadow map and its comparison sampler, the
     /// filterable techniques' moment map and its sampler, a point light's cube with
-    /// its nearest comparison and gathering samplers, and on the mask path the light's
-    /// layer of the shadow mask.
+    /// its nearest comparison and gathering samplers, on the mask path the light's
+    /// layer of the shadow mask, and in the mask pass of a light whose penumbrae it
+    /// classifies the map's min-max pyramid (`rays/pyramid.rs`).
     pub shadow: wgpu::BindGroupLayout,
     /// The shadow receiver's one group, in the host's shader: the light's and the
     /// camera's uniforms, then the shadow resources in the order of `shadow`.
@@ -194,6 +195,9 @@ pub(crate) struct Layouts {
     pub trace_screen: wgpu::BindGroupLayout,
     /// Group 2 of the trace pass: the light's layer of the mask, written.
     pub refined_mask: wgpu::BindGroupLayout,
+    /// Group 3 of the mask pass of a light whose penumbrae it classifies: its
+    /// penumbra history, read and written.
+    pub penumbra_history: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -222,7 +226,20 @@ impl Layouts {
             ),
             camera: layout("camera", &[uniform_entry(0, vf)]),
             forward_rays: crate::rays::forward_layouts(device),
-            shadow: layout("shadow map", &[shadow_entries(0), vec![unfilterable_texture_entry(9)]].concat()),
+            shadow: layout(
+                "shadow map",
+                &[
+                    shadow_entries(0),
+                    vec![unfilterable_texture_entry(9)],
+                    (10..12)
+                        .map(|binding| {
+                            let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+                            fragment_entry(binding, texture(unfiltered, wgpu::TextureViewDimension::D2Array))
+                        })
+                        .collect(),
+                ]
+                .concat(),
+            ),
             receiver: layout(
                 "shadow receiver",
                 &[vec![uniform_entry(0, fragment), uniform_entry(1, fragment)], shadow_entries(2)].concat(),
@@ -241,6 +258,7 @@ impl Layouts {
             refine_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Append),
             trace_screen: crate::rays::refine_screen_layout(device, crate::rays::ListAccess::Read),
             refined_mask: crate::rays::refined_mask_layout(device),
+            penumbra_history: crate::rays::history_layout(device),
         }
     }
 }

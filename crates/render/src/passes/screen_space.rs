@@ -53,15 +53,39 @@ pub(crate) fn prepass_wgsl() -> String {
 /// The shadow-mask pass's WGSL for `key`, composed.
 pub(crate) fn mask_wgsl(key: MaskKey) -> String {
     let mut parts = lighting::camera_shading_wgsl();
-    parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
+    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+        parts.extend(lighting::penumbra_lookup_wgsl(key.technique, key.lookup));
+    } else {
+        parts.extend(lighting::visibility_wgsl(key.technique, Lookup::Own(key.lookup)));
+    }
     parts.push(super::OCTAHEDRON_WGSL.to_owned());
     parts.push(include_str!("contact.wgsl").to_owned());
     parts.push(super::SCREEN_COMMON_WGSL.to_owned());
     parts.extend(crate::rays::mask_refine_wgsl(key.refine, key.lookup, key.size));
     parts.push(super::FULLSCREEN_WGSL.to_owned());
-    parts.push(include_str!("shadow_mask.wgsl").to_owned());
+    parts.push(mask_module(key).to_owned());
     let refs: Vec<&str> = parts.iter().map(String::as_str).collect();
     compose_wgsl(&refs)
+}
+
+/// The module of `key`'s mask pass: the penumbra classification's
+/// (rays/penumbra_mask.wgsl, `fs_penumbra_mask`) for a light whose penumbrae it
+/// classifies, shadow_mask.wgsl's (`fs_mask`) for every other.
+fn mask_module(key: MaskKey) -> &'static str {
+    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+        include_str!("../rays/penumbra_mask.wgsl")
+    } else {
+        include_str!("shadow_mask.wgsl")
+    }
+}
+
+/// The fragment entry point of [`mask_module`].
+fn mask_entry(key: MaskKey) -> &'static str {
+    if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+        "fs_penumbra_mask"
+    } else {
+        "fs_mask"
+    }
 }
 
 pub(crate) struct ScreenSpacePass {
@@ -73,6 +97,8 @@ pub(crate) struct ScreenSpacePass {
     mask_layout: wgpu::PipelineLayout,
     /// The mask pipelines that list pixels for rays bind the list in group 1.
     refine_layout: wgpu::PipelineLayout,
+    /// Those that classify penumbrae bind the light's penumbra history in group 3.
+    penumbra_layout: wgpu::PipelineLayout,
     masks: HashMap<MaskKey, wgpu::RenderPipeline>,
 }
 
@@ -93,7 +119,24 @@ impl ScreenSpacePass {
             bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.refine_screen), Some(&layouts.shadow)],
             immediate_size: 0,
         });
-        Self { prepass_layout, prepass: None, mask_layout, refine_layout, masks: HashMap::new() }
+        let penumbra_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow mask, penumbrae classified"),
+            bind_group_layouts: &[
+                Some(&layouts.scene),
+                Some(&layouts.refine_screen),
+                Some(&layouts.shadow),
+                Some(&layouts.penumbra_history),
+            ],
+            immediate_size: 0,
+        });
+        Self {
+            prepass_layout,
+            prepass: None,
+            mask_layout,
+            refine_layout,
+            penumbra_layout,
+            masks: HashMap::new(),
+        }
     }
 
     /// The prepass pipeline: groups 0 (scene), 1 (camera) and 3 (material).
@@ -125,9 +168,13 @@ impl ScreenSpacePass {
     /// and the light's counters) and 2 (the light's shadow resources), drawn as one
     /// full-screen triangle.
     pub fn mask(&mut self, device: &wgpu::Device, key: MaskKey) -> &wgpu::RenderPipeline {
-        let layout = match key.refine {
-            Refine::Off => &self.mask_layout,
-            Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.refine_layout,
+        let layout = if crate::rays::classifies_penumbrae(key.refine, key.lookup, key.size) {
+            &self.penumbra_layout
+        } else {
+            match key.refine {
+                Refine::Off => &self.mask_layout,
+                Refine::Auto | Refine::Rays | Refine::EveryPixel => &self.refine_layout,
+            }
         };
         self.masks.entry(key).or_insert_with(|| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -148,7 +195,7 @@ impl ScreenSpacePass {
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
-                    entry_point: Some("fs_mask"),
+                    entry_point: Some(mask_entry(key)),
                     compilation_options: Default::default(),
                     targets: &[Some(MASK_FORMAT.into())],
                 }),

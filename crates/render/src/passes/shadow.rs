@@ -10,6 +10,11 @@
 //! pipeline's shape as data, and the tests below hold the opaque one to that, so that
 //! the pass stays within reach of the depth-only baseline (`depth_baseline`).
 
+/// What a shadow map's texel that no caster covers holds: the depth pass clears to
+/// the far plane. The penumbra classification and the map's pyramid leave such texels
+/// out (depth_pyramid.wgsl, penumbra_classify.wgsl: `MAP_CLEARED`).
+pub(crate) const MAP_CLEARED_DEPTH: f32 = 1.0;
+
 use std::collections::HashMap;
 
 use gnomon_scene::{

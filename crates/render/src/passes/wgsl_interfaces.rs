@@ -92,6 +92,32 @@ pub(crate) const RAY_FIRST_HIT: WgslInterface = WgslInterface {
     returns: Some("f32"),
 };
 
+/// The share of a light's area a surface point sees, and the mean distance to the
+/// casters that hide the rest (-1: none): `beam_area_visibility`
+/// (rays/penumbra_beam.wgsl, one walk of the BVH by the cone to the light) or
+/// `ray_area_visibility` (rays/surface_rays.wgsl, one ray per sample, where the
+/// casters are the adapter's acceleration structures), by `Traversal`.
+pub(crate) const AREA_VISIBILITY: WgslInterface = WgslInterface {
+    name: "area_visibility",
+    params: &[
+        ("origin", "vec3<f32>"),
+        ("world", "vec3<f32>"),
+        ("geometric_n", "vec3<f32>"),
+        ("pixel", "u32"),
+    ],
+    returns: Some("vec2<f32>"),
+};
+
+/// The layer that holds a receiver, for the mask pass of a light whose penumbrae it
+/// classifies where its history kept the classification: `map_penumbra_layer`
+/// (rays/penumbra_map.wgsl, the cascade the lookup reads) or `cube_penumbra_layer`
+/// (rays/penumbra_cube.wgsl, the face), by `MapLookup`.
+pub(crate) const PENUMBRA_LAYER: WgslInterface = WgslInterface {
+    name: "penumbra_layer",
+    params: &[("world", "vec3<f32>"), ("n", "vec3<f32>"), ("l", "vec3<f32>"), ("view_depth", "f32")],
+    returns: Some("f32"),
+};
+
 /// Whether a ray decides a pixel the map answered: `classified_ray_decides`
 /// (refine_classify.wgsl) or `unrefined_ray_decides` (refine_off.wgsl: never), by
 /// `Refine`.

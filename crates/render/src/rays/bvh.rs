@@ -55,7 +55,11 @@ pub(crate) struct TriangleGpu {
     /// Index of its [`AlphaGpu`], or [`NO_ALPHA`].
     pub alpha: u32,
     pub v1: [f32; 3],
-    pub _pad1: u32,
+    /// 1 for a triangle of a closed, opaque mesh (`gnomon_math::topology`), whose
+    /// faces on one side of a point a penumbra beam may skip: every segment that
+    /// meets the mesh from outside crosses a face of either side
+    /// (`penumbra_beam.wgsl`); 0 otherwise.
+    pub closed: u32,
     pub v2: [f32; 3],
     pub _pad2: u32,
 }
@@ -148,6 +152,8 @@ pub(crate) struct CasterBvh {
 struct Gathered {
     triangles: Vec<[Vec3A; 3]>,
     alpha: Vec<Option<AlphaGpu>>,
+    /// Whether each triangle's mesh is closed and opaque ([`TriangleGpu::closed`]).
+    closed: Vec<bool>,
     /// Per scene instance, its triangles' range (empty for a non-caster).
     instance_triangles: Vec<Range<u32>>,
 }
@@ -165,8 +171,14 @@ impl CasterBvh {
         let pad = 1e-6 * scene_size;
         if gathered.triangles.is_empty() {
             let leaf = NodeGpu { min: [0.0; 3], count: 1, max: [0.0; 3], first: 0 };
-            let point =
-                TriangleGpu { v0: [0.0; 3], alpha: NO_ALPHA, v1: [0.0; 3], _pad1: 0, v2: [0.0; 3], _pad2: 0 };
+            let point = TriangleGpu {
+                v0: [0.0; 3],
+                alpha: NO_ALPHA,
+                v1: [0.0; 3],
+                closed: 0,
+                v2: [0.0; 3],
+                _pad2: 0,
+            };
             return Self {
                 nodes: vec![leaf],
                 triangles: vec![point],
@@ -206,7 +218,14 @@ impl CasterBvh {
                     alpha.push(a);
                     alpha.len() as u32 - 1
                 });
-                TriangleGpu { v0, alpha: test, v1, _pad1: 0, v2, _pad2: 0 }
+                TriangleGpu {
+                    v0,
+                    alpha: test,
+                    v1,
+                    closed: u32::from(gathered.closed[k as usize]),
+                    v2,
+                    _pad2: 0,
+                }
             })
             .collect();
         let nodes: Vec<NodeGpu> = bvh
@@ -399,7 +418,13 @@ fn runs(sorted: &[u32]) -> Vec<Range<u32>> {
 
 /// Every casting instance's triangles in world space, with their alpha tests.
 fn gather(scene: &Scene, texture_slots: &[Option<u32>]) -> Gathered {
-    let mut out = Gathered { triangles: Vec::new(), alpha: Vec::new(), instance_triangles: Vec::new() };
+    let mut out = Gathered {
+        triangles: Vec::new(),
+        alpha: Vec::new(),
+        closed: Vec::new(),
+        instance_triangles: Vec::new(),
+    };
+    let closed_meshes = scene.closed_meshes();
     for inst in &scene.instances {
         let first = out.triangles.len() as u32;
         if !inst.casts_shadow {
@@ -431,6 +456,8 @@ fn gather(scene: &Scene, texture_slots: &[Option<u32>]) -> Gathered {
                 }
                 AlphaMode::Opaque | AlphaMode::Blend => None,
             });
+            let opaque = matches!(material.alpha_mode, AlphaMode::Opaque | AlphaMode::Blend);
+            out.closed.push(opaque && closed_meshes[inst.mesh]);
         }
         out.instance_triangles.push(first..out.triangles.len() as u32);
     }

@@ -9,22 +9,27 @@
 mod accel;
 mod bvh;
 mod forward;
+pub(crate) mod pyramid;
 pub(crate) mod query;
 pub(crate) mod refine;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
+pub(crate) use pyramid::{
+    PLANES_FORMAT, Pyramid, PyramidInput, PyramidLayout, PyramidParams, PyramidPass, RANGES_FORMAT,
+};
 pub use query::{ShadowRay, ShadowRays};
 #[cfg(test)]
 pub(crate) use refine::trace_pass_wgsl;
 pub(crate) use refine::{
-    LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage, mask_refine_wgsl,
-    refined_mask_layout, screen_layout as refine_screen_layout,
+    HISTORY_FORMAT, LightSize, ListAccess, RefineLists, TraceGroups, TracePasses, TraceStage,
+    classifies_penumbrae, history_layout, mask_refine_wgsl, refined_mask_layout,
+    screen_layout as refine_screen_layout,
 };
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};
 
-use gnomon_scene::{Light, settings::Refine};
+use gnomon_scene::settings::Refine;
 use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
@@ -37,12 +42,12 @@ use traversal::FIRST_BINDING;
 pub(crate) const GROUP: u32 = 3;
 
 /// The refinement a light gets on the mask path: `refine`, with `auto` resolved to
-/// `rays` for a hard light and to `off` for a light with an area, whose refined
-/// pixels cost `penumbra_rays` rays each: asked for by name only.
-pub(crate) fn light_refine(refine: Refine, light: &Light) -> Refine {
+/// `rays`, for a hard light (a ray where the map is unsure) and for a light with an
+/// area alike (a penumbra beam where the map cannot say the pixel is lit or in umbra,
+/// a quarter of them a frame: `penumbra_mask.wgsl`).
+pub(crate) fn light_refine(refine: Refine) -> Refine {
     match refine {
-        Refine::Auto if light.is_hard() => Refine::Rays,
-        Refine::Auto => Refine::Off,
+        Refine::Auto => Refine::Rays,
         Refine::Off | Refine::Rays | Refine::EveryPixel => refine,
     }
 }
@@ -168,6 +173,8 @@ pub(crate) struct GpuBvh {
     tree: CasterBvh,
     /// Nodes, triangles, alpha tests, alpha textures, alpha texels: bindings 2–6.
     buffers: Vec<wgpu::Buffer>,
+    /// The light's samples and half-plane masks ([`light_mask_words`]): binding 7.
+    light_masks: wgpu::TextureView,
     /// The acceleration structures and the ray-query tracer's group, built on first
     /// use; or why this device's structures cannot take the scene.
     accel: OnceLock<Result<QueryTracer, RayQueriesUnavailable>>,
@@ -180,6 +187,50 @@ pub(crate) struct GpuBvh {
 struct QueryTracer {
     accel: CasterAccel,
     group: wgpu::BindGroup,
+}
+
+/// The light's samples and its half-plane masks (`gnomon_math::light_masks`) as
+/// penumbra_beam.wgsl reads them, one `Rgba32Uint` texel to four words: row 0 the
+/// samples two to a texel, as f32 bits (the rest of the row zero), then a row per
+/// angle bin of the table, a mask to each offset bin. A texture, not a storage
+/// buffer: the trace pass already binds WebGPU's default eight of those. The same
+/// for every scene and light, made once.
+fn light_mask_words() -> &'static [u32] {
+    use gnomon_math::light_masks::{ANGLE_BINS, MASK_WORDS, OFFSET_BINS, SAMPLES, half_plane_table, samples};
+    const { assert!(SAMPLES / 2 <= OFFSET_BINS && MASK_WORDS == 4) };
+    static WORDS: OnceLock<Vec<u32>> = OnceLock::new();
+    WORDS.get_or_init(|| {
+        let mut words: Vec<u32> =
+            samples().into_iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]).collect();
+        words.resize(OFFSET_BINS * MASK_WORDS, 0);
+        words.extend(half_plane_table().into_iter().flatten());
+        debug_assert_eq!(words.len(), (ANGLE_BINS + 1) * OFFSET_BINS * MASK_WORDS);
+        words
+    })
+}
+
+/// The texture of [`light_mask_words`].
+fn light_mask_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
+    use gnomon_math::light_masks::{ANGLE_BINS, OFFSET_BINS};
+    device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("light masks"),
+            size: wgpu::Extent3d {
+                width: OFFSET_BINS as u32,
+                height: ANGLE_BINS as u32 + 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(light_mask_words()),
+    )
 }
 
 /// Which of [`GpuBvh`]'s buffers holds what.
@@ -227,6 +278,8 @@ impl GpuBvh {
                 })
             })
             .collect();
+            let masks =
+                light_mask_texture(device, &gpu.queue).create_view(&wgpu::TextureViewDescriptor::default());
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()
                 .zip(FIRST_BINDING..)
@@ -234,6 +287,10 @@ impl GpuBvh {
                     binding,
                     resource: buffer.as_entire_binding(),
                 })
+                .chain(std::iter::once(wgpu::BindGroupEntry {
+                    binding: traversal::LIGHT_MASKS_BINDING,
+                    resource: wgpu::BindingResource::TextureView(&masks),
+                }))
                 .collect();
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shadow rays"),
@@ -246,6 +303,7 @@ impl GpuBvh {
                 triangles: bvh.casters,
                 tree: bvh,
                 buffers,
+                light_masks: masks,
                 accel: OnceLock::new(),
                 scene: scene.name.clone(),
             }
@@ -317,9 +375,13 @@ impl GpuBvh {
     pub(crate) fn bindings(&self, traversal: Traversal) -> Vec<(u32, crate::pool::Binding)> {
         use crate::pool::Binding;
         match traversal {
-            Traversal::Shader => {
-                (FIRST_BINDING..).zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone()))).collect()
-            }
+            Traversal::Shader => (FIRST_BINDING..)
+                .zip(self.buffers.iter().map(|b| Binding::Buffer(b.clone())))
+                .chain(std::iter::once((
+                    traversal::LIGHT_MASKS_BINDING,
+                    Binding::View(self.light_masks.clone()),
+                )))
+                .collect(),
             Traversal::RayQuery => {
                 std::iter::once((FIRST_BINDING, Binding::Tlas(self.query_tracer().accel.tlas().clone())))
                     .chain(

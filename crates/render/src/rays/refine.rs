@@ -5,7 +5,9 @@
 //! (`refine_trace.wgsl`). Only listed pixels pay for a ray, and a group of the trace
 //! pass holds listed pixels only, so no lane waits on a neighbour's ray.
 
-use crate::passes::wgsl_interfaces::{DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES};
+use crate::passes::wgsl_interfaces::{
+    AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES,
+};
 use gnomon_scene::settings::Refine;
 
 use std::collections::HashMap;
@@ -26,14 +28,20 @@ pub(crate) const MAX_GROUPS: u32 = 65_535;
 /// `min_storage_buffer_offset_alignment` WebGPU allows, so every device accepts the
 /// dynamic offset.
 pub(crate) const COUNTER_STRIDE: u64 = 256;
-/// Bytes of one light's counters (`RefineCounters` in refine_list.wgsl): the three
-/// workgroup counts of the indirect dispatch, then the pixels listed.
-const COUNTER_BYTES: u64 = 16;
+/// Bytes of one light's counters (`RefineCounters` in refine_append.wgsl): the three
+/// workgroup counts of the trace pass's indirect dispatch, then the pixels listed;
+/// then the same for the pixels listed to be filled; then the unsure pixels their
+/// penumbra history answered: 36 bytes, which the trace pass reads as a struct of
+/// two `vec3<u32>` (`ListedPixels`, 16-byte aligned) of 48.
+const COUNTER_BYTES: u64 = 48;
+/// Bytes from a light's counters to those of its fill pass.
+const FILL_COUNTERS: u64 = 16;
 /// Texels of the ring around a lookup's bilinear 2×2 that the footprint test reads
 /// (`refine_footprint.wgsl`): a virtual map's pixels ask for the pages it reaches.
 pub(crate) const UNSURE_RING_TEXELS: i32 = 2;
-/// Bytes of one listed pixel (`UnsurePixel`): its position and its map layer.
-pub(crate) const PIXEL_BYTES: u64 = 8;
+/// Bytes of one listed pixel (`UnsurePixel`): its position, its map layer, and the
+/// mean and count of the beams its penumbra history holds.
+pub(crate) const PIXEL_BYTES: u64 = 16;
 
 /// The constants the list (`refine_list.wgsl` and the passes that import it) shares
 /// with Rust.
@@ -45,7 +53,17 @@ pub(crate) fn list_wgsl() -> String {
 /// with each pixel's map answer: never, when `refine` is off; otherwise the
 /// classification ([`classify_wgsl`]) and the list it appends to.
 pub(crate) fn mask_refine_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) -> Vec<String> {
-    let Some(mut parts) = classify_wgsl(refine, lookup, size) else {
+    let classified = classifies_penumbrae(refine, lookup, size).then(|| {
+        // The lookup classified the pixel already (`penumbra_map_lookup`): what it
+        // left unsure it said by its visibility.
+        vec![
+            "const REFINE_EVERY_PIXEL: bool = false;\nconst REFINE_PENUMBRAE: bool = true;\n".to_owned(),
+            include_str!("refine_classify.wgsl").to_owned(),
+            RAY_DECIDES.bind("classified_ray_decides"),
+            MAP_UNSURE.bind("classified_map_unsure"),
+        ]
+    });
+    let Some(mut parts) = classified.or_else(|| classify_wgsl(refine, lookup, size)) else {
         return vec![
             include_str!("refine_off.wgsl").to_owned(),
             RAY_DECIDES.bind("unrefined_ray_decides"),
@@ -74,6 +92,23 @@ impl LightSize {
     pub fn of(light: &gnomon_scene::Light) -> Self {
         if light.is_hard() { LightSize::Hard } else { LightSize::Area }
     }
+}
+
+/// Whether the mask pass of a light of `size` refined by `refine` and looked up by
+/// `lookup` classifies its penumbrae by the map's min-max pyramid
+/// (`penumbra_classify.wgsl`): a light with an area whose rays run where the map is
+/// unsure, on a 2D map or a point light's cube. Its lookup is then the
+/// classification alone, lit, umbra or unsure, and no technique's estimate.
+pub(crate) fn classifies_penumbrae(refine: Refine, lookup: MapLookup, size: LightSize) -> bool {
+    let traced = match refine {
+        Refine::Auto | Refine::Rays => true,
+        Refine::Off | Refine::EveryPixel => false,
+    };
+    let pyramid = match lookup {
+        MapLookup::Map | MapLookup::Cube => true,
+        MapLookup::Paraboloid | MapLookup::Virtual => false,
+    };
+    traced && pyramid && size == LightSize::Area
 }
 
 /// The WGSL of `ray_decides`, which says whether a ray decides a pixel: the
@@ -127,11 +162,19 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
 /// The shadow rays from surface points (surface_rays.wgsl) with what they need: the
 /// tracer of `traversal`, its bindings in `group`, and the light's samples.
 pub(crate) fn surface_rays_wgsl(group: u32, traversal: Traversal) -> Vec<String> {
-    vec![
+    let mut parts = vec![
         super::trace_wgsl(group, traversal),
         include_str!("light_sample.wgsl").to_owned(),
         include_str!("surface_rays.wgsl").to_owned(),
-    ]
+    ];
+    match traversal {
+        Traversal::Shader => {
+            parts.push(include_str!("penumbra_beam.wgsl").to_owned());
+            parts.push(AREA_VISIBILITY.bind("beam_area_visibility"));
+        }
+        Traversal::RayQuery => parts.push(AREA_VISIBILITY.bind("ray_area_visibility")),
+    }
+    parts
 }
 
 /// The trace pass's WGSL for `traversal` and a light of `size`, composed.
@@ -191,8 +234,9 @@ pub(crate) fn screen_layout(device: &wgpu::Device, access: ListAccess) -> wgpu::
     })
 }
 
-/// Group 2 of the trace and filter passes: the light's layer of the mask, written
-/// (0), and a copy of it as the trace pass left it, read by the filter pass (1).
+/// Group 2 of the trace and fill passes: the light's layer of the mask, written (0),
+/// a copy of it as the trace pass left it, read by the fill pass (1), and the light's
+/// penumbra history as this frame leaves it, written (2).
 pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
@@ -200,17 +244,15 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
         ty,
         count: None,
     };
+    let written = |format| wgpu::BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format,
+        view_dimension: wgpu::TextureViewDimension::D2,
+    };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("refined shadow mask"),
         entries: &[
-            entry(
-                0,
-                wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: passes::screen_space::MASK_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-            ),
+            entry(0, written(passes::screen_space::MASK_FORMAT)),
             entry(
                 1,
                 wgpu::BindingType::Texture {
@@ -219,6 +261,43 @@ pub(crate) fn refined_mask_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
                     multisampled: false,
                 },
             ),
+            entry(2, written(HISTORY_FORMAT)),
+        ],
+    })
+}
+
+/// The format of a light's penumbra history (penumbra_mask.wgsl): per pixel, its
+/// value and the beams behind it.
+pub(crate) const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+
+/// Group 3 of the mask pass of a light whose penumbrae it classifies: its penumbra
+/// history as the last frame left it, read (0), and as this frame leaves it, written
+/// (1).
+pub(crate) fn history_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let fragment = wgpu::ShaderStages::FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("penumbra history"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: fragment,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: fragment,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: HISTORY_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
         ],
     })
 }
@@ -244,11 +323,11 @@ impl TracePasses {
     }
 }
 
-/// The trace pass's pipeline, and the penumbra filter's that follows it under a
-/// light with an area (`cs_filter_penumbra` in refine_trace.wgsl).
+/// The trace pass's pipeline, and the penumbra fill's that follows it under a light
+/// with an area (`cs_fill_penumbra` in refine_trace.wgsl).
 pub(crate) struct TracePass {
     trace: wgpu::ComputePipeline,
-    filter: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
 }
 
 impl TracePass {
@@ -277,31 +356,22 @@ impl TracePass {
                 cache: None,
             })
         };
-        Self { trace: pipeline("cs_trace"), filter: pipeline("cs_filter_penumbra") }
+        Self { trace: pipeline("cs_trace"), fill: pipeline("cs_fill_penumbra") }
     }
 
     /// Records `stage` of light `light` over its listed pixels.
     pub fn record(&self, pass: &mut wgpu::ComputePass, stage: TraceStage, groups: &TraceGroups, light: u32) {
-        let pipeline = match stage {
-            TraceStage::Trace => &self.trace,
-            TraceStage::PenumbraFilter => &self.filter,
+        let (pipeline, arguments) = match stage {
+            TraceStage::Trace => (&self.trace, 0),
+            TraceStage::PenumbraFill => (&self.fill, FILL_COUNTERS),
         };
-        self.dispatch(pipeline, pass, groups, light);
-    }
-
-    fn dispatch(
-        &self,
-        pipeline: &wgpu::ComputePipeline,
-        pass: &mut wgpu::ComputePass,
-        groups: &TraceGroups,
-        light: u32,
-    ) {
+        let counters = RefineLists::counter_offset(light);
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, groups.scene, &[]);
-        pass.set_bind_group(1, groups.screen, &[RefineLists::counter_offset(light)]);
+        pass.set_bind_group(1, groups.screen, &[counters]);
         pass.set_bind_group(2, groups.mask, &[]);
         pass.set_bind_group(super::GROUP, groups.bvh, &[]);
-        pass.dispatch_workgroups_indirect(groups.counters, u64::from(RefineLists::counter_offset(light)));
+        pass.dispatch_workgroups_indirect(groups.counters, u64::from(counters) + arguments);
     }
 }
 
@@ -312,9 +382,9 @@ pub(crate) enum TraceStage {
     /// (`groups.mask`).
     Trace,
     /// After the trace and a copy of the light's layer of the mask into the group's
-    /// `traced_mask`, under a light with an area: each listed pixel becomes an
-    /// edge-aware average of its neighbours.
-    PenumbraFilter,
+    /// `traced_mask`, under a light with an area: each unsure pixel no beam answered
+    /// takes the mean of its answered neighbours.
+    PenumbraFill,
 }
 
 impl TraceStage {
@@ -322,7 +392,7 @@ impl TraceStage {
     pub fn label(self) -> &'static str {
         match self {
             TraceStage::Trace => "shadow mask ray trace",
-            TraceStage::PenumbraFilter => "penumbra filter",
+            TraceStage::PenumbraFill => "penumbra fill",
         }
     }
 }
@@ -346,6 +416,16 @@ pub(crate) struct TraceGroups<'a> {
     pub size: LightSize,
     /// The counters, whose first three words at the light's offset are the dispatch.
     pub counters: &'a wgpu::Buffer,
+}
+
+/// What a light's counters say of its pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Listed {
+    /// Traced this frame: a ray (or a penumbra beam) each.
+    pub traced: u32,
+    /// Decided by rays, this frame or before: the traced, the filled and those their
+    /// penumbra history answered.
+    pub unsure: u32,
 }
 
 /// A frame's list of unsure pixels (room for every pixel of the screen, reused by
@@ -414,18 +494,24 @@ impl RefineLists {
         )
     }
 
-    /// The trace and filter passes' group 2: `mask_layer`, written, and `traced`, the
-    /// copy of it that the filter reads.
+    /// The trace and fill passes' group 2: `mask_layer`, written, `traced`, the copy
+    /// of it that the fill reads, and `history`, the light's penumbra history as this
+    /// frame leaves it.
     pub fn mask_group(
         pool: &mut Pool,
         layouts: &Layouts,
         mask_layer: &wgpu::TextureView,
         traced: &wgpu::TextureView,
+        history: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
         pool.bind_group(
             "refined shadow mask",
             &layouts.refined_mask,
-            &[Binding::View(mask_layer.clone()), Binding::View(traced.clone())],
+            &[
+                Binding::View(mask_layer.clone()),
+                Binding::View(traced.clone()),
+                Binding::View(history.clone()),
+            ],
         )
     }
 
@@ -443,9 +529,17 @@ impl RefineLists {
         copy
     }
 
-    /// Pixels each light listed, from a copy of the counters read back.
-    pub fn listed(counters: &[u32], lights: usize) -> Vec<u32> {
+    /// Pixels each light listed, from a copy of the counters read back: beamed (or
+    /// traced) this frame, and unsure in all (beamed, filled, or answered by their
+    /// penumbra history).
+    pub fn listed(counters: &[u32], lights: usize) -> Vec<Listed> {
         let stride = (COUNTER_STRIDE / 4) as usize;
-        (0..lights).map(|light| counters.get(light * stride + 3).copied().unwrap_or(0)).collect()
+        let word = |light: usize, k: usize| counters.get(light * stride + k).copied().unwrap_or(0);
+        (0..lights)
+            .map(|light| Listed {
+                traced: word(light, 3),
+                unsure: word(light, 3) + word(light, 7) + word(light, 8),
+            })
+            .collect()
     }
 }

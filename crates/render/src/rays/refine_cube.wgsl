@@ -7,7 +7,8 @@
 // receiver's plane, exactly. A receiver seen edge-on from the light is unsure.
 import package::passes::light_binding::light;
 import package::passes::shading::MIN_NORMAL_OFFSET_SCALE;
-import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_unsure, map_step, receiver_bias};
+import package::rays::refine_footprint::{FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_unsure, receiver_bias};
+import package::rays::map_step::map_step;
 import package::techniques::cube::cube_texel_world_size;
 
 // The receiver's plane, for `footprint_receiver`: its normal, `offset · normal` (the

@@ -10,14 +10,6 @@ import package::constants::UNSURE_RING_TEXELS;
 // depth is too close to the receiver's to trust.
 const UNSURE_DEPTH_TEXELS: f32 = 2.0;
 
-// The map's (u, v, depth) moved by a world-space step `t` from a point of clip-space
-// w `w` and normalized device coordinates `ndc` in a layer with `clip_from_world`,
-// to first order: clip moves by M·(t, 0), so NDC by the quotient rule's
-// (Δclip.xyz − ndc·Δclip.w) / w. Exact for orthographic maps, where w ≡ 1.
-fn map_step(clip_from_world: mat4x4<f32>, ndc: vec3<f32>, w: f32, t: vec3<f32>) -> vec3<f32> {
-    let d = clip_from_world * vec4<f32>(t, 0.0);
-    return (d.xyz - ndc * d.w) / w * vec3<f32>(0.5, -0.5, 1.0);
-}
 
 // A receiver closer than this to edge-on to the light (N·L below it: within 5.7°) is
 // `FootprintBounds::grazing`. Its depth in the map changes by tan θ ≥ 10 texels of

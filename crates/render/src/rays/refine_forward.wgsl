@@ -16,8 +16,8 @@
 // 2.6× slower on lavapipe).
 import package::constants::{DEBUG_VIEW_TRACED, TRACED_LAYER_FLAG};
 import package::passes::camera_binding::camera;
-import package::rays::surface_rays::{area_visibility, centre_ray_blocked, surface_ray_origin};
-import package::variant::{REFINE_PENUMBRAE, ray_decides};
+import package::rays::surface_rays::{centre_ray_blocked, surface_ray_origin};
+import package::variant::{REFINE_PENUMBRAE, area_visibility, ray_decides};
 
 // The fragment's (visibility, layer): the map's `shadow`, or where a ray decides, the
 // rays' answer, with the traced view's mark on the layer.

@@ -7,10 +7,14 @@ struct UnsurePixel {
     // x | y << 16.
     pixel: u32,
     // Low 16 bits: the shadow-map layer that shaded it, kept in the mask for the
-    // cascade view. High 16 bits: under a light with an area, the penumbra's
-    // width on screen in 1/16 px, which the trace pass writes for the filter pass (0
-    // before).
+    // cascade view. High 16 bits: under a light with an area traced by rays, the
+    // penumbra's width on screen in 1/16 px, which the trace pass writes for the
+    // filter pass (0 before).
     layer: u32,
+    // Under a light with an area beamed (penumbra_mask.wgsl): the mean of the beams
+    // the pixel's history holds, and how many (0: none).
+    mean: f32,
+    beams: f32,
 };
 
 // Written by the mask pass (refine_append.wgsl), completed by the trace pass.

@@ -25,7 +25,8 @@
 import package::passes::light_binding::{light, light_distance_from_depth, texel_shape, texel_world_size_at};
 import package::passes::light_kinds::emitter_cone_radius;
 import package::passes::map_visibility::{local_texel_world_size, shadow_coords};
-import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_evidence, leaves_unsure, map_step, receiver_bias};
+import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_evidence, leaves_unsure, receiver_bias};
+import package::rays::map_step::map_step;
 import package::techniques::bindings::shadow_map;
 import package::variant::REFINE_PENUMBRAE;
 

@@ -35,14 +35,15 @@ fn centre_ray_blocked(origin: vec3<f32>, world: vec3<f32>, l: vec3<f32>) -> bool
     return ray_blocked(origin, l, emitter_ray_length(light.emitter, world));
 }
 
-// The share of `light.rays.penumbra_rays` rays from `origin` to points stratified over the
+// `area_visibility` by rays, where they cannot walk a penumbra beam (ray queries):
+// the share of `light.rays.penumbra_rays` rays from `origin` to points stratified over the
 // light's area that arrive, each weighted by its point's falloff
 // (`emitter_sample_weight`), and the mean distance to the caster that each blocked
 // ray met (-1 when none was blocked). `pixel` seeds the pixel's own pattern, so
 // neighbours' errors are independent and the filter pass averages them down. A
 // sample below the surface's horizon is blocked by the surface itself, as in the
 // reference, and has no caster's distance.
-fn area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, pixel: u32) -> vec2<f32> {
+fn ray_area_visibility(origin: vec3<f32>, world: vec3<f32>, geometric_n: vec3<f32>, pixel: u32) -> vec2<f32> {
     let count = light.rays.penumbra_rays;
     let grid = cmj_grid(count);
     let pattern = lowbias32(pixel ^ 0x9e3779b9u);

@@ -22,7 +22,8 @@ struct BvhTriangle {
     // Index into bvh_alpha, or NO_ALPHA.
     alpha: u32,
     v1: vec3<f32>,
-    _pad1: u32,
+    // 1 for a triangle of a closed, opaque mesh (bvh.rs's `TriangleGpu::closed`).
+    closed: u32,
     v2: vec3<f32>,
     _pad2: u32,
 };

@@ -100,6 +100,10 @@ pub(crate) fn trace_wgsl(group: u32, traversal: Traversal) -> String {
 /// declare).
 pub(crate) const FIRST_BINDING: u32 = 2;
 
+/// The binding of the light's samples and half-plane masks (`light_masks` in
+/// penumbra_beam.wgsl, a texture), after the shader tracer's five buffers.
+pub(crate) const LIGHT_MASKS_BINDING: u32 = FIRST_BINDING + 5;
+
 /// The entries of the tracer's bindings, seen by `stages`: for the shader, five
 /// read-only buffers at 2–6 (nodes, triangles, alpha tests, alpha textures, alpha
 /// texels); for ray queries, the top-level structure at 2 and the three alpha
@@ -113,9 +117,18 @@ pub(crate) fn entries(stages: wgpu::ShaderStages, traversal: Traversal) -> Vec<w
     };
     let alpha = (FIRST_BINDING + 2..FIRST_BINDING + 5).map(|binding| entry(binding, buffer));
     match traversal {
-        Traversal::Shader => {
-            (FIRST_BINDING..FIRST_BINDING + 2).map(|binding| entry(binding, buffer)).chain(alpha).collect()
-        }
+        Traversal::Shader => (FIRST_BINDING..FIRST_BINDING + 2)
+            .map(|binding| entry(binding, buffer))
+            .chain(alpha)
+            .chain(std::iter::once(entry(
+                LIGHT_MASKS_BINDING,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            )))
+            .collect(),
         Traversal::RayQuery => std::iter::once(entry(
             FIRST_BINDING,
             wgpu::BindingType::AccelerationStructure { vertex_return: false },

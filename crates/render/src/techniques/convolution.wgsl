@@ -8,6 +8,7 @@
 //
 // Layer j holds (sin, cos) of terms 2j and 2j + 1 (0-based).
 // Its parameters (`ConvolutionParams` in convolution.rs).
+import package::constants::PI;
 import package::passes::light_binding::light;
 import package::techniques::common::ShadowQuery;
 import package::techniques::filterable::{receiver_moment_depth, sample_moments};
@@ -19,8 +20,6 @@ struct ConvolutionParams {
     offset: f32,       // o, its offset
     _pad0: vec4<u32>,
 };
-
-const PI: f32 = 3.14159265;
 
 fn frequency(k: u32) -> f32 {
     return PI * f32(2u * k + 1u);

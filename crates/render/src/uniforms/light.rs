@@ -197,12 +197,15 @@ pub struct RaysGpu {
     /// (`ScreenSpaceSettings::penumbra_rays`), 0 for a hard light, whose pixel casts
     /// one ray to its centre.
     pub penumbra_rays: u32,
+    /// 1 where the light's penumbra history holds the last frame's answers, which this
+    /// frame then starts from; 0 where anything they depend on changed
+    /// (`frame/penumbra_history.rs`).
+    pub history: u32,
+    /// The frames the history holds, counting this one: which quarter of the unsure
+    /// pixels this frame beams, and how their samples turn.
+    pub frame: u32,
     /// Padding.
     pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
 }
 
 /// The light uniform (`Light` in `light.wgsl`): the light, its map's layers and the

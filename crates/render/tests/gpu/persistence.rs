@@ -77,10 +77,12 @@ fn created_in_steady_state(renderer: &mut Renderer, scene: &Scene, settings: &Se
         gpu.queue.submit([encoder.finish()]);
     };
     // The viewer's entry points alternate: warm each up (each holds its own
-    // readbacks), then alternate them.
+    // readbacks), then alternate them. A light whose penumbrae are beamed writes one
+    // of its history's two textures and reads the other, in turn (penumbra_history.rs),
+    // so each entry point is warmed up on both.
     let alternating = [Entry::ReadBack, Entry::Live, Entry::Timed];
-    for entry in alternating {
-        frame_through(renderer, entry);
+    for entry in alternating.iter().chain(&alternating) {
+        frame_through(renderer, *entry);
     }
     let mut created = Creations::default();
     let mut count = |renderer: &Renderer, before: Creations| {
@@ -97,9 +99,11 @@ fn created_in_steady_state(renderer: &mut Renderer, scene: &Scene, settings: &Se
     }
     count(renderer, before);
     // A host's frames take one entry point each time: what only another entry point
-    // uses may have been dropped meanwhile, so each gets its own warm-up frame.
+    // uses may have been dropped meanwhile, so each gets its own warm-up frames.
     let embedded: &[Entry] = if receives { &[Entry::Into, Entry::Shadows] } else { &[Entry::Into] };
     for &entry in embedded {
+        // Two warm-up frames: both of a beamed light's history textures.
+        frame_through(renderer, entry);
         frame_through(renderer, entry);
         let before = renderer.creations();
         for _ in 0..STEADY_FRAMES / 2 {

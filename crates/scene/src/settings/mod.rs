@@ -226,6 +226,7 @@ impl Settings {
         check_limit(l.point_radius, "light.point_radius", &limits::LIGHT_RADIUS)?;
         self.shadow.validate()?;
         PENUMBRA_RAYS_RANGE.check(self.screen.penumbra_rays)?;
+        PENUMBRA_FRAMES_RANGE.check(self.screen.penumbra_frames)?;
         REFERENCE_SAMPLES_RANGE.check(self.reference.samples)?;
         Ok(())
     }
@@ -241,8 +242,8 @@ impl Settings {
 
     /// Whether a frame with these lights resolves its shadows in a screen-space mask:
     /// as --shadow-path says, and with `auto` when any light marches contact shadows
-    /// or refines its shadow by rays (a hard light under `auto` refinement, or any
-    /// light under rays asked for by name or traced by its technique), which run best
+    /// or refines its shadow by rays (any light under `auto` refinement or rays asked
+    /// for by name, or one traced by its technique), which run best
     /// on the mask path, and when several lights are lit from a light list. Rays
     /// asked for with --shadow-path forward are traced in the lighting pass instead;
     /// contact shadows with it are refused: they march through the mask path's depth
@@ -250,8 +251,7 @@ impl Settings {
     pub fn uses_shadow_mask(&self, lights: &[ResolvedLight]) -> Result<bool, SettingsError> {
         let rays = lights.iter().any(|l| match self.light_refine(l) {
             Refine::Off => false,
-            Refine::Auto => l.light.is_hard(),
-            Refine::Rays | Refine::EveryPixel => true,
+            Refine::Auto | Refine::Rays | Refine::EveryPixel => true,
         });
         let contact = lights.iter().find(|l| l.shadow.contact.contact_shadows);
         match (self.screen.shadow_path, contact) {

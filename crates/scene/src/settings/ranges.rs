@@ -161,6 +161,7 @@ pub static ALL: &[&SettingRange] = &[
     &super::CONTACT_STEPS_RANGE,
     &super::CONTACT_THICKNESS_RANGE,
     &super::PENUMBRA_RAYS_RANGE,
+    &super::PENUMBRA_FRAMES_RANGE,
     &super::REFERENCE_SAMPLES_RANGE,
 ];
 

@@ -55,24 +55,25 @@ pub enum Lighting {
 /// The default, `auto`, is `rays` for hard lights wherever they can run: no shadow
 /// map resolves a caster finer than its texel, and on the 36 measured glTF cases the
 /// map alone left up to 2 % of light-facing pixels wrong where the rays leave at most
-/// 0.06 % (docs/defaults.md). Area lights are refined only when asked (`rays`): a
-/// penumbra pixel costs `penumbra_rays` rays. Pass `off` to see a technique's own
-/// answer.
+/// 0.06 % (docs/defaults.md). A light with an area is refined too: the map's pyramid
+/// finds its unsure penumbra pixels and they are beamed over the light's area
+/// (docs/soft-shadows.md). Pass `off` to see a technique's own answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Refine {
-    /// `rays` for every hard light when the frame takes the mask path (under
-    /// --shadow-path auto, which then takes it for them, or mask); `off` for lights
-    /// with an area, and for every light with --shadow-path forward (ask for `rays`
-    /// by name to trace there).
+    /// `rays` for every light, hard or with an area, when the frame takes the mask
+    /// path (under --shadow-path auto, which then takes it for them, or mask); `off`
+    /// with --shadow-path forward (ask for `rays` by name to trace there).
     #[default]
     Auto,
     /// Every pixel keeps its shadow map's answer.
     Off,
     /// Pixels the map is unsure of (taps that disagree, a receiver within a few
-    /// texels' depth of the stored depth) trace one ray, or `penumbra_rays` under a
-    /// light with an area; the rest keep the map's answer.
+    /// texels' depth of the stored depth) trace one ray; under a light with an area,
+    /// those the map's pyramid cannot classify are beamed over 128 samples of it on
+    /// the mask path, or trace `penumbra_rays` rays on the forward path. The rest keep
+    /// the map's answer.
     Rays,
     /// Every pixel that faces the light traces its rays: exact (up to the penumbra's
     /// sampling noise), and the upper baseline of cost.
@@ -149,16 +150,32 @@ pub struct ScreenSpaceSettings {
         arg(long, value_enum, default_value_t, help_heading = "Screen-space shadows")
     )]
     pub lighting: Lighting,
-    /// Shadow rays per refined pixel under a light with an area, stratified over the
-    /// light's disk, cone or sphere as the CPU reference samples it: 1 to 256. 16
-    /// rays and an edge-aware filter take PCSS's penumbra error to 0.11–0.41× on the
-    /// measured scenes (docs/rays.md).
+    /// Shadow rays per refined pixel under a light with an area on the forward path,
+    /// stratified over the light's disk, cone or sphere as the CPU reference samples
+    /// it: 1 to 256 (docs/rays.md). The mask path beams an area light's unsure pixels
+    /// instead, over the penumbra beam's fixed 128 samples of the light, whatever this
+    /// says (docs/soft-shadows.md).
     #[cfg_attr(
         feature = "cli",
         arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_rays, help_heading = "Screen-space shadows")
     )]
     pub penumbra_rays: u32,
+    /// Frames a still image's penumbrae gather under a light with an area whose
+    /// unsure pixels are beamed (`render`, `compare`, Python's `render`): each frame
+    /// beams a quarter of them and keeps what the frames before found where nothing
+    /// moved, so 4 frames beam every one once and 16 four times (512 samples each). A
+    /// live view (the viewer, the lab) gathers them as it goes; 1 returns the first
+    /// frame, a quarter beamed and the rest filled from their neighbours.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_frames, help_heading = "Screen-space shadows")
+    )]
+    pub penumbra_frames: u32,
 }
+
+/// `screen.penumbra_frames`' range.
+pub const PENUMBRA_FRAMES_RANGE: SettingRange =
+    SettingRange::closed("screen.penumbra_frames", 1.0, 256.0, "frames a still image's penumbrae gather");
 
 /// The most shadow rays a refined pixel casts under a light with an area.
 pub const MAX_PENUMBRA_RAYS: u32 = 256;
@@ -187,6 +204,7 @@ impl Default for ScreenSpaceSettings {
             tracer: Tracer::Auto,
             lighting: Lighting::LightList,
             penumbra_rays: 16,
+            penumbra_frames: 16,
         }
     }
 }

@@ -106,6 +106,12 @@ impl BiasSettings {
     pub fn none() -> Self {
         Self { depth_bias: 0, slope_bias: 0.0, normal_offset: 0.0, cull: CullMode::Back }
     }
+
+    /// These settings with no depth offset in the map (constant or slope-scaled): for a
+    /// map read for where its casters are, not compared with a receiver's depth.
+    pub fn without_depth_offsets(&self) -> Self {
+        Self { depth_bias: 0, slope_bias: 0.0, ..self.clone() }
+    }
 }
 
 impl Default for BiasSettings {

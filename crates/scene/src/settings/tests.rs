@@ -318,7 +318,7 @@ fn several_lights_take_the_mask_path_for_their_light_list_under_auto_only() {
 }
 
 #[test]
-fn refining_by_default_takes_the_mask_path_for_hard_lights_only() {
+fn refining_by_default_takes_the_mask_path_for_hard_and_area_lights() {
     let scene = crate::builtin::spheres();
     let mut s = Settings::default();
     assert_eq!(s.screen.refine, Refine::Auto);
@@ -328,12 +328,14 @@ fn refining_by_default_takes_the_mask_path_for_hard_lights_only() {
     // Forward asked for by name: auto refinement yields, with no error.
     s.screen.shadow_path = ShadowPath::Forward;
     assert!(!s.uses_shadow_mask(&lights).unwrap(), "auto refinement gives way to --shadow-path forward");
-    // A sun with a disk: no light for one ray to decide, so auto stays forward.
+    // A sun with a disk: its penumbrae are beamed on the mask path by default.
     s.screen.shadow_path = ShadowPath::Auto;
     s.light.sun_angular_diameter = Some(1.0);
     let soft = s.resolve_lights(&scene).unwrap();
     assert!(!soft[0].light.is_hard());
-    assert!(!s.uses_shadow_mask(&soft).unwrap(), "auto refinement with only area lights is forward");
+    assert!(s.uses_shadow_mask(&soft).unwrap(), "auto refinement takes the mask for an area light");
+    s.screen.refine = Refine::Off;
+    assert!(!s.uses_shadow_mask(&soft).unwrap(), "nothing refined and one light: forward");
     s.screen.refine = Refine::Rays;
     assert!(s.uses_shadow_mask(&soft).unwrap(), "rays by name take the mask as before");
 }
