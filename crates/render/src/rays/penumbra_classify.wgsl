@@ -342,7 +342,9 @@ fn first_level_hides(r: Receiver, reach: Reach, q: Square, tolerance: f32) -> bo
 
 // The most squares one search of `square_may_hide` weighs below the square it
 // starts from, and the deepest its stack of squares still to weigh grows (three a
-// level below the first, and one).
+// level below the first, and one). Of the truly lit pixels under `spheres`' point
+// light, a budget of 64 left 39 % to the beams, 256 leaves 36 %: the squares cost
+// far less than the beams they spare.
 const DESCENT_SQUARES: u32 = 256u;
 const DESCENT_STACK: i32 = 40;
 

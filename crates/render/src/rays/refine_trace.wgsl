@@ -137,6 +137,12 @@ struct FillCentre {
 // plane, with normals within about 25° of its own.
 const SURFACE_PIXELS: f32 = 2.0;
 const SURFACE_COS: f32 = 0.9;
+// Neighbours near enough along the surface to interpolate between: within this many
+// pixel widths (a face-on pixel's diagonal neighbour lies 1.4 away). Seen at a
+// grazing angle, a pixel's neighbours along the view lie far apart on the surface,
+// and a shadow as narrow as a pixel's height there (a far post's, along a low sun)
+// lies between them unseen.
+const FILL_REACH_PIXELS: f32 = 3.0;
 
 // What a fill's answered neighbours say: their weighted sum and weight, their least
 // and greatest answer, and whether two of them on either side of the pixel both lie
@@ -177,7 +183,11 @@ fn neighbours(c: FillCentre) -> Neighbours {
             continue;
         }
         let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
-        if abs(dot(c.n, q_surface.xyz - c.world)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+        let apart = q_surface.xyz - c.world;
+        if abs(dot(c.n, apart)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+            continue;
+        }
+        if dot(apart, apart) > FILL_REACH_PIXELS * FILL_REACH_PIXELS * c.pixel_world * c.pixel_world {
             continue;
         }
         // A neighbour facing away from the light or outside its cone is dark by
