@@ -113,7 +113,11 @@ fn the_mask_path_shows_the_forward_paths_surface_at_every_pixel_of_real_scenes()
 
 /// The drawn metric of `compare`: the frame's visibility against the truth traced
 /// from its own surfaces, every light-facing pixel counted.
-fn drawn_metrics(scene: &Scene, s: &Settings, frame: &Frame) -> gnomon_reference::drawn::DrawnMetrics {
+pub(crate) fn drawn_metrics(
+    scene: &Scene,
+    s: &Settings,
+    frame: &Frame,
+) -> gnomon_reference::drawn::DrawnMetrics {
     use gnomon_reference::drawn::{DrawnOptions, DrawnSurfaces, drawn_truth, measure_drawn};
     let traced = gnomon_reference::TracedScene::build(scene);
     let light = s.resolve_light(scene).unwrap();

@@ -105,20 +105,6 @@ fn emitter_above_plane(e: Emitter, world: vec3<f32>, normal: vec3<f32>) -> bool 
     return height > e.size;
 }
 
-// The least a ray from a point toward a sun's disk rises over a plane, per unit of
-// its length, where `normal` is the unit normal of the plane's side the point and
-// the sun lie on: the sine of the disk's lowest point's elevation over the plane (the
-// disk's centre asin(c) above it, its radius asin(s)). 0 for a spot or a point light,
-// whose rays' rise depends on where they start.
-fn sun_least_rise(e: Emitter, normal: vec3<f32>) -> f32 {
-    if e.kind != LIGHT_SUN {
-        return 0.0;
-    }
-    let c = dot(normal, -e.direction);
-    let s = e.size * inverseSqrt(1.0 + e.size * e.size);
-    return c * sqrt(max(1.0 - s * s, 0.0)) - sqrt(max(1.0 - c * c, 0.0)) * s;
-}
-
 // The radius, in world units, of the cone from a receiver at light distance
 // `receiver` to the light's area, at light distance `at`: e.size × (d − at) for a sun
 // (the tangent of its angular radius), e.size × (d − at) / d for a spot's disk or a

@@ -83,14 +83,15 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
 // that no beam answered, this frame or before (listed from the list's far end), is
 // answered from its neighbours' answers on the same surface within one pixel, read
 // from the copy `traced_mask`: their mean, each weighed by the inverse square of its
-// distance, where they differ by at most `FILL_SPREAD`, lie on either side of it and
-// one lies inside a penumbra (`Neighbours`); or else by a beam of its own. A quarter of the unsure pixels are
-// beamed, one of each 2 × 2 block, so every pixel has beamed or decided neighbours
-// within one pixel on its surface unless the block lies across an edge; where the
-// penumbra is wide they differ little, and its mean is its interpolation, within a
-// few hundredths; where it is narrow (a contact, a small light) they differ by much
-// more, and the mean would smear it. The mean is no estimate of the pixel's own: the
-// history keeps it with no beam, and the pixel is beamed in its turn.
+// distance, where they differ by at most `FILL_SPREAD` and two of them inside a
+// penumbra lie on either side of it (`Neighbours`); or else by a beam of its own. A
+// quarter of the unsure pixels are beamed, one of each 2 × 2 block, so every pixel
+// has beamed or decided neighbours within one pixel on its surface unless the block
+// lies across an edge; where the penumbra is wide they differ little, and its mean
+// is its interpolation, within a few hundredths; where it is narrow (a contact, a
+// small light) they differ by much more, and the mean would smear it. The mean is no
+// estimate of the pixel's own: the history keeps it with no beam, and the pixel is
+// beamed in its turn.
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let count = listed.fill_count;
@@ -105,7 +106,7 @@ fn cs_fill_penumbra(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
         let near = neighbours(centre);
         var visibility: f32;
         var beams = 0.0;
-        if near.across && near.partial && near.highest - near.lowest <= FILL_SPREAD {
+        if near.across && near.highest - near.lowest <= FILL_SPREAD {
             visibility = near.sum / near.weight;
         } else {
             let origin = surface_ray_origin(centre.world, n, surface.w);
@@ -136,33 +137,39 @@ struct FillCentre {
 // plane, with normals within about 25° of its own.
 const SURFACE_PIXELS: f32 = 2.0;
 const SURFACE_COS: f32 = 0.9;
+// Neighbours near enough along the surface to interpolate between: within this many
+// pixel widths (a face-on pixel's diagonal neighbour lies 1.4 away). Seen at a
+// grazing angle, a pixel's neighbours along the view lie far apart on the surface,
+// and a shadow as narrow as a pixel's height there (a far post's, along a low sun)
+// lies between them unseen.
+const FILL_REACH_PIXELS: f32 = 3.0;
 
 // What a fill's answered neighbours say: their weighted sum and weight, their least
-// and greatest answer, and whether two of them lie on either side of the pixel, so
-// that their mean interpolates between them rather than carrying one side's answer
-// over an edge the pixel may lie beyond (a penumbra a pixel or two wide, whose
-// answered neighbours all lie on its lit side).
+// and greatest answer, and whether two of them on either side of the pixel both lie
+// inside a penumbra (strictly between 0 and 1), so that their mean interpolates
+// across it. One side's answer carried over an edge the pixel may lie beyond (a
+// penumbra a pixel or two wide, whose answered neighbours all lie on its lit side)
+// would be wrong; so would the mean of a pair of which one is lit or umbra: the pixel
+// between them is unsure because a caster reaches its cone and not theirs, a shadow
+// a pixel wide (a wire's, a contact's first pixels, a far post's seen along a low
+// sun), which the mean would erase. (Taking such pairs made `grazing`'s first frame
+// under a sun 10° up 0.073 off in its penumbrae, where its 16th is 0.004.)
 struct Neighbours {
     sum: f32,
     weight: f32,
     lowest: f32,
     highest: f32,
     across: bool,
-    // Whether one of them is strictly between 0 and 1: a beam's answer inside a
-    // penumbra. Where every answer is the map's lit or umbra (or a beam's that
-    // matches one), the pixel between them is unsure because a caster reaches its
-    // cone and not theirs: a shadow a pixel wide (a wire's, a contact's first
-    // pixels), which their mean would erase.
-    partial: bool,
 };
 
 // The answered neighbours within one pixel of `c` on its surface
 // (`cs_fill_penumbra`).
 fn neighbours(c: FillCentre) -> Neighbours {
     let size = vec2<i32>(textureDimensions(traced_mask));
-    var near = Neighbours(0.0, 0.0, 1.0, 0.0, false, false);
-    // Which of the 3 × 3 answered, bit k for neighbour k (row by row).
-    var answered = 0u;
+    var near = Neighbours(0.0, 0.0, 1.0, 0.0, false);
+    // Which of the 3 × 3 answered inside a penumbra, bit k for neighbour k (row by
+    // row).
+    var partial = 0u;
     for (var k = 0; k < 9; k++) {
         let d = vec2<i32>(k % 3 - 1, k / 3 - 1);
         let q = c.texel + d;
@@ -176,7 +183,11 @@ fn neighbours(c: FillCentre) -> Neighbours {
             continue;
         }
         let q_n = octahedron_decode(textureLoad(prepass_normals, q, 0).zw);
-        if abs(dot(c.n, q_surface.xyz - c.world)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+        let apart = q_surface.xyz - c.world;
+        if abs(dot(c.n, apart)) > SURFACE_PIXELS * c.pixel_world || dot(c.n, q_n) < SURFACE_COS {
+            continue;
+        }
+        if dot(apart, apart) > FILL_REACH_PIXELS * FILL_REACH_PIXELS * c.pixel_world * c.pixel_world {
             continue;
         }
         // A neighbour facing away from the light or outside its cone is dark by
@@ -191,14 +202,15 @@ fn neighbours(c: FillCentre) -> Neighbours {
         near.weight += w;
         near.lowest = min(near.lowest, visibility);
         near.highest = max(near.highest, visibility);
-        near.partial = near.partial || (visibility > 0.0 && visibility < 1.0);
-        answered |= 1u << u32(k);
+        if visibility > 0.0 && visibility < 1.0 {
+            partial |= 1u << u32(k);
+        }
     }
     // Either side along a row, a column or a diagonal: neighbours 3 and 5, 1 and 7,
     // 0 and 8, 2 and 6.
     for (var pair = 0u; pair < 4u; pair++) {
         let sides = (1u << FILL_OPPOSITE[pair].x) | (1u << FILL_OPPOSITE[pair].y);
-        near.across = near.across || (answered & sides) == sides;
+        near.across = near.across || (partial & sides) == sides;
     }
     return near;
 }
