@@ -71,15 +71,13 @@ struct Receiver {
     // Whether the layer is a cube face, whose depths the pyramid holds as
     // `cube_depth` (depth_pyramid.wgsl) rather than as the face stores them.
     cube: bool,
-    // Where it lies in the world.
-    world: vec3<f32>,
 };
 
 // A receiver outside its layer, or seen edge-on from the light: the map cannot say.
 // Its texel lies past every layer's edge.
 const UNPLACED_TEXEL: f32 = -1e9;
-fn unplaced_receiver(layer: u32, cube: bool, world: vec3<f32>) -> Receiver {
-    return Receiver(vec2<f32>(UNPLACED_TEXEL), 0.0, vec2<f32>(0.0), 1.0, layer, cube, world);
+fn unplaced_receiver(layer: u32, cube: bool) -> Receiver {
+    return Receiver(vec2<f32>(UNPLACED_TEXEL), 0.0, vec2<f32>(0.0), 1.0, layer, cube);
 }
 
 // A cube face's depth at distance `z` along its axis: 1 − near / z, which like a

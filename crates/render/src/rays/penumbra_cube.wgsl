@@ -17,17 +17,17 @@ fn cube_receiver(face: u32, world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec
     let clip_from_world = light.cascade_clip_from_world[face];
     let clip = clip_from_world * vec4<f32>(world, 1.0);
     if clip.w <= 0.0 {
-        return unplaced_receiver(face, true, world);
+        return unplaced_receiver(face, true);
     }
     let ndc = clip.xyz / clip.w;
     let step = light.map.near / (clip.w * clip.w);
     let a = vec3<f32>(map_step(clip_from_world, ndc, clip.w, world_dx).xy, step * (clip_from_world * vec4<f32>(world_dx, 0.0)).w);
     let b = vec3<f32>(map_step(clip_from_world, ndc, clip.w, world_dy).xy, step * (clip_from_world * vec4<f32>(world_dy, 0.0)).w);
     if abs(a.x * b.y - a.y * b.x) <= 1e-20 {
-        return unplaced_receiver(face, true, world);
+        return unplaced_receiver(face, true);
     }
     let texel = (ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5)) * light.map.resolution - vec2<f32>(0.5);
-    return Receiver(texel, cube_depth(clip.w), plane_gradient(a, b), clip.w, face, true, world);
+    return Receiver(texel, cube_depth(clip.w), plane_gradient(a, b), clip.w, face, true);
 }
 
 // A face's axis, as `cube_face` numbers the faces: +x, −x, +y, −y, +z, −z.

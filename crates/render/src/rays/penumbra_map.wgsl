@@ -14,12 +14,12 @@ fn map_receiver(world: vec3<f32>, world_dx: vec3<f32>, world_dy: vec3<f32>, laye
     let a = map_step(clip_from_world, clip.xyz / clip.w, clip.w, world_dx);
     let b = map_step(clip_from_world, clip.xyz / clip.w, clip.w, world_dy);
     if clip.w <= 0.0 || abs(a.x * b.y - a.y * b.x) <= 1e-20 {
-        return unplaced_receiver(layer, false, world);
+        return unplaced_receiver(layer, false);
     }
     let ndc = clip.xyz / clip.w;
     let texel = (ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5)) * light.map.resolution - vec2<f32>(0.5);
     let distance = -(light.light_from_world * vec4<f32>(world, 1.0)).z;
-    return Receiver(texel, ndc.z, plane_gradient(a, b), distance, layer, false, world);
+    return Receiver(texel, ndc.z, plane_gradient(a, b), distance, layer, false);
 }
 
 // `lookup_visibility` for a light with an area whose penumbrae are traced, on a 2D
