@@ -6,6 +6,7 @@
 pub mod builtin;
 pub mod camera_path;
 mod casters;
+pub mod files;
 #[cfg(feature = "cli")]
 pub mod flags;
 pub mod framing;

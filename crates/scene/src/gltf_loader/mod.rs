@@ -178,22 +178,14 @@ fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene
 /// The model file's bytes: a regular file (not a directory, FIFO or device, each of
 /// which is named as what it is), no larger than a model may be.
 fn read_model(path: &Path) -> Result<Vec<u8>, String> {
-    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => "cannot read: no such file".to_string(),
-        _ => format!("cannot read: {e}"),
-    })?;
-    if !metadata.is_file() {
-        return Err(format!("cannot read: it is {}, not a regular file", sources::file_kind(&metadata)));
-    }
-    let limit = crate::limits::MAX_MODEL_BYTES;
-    if metadata.len() > limit {
-        return Err(format!(
-            "the file is {}; a model may be at most {}",
-            sources::size(metadata.len()),
-            sources::size(limit)
-        ));
-    }
-    std::fs::read(path).map_err(|e| format!("cannot read: {e}"))
+    crate::files::read_regular(path, crate::files::Links::Follow, crate::limits::MAX_MODEL_BYTES, "a model")
+        .map_err(|e| match e {
+            crate::files::ReadError::Missing => "cannot read: no such file".into(),
+            crate::files::ReadError::NotRegular(kind) => {
+                format!("cannot read: it is {kind}, not a regular file")
+            }
+            other => other.to_string(),
+        })
 }
 
 /// glTF 2.x only: `asset.version` is "2.0" (a `minVersion` above it is refused too).

@@ -198,25 +198,17 @@ pub fn load_with(
     options: &gltf_loader::LoadOptions,
 ) -> Result<LoadedSceneFile, SceneFileError> {
     let unreadable = |problem: String| SceneFileError { path: path.to_path_buf(), location: None, problem };
-    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => unreadable("cannot read: no such file".into()),
-        _ => unreadable(format!("cannot read: {e}")),
-    })?;
-    if !metadata.is_file() {
-        return Err(unreadable(format!(
-            "cannot read: it is {}, not a regular file",
-            gltf_loader::sources::file_kind(&metadata)
-        )));
-    }
     let limit = crate::limits::MAX_SCENE_FILE_BYTES;
-    if metadata.len() > limit {
-        return Err(unreadable(format!(
-            "the file is {}; a scene file may be at most {}",
-            gltf_loader::sources::size(metadata.len()),
-            gltf_loader::sources::size(limit)
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| unreadable(format!("cannot read: {e}")))?;
+    let bytes = crate::files::read_regular(path, crate::files::Links::Follow, limit, "a scene file")
+        .map_err(|e| match e {
+            crate::files::ReadError::Missing => unreadable("cannot read: no such file".into()),
+            crate::files::ReadError::NotRegular(kind) => {
+                unreadable(format!("cannot read: it is {kind}, not a regular file"))
+            }
+            other => unreadable(other.to_string()),
+        })?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| unreadable("cannot read: it is not UTF-8 text".into()))?;
     let source = Source { path: path.to_path_buf(), text };
     // toml's own errors carry the line, the column and the offending text.
     let file: SceneFile = toml::from_str(&source.text).map_err(|e| source.fail(e.to_string()))?;
