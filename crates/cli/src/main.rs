@@ -166,6 +166,8 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::Scene(_)
         | RenderError::EmptyScene(_)
         | RenderError::SceneTooLarge { .. }
+        | RenderError::OverBudget { .. }
+        | RenderError::MemoryBudget(_)
         | RenderError::UnknownInstance { .. }
         | RenderError::InstancesChanged { .. }
         | RenderError::Gpu { .. } => None,

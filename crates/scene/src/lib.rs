@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod gltf_loader;
 pub mod lights;
 pub mod limits;
+pub mod memory;
 mod model;
 mod scene_error;
 pub mod scene_file;

@@ -16,8 +16,6 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use crate::limits::MAX_MODEL_BYTES;
-
 /// Where the files a model names may be.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum UriScope {
@@ -32,16 +30,22 @@ pub enum UriScope {
     EmbeddedOnly,
 }
 
-/// The bytes a model may make the loader hold: its buffers, its decoded images and
-/// the vertex data it expands, together ([`MAX_MODEL_BYTES`]).
+/// The bytes a model (or every model of a scene file, sharing one) may make the
+/// loader hold: its buffers, its decoded images, the meshes it makes and their placed
+/// copies, together: the frame's budget ([`crate::memory::frame_budget`]), so that
+/// what loads is what the frame can then hold.
 #[derive(Debug)]
 pub struct Budget {
     left: u64,
+    limit: u64,
+    source: String,
 }
 
 impl Default for Budget {
     fn default() -> Self {
-        Budget { left: MAX_MODEL_BYTES }
+        let (limit, source) = crate::memory::frame_budget()
+            .unwrap_or((crate::memory::DEFAULT_FRAME_BUDGET, "the default".into()));
+        Budget { left: limit, limit, source }
     }
 }
 
@@ -50,10 +54,11 @@ impl Budget {
     pub fn take(&mut self, bytes: u64, what: &str) -> Result<(), String> {
         if bytes > self.left {
             return Err(format!(
-                "{what} takes {} but the model may take at most {} in all (buffers, decoded images \
-                 and vertex data; {} left)",
+                "{what} takes {} but a scene may take at most {} in all ({}: buffers, decoded images, \
+                 meshes and their placed copies; {} left)",
                 size(bytes),
-                size(MAX_MODEL_BYTES),
+                size(self.limit),
+                self.source,
                 size(self.left)
             ));
         }
@@ -62,15 +67,8 @@ impl Budget {
     }
 }
 
-/// `bytes` in words: `8.0 GB`, `294 KB`.
-pub fn size(bytes: u64) -> String {
-    match bytes {
-        b if b >= 1 << 30 => format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30)),
-        b if b >= 1 << 20 => format!("{:.1} MiB", b as f64 / f64::from(1u32 << 20)),
-        b if b >= 1 << 10 => format!("{:.1} KiB", b as f64 / 1024.0),
-        b => format!("{b} bytes"),
-    }
-}
+/// `bytes` in words: `8.0 GiB`, `294.0 KiB`.
+pub use crate::memory::size;
 
 /// The file a URI names, resolved against the model's folder `base` and checked:
 /// inside the folder unless `scope` allows more, and a regular file.
@@ -323,8 +321,8 @@ mod tests {
     #[test]
     fn the_budget_refuses_what_it_cannot_hold_and_says_how_much() {
         let mut budget = Budget::default();
-        budget.take(MAX_MODEL_BYTES / 2, "buffer 0").unwrap();
-        let e = budget.take(MAX_MODEL_BYTES, "image 4").unwrap_err();
-        assert!(e.contains("image 4") && e.contains("GiB"), "{e}");
+        budget.take(budget.limit / 2, "buffer 0").unwrap();
+        let e = budget.take(budget.limit, "image 4").unwrap_err();
+        assert!(e.contains("image 4") && e.contains("at most") && e.contains("left"), "{e}");
     }
 }

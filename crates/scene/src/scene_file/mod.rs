@@ -59,6 +59,7 @@ use crate::{
 
 mod entries;
 mod locate;
+mod three;
 
 use entries::{EntryError, LightEntry, PointEntry, SpotEntry, SunEntry};
 pub use locate::{KeyPath, Step, display, locate};
@@ -98,9 +99,9 @@ struct SceneFile {
 #[serde(deny_unknown_fields)]
 struct ModelEntry {
     file: PathBuf,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three::exact")]
     translation: [f32; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three::exact")]
     rotation_degrees: [f32; 3],
     #[serde(default = "one")]
     scale: f32,
@@ -117,7 +118,9 @@ fn one() -> f32 {
 #[serde(deny_unknown_fields)]
 struct ViewEntry {
     name: String,
+    #[serde(deserialize_with = "three::exact")]
     eye: [f32; 3],
+    #[serde(deserialize_with = "three::exact")]
     target: [f32; 3],
     fov: Option<f32>,
     near: Option<f32>,
@@ -306,10 +309,12 @@ fn start_scene(
         None => None,
     };
     let base = source.path.parent().unwrap_or(Path::new("."));
+    // One budget for every model: a dozen small files must not each take the frame's.
+    let mut budget = gltf_loader::sources::Budget::default();
     for (i, model) in file.model.iter().enumerate() {
         let at = |key: &'static str| [Step::Key("model"), Step::Index(i), Step::Key(key)];
         let model_path = base.join(&model.file);
-        let (loaded, extras) = gltf_loader::load_with(&model_path, options)
+        let (loaded, extras) = gltf_loader::load_charged(&model_path, options, &mut budget)
             .map_err(|e| source.fail_at(&at("file"), format!("model: {e}")))?;
         warnings.extend(extras.warnings.iter().map(|w| format!("model `{}`: {w}", model.file.display())));
         let [rx, ry, rz] = model.rotation_degrees.map(f32::to_radians);
