@@ -315,7 +315,13 @@ mod tests {
         };
         let repeated = grid_of(Requested { depth_bias: range("0..1:64"), ..Default::default() }).unwrap_err();
         assert!(matches!(repeated, PlanError::RepeatedValues { distinct: 2, steps: 64, .. }), "{repeated}");
-        assert!(grid_of(Requested { depth_bias: range("0..63:64"), ..Default::default() }).is_ok());
+        let whole = Requested {
+            depth_bias: range("0..63:64"),
+            slope_bias: range("0..0:1"),
+            normal_offset: range("0..0:1"),
+            kernel: None,
+        };
+        assert_eq!(grid_of(whole).unwrap().len(), 64, "64 whole values in 0..63");
         let all = Requested {
             depth_bias: range("0..63:64"),
             slope_bias: range("0..4:64"),

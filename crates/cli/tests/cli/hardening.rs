@@ -213,6 +213,8 @@ fn an_interrupt_while_staging_leaves_no_file_behind() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_gnomon"))
         .current_dir(dir)
         .args(["render", "--width", "2048", "--height", "2048", "--aov-out", "aov", "--out", "a.png"])
+        // A frame of 4 M pixels, over the default budget: large, so that staging lasts.
+        .env("GNOMON_MEMORY_MIB", "4096")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()

@@ -55,7 +55,10 @@ impl Renderer {
                 // A cube's six faces (two paraboloids take fewer: charged as a cube).
                 ShadowView::Omni { .. } => 6,
             };
-            let filterable = self.techniques.check(shadow)?.filterable_map(&shadow.filter).is_some();
+            // The light's own technique check first: a technique that cannot shadow it
+            // is that error, not a budget's.
+            let technique = self.techniques.check_light(shadow, &light.light, &light.name)?;
+            let filterable = technique.filterable_map(&shadow.filter).is_some();
             let per_texel =
                 memory::BYTES_PER_MAP_TEXEL + if filterable { memory::BYTES_PER_MOMENT_TEXEL } else { 0 };
             charges.push(Charge {
