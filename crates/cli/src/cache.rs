@@ -367,7 +367,7 @@ mod tests {
     #[test]
     fn the_key_changes_with_materials_and_textures() {
         let scene = gnomon_scene::builtin::build("spheres").unwrap();
-        let light = scene.lights[0].light.clone();
+        let light = scene.lights[0].light;
         let options = ReferenceOptions { width: 4, height: 4, samples: 1 };
         let base = key(&scene, &scene.camera, &light, &options);
         let mut masked = scene.clone();

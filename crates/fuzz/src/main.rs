@@ -108,7 +108,10 @@ fn default_seeds(target: Target) -> Vec<PathBuf> {
             .collect()
     };
     match target {
-        Target::SceneFile => with_extension(root.join("examples"), &["toml"]),
+        Target::SceneFile => [root.join("examples"), root.join("crates/fuzz/seeds/scene-file")]
+            .into_iter()
+            .flat_map(|dir| with_extension(dir, &["toml"]))
+            .collect(),
         Target::Gltf => [
             root.join("examples/data"),
             root.join("crates/scene/tests/data/broken"),

@@ -283,3 +283,22 @@ fn a_pseudo_file_of_no_stated_length_is_read_as_empty() {
     let e = gltf_loader::load(&link).unwrap_err().to_string();
     assert!(e.contains("empty"), "{e}");
 }
+
+#[test]
+fn the_models_of_a_scene_file_share_one_budget() {
+    // Each model alone fits (2.1 M vertices, 0.3 GiB as held); twelve together do not.
+    let temp = temp_dir("round3-models");
+    std::fs::write(temp.path().join("big.gltf"), sparse_model(2_100_000, 1, 1)).unwrap();
+    let one = temp.path().join("one.toml");
+    std::fs::write(&one, "[[model]]\nfile = \"big.gltf\"\n").unwrap();
+    assert!(gnomon_scene::scene_file::load(&one, None).is_ok());
+    let twelve = temp.path().join("twelve.toml");
+    let models: String =
+        (0..12).map(|i| format!("[[model]]\nfile = \"big.gltf\"\ntranslation = [{i}, 0, 0]\n")).collect();
+    std::fs::write(&twelve, models).unwrap();
+    let e = gnomon_scene::scene_file::load(&twelve, None).err().unwrap().to_string();
+    assert!(
+        e.contains("a scene may take at most") && !e.contains(":1:"),
+        "refused past the first model: {e}"
+    );
+}
