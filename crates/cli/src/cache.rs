@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use gnomon_reference::{ReferenceImage, ReferenceOptions};
-use gnomon_scene::{Camera, Light, Scene};
+use gnomon_scene::{Camera, Light, Scene, Texture};
 
 const MAGIC: &[u8; 8] = b"GNOMREF1";
 /// Part of every key: bump it whenever the tracer's results change, so that caches
@@ -29,21 +29,42 @@ pub fn cache_dir() -> Option<PathBuf> {
     std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache").join("gnomon"))
 }
 
-/// A stable key for a reference: xxh3 over the scene's geometry and every parameter.
+/// A stable key for a reference: xxh3 over everything that changes its answer: the
+/// scene's geometry (positions, normals, texture coordinates, indices), its materials
+/// and textures (alpha masks cut holes in casters), its instances and ground, and the
+/// camera, light and options.
 pub fn key(scene: &Scene, camera: &Camera, light: &Light, options: &ReferenceOptions) -> String {
     let mut h = xxhash_rust::xxh3::Xxh3::new();
     h.update(MAGIC);
     h.update(&TRACER_REVISION.to_le_bytes());
+    let count = |h: &mut xxhash_rust::xxh3::Xxh3, n: usize| h.update(&(n as u64).to_le_bytes());
     for mesh in &scene.meshes {
-        h.update(bytemuck::cast_slice(&mesh.positions.iter().map(|p| p.to_array()).collect::<Vec<_>>()));
+        // Each array's length first, so that bytes moved from one to the next differ.
+        count(&mut h, mesh.positions.len());
+        mesh.positions.iter().for_each(|p| h.update(bytemuck::cast_slice(&p.to_array())));
+        count(&mut h, mesh.normals.len());
+        mesh.normals.iter().for_each(|n| h.update(bytemuck::cast_slice(&n.to_array())));
+        count(&mut h, mesh.uvs.len());
+        mesh.uvs.iter().for_each(|uv| h.update(bytemuck::cast_slice(&uv.to_array())));
+        count(&mut h, mesh.indices.len());
         h.update(bytemuck::cast_slice(&mesh.indices));
     }
+    for texture in &scene.textures {
+        let Texture { name: _, width, height, rgba8, wrap_u, wrap_v, nearest } = texture;
+        h.update(format!("{width}x{height} {wrap_u:?} {wrap_v:?} {nearest}").as_bytes());
+        count(&mut h, rgba8.len());
+        h.update(rgba8);
+    }
+    // Debug formatting of f32 round-trips exactly, so it is a faithful key; a
+    // material's name is part of it, harmlessly.
+    h.update(format!("{:?}", scene.materials).as_bytes());
     for inst in &scene.instances {
         h.update(bytemuck::cast_slice(&inst.world_from_object.to_cols_array()));
-        h.update(&[inst.mesh as u8, (inst.mesh >> 8) as u8, inst.casts_shadow as u8]);
+        count(&mut h, inst.mesh);
+        count(&mut h, inst.material);
+        h.update(&[u8::from(inst.casts_shadow)]);
     }
-    // Debug formatting of f32 round-trips exactly, so it is a faithful key.
-    h.update(format!("{camera:?}{light:?}{options:?}").as_bytes());
+    h.update(format!("{camera:?}{light:?}{options:?} ground {}", scene.has_ground).as_bytes());
     format!("{:016x}", h.digest())
 }
 
@@ -108,13 +129,36 @@ fn trim(dir: &Path, max_bytes: u64, keep: &Path) {
     }
 }
 
+/// The size of a cached reference of `options`' image: its header and, per pixel,
+/// visibility, error, id, triangle and depth (4 bytes each), position (12) and the
+/// faces-light flag (1).
+fn entry_bytes(options: &ReferenceOptions) -> u64 {
+    let pixels = u64::from(options.width) * u64::from(options.height);
+    (MAGIC.len() + 3 * 4 + 8) as u64 + pixels * (5 * 4 + 12 + 1)
+}
+
 /// Loads a cached reference of the expected size, or `None` (missing, unreadable or stale).
+/// Only a regular file the user owns, of exactly the size the image needs, is read: a
+/// link, a FIFO or a file someone else put in the cache is a miss.
 /// A hit marks the file as used, for the least-recently-used trim.
 pub fn load(path: &Path, options: &ReferenceOptions) -> Option<ReferenceImage> {
-    let bytes = std::fs::read(path).ok()?;
-    if let Ok(file) = std::fs::File::options().append(true).open(path) {
-        let _ = file.set_modified(std::time::SystemTime::now());
+    use gnomon_scene::files::{Links, open_regular};
+    let (file, metadata) = open_regular(path, Links::Refuse).ok()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        // SAFETY: geteuid has no preconditions and cannot fail.
+        if metadata.uid() != unsafe { libc::geteuid() } {
+            return None;
+        }
     }
+    let expected = entry_bytes(options);
+    if metadata.len() != expected {
+        return None;
+    }
+    let mut bytes = Vec::with_capacity(expected as usize);
+    std::io::Read::read_to_end(&mut std::io::Read::take(&file, expected), &mut bytes).ok()?;
+    let _ = file.set_modified(std::time::SystemTime::now());
     let mut r = Reader { bytes: &bytes, at: 0 };
     if r.take(8)? != MAGIC {
         return None;
@@ -161,9 +205,10 @@ pub fn store(path: &Path, image: &ReferenceImage) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let temp = path.with_extension(format!("tmp-{}", std::process::id()));
-    crate::output::track_temporary(&temp);
-    let written = std::fs::write(&temp, bytes).and_then(|()| std::fs::rename(&temp, path));
+    // Created exclusively under a name no one can predict, then renamed over the
+    // entry (which replaces a link there rather than following it).
+    let (mut file, temp) = crate::output::create_staging(path)?;
+    let written = std::io::Write::write_all(&mut file, &bytes).and_then(|()| std::fs::rename(&temp, path));
     if written.is_err() {
         let _ = std::fs::remove_file(&temp);
     }
@@ -315,5 +360,84 @@ mod tests {
             .collect();
         assert_eq!(left, ["reference-new.bin", "reference-b.bin"], "a (3 days) and c (2 days) went first");
         assert!(dir.path().join("unrelated.txt").exists(), "only references are touched");
+    }
+
+    /// The audit's pair: one mesh, opaque and then cut away by an alpha mask, must not
+    /// share a cached reference (the second would be served the first's shadow).
+    #[test]
+    fn the_key_changes_with_materials_and_textures() {
+        let scene = gnomon_scene::builtin::build("spheres").unwrap();
+        let light = scene.lights[0].light;
+        let options = ReferenceOptions { width: 4, height: 4, samples: 1 };
+        let base = key(&scene, &scene.camera, &light, &options);
+        let mut masked = scene.clone();
+        masked.materials[0].alpha = 0.0;
+        masked.materials[0].alpha_mode = gnomon_scene::AlphaMode::Mask { cutoff: 0.5 };
+        assert_ne!(key(&masked, &masked.camera, &light, &options), base, "alpha 0, MASK");
+        let mut textured = scene.clone();
+        textured.textures.push(Texture {
+            name: "t".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![255, 255, 255, 0],
+            wrap_u: gnomon_scene::Wrap::Repeat,
+            wrap_v: gnomon_scene::Wrap::Repeat,
+            nearest: false,
+        });
+        assert_ne!(key(&textured, &textured.camera, &light, &options), base, "a texture");
+        assert_eq!(key(&scene.clone(), &scene.camera, &light, &options), base, "and is stable");
+    }
+
+    fn tiny_image() -> ReferenceImage {
+        ReferenceImage {
+            width: 1,
+            height: 1,
+            samples: 4,
+            visibility: vec![0.5],
+            faces_light: vec![true],
+            std_error: vec![0.0],
+            object_id: vec![1],
+            triangle: vec![2],
+            depth: vec![3.0],
+            position: vec![Vec3::ONE],
+            rays: 4,
+        }
+    }
+
+    /// A link planted at the temporary name an earlier Gnomon chose
+    /// (`reference-KEY.tmp-PID`) is not written through.
+    #[cfg(unix)]
+    #[test]
+    fn storing_does_not_follow_a_planted_link() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "secret").unwrap();
+        let path = dir.path().join("reference-k.bin");
+        let planted = path.with_extension(format!("tmp-{}", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        store(&path, &tiny_image()).unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "secret", "the victim is untouched");
+        assert!(std::fs::symlink_metadata(&path).unwrap().file_type().is_file());
+        let options = ReferenceOptions { width: 1, height: 1, samples: 4 };
+        assert_eq!(load(&path, &options).unwrap().visibility, [0.5]);
+    }
+
+    /// Only a regular file is served: a link (to a reference someone else wrote) and a
+    /// FIFO (which would block the read forever) are cache misses.
+    #[cfg(unix)]
+    #[test]
+    fn only_regular_files_are_served() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("elsewhere.bin");
+        store(&real, &tiny_image()).unwrap();
+        let options = ReferenceOptions { width: 1, height: 1, samples: 4 };
+        assert!(load(&real, &options).is_some());
+        let link = dir.path().join("reference-link.bin");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        assert!(load(&link, &options).is_none(), "a link is not served");
+        let fifo = dir.path().join("reference-fifo.bin");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(made.success());
+        assert!(load(&fifo, &options).is_none(), "a FIFO is a miss, at once");
     }
 }

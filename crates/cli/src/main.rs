@@ -67,28 +67,43 @@ fn parse_cli(techniques: &gnomon_render::techniques::TechniqueRegistry) -> Cli {
 
 /// Points `XDG_RUNTIME_DIR` at a private directory when it is unset or not a
 /// directory: Mesa's Vulkan window-system code prints "XDG_RUNTIME_DIR is invalid or
-/// not set" on every run otherwise, though a headless run never needs it.
-fn quiet_runtime_dir() {
+/// not set" on every run otherwise, though a headless run never needs it. The folder
+/// `$TMPDIR/gnomon-runtime-UID` is used only if it is a real directory (not a link)
+/// that the user owns and no one else may enter; anything else there, perhaps planted
+/// by another user to receive a window-system connection, is left alone and a fresh
+/// private folder is made instead, removed when the returned guard drops.
+fn quiet_runtime_dir() -> Option<tempfile::TempDir> {
     let valid = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
     if valid {
-        return;
+        return None;
     }
     #[cfg(unix)]
     {
         use std::os::unix::fs::{DirBuilderExt, MetadataExt};
-        let user = std::fs::metadata("/proc/self").map(|m| m.uid()).unwrap_or(0);
+        // SAFETY: getuid has no preconditions and cannot fail.
+        let user = unsafe { libc::getuid() };
         let dir = std::env::temp_dir().join(format!("gnomon-runtime-{user}"));
-        let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
-        if made.is_ok() || dir.is_dir() {
-            // SAFETY: called first thing in `main`, before any thread exists that
-            // could read the environment concurrently.
-            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
-        }
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        let private = std::fs::symlink_metadata(&dir)
+            .is_ok_and(|m| m.is_dir() && m.uid() == user && m.mode() & 0o077 == 0);
+        let (dir, guard) = if private {
+            (dir, None)
+        } else {
+            // tempfile makes its folders 0700 under an unpredictable name.
+            let fresh = tempfile::Builder::new().prefix("gnomon-runtime-").tempdir().ok()?;
+            (fresh.path().to_path_buf(), Some(fresh))
+        };
+        // SAFETY: called first thing in `main`, before any thread exists that
+        // could read the environment concurrently.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        guard
     }
+    #[cfg(not(unix))]
+    None
 }
 
 fn main() -> ExitCode {
-    quiet_runtime_dir();
+    let _runtime_dir = quiet_runtime_dir();
     let techniques = gnomon_render::techniques::TechniqueRegistry::builtin();
     let cli = parse_cli(&techniques);
     output::remove_temporaries_on_interrupt();
@@ -151,6 +166,8 @@ fn flag_of(e: &anyhow::Error) -> Option<String> {
         | RenderError::Scene(_)
         | RenderError::EmptyScene(_)
         | RenderError::SceneTooLarge { .. }
+        | RenderError::OverBudget { .. }
+        | RenderError::MemoryBudget(_)
         | RenderError::UnknownInstance { .. }
         | RenderError::InstancesChanged { .. }
         | RenderError::Gpu { .. } => None,

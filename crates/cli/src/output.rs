@@ -10,7 +10,7 @@ use gnomon_math::{LightProjection, ProjectionKind, linearize_perspective_depth};
 use gnomon_render::ShadowMapImage;
 
 /// Fails unless `path` has one of `extensions`, its directory exists and takes new
-/// files, and `path` is absent or a regular file.
+/// files, and `path` is absent, a regular file or a link (which is replaced).
 pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Result<()> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !ext.as_deref().is_some_and(|e| extensions.contains(&e)) {
@@ -20,6 +20,7 @@ pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Resul
             extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ")
         );
     }
+    check_destination(path, flag)?;
     let dir = parent_dir(path);
     if !dir.is_dir() {
         bail!(
@@ -27,12 +28,6 @@ pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Resul
             path.display(),
             dir.display()
         );
-    }
-    if path.is_dir() {
-        bail!("{flag} {}: is a directory, expected a file name", path.display());
-    }
-    if let Some(kind) = not_a_regular_file(path) {
-        bail!("{flag} {}: exists and is {kind}; outputs replace regular files only", path.display());
     }
     probe_writable(dir)
         .with_context(|| format!("{flag} {}: cannot write in {}", path.display(), dir.display()))
@@ -42,16 +37,81 @@ pub fn check_file(path: &Path, extensions: &[&str], flag: &str) -> anyhow::Resul
 /// takes no files (read-only, or a pseudo file system such as /proc) is found before
 /// the work, not when the outputs are moved into place at its end.
 fn probe_writable(dir: &Path) -> std::io::Result<()> {
-    let probe = dir.join(format!(".gnomon-probe-{}", std::process::id()));
-    std::fs::OpenOptions::new().write(true).create_new(true).open(&probe)?;
-    std::fs::remove_file(&probe)
+    // Dropping the temporary file removes it.
+    tempfile::Builder::new().prefix(".gnomon-probe-").tempfile_in(dir).map(drop)
 }
 
-/// What is at `path` when it is neither absent nor a regular file (a device, a FIFO,
-/// a directory, a socket): a rename over it would replace a device node with a file.
+/// The longest file name most file systems take (ext4, XFS, APFS, NTFS: 255 bytes).
+const NAME_MAX_BYTES: usize = 255;
+/// A staging file's name around its destination's: `.NAME.` + random + this suffix.
+const STAGING_SUFFIX: &str = ".gnomon-tmp";
+/// How many random characters a staging name holds: 62⁸ names, so one cannot be
+/// guessed and planted in a shared folder before the run creates it.
+const STAGING_RANDOM: usize = 8;
+
+/// The staging file's prefix for a destination named `name`.
+fn staging_prefix(name: &str) -> String {
+    format!(".{name}.")
+}
+
+/// A new, empty file beside `path` to encode it into: created exclusively (`O_EXCL`,
+/// so a link or file planted at its name is never opened) under a name no one can
+/// predict, and registered for removal on an interrupt from the moment it exists
+/// (until [`forget_temporary`]).
+pub fn create_staging(path: &Path) -> std::io::Result<(std::fs::File, PathBuf)> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let prefix = staging_prefix(&name);
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(STAGING_SUFFIX).rand_bytes(STAGING_RANDOM);
+    #[cfg(unix)]
+    {
+        // An output is as readable as any file the user makes (the umask applies);
+        // tempfile's default, 0600, would hide images from the user's group.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    // Holding the lock while the file is made keeps an interrupt from missing it.
+    let mut live = LIVE_TEMPS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let (file, temp) = builder.tempfile_in(parent_dir(path))?.keep().map_err(|e| e.error)?;
+    live.push(temp.clone());
+    Ok((file, temp))
+}
+
+/// The checks on one output file that need no folder to exist yet (so they serve the
+/// files inside an `--aov-out` folder too): no trailing `/`, a name short enough for
+/// its staging name, and nothing but a regular file or a link already there.
+pub fn check_destination(path: &Path, flag: &str) -> anyhow::Result<()> {
+    if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
+        bail!("{flag} {}: ends in `/`, which names a folder; give a file name", path.display());
+    }
+    let name = path.file_name().map(|n| n.len()).unwrap_or_default();
+    let staged = staging_prefix("").len() + name + STAGING_RANDOM + STAGING_SUFFIX.len();
+    if staged > NAME_MAX_BYTES {
+        bail!(
+            "{flag} {}: its file name is {name} bytes; at most {} fit, since it is first written under \
+             a staging name {} bytes longer (file names take at most {NAME_MAX_BYTES} bytes)",
+            path.display(),
+            NAME_MAX_BYTES - (staged - name),
+            staged - name
+        );
+    }
+    if path.is_dir() {
+        bail!("{flag} {}: is a directory, expected a file name", path.display());
+    }
+    if let Some(kind) = not_a_regular_file(path) {
+        bail!("{flag} {}: exists and is {kind}; outputs replace regular files only", path.display());
+    }
+    Ok(())
+}
+
+/// What is at `path` when it is neither absent, nor a regular file, nor a link (a
+/// device, a FIFO, a directory, a socket): a rename over it would replace a device
+/// node with a file. A link is replaced by the output, never written through, so a
+/// link is fine whatever it points at.
 fn not_a_regular_file(path: &Path) -> Option<&'static str> {
-    let metadata = std::fs::metadata(path).ok()?;
-    (!metadata.is_file()).then(|| gnomon_scene::gltf_loader::sources::file_kind(&metadata))
+    let metadata = std::fs::symlink_metadata(path).ok()?;
+    let fine = metadata.is_file() || metadata.file_type().is_symlink();
+    (!fine).then(|| gnomon_scene::gltf_loader::sources::file_kind(&metadata))
 }
 
 /// Fails unless `dir` is a directory or could be created (its parent exists).
@@ -91,13 +151,6 @@ pub fn remove_temporaries_on_interrupt() {
     });
     if let Err(e) = installed {
         eprintln!("gnomon: warning: cannot catch Ctrl-C ({e}); an interrupted run may leave temporary files");
-    }
-}
-
-/// Marks `temp` as live (removed on an interrupt) until [`forget_temporary`].
-pub fn track_temporary(temp: &Path) {
-    if let Ok(mut live) = LIVE_TEMPS.lock() {
-        live.push(temp.to_path_buf());
     }
 }
 
@@ -158,7 +211,7 @@ impl Drop for Staged {
 }
 
 impl Staged {
-    fn temp_for(&mut self, path: &Path) -> anyhow::Result<PathBuf> {
+    fn temp_for(&mut self, path: &Path) -> anyhow::Result<std::fs::File> {
         if let Some(kind) = not_a_regular_file(path) {
             bail!("cannot write {}: it is {kind}; outputs replace regular files only", path.display());
         }
@@ -169,20 +222,24 @@ impl Staged {
                 earlier.display()
             );
         }
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let temp = parent_dir(path).join(format!(".{name}.gnomon-{}.tmp", std::process::id()));
-        track_temporary(&temp);
-        self.files.push((temp.clone(), path.to_path_buf()));
-        Ok(temp)
+        let (file, temp) =
+            create_staging(path).with_context(|| format!("cannot write {}", path.display()))?;
+        self.files.push((temp, path.to_path_buf()));
+        Ok(file)
     }
 
+    /// Encodes one output into its staging file, through the open handle: the file
+    /// is never opened again by name, so nothing swapped in at that name is written.
     fn write_with(
         &mut self,
         path: &Path,
-        write: impl FnOnce(&Path) -> anyhow::Result<()>,
+        write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> anyhow::Result<()>,
     ) -> anyhow::Result<()> {
-        let temp = self.temp_for(path)?;
-        write(&temp).with_context(|| format!("cannot write {}", path.display()))
+        let file = self.temp_for(path)?;
+        let mut writer = std::io::BufWriter::new(file);
+        write(&mut writer)
+            .and_then(|()| Ok(std::io::Write::flush(&mut writer)?))
+            .with_context(|| format!("cannot write {}", path.display()))
     }
 
     fn png(
@@ -193,8 +250,8 @@ impl Staged {
         bytes: &[u8],
         color: image::ExtendedColorType,
     ) -> anyhow::Result<()> {
-        self.write_with(path, |temp| {
-            image::save_buffer_with_format(temp, bytes, width, height, color, image::ImageFormat::Png)?;
+        self.write_with(path, |out| {
+            image::write_buffer_with_format(out, bytes, width, height, color, image::ImageFormat::Png)?;
             Ok(())
         })
     }
@@ -217,11 +274,11 @@ impl Staged {
         values: &[f32],
     ) -> anyhow::Result<()> {
         let npy = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"));
-        self.write_with(path, |temp| {
+        self.write_with(path, |out| {
             if npy {
-                write_npy(temp, &[height as usize, width as usize], values)
+                write_npy(out, &[height as usize, width as usize], values)
             } else {
-                write_exr_y(temp, width, height, values)
+                write_exr_y(out, width, height, values)
             }
         })
     }
@@ -240,22 +297,24 @@ impl Staged {
             return self.exr_rgb(path, width, height, values);
         }
         let flat: Vec<f32> = values.iter().flat_map(|v| v.to_array()).collect();
-        self.write_with(path, |temp| write_npy(temp, &[height as usize, width as usize, 3], &flat))
+        self.write_with(path, |out| write_npy(out, &[height as usize, width as usize, 3], &flat))
     }
 
     pub fn exr_rgb(&mut self, path: &Path, width: u32, height: u32, values: &[Vec3]) -> anyhow::Result<()> {
-        self.write_with(path, |temp| {
+        self.write_with(path, |out| {
+            use exr::prelude::*;
             let w = width as usize;
-            exr::prelude::write_rgb_file(temp, w, height as usize, |x, y| {
-                let v = values[y * w + x];
+            let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+                let v = values[p.y() * w + p.x()];
                 (v.x, v.y, v.z)
-            })?;
+            });
+            Image::from_channels((w, height as usize), channels).write().to_buffered(out)?;
             Ok(())
         })
     }
 
     pub fn text(&mut self, path: &Path, text: &str) -> anyhow::Result<()> {
-        self.write_with(path, |temp| Ok(std::fs::write(temp, text)?))
+        self.write_with(path, |out| Ok(std::io::Write::write_all(out, text.as_bytes())?))
     }
 
     /// Moves every staged file into place and returns the destinations. All or
@@ -266,7 +325,9 @@ impl Staged {
         let mut moved: Vec<(&Path, Option<PathBuf>)> = Vec::new();
         let mut failure = None;
         for (temp, dest) in &files {
-            let backup = dest.exists().then(|| temp.with_extension("old"));
+            // `symlink_metadata`: a link at the destination (even a dangling one) is
+            // set aside and replaced like a file; `rename` never follows it.
+            let backup = std::fs::symlink_metadata(dest).is_ok().then(|| temp.with_extension("old"));
             let result = match &backup {
                 Some(b) => std::fs::rename(dest, b).and_then(|()| {
                     std::fs::rename(temp, dest).inspect_err(|_| {
@@ -304,19 +365,19 @@ impl Staged {
 }
 
 /// A single-channel float32 OpenEXR file with channel `Y`.
-fn write_exr_y(path: &Path, width: u32, height: u32, values: &[f32]) -> anyhow::Result<()> {
+fn write_exr_y(out: &mut impl WriteSeek, width: u32, height: u32, values: &[f32]) -> anyhow::Result<()> {
     use exr::prelude::*;
     let w = width as usize;
     let channels = SpecificChannels::build()
         .with_channel("Y")
         .with_pixel_fn(|p: Vec2<usize>| (values[p.y() * w + p.x()],));
-    Image::from_channels((w, height as usize), channels).write().to_file(path)?;
+    Image::from_channels((w, height as usize), channels).write().to_buffered(out)?;
     Ok(())
 }
 
 /// A NumPy `.npy` file (format version 1.0): little-endian float32, C order, of
 /// `shape` (height, width, and channels where there are several).
-fn write_npy(path: &Path, shape: &[usize], values: &[f32]) -> anyhow::Result<()> {
+fn write_npy(out: &mut impl std::io::Write, shape: &[usize], values: &[f32]) -> anyhow::Result<()> {
     let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
     let mut header = format!(
         "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}), }}",
@@ -333,9 +394,13 @@ fn write_npy(path: &Path, shape: &[usize], values: &[f32]) -> anyhow::Result<()>
     for v in values {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
-    std::fs::write(path, bytes)?;
+    out.write_all(&bytes)?;
     Ok(())
 }
+
+/// What the OpenEXR encoder writes into: it seeks back to fill in its offset tables.
+pub trait WriteSeek: std::io::Write + std::io::Seek {}
+impl<T: std::io::Write + std::io::Seek> WriteSeek for T {}
 
 /// Visibility as RGBA8 gray (V = 1 white), with background (NaN) dark blue-grey.
 pub fn visibility_rgba(visibility: &[f32]) -> Vec<u8> {
@@ -396,7 +461,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("gnomon-npy-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("v.npy");
-        write_npy(&path, &[2, 3], &[0.0, 0.5, 1.0, f32::NAN, 0.25, 0.75]).unwrap();
+        write_npy(
+            &mut std::fs::File::create(&path).unwrap(),
+            &[2, 3],
+            &[0.0, 0.5, 1.0, f32::NAN, 0.25, 0.75],
+        )
+        .unwrap();
         let bytes = std::fs::read(&path).unwrap();
         assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
         let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
@@ -419,19 +489,76 @@ mod tests {
         assert!(check_file(Path::new("out.png"), &["png"], "--out").is_ok());
     }
 
-    /// A device node (here a link to /dev/null named like a PNG) is not replaced by
-    /// the output: refused before anything is written, by the flag and in staging.
+    /// A special file (here a FIFO named like a PNG; a device node is refused the same
+    /// way) is not replaced by the output: refused before anything is written, by the
+    /// flag and in staging. A link to a device is replaced, never written through.
     #[cfg(unix)]
     #[test]
-    fn a_device_is_not_an_output() {
+    fn a_special_file_is_not_an_output() {
         let dir = tempfile::tempdir().unwrap();
-        let device = dir.path().join("x.png");
-        std::os::unix::fs::symlink("/dev/null", &device).unwrap();
-        let e = check_file(&device, &["png"], "--out").unwrap_err().to_string();
-        assert!(e.contains("--out") && e.contains("a character device"), "{e}");
+        let fifo = dir.path().join("x.png");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let e = check_file(&fifo, &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("--out") && e.contains("a FIFO"), "{e}");
         let mut staged = Staged::default();
-        let e = staged.text(&device, "text").unwrap_err().to_string();
-        assert!(e.contains("a character device"), "{e}");
-        assert!(std::fs::symlink_metadata(&device).unwrap().file_type().is_symlink(), "left as it was");
+        let e = staged.text(&fifo, "text").unwrap_err().to_string();
+        assert!(e.contains("a FIFO"), "{e}");
+        let link = dir.path().join("null.txt");
+        std::os::unix::fs::symlink("/dev/null", &link).unwrap();
+        let mut staged = Staged::default();
+        staged.text(&link, "text").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&link).unwrap(), "text", "the link became the output");
+    }
+
+    #[test]
+    fn names_that_cannot_be_staged_are_refused_before_the_work() {
+        let e = check_file(Path::new("x.png/"), &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("ends in `/`"), "{e}");
+        let long = format!("{}.png", "a".repeat(240));
+        let e = check_file(Path::new(&long), &["png"], "--out").unwrap_err().to_string();
+        assert!(e.contains("244 bytes") && e.contains("at most 234"), "{e}");
+        assert!(check_file(Path::new(&format!("{}.png", "a".repeat(230))), &["png"], "--out").is_ok());
+    }
+
+    /// A link planted where the staging file would go, under the name an earlier
+    /// Gnomon chose (`.NAME.gnomon-PID.tmp`), is neither followed nor left behind as
+    /// the output: the victim it points at keeps its bytes.
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_a_staging_name_is_not_followed() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "secret").unwrap();
+        let planted = dir.path().join(format!(".out.txt.gnomon-{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        let out = dir.path().join("out.txt");
+        let mut staged = Staged::default();
+        staged.text(&out, "output").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "secret", "the victim is untouched");
+        let kind = std::fs::symlink_metadata(&out).unwrap().file_type();
+        assert!(kind.is_file(), "the output is a regular file, not a link: {kind:?}");
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "output");
+    }
+
+    /// A link at the destination itself is replaced by the output, not written through.
+    #[cfg(unix)]
+    #[test]
+    fn a_link_at_the_destination_is_replaced_not_followed() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "secret").unwrap();
+        let out = dir.path().join("out.txt");
+        std::os::unix::fs::symlink(&victim, &out).unwrap();
+        check_file(&out, &["txt"], "--out").unwrap();
+        let mut staged = Staged::default();
+        staged.text(&out, "output").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "secret");
+        assert!(std::fs::symlink_metadata(&out).unwrap().file_type().is_file());
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "output");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(left.len(), 2, "no staging or backup file is left: {left:?}");
     }
 }

@@ -137,6 +137,9 @@ fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
         output::check_dir(dir, "--aov-out")?;
     }
     let aov_files: Vec<PathBuf> = args.aov_out.iter().flat_map(|d| aov_files(d, args.aov_format)).collect();
+    for path in &aov_files {
+        output::check_destination(path, "--aov-out")?;
+    }
     let planned: Vec<output::Planned> =
         [("--out", Some(&args.out)), ("--shadow-map-out", args.shadow_map_out.as_ref())]
             .into_iter()

@@ -14,6 +14,11 @@
 //! worker keeps it in, saves it as a crash, and starts a new worker for the rest of
 //! the target's time. So a small file that makes Gnomon allocate gigabytes is found
 //! as a crash, not lost with the process.
+//!
+//! Each input also has a time limit (`--input-seconds`, 10 by default): the
+//! supervisor watches the file the worker writes each input to, and a worker that
+//! keeps one input longer is killed and its input saved as a timeout. So a small
+//! file that makes a build step slow is a finding too, not a long run.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
@@ -83,6 +88,10 @@ struct Args {
     /// crash (Gnomon must refuse such an input before allocating).
     #[arg(long, default_value_t = 1024)]
     memory_cap_mb: usize,
+    /// The seconds one input may take: a worker still on one input after this is
+    /// killed and the input saved as a timeout.
+    #[arg(long, default_value_t = 10)]
+    input_seconds: u64,
     /// Run one target in this process and write its report to this file (what the
     /// supervisor starts; not for use by hand).
     #[arg(long, hide = true, value_name = "REPORT")]
@@ -99,7 +108,10 @@ fn default_seeds(target: Target) -> Vec<PathBuf> {
             .collect()
     };
     match target {
-        Target::SceneFile => with_extension(root.join("examples"), &["toml"]),
+        Target::SceneFile => [root.join("examples"), root.join("crates/fuzz/seeds/scene-file")]
+            .into_iter()
+            .flat_map(|dir| with_extension(dir, &["toml"]))
+            .collect(),
         Target::Gltf => [
             root.join("examples/data"),
             root.join("crates/scene/tests/data/broken"),
@@ -133,14 +145,14 @@ fn main() -> ExitCode {
         return worker(&args, targets[0], report_path);
     }
     println!(
-        "| target | seconds | executions | per second | distinct outcomes | corpus | slowest input | crashes (of them out of memory) | caught panics |"
+        "| target | seconds | executions | per second | distinct outcomes | corpus | slowest input | crashes (of them out of memory, timed out) | caught panics |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut crashed = false;
     for target in targets {
         let run = supervise(&args, target);
         println!(
-            "| {} | {} | {} | {:.0} | {} | {} | {:.0} ms | {} ({}) | {} |",
+            "| {} | {} | {} | {:.0} | {} | {} | {:.0} ms | {} ({}, {}) | {} |",
             target.name(),
             args.seconds,
             run.report.executions,
@@ -150,6 +162,7 @@ fn main() -> ExitCode {
             run.report.slowest.as_secs_f64() * 1e3,
             run.report.crashes.len(),
             run.out_of_memory,
+            run.timeouts,
             run.report.caught.len()
         );
         for crash in &run.report.crashes {
@@ -174,6 +187,35 @@ struct Supervised {
     report: Report,
     /// Of the crashes, the inputs that took a worker past the memory cap.
     out_of_memory: usize,
+    /// Of the crashes, the inputs that took longer than `--input-seconds`.
+    timeouts: usize,
+}
+
+/// How a worker ended.
+enum Ended {
+    /// It exited, with this status.
+    Exited(std::process::ExitStatus),
+    /// It was killed after holding one input past the time limit.
+    TimedOut,
+}
+
+/// Waits for `child`, killing it if the input it works on (the file `current`, which
+/// it rewrites for each input) stays the same for longer than `limit`.
+fn watch(mut child: std::process::Child, current: &Path, limit: Duration) -> Ended {
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) => return Ended::Exited(status),
+            Ok(None) => {}
+            Err(_) => return Ended::TimedOut,
+        }
+        let idle = std::fs::metadata(current).and_then(|m| m.modified()).ok().and_then(|m| m.elapsed().ok());
+        if idle.is_some_and(|idle| idle > limit) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Ended::TimedOut;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }
 
 /// Runs `target` in workers for `--seconds` in all, starting a new one (with the next
@@ -200,15 +242,25 @@ fn supervise(args: &Args, target: Target) -> Supervised {
         for seed in &args.seeds {
             command.arg("--seeds").arg(seed);
         }
-        let status = command.status().expect("starting a fuzzing worker");
-        match read_report(&report_path) {
-            Some(report) if status.success() => add(&mut total.report, report),
-            _ => {
+        let child = command.spawn().expect("starting a fuzzing worker");
+        let ended = watch(child, &current_path, Duration::from_secs(args.input_seconds));
+        match (ended, read_report(&report_path)) {
+            (Ended::Exited(status), Some(report)) if status.success() => add(&mut total.report, report),
+            (Ended::TimedOut, _) => {
+                let path = save_input(args, &current_path, format!("{}-timeout-{restarts}", target.name()));
+                eprintln!(
+                    "gnomon-fuzz: {} took over {} s on one input; it is {}",
+                    target.name(),
+                    args.input_seconds,
+                    path.display()
+                );
+                total.report.crashes.push(path);
+                total.timeouts += 1;
+            }
+            (Ended::Exited(status), _) => {
                 // The worker died on its current input: past the memory cap, or any
                 // other abort. Keep the input; go on with a new worker.
-                let _ = std::fs::create_dir_all(&args.crashes);
-                let path = args.crashes.join(format!("{}-died-{}", target.name(), restarts));
-                let _ = std::fs::copy(&current_path, &path);
+                let path = save_input(args, &current_path, format!("{}-died-{restarts}", target.name()));
                 eprintln!(
                     "gnomon-fuzz: {} worker died ({status}); its input is {}",
                     target.name(),
@@ -221,6 +273,14 @@ fn supervise(args: &Args, target: Target) -> Supervised {
         restarts += 1;
     }
     total
+}
+
+/// Keeps the input a worker died or stalled on, under `--crashes` as `name`.
+fn save_input(args: &Args, current: &Path, name: String) -> PathBuf {
+    let _ = std::fs::create_dir_all(&args.crashes);
+    let path = args.crashes.join(name);
+    let _ = std::fs::copy(current, &path);
+    path
 }
 
 fn add(total: &mut Report, one: Report) {

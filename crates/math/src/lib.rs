@@ -27,6 +27,7 @@ pub mod fitting;
 pub mod kernels;
 mod light;
 pub mod light_masks;
+pub mod median_bvh;
 pub mod octahedron;
 pub mod omni;
 mod projection;

@@ -201,6 +201,18 @@ pub enum RenderError {
     /// A setting is out of its valid range.
     #[error(transparent)]
     Settings(#[from] SettingsError),
+    /// The frame (or the scene alone) would take more memory than the budget allows
+    /// ([`gnomon_scene::memory`]).
+    #[error("scene `{scene}`: {over}")]
+    OverBudget {
+        /// The scene's name.
+        scene: String,
+        /// What it would take, the budget and the largest items.
+        over: gnomon_scene::memory::OverBudget,
+    },
+    /// The memory budget asked for is not valid (its variable and the valid range).
+    #[error("{0}")]
+    MemoryBudget(String),
     /// The scene is not well formed (checked before upload).
     #[error(transparent)]
     Scene(#[from] SceneError),

@@ -6,6 +6,7 @@
 pub mod builtin;
 pub mod camera_path;
 mod casters;
+pub mod files;
 #[cfg(feature = "cli")]
 pub mod flags;
 pub mod framing;
@@ -13,6 +14,7 @@ pub mod geometry;
 pub mod gltf_loader;
 pub mod lights;
 pub mod limits;
+pub mod memory;
 mod model;
 mod scene_error;
 pub mod scene_file;

@@ -54,7 +54,21 @@ pub enum PlanError {
         "nothing to sweep: every range holds one value; give at least one LOW..HIGH:STEPS with STEPS ≥ 2 (--sweep-depth-bias, --sweep-slope-bias, --sweep-normal-offset or --sweep-kernel)"
     )]
     OnePoint,
+    #[error(
+        "{flag} {range} gives {distinct} distinct values in {steps} steps: the depth bias is a whole number of \
+         units, so give at most {distinct} steps over that range"
+    )]
+    RepeatedValues { flag: &'static str, range: SweepRange, steps: u32, distinct: usize },
+    #[error(
+        "the sweep is {points} points ({detail}), each a render of every view: at most {MAX_GRID_POINTS}; sweep \
+         fewer settings at once, or fewer steps"
+    )]
+    TooManyPoints { points: u64, detail: String },
 }
+
+/// The most points a calibration's grid may hold: each is a render of every view, so
+/// 1024 points at the default 4 views are some 4 096 renders.
+pub const MAX_GRID_POINTS: u64 = 1024;
 
 /// One setting a calibration may sweep, as messages name it.
 struct Knob {
@@ -167,6 +181,27 @@ pub fn grid(
         values.of(&NORMAL_OFFSET, requested.normal_offset, Some(DEFAULT_NORMAL_OFFSET), b.normal_offset)?;
     let default_kernel = (kernel_unit == KernelUnit::Texels).then_some(DEFAULT_KERNEL);
     let kernels = values.of(&KERNEL, requested.kernel, default_kernel, base.pcf_kernel)?;
+    // The depth bias is a whole number: a range of more steps than whole values would
+    // measure the same points many times over.
+    let mut depth_biases: Vec<f32> = depth_biases.iter().map(|v| v.round()).collect();
+    depth_biases.dedup();
+    if let Some(range) = requested.depth_bias
+        && depth_biases.len() < range.steps as usize
+    {
+        return Err(PlanError::RepeatedValues {
+            flag: DEPTH_BIAS.flag,
+            range,
+            steps: range.steps,
+            distinct: depth_biases.len(),
+        });
+    }
+    let counts = [depth_biases.len(), slope_biases.len(), normal_offsets.len(), kernels.len()];
+    let points: u64 = counts.iter().map(|&n| n as u64).product();
+    if points > MAX_GRID_POINTS {
+        let [d, s, n, k] = counts;
+        let detail = format!("{d} depth biases × {s} slope biases × {n} normal offsets × {k} kernels");
+        return Err(PlanError::TooManyPoints { points, detail });
+    }
     let mut grid = Vec::new();
     for &depth_bias in &depth_biases {
         for &slope_bias in &slope_biases {
@@ -269,6 +304,32 @@ mod tests {
         let one =
             Requested { slope_bias: range("1..1:1"), normal_offset: range("0..0:1"), ..Default::default() };
         assert!(matches!(grid_of(Technique::HARD, one), Err(PlanError::OnePoint)));
+    }
+
+    /// The audit's two: 64 steps of a whole-number bias over 0..1 (two values), and a
+    /// grid of 64⁴ points.
+    #[test]
+    fn repeated_points_and_huge_grids_are_refused() {
+        let grid_of = |requested: Requested| {
+            grid(&requested, &TechniqueRegistry::builtin(), &Technique::HARD, &base(), KernelUnit::Texels)
+        };
+        let repeated = grid_of(Requested { depth_bias: range("0..1:64"), ..Default::default() }).unwrap_err();
+        assert!(matches!(repeated, PlanError::RepeatedValues { distinct: 2, steps: 64, .. }), "{repeated}");
+        let whole = Requested {
+            depth_bias: range("0..63:64"),
+            slope_bias: range("0..0:1"),
+            normal_offset: range("0..0:1"),
+            kernel: None,
+        };
+        assert_eq!(grid_of(whole).unwrap().len(), 64, "64 whole values in 0..63");
+        let all = Requested {
+            depth_bias: range("0..63:64"),
+            slope_bias: range("0..4:64"),
+            normal_offset: range("0..2:64"),
+            kernel: None,
+        };
+        let huge = grid_of(all).unwrap_err();
+        assert!(matches!(huge, PlanError::TooManyPoints { points: 262_144, .. }), "{huge}");
     }
 
     #[test]

@@ -30,7 +30,8 @@ fn flags_beyond_their_finite_range_are_refused_before_any_work() {
         ("--sun-elevation", "-30", "(0, 90]"),
         ("--sun-azimuth", "inf", "[-360, 360]"),
         ("--sun-angular-diameter", "1e30", "[0, 30]"),
-        ("--fov", "0", "between 0 and 180"),
+        ("--fov", "0", "at least 0.01 degrees and below 180"),
+        ("--fov", "1e-5", "at least 0.01 degrees"),
         ("--camera-near", "-1", "(0, 1e7]"),
         ("--csm-scale", "1e30", "(0, 100]"),
         ("--contact-distance", "1e30", "(0, 1e7]"),
@@ -212,6 +213,8 @@ fn an_interrupt_while_staging_leaves_no_file_behind() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_gnomon"))
         .current_dir(dir)
         .args(["render", "--width", "2048", "--height", "2048", "--aov-out", "aov", "--out", "a.png"])
+        // A frame of 4 M pixels, over the default budget: large, so that staging lasts.
+        .env("GNOMON_MEMORY_MIB", "4096")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()

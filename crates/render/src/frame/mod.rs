@@ -12,6 +12,7 @@ mod host_target;
 mod late;
 mod light_passes;
 mod map_cache;
+mod memory;
 mod moment_cache;
 mod outputs;
 mod penumbra_history;
@@ -95,6 +96,9 @@ pub struct Renderer {
     penumbra_histories: penumbra_history::PenumbraHistories,
     /// Each virtual light's pool of pages, kept across frames.
     virtual_lights: virtual_pages::VirtualLights,
+    /// The bytes a frame may hold, and where that limit came from
+    /// ([`gnomon_scene::memory::frame_budget`]).
+    memory_budget: (u64, String),
 }
 
 impl Renderer {
@@ -107,6 +111,7 @@ impl Renderer {
     /// A renderer that knows `techniques`: the built-in ones and any the host
     /// registered ([`TechniqueRegistry::with`]).
     pub fn with_techniques(gpu: &Gpu, techniques: TechniqueRegistry) -> Result<Self, RenderError> {
+        let memory_budget = gnomon_scene::memory::frame_budget().map_err(RenderError::MemoryBudget)?;
         gpu.checked("creating the renderer", || {
             let device = &gpu.device;
             let layouts = Layouts::new(device);
@@ -136,6 +141,7 @@ impl Renderer {
                 techniques,
                 layouts,
                 passes,
+                memory_budget,
             }
         })
     }
@@ -181,6 +187,7 @@ impl Renderer {
         request: &OutputRequest,
     ) -> Result<Frame, RenderError> {
         settings.validate()?;
+        self.check_frame_memory(scene, settings)?;
         let uploaded = self.upload(scene)?;
         self.render_uploaded_async(&uploaded, scene, settings, request).await
     }
@@ -194,6 +201,7 @@ impl Renderer {
 
     /// Uploads a scene's geometry, instances and textures.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene, RenderError> {
+        self.check_scene_memory(scene)?;
         GpuScene::upload(&self.gpu, scene, &self.layouts)
     }
 

@@ -86,6 +86,7 @@ impl Renderer {
         self.pool.end_frame();
         settings.validate()?;
         self.check_limits(settings)?;
+        self.check_frame_memory(scene, settings)?;
         let mut plan = self.plan_frame(uploaded, scene, settings, request.fixed_layout).await?;
         let fallbacks = self.prepare_rays(uploaded, scene, settings, &mut plan)?;
         let planned = Instant::now();

@@ -62,6 +62,24 @@ fn every_caster_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
     assert!(bvh.depth <= MAX_DEPTH && bvh.depth > 1);
 }
 
+/// 500 copies of one mesh in one place (issue 75: 1 000 made PLOC's tree 1 009
+/// levels deep): the median-split fallback keeps every triangle in one leaf inside
+/// its boxes, and the tree shallow enough for the GPU's stack, and refits.
+#[test]
+fn coincident_instances_build_a_shallow_tree_that_refits() {
+    let mut scene = builtin::spheres();
+    let copy = scene.instances[1].clone();
+    scene.instances.extend((0..500).map(|_| copy.clone()));
+    let mut bvh = CasterBvh::build(&scene);
+    assert_eq!(bvh.triangles.len(), caster_triangles(&scene));
+    assert_boxes_hold_their_triangles(&bvh);
+    assert!(bvh.depth <= MAX_DEPTH, "depth {}", bvh.depth);
+    let last = scene.instances.len() - 1;
+    scene.instances[last].world_from_object *= Mat4::from_translation(Vec3::new(0.0, 5.0, 0.0));
+    bvh.refit(&scene, &[last]);
+    assert_refitted(&bvh, &scene);
+}
+
 /// Checks that `bvh`, refitted after moves, holds exactly the triangles a new
 /// build of `scene` holds, each inside all of its boxes, and that every box is
 /// tight: the refitted ones and those the refit left alone.

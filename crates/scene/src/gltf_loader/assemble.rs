@@ -21,36 +21,58 @@ pub(super) fn build(
     document: &gltf::Document,
     buffers: &[gltf::buffer::Data],
     images: &[gltf::image::Data],
+    budget: &mut super::sources::Budget,
 ) -> Result<(Scene, FileExtras), String> {
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let textures = textures(document, images)?;
-    let materials = materials(document);
+    let textures = textures(document, images, budget)?;
+    let materials = materials(document, &textures.of_gltf_texture);
     let meshes = meshes(document, buffers, &materials)?;
     let mut placed = walk(document, &meshes, &materials.list)?;
+    charge_placed(&meshes.list, &placed.instances, budget)?;
     drawn(&meshes, &mut placed)?;
-    finish(Parts { name, textures, materials: materials.list, meshes: meshes.list, placed })
+    finish(Parts { name, textures: textures.list, materials: materials.list, meshes: meshes.list, placed })
 }
 
-/// One texture per glTF texture, with its image and sampler.
-fn textures(document: &gltf::Document, images: &[gltf::image::Data]) -> Result<Vec<Texture>, String> {
-    document
-        .textures()
-        .map(|t| {
-            let image = images
-                .get(t.source().index())
-                .ok_or_else(|| format!("texture {} has no image", t.index()))?;
-            let sampler = t.sampler();
-            Ok(Texture {
-                name: t.name().unwrap_or("texture").to_string(),
-                width: image.width,
-                height: image.height,
-                rgba8: images::to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
-                wrap_u: images::wrap(sampler.wrap_s()),
-                wrap_v: images::wrap(sampler.wrap_t()),
-                nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
-            })
-        })
-        .collect()
+/// The scene's textures and, for each glTF texture, its index among them: one per
+/// distinct image and sampler, so that many glTF textures of one image hold its
+/// pixels once (16 textures of one 4096² PNG took 3.2 GB when each had its copy).
+struct Textures {
+    list: Vec<Texture>,
+    of_gltf_texture: Vec<usize>,
+}
+
+fn textures(
+    document: &gltf::Document,
+    images: &[gltf::image::Data],
+    budget: &mut super::sources::Budget,
+) -> Result<Textures, String> {
+    let mut out = Textures { list: Vec::new(), of_gltf_texture: Vec::new() };
+    let mut seen: Vec<(usize, Option<usize>)> = Vec::new();
+    for t in document.textures() {
+        let key = (t.source().index(), t.sampler().index());
+        if let Some(at) = seen.iter().position(|k| *k == key) {
+            out.of_gltf_texture.push(at);
+            continue;
+        }
+        let image = images.get(key.0).ok_or_else(|| format!("texture {} has no image", t.index()))?;
+        // Each distinct texture holds its own pixels, here and on the GPU.
+        let texels = u64::from(image.width) * u64::from(image.height);
+        let what = format!("texture {}, {}×{} texels,", t.index(), image.width, image.height);
+        budget.take(texels.saturating_mul(crate::memory::BYTES_PER_TEXEL), &what)?;
+        let sampler = t.sampler();
+        out.list.push(Texture {
+            name: t.name().unwrap_or("texture").to_string(),
+            width: image.width,
+            height: image.height,
+            rgba8: images::to_rgba8(image).map_err(|e| format!("texture {}: {e}", t.index()))?,
+            wrap_u: images::wrap(sampler.wrap_s()),
+            wrap_v: images::wrap(sampler.wrap_t()),
+            nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
+        });
+        seen.push(key);
+        out.of_gltf_texture.push(out.list.len() - 1);
+    }
+    Ok(out)
 }
 
 /// The file's materials and a default one (last) for primitives without one, with
@@ -61,7 +83,7 @@ struct Materials {
     default: usize,
 }
 
-fn materials(document: &gltf::Document) -> Materials {
+fn materials(document: &gltf::Document, texture_of: &[usize]) -> Materials {
     let mut list = Vec::new();
     let mut texcoord_sets = Vec::new();
     for m in document.materials() {
@@ -70,7 +92,8 @@ fn materials(document: &gltf::Document) -> Materials {
         let texture = pbr.base_color_texture();
         let mut material = Material::new(m.name().unwrap_or("material"), Vec3::new(r, g, b));
         material.alpha = a;
-        material.base_color_texture = texture.as_ref().map(|t| t.texture().index());
+        material.base_color_texture =
+            texture.as_ref().and_then(|t| texture_of.get(t.texture().index()).copied());
         material.alpha_mode = match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
@@ -113,10 +136,13 @@ fn meshes(
             let label = format!("mesh {} (`{}`) primitive {k}", mesh.index(), mesh.name().unwrap_or(""));
             let material = prim.material().index().unwrap_or(materials.default);
             match primitives::read(&prim, buffers, materials.texcoord_sets[material], label)? {
-                Some(m) => {
+                Some(mut m) => {
                     out.modes.triangles += 1;
-                    out.list.push(m);
-                    here.push(MeshMaterial { mesh: out.list.len() - 1, material });
+                    out.modes.degenerate_triangles += primitives::drop_degenerate(&mut m);
+                    if !m.indices.is_empty() {
+                        out.list.push(m);
+                        here.push(MeshMaterial { mesh: out.list.len() - 1, material });
+                    }
                 }
                 None if prim.mode() == gltf::mesh::Mode::Points => out.modes.points += 1,
                 None => out.modes.lines += 1,
@@ -240,7 +266,9 @@ fn perspective_camera(node: &gltf::Node, world: Mat4) -> Option<Camera> {
         up,
         fov_y_degrees: p.yfov().to_degrees(),
         near: p.znear(),
-        far: p.zfar().unwrap_or(p.znear() * 1e5),
+        // No `zfar`: an infinite projection (glTF 2.0, §3.10.3), which `finish` turns
+        // into a far plane past everything the file holds.
+        far: p.zfar().unwrap_or(f32::INFINITY),
     })
 }
 
@@ -250,10 +278,22 @@ fn drawn(meshes: &Meshes, placed: &mut Placed) -> Result<(), String> {
     if let Some(skipped) = meshes.modes.skipped() {
         placed.extras.warnings.push(format!("{skipped} skipped: points and lines cast no shadow"));
     }
+    if meshes.modes.degenerate_triangles > 0 {
+        placed.extras.warnings.push(format!(
+            "{} triangle(s) of zero area dropped: they cover no pixel and cast no shadow",
+            meshes.modes.degenerate_triangles
+        ));
+    }
     if placed.singular_nodes > 0 {
         placed.extras.warnings.push(format!(
             "{} node(s) with meshes have a singular transform (determinant 0): they flatten to nothing",
             placed.singular_nodes
+        ));
+    }
+    if placed.instances.is_empty() && meshes.modes.degenerate_triangles > 0 {
+        return Err(format!(
+            "every triangle of its scene has zero area ({} dropped): nothing would be drawn",
+            meshes.modes.degenerate_triangles
         ));
     }
     if placed.instances.is_empty() {
@@ -272,19 +312,43 @@ fn drawn(meshes: &Meshes, placed: &mut Placed) -> Result<(), String> {
     Ok(())
 }
 
+/// Charges every instance's triangles as the casters' BVHs will hold them, placed in
+/// world space: a mesh instanced a hundred times is held a hundred times there.
+fn charge_placed(
+    meshes: &[Mesh],
+    instances: &[Instance],
+    budget: &mut super::sources::Budget,
+) -> Result<(), String> {
+    use crate::memory::{BYTES_PER_INSTANCE, BYTES_PER_PLACED_TRIANGLE};
+    let placed: u64 = instances.iter().map(|i| meshes[i.mesh].indices.len() as u64 / 3).sum();
+    let bytes = placed
+        .saturating_mul(BYTES_PER_PLACED_TRIANGLE)
+        .saturating_add(instances.len() as u64 * BYTES_PER_INSTANCE);
+    budget.take(bytes, &format!("its {} instances' {placed} placed triangles", instances.len()))
+}
+
 /// Whether any instance has a triangle of non-zero area once placed: a file of
 /// degenerate triangles only (or of meshes flattened by their nodes) draws an empty
 /// sky, which a calibration would then measure as "0 pixels".
 fn draws_anything(meshes: &[Mesh], instances: &[Instance]) -> bool {
     instances.iter().any(|instance| {
         let mesh = &meshes[instance.mesh];
-        let world: Vec<Vec3> =
-            mesh.positions.iter().map(|p| instance.world_from_object.transform_point3(*p)).collect();
+        // Placed a triangle at a time: usually the first answers, with no copy of the
+        // mesh made per instance.
+        let place = |i: u32| instance.world_from_object.transform_point3(mesh.positions[i as usize]);
         mesh.indices.chunks_exact(3).any(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| world[i as usize]);
+            let [a, b, c] = [t[0], t[1], t[2]].map(place);
             (b - a).cross(c - a).length_squared() > 0.0
         })
     })
+}
+
+/// A far plane for an infinite glTF projection: past the farthest corner of the
+/// scene's bounds from the eye (with a margin for the depth test's rounding), so
+/// that everything the file holds is drawn, and at least twice the near plane.
+fn far_past_everything(camera: &Camera, bounds: &gnomon_math::Aabb) -> f32 {
+    let farthest = bounds.corners().iter().map(|c| c.distance(camera.eye)).fold(0.0_f32, f32::max);
+    (farthest * 1.05).max(camera.near * 2.0)
 }
 
 /// What the scene is made of.
@@ -335,6 +399,9 @@ fn finish(parts: Parts) -> Result<(Scene, FileExtras), String> {
     let (center, radius) = (bounds.center(), bounds.bounding_radius().max(1e-3));
     extras.has_camera = camera.is_some();
     scene.camera = camera.unwrap_or_else(|| crate::framing::default_camera(&scene));
+    if scene.camera.far == f32::INFINITY {
+        scene.camera.far = far_past_everything(&scene.camera, &bounds);
+    }
     scene.lights = listed;
     // A kind the file lists no light of gets Gnomon's default; one it lists draws its first.
     if !extras.has_sun {

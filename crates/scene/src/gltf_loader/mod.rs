@@ -18,6 +18,7 @@ mod node_extras;
 mod primitives;
 pub mod sources;
 mod structure;
+mod values;
 
 pub use sources::UriScope;
 
@@ -67,8 +68,19 @@ pub fn load(path: &Path) -> Result<(Scene, FileExtras), LoadError> {
 
 /// Loads `path` into a scene as [`load`] does, with `options`.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtras), LoadError> {
+    load_charged(path, options, &mut sources::Budget::default())
+}
+
+/// Loads `path` as [`load_with`] does, charging what it holds to `budget`: the one
+/// budget every model of a scene file shares, so that twelve models of a few
+/// kilobytes cannot each take the whole frame's memory.
+pub fn load_charged(
+    path: &Path,
+    options: &LoadOptions,
+    budget: &mut sources::Budget,
+) -> Result<(Scene, FileExtras), LoadError> {
     let bytes = read_model(path).map_err(|problem| LoadError { path: path.to_path_buf(), problem })?;
-    load_bytes(&bytes, path, options)
+    load_bytes(&bytes, path, options, budget)
 }
 
 /// Loads a model given as bytes (a `.glb`, or a `.gltf` whose data are `data:`
@@ -87,11 +99,21 @@ pub fn load_from_bytes(bytes: &[u8], name: &str) -> Result<(Scene, FileExtras), 
             ),
         });
     }
-    load_bytes(bytes, path, &LoadOptions { uri_scope: UriScope::EmbeddedOnly })
+    load_bytes(
+        bytes,
+        path,
+        &LoadOptions { uri_scope: UriScope::EmbeddedOnly },
+        &mut sources::Budget::default(),
+    )
 }
 
 /// Loads the model `bytes`, read from (or named) `path`.
-fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene, FileExtras), LoadError> {
+fn load_bytes(
+    bytes: &[u8],
+    path: &Path,
+    options: &LoadOptions,
+    budget: &mut sources::Budget,
+) -> Result<(Scene, FileExtras), LoadError> {
     let fail = |problem: String| LoadError { path: path.to_path_buf(), problem };
     glb_header_fits(bytes).map_err(fail)?;
     // A first look without validation, for the problems validation would misname.
@@ -127,14 +149,14 @@ fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene
         }
         check_version(json).map_err(fail)?;
         structure::check(json).map_err(fail)?;
+        values::check(json).map_err(fail)?;
     }
     // The gltf crate validates the JSON and the buffer and accessor ranges; guard
     // against a panic on data it does not check all the same.
     let base = path.parent().unwrap_or(Path::new("."));
-    let mut budget = sources::Budget::default();
     let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| describe(&e))?;
-        let buffers = sources::buffers(&document, base, blob, options.uri_scope, &mut budget)?;
+        let buffers = sources::buffers(&document, base, blob, options.uri_scope, budget)?;
         Ok::<_, String>((document, buffers))
     }))
     .map_err(|_| fail("the glTF importer failed on malformed data".into()))?;
@@ -155,15 +177,17 @@ fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene
             return Err(fail(problem));
         }
     };
-    accessors_fit(&document, &mut budget).map_err(fail)?;
-    let extension_warnings = extensions(&document).map_err(fail)?;
+    accessors_fit(&document, budget).map_err(fail)?;
+    values::sparse_indices(&document, &buffers).map_err(fail)?;
+    let mut extension_warnings = extensions(&document).map_err(fail)?;
+    extension_warnings.extend(values::unsupported(document.as_json()));
     let images = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        images::import(&document, base, &buffers, options.uri_scope, &mut budget)
+        images::import(&document, base, &buffers, options.uri_scope, budget)
     }))
     .map_err(|_| fail("the glTF image reader failed on malformed data".into()))?
     .map_err(fail)?;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        assemble::build(path, &document, &buffers, &images)
+        assemble::build(path, &document, &buffers, &images, budget)
     }))
     .map(|built| {
         built.map(|(scene, mut extras)| {
@@ -178,22 +202,19 @@ fn load_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<(Scene
 /// The model file's bytes: a regular file (not a directory, FIFO or device, each of
 /// which is named as what it is), no larger than a model may be.
 fn read_model(path: &Path) -> Result<Vec<u8>, String> {
-    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => "cannot read: no such file".to_string(),
-        _ => format!("cannot read: {e}"),
-    })?;
-    if !metadata.is_file() {
-        return Err(format!("cannot read: it is {}, not a regular file", sources::file_kind(&metadata)));
+    use crate::files::{Links, ReadError, read_regular};
+    let bytes = read_regular(path, Links::Follow, crate::limits::MAX_MODEL_BYTES, "a model").map_err(
+        |e| match e {
+            ReadError::Missing => "cannot read: no such file".to_string(),
+            ReadError::NotRegular(kind) => format!("cannot read: it is {kind}, not a regular file"),
+            other => other.to_string(),
+        },
+    )?;
+    if bytes.is_empty() {
+        // A pseudo file (`/proc/self/pagemap`) states no length and is read as such.
+        return Err("the file is empty (it states a length of 0 bytes)".into());
     }
-    let limit = crate::limits::MAX_MODEL_BYTES;
-    if metadata.len() > limit {
-        return Err(format!(
-            "the file is {}; a model may be at most {}",
-            sources::size(metadata.len()),
-            sources::size(limit)
-        ));
-    }
-    std::fs::read(path).map_err(|e| format!("cannot read: {e}"))
+    Ok(bytes)
 }
 
 /// glTF 2.x only: `asset.version` is "2.0" (a `minVersion` above it is refused too).
@@ -235,6 +256,30 @@ fn accessors_fit(document: &gltf::Document, budget: &mut sources::Budget) -> Res
         // and the element itself as stored.
         let expanded = (accessor.count() as u64).saturating_mul(element.max(16));
         budget.take(expanded, &format!("{what}, {} elements,", accessor.count()))?;
+    }
+    primitives_fit(document, budget)
+}
+
+/// Charges every triangle primitive's mesh as Gnomon will hold it, once per
+/// primitive that reads it (300 primitives sharing one POSITION accessor make 300
+/// meshes): its vertices and triangles ([`crate::memory`]'s costs). A sparse
+/// accessor's count is charged whole, whatever few bytes it is stored in.
+fn primitives_fit(document: &gltf::Document, budget: &mut sources::Budget) -> Result<(), String> {
+    use crate::memory::{BYTES_PER_TRIANGLE, BYTES_PER_VERTEX};
+    for mesh in document.meshes() {
+        for (k, prim) in mesh.primitives().enumerate() {
+            let Some(positions) = prim.get(&gltf::Semantic::Positions) else { continue };
+            let vertices = positions.count() as u64;
+            let triangles = prim.indices().map_or(vertices, |i| i.count() as u64) / 3;
+            let bytes = vertices
+                .saturating_mul(BYTES_PER_VERTEX)
+                .saturating_add(triangles.saturating_mul(BYTES_PER_TRIANGLE));
+            let what = format!(
+                "mesh {} primitive {k}, {vertices} vertices and {triangles} triangles,",
+                mesh.index()
+            );
+            budget.take(bytes, &what)?;
+        }
     }
     Ok(())
 }
@@ -309,6 +354,38 @@ fn glb_header_fits(bytes: &[u8]) -> Result<(), String> {
             "is a binary glTF (GLB) whose header declares a length of {length} bytes, less than the \
              {HEADER_BYTES}-byte header itself"
         ));
+    }
+    if u64::from(length) != bytes.len() as u64 {
+        return Err(format!(
+            "is a binary glTF (GLB) whose header declares a length of {length} bytes, but the file holds {}: \
+             the two must agree (glTF 2.0, §4.4.2)",
+            bytes.len()
+        ));
+    }
+    glb_chunks(&bytes[HEADER_BYTES as usize..])
+}
+
+/// Walks a GLB's chunks after its header: each fits in the file, and there is at
+/// most one binary chunk (glTF 2.0, §4.4.3.3); a second would be silently ignored.
+fn glb_chunks(mut rest: &[u8]) -> Result<(), String> {
+    const BIN: u32 = 0x004E_4942;
+    let mut binary_chunks = 0;
+    while rest.len() >= 8 {
+        let word = |at: usize| u32::from_le_bytes([rest[at], rest[at + 1], rest[at + 2], rest[at + 3]]);
+        let (length, kind) = (word(0) as usize, word(4));
+        let Some(after) = rest.get(8..).and_then(|r| r.get(length..)) else {
+            return Err(format!(
+                "is a binary glTF (GLB) with a chunk of {length} bytes that runs past the file's end"
+            ));
+        };
+        binary_chunks += usize::from(kind == BIN);
+        if binary_chunks > 1 {
+            return Err(
+                "is a binary glTF (GLB) with two binary (BIN) chunks; it may have one (glTF 2.0, §4.4.3.3)"
+                    .into(),
+            );
+        }
+        rest = after;
     }
     Ok(())
 }

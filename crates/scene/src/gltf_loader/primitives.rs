@@ -17,6 +17,9 @@ pub struct ModeCounts {
     pub points: usize,
     /// Lines, line loops and line strips: skipped.
     pub lines: usize,
+    /// Triangles of zero area, dropped: they cover no pixel and block no ray, and a
+    /// file of thousands at one point made the BVH and meshlet builds degenerate.
+    pub degenerate_triangles: usize,
 }
 
 impl ModeCounts {
@@ -163,6 +166,48 @@ pub fn read(
         return Err(format!("{label}: {} texture coordinates for {} positions", uvs.len(), positions.len()));
     }
     Ok(Some(Mesh { name: label, positions, normals, uvs, indices }))
+}
+
+/// Removes `mesh`'s triangles of zero area (their edges' cross product is exactly 0,
+/// which no affine placement changes) and returns how many went.
+pub fn drop_degenerate(mesh: &mut Mesh) -> usize {
+    let before = mesh.indices.len() / 3;
+    let positions = &mesh.positions;
+    let kept: Vec<u32> = mesh
+        .indices
+        .chunks_exact(3)
+        .filter(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+            (b - a).cross(c - a) != Vec3::ZERO
+        })
+        .flatten()
+        .copied()
+        .collect();
+    mesh.indices = kept;
+    let dropped = before - mesh.indices.len() / 3;
+    if dropped > 0 {
+        keep_referenced_vertices(mesh);
+    }
+    dropped
+}
+
+/// Removes the vertices no triangle of `mesh` uses any more (a file of millions of
+/// vertices at one point keeps none of them), renumbering the indices.
+fn keep_referenced_vertices(mesh: &mut Mesh) {
+    const UNUSED: u32 = u32::MAX;
+    let mut new_index = vec![UNUSED; mesh.positions.len()];
+    let mut order = Vec::new();
+    for i in &mut mesh.indices {
+        let slot = &mut new_index[*i as usize];
+        if *slot == UNUSED {
+            *slot = order.len() as u32;
+            order.push(*i as usize);
+        }
+        *i = *slot;
+    }
+    mesh.positions = order.iter().map(|&v| mesh.positions[v]).collect();
+    mesh.normals = order.iter().map(|&v| mesh.normals[v]).collect();
+    mesh.uvs = order.iter().map(|&v| mesh.uvs[v]).collect();
 }
 
 /// Area-weighted vertex normals, for meshes that come without them.

@@ -16,8 +16,6 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use crate::limits::MAX_MODEL_BYTES;
-
 /// Where the files a model names may be.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum UriScope {
@@ -32,16 +30,22 @@ pub enum UriScope {
     EmbeddedOnly,
 }
 
-/// The bytes a model may make the loader hold: its buffers, its decoded images and
-/// the vertex data it expands, together ([`MAX_MODEL_BYTES`]).
+/// The bytes a model (or every model of a scene file, sharing one) may make the
+/// loader hold: its buffers, its decoded images, the meshes it makes and their placed
+/// copies, together: the frame's budget ([`crate::memory::frame_budget`]), so that
+/// what loads is what the frame can then hold.
 #[derive(Debug)]
 pub struct Budget {
     left: u64,
+    limit: u64,
+    source: String,
 }
 
 impl Default for Budget {
     fn default() -> Self {
-        Budget { left: MAX_MODEL_BYTES }
+        let (limit, source) = crate::memory::frame_budget()
+            .unwrap_or((crate::memory::DEFAULT_FRAME_BUDGET, "the default".into()));
+        Budget { left: limit, limit, source }
     }
 }
 
@@ -50,10 +54,11 @@ impl Budget {
     pub fn take(&mut self, bytes: u64, what: &str) -> Result<(), String> {
         if bytes > self.left {
             return Err(format!(
-                "{what} takes {} but the model may take at most {} in all (buffers, decoded images \
-                 and vertex data; {} left)",
+                "{what} takes {} but a scene may take at most {} in all ({}: buffers, decoded images, \
+                 meshes and their placed copies; {} left)",
                 size(bytes),
-                size(MAX_MODEL_BYTES),
+                size(self.limit),
+                self.source,
                 size(self.left)
             ));
         }
@@ -62,15 +67,8 @@ impl Budget {
     }
 }
 
-/// `bytes` in words: `8.0 GB`, `294 KB`.
-pub fn size(bytes: u64) -> String {
-    match bytes {
-        b if b >= 1 << 30 => format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30)),
-        b if b >= 1 << 20 => format!("{:.1} MiB", b as f64 / f64::from(1u32 << 20)),
-        b if b >= 1 << 10 => format!("{:.1} KiB", b as f64 / 1024.0),
-        b => format!("{b} bytes"),
-    }
-}
+/// `bytes` in words: `8.0 GiB`, `294.0 KiB`.
+pub use crate::memory::size;
 
 /// The file a URI names, resolved against the model's folder `base` and checked:
 /// inside the folder unless `scope` allows more, and a regular file.
@@ -94,6 +92,9 @@ pub fn resolve(base: &Path, uri: &str, scope: UriScope, what: &str) -> Result<Pa
         UriScope::Anywhere => false,
     };
     let path = base.join(decoded.as_ref());
+    if folder_check {
+        inside_folder(base, &path, uri, what)?;
+    }
     let metadata = std::fs::metadata(&path).map_err(|e| {
         let base_shown = if base.as_os_str().is_empty() { Path::new(".") } else { base };
         match e.kind() {
@@ -106,21 +107,39 @@ pub fn resolve(base: &Path, uri: &str, scope: UriScope, what: &str) -> Result<Pa
     if !metadata.is_file() {
         return Err(format!("{what}: `{uri}` is {}, not a regular file", file_kind(&metadata)));
     }
-    if folder_check {
-        let folder =
-            std::fs::canonicalize(if base.as_os_str().is_empty() { Path::new(".") } else { base })
-                .map_err(|e| format!("{what}: cannot resolve the model's folder {}: {e}", base.display()))?;
-        let target =
-            std::fs::canonicalize(&path).map_err(|e| format!("{what}: cannot resolve `{uri}`: {e}"))?;
-        if !target.starts_with(&folder) {
-            return Err(format!(
-                "{what}: `{uri}` lies outside the model's folder ({}); a model may only name files beside \
-                 or below it (a caller may allow more: `UriScope::Anywhere`)",
-                folder.display()
-            ));
-        }
-    }
     Ok(path)
+}
+
+/// Refuses `path` unless it lies in the model's folder `base`, links resolved. The
+/// answer is the same whether or not the file exists, so a model cannot probe which
+/// paths outside its folder exist: the deepest part of the path that exists is
+/// resolved and must lie inside, and what follows it is checked by its names alone
+/// (no `..`).
+fn inside_folder(base: &Path, path: &Path, uri: &str, what: &str) -> Result<(), String> {
+    let folder = std::fs::canonicalize(if base.as_os_str().is_empty() { Path::new(".") } else { base })
+        .map_err(|e| format!("{what}: cannot resolve the model's folder {}: {e}", base.display()))?;
+    // `file_name` is never `..`, so the names popped here cannot climb; a path whose
+    // last part is `..` (`missing/..`) is resolved or refused as a whole.
+    let mut existing = path;
+    let resolved = loop {
+        match std::fs::canonicalize(existing) {
+            Ok(resolved) => break Some(resolved),
+            Err(_) => match (existing.parent(), existing.file_name()) {
+                (Some(parent), Some(_)) => {
+                    existing = if parent.as_os_str().is_empty() { Path::new(".") } else { parent }
+                }
+                _ => break None,
+            },
+        }
+    };
+    if resolved.is_some_and(|r| r.starts_with(&folder)) {
+        return Ok(());
+    }
+    Err(format!(
+        "{what}: `{uri}` lies outside the model's folder ({}); a model may only name files beside \
+         or below it (a caller may allow more: `UriScope::Anywhere`)",
+        folder.display()
+    ))
 }
 
 /// What kind of file system entry `metadata` describes, for a message.
@@ -148,8 +167,9 @@ pub fn file_kind(metadata: &std::fs::Metadata) -> &'static str {
 /// The first `length` bytes of the regular file at `path` (checked by [`resolve`]),
 /// which must hold at least that many.
 pub fn read_prefix(path: &Path, length: u64, what: &str, uri: &str) -> Result<Vec<u8>, String> {
-    let file = std::fs::File::open(path).map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?;
-    let on_disk = file.metadata().map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?.len();
+    let (file, metadata) = crate::files::open_regular(path, crate::files::Links::Follow)
+        .map_err(|e| format!("{what}: cannot read its file `{uri}`: {e}"))?;
+    let on_disk = metadata.len();
     if on_disk < length {
         return Err(format!(
             "{what}: its file `{uri}` holds {} but the model declares {}",
@@ -253,6 +273,15 @@ mod tests {
         // A model given as bytes names no file at all, even one beside it.
         let e = resolve(&model, "mine.bin", UriScope::EmbeddedOnly, "buffer 0").unwrap_err();
         assert!(e.contains("given as bytes") && e.contains("`mine.bin`"), "{e}");
+        // A missing file outside gets the same answer as an existing one: a model
+        // cannot probe which paths exist.
+        let missing = resolve(&model, "../no-such.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+        let existing = resolve(&model, "../secret.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+        assert_eq!(missing.replace("no-such", "secret"), existing);
+        let e = resolve(&model, "sub/../gone.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+        assert!(e.contains("outside"), "a path through a missing folder is judged as outside: {e}");
+        let e = resolve(&model, "gone.bin", UriScope::ModelFolder, "buffer 0").unwrap_err();
+        assert!(e.contains("is missing"), "a missing file inside is reported as missing: {e}");
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(dir.path().join("secret.bin"), model.join("link.bin")).unwrap();
@@ -292,8 +321,8 @@ mod tests {
     #[test]
     fn the_budget_refuses_what_it_cannot_hold_and_says_how_much() {
         let mut budget = Budget::default();
-        budget.take(MAX_MODEL_BYTES / 2, "buffer 0").unwrap();
-        let e = budget.take(MAX_MODEL_BYTES, "image 4").unwrap_err();
-        assert!(e.contains("image 4") && e.contains("GiB"), "{e}");
+        budget.take(budget.limit / 2, "buffer 0").unwrap();
+        let e = budget.take(budget.limit, "image 4").unwrap_err();
+        assert!(e.contains("image 4") && e.contains("at most") && e.contains("left"), "{e}");
     }
 }

@@ -17,6 +17,7 @@ pub(super) struct SunEntry {
     azimuth: f32,
     #[serde(default)]
     angular_diameter: f32,
+    #[serde(default, deserialize_with = "super::three::optional")]
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
 }
@@ -24,13 +25,16 @@ pub(super) struct SunEntry {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SpotEntry {
+    #[serde(deserialize_with = "super::three::exact")]
     position: [f32; 3],
+    #[serde(deserialize_with = "super::three::exact")]
     target: [f32; 3],
     outer_angle: f32,
     inner_angle: Option<f32>,
     range: f32,
     #[serde(default)]
     radius: f32,
+    #[serde(default, deserialize_with = "super::three::optional")]
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
     falloff: Option<FalloffEntry>,
@@ -39,10 +43,12 @@ pub(super) struct SpotEntry {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct PointEntry {
+    #[serde(deserialize_with = "super::three::exact")]
     position: [f32; 3],
     range: f32,
     #[serde(default)]
     radius: f32,
+    #[serde(default, deserialize_with = "super::three::optional")]
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
     falloff: Option<FalloffEntry>,
@@ -59,12 +65,15 @@ pub(super) struct LightEntry {
     elevation: Option<f32>,
     azimuth: Option<f32>,
     angular_diameter: Option<f32>,
+    #[serde(default, deserialize_with = "super::three::optional")]
     position: Option<[f32; 3]>,
+    #[serde(default, deserialize_with = "super::three::optional")]
     target: Option<[f32; 3]>,
     outer_angle: Option<f32>,
     inner_angle: Option<f32>,
     range: Option<f32>,
     radius: Option<f32>,
+    #[serde(default, deserialize_with = "super::three::optional")]
     color: Option<[f32; 3]>,
     intensity: Option<f32>,
     falloff: Option<FalloffEntry>,

@@ -59,6 +59,7 @@ use crate::{
 
 mod entries;
 mod locate;
+mod three;
 
 use entries::{EntryError, LightEntry, PointEntry, SpotEntry, SunEntry};
 pub use locate::{KeyPath, Step, display, locate};
@@ -98,9 +99,9 @@ struct SceneFile {
 #[serde(deny_unknown_fields)]
 struct ModelEntry {
     file: PathBuf,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three::exact")]
     translation: [f32; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three::exact")]
     rotation_degrees: [f32; 3],
     #[serde(default = "one")]
     scale: f32,
@@ -117,7 +118,9 @@ fn one() -> f32 {
 #[serde(deny_unknown_fields)]
 struct ViewEntry {
     name: String,
+    #[serde(deserialize_with = "three::exact")]
     eye: [f32; 3],
+    #[serde(deserialize_with = "three::exact")]
     target: [f32; 3],
     fov: Option<f32>,
     near: Option<f32>,
@@ -198,25 +201,17 @@ pub fn load_with(
     options: &gltf_loader::LoadOptions,
 ) -> Result<LoadedSceneFile, SceneFileError> {
     let unreadable = |problem: String| SceneFileError { path: path.to_path_buf(), location: None, problem };
-    let metadata = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => unreadable("cannot read: no such file".into()),
-        _ => unreadable(format!("cannot read: {e}")),
-    })?;
-    if !metadata.is_file() {
-        return Err(unreadable(format!(
-            "cannot read: it is {}, not a regular file",
-            gltf_loader::sources::file_kind(&metadata)
-        )));
-    }
     let limit = crate::limits::MAX_SCENE_FILE_BYTES;
-    if metadata.len() > limit {
-        return Err(unreadable(format!(
-            "the file is {}; a scene file may be at most {}",
-            gltf_loader::sources::size(metadata.len()),
-            gltf_loader::sources::size(limit)
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| unreadable(format!("cannot read: {e}")))?;
+    let bytes = crate::files::read_regular(path, crate::files::Links::Follow, limit, "a scene file")
+        .map_err(|e| match e {
+            crate::files::ReadError::Missing => unreadable("cannot read: no such file".into()),
+            crate::files::ReadError::NotRegular(kind) => {
+                unreadable(format!("cannot read: it is {kind}, not a regular file"))
+            }
+            other => unreadable(other.to_string()),
+        })?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| unreadable("cannot read: it is not UTF-8 text".into()))?;
     let source = Source { path: path.to_path_buf(), text };
     // toml's own errors carry the line, the column and the offending text.
     let file: SceneFile = toml::from_str(&source.text).map_err(|e| source.fail(e.to_string()))?;
@@ -314,10 +309,12 @@ fn start_scene(
         None => None,
     };
     let base = source.path.parent().unwrap_or(Path::new("."));
+    // One budget for every model: a dozen small files must not each take the frame's.
+    let mut budget = gltf_loader::sources::Budget::default();
     for (i, model) in file.model.iter().enumerate() {
         let at = |key: &'static str| [Step::Key("model"), Step::Index(i), Step::Key(key)];
         let model_path = base.join(&model.file);
-        let (loaded, extras) = gltf_loader::load_with(&model_path, options)
+        let (loaded, extras) = gltf_loader::load_charged(&model_path, options, &mut budget)
             .map_err(|e| source.fail_at(&at("file"), format!("model: {e}")))?;
         warnings.extend(extras.warnings.iter().map(|w| format!("model `{}`: {w}", model.file.display())));
         let [rx, ry, rz] = model.rotation_degrees.map(f32::to_radians);

@@ -148,7 +148,7 @@ pub struct CameraSettings {
     /// Point the camera looks at, as X,Y,Z [default: the scene's].
     #[cfg_attr(feature = "cli", arg(long = "camera-target", value_name = "X,Y,Z", value_parser = parse_vec3, help_heading = "Camera"))]
     pub target: Option<Vec3>,
-    /// Full vertical field of view in degrees, in (0, 180) [default: the scene's].
+    /// Full vertical field of view in degrees, in [0.01, 180) [default: the scene's].
     #[cfg_attr(feature = "cli", arg(long = "fov", value_name = "DEGREES", help_heading = "Camera"))]
     pub fov_y_degrees: Option<f32>,
     /// Near clip distance in world units, > 0 [default: the scene's].

@@ -50,6 +50,10 @@ const RULES: &[(&str, Uses, &str)] = &[
         |s, lights| lights.iter().any(|l| l.shadow.map.resolution == s.shadow.map.resolution),
         "a light that does not set its own (each light here sets its own `shadow.map.resolution` in the scene)",
     ),
+    ("shadow.virtual_map.pool_side", uses_virtual, VIRTUAL),
+    ("shadow.virtual_map.lod_bias", uses_virtual, VIRTUAL),
+    ("shadow.virtual_map.edge_levels", uses_virtual, VIRTUAL),
+    ("shadow.virtual_map.level_resolution", uses_virtual, VIRTUAL),
     ("shadow.cascades.count", uses_cascades, CASCADES),
     ("shadow.cascades.split", uses_cascades, CASCADES),
     ("shadow.cascades.split_lambda", uses_cascades, CASCADES),
@@ -95,6 +99,12 @@ fn traces_rays(s: &Settings, lights: &[ResolvedLight]) -> bool {
 }
 
 const CASCADES: &str = "`shadow.partition` cascades and a sun";
+
+const VIRTUAL: &str = "`shadow.partition` virtual";
+
+fn uses_virtual(_: &Settings, lights: &[ResolvedLight]) -> bool {
+    lights.iter().any(|l| l.shadow.partition == Partition::Virtual)
+}
 
 fn uses_cascades(_: &Settings, lights: &[ResolvedLight]) -> bool {
     lights.iter().any(|l| {

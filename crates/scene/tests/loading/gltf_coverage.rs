@@ -107,7 +107,8 @@ fn an_index_accessor_past_its_buffer_is_an_error_that_names_it() {
 
 #[test]
 fn a_singular_node_matrix_warns_and_a_scene_of_nothing_else_is_refused() {
-    let zero = "[0,0,0,0, 0,0,0,0, 0,0,0,0, 0,0,0,0]";
+    // Scale 0: singular, and still affine (a last row of zeros is refused as projective).
+    let zero = "[0,0,0,0, 0,0,0,0, 0,0,0,0, 0,0,0,1]";
     let (_, extras) =
         load("singular", &Quad { matrix: Some(zero), copies: 1, ..Default::default() }).unwrap();
     assert!(extras.warnings.iter().any(|w| w.contains("singular transform")), "{:?}", extras.warnings);

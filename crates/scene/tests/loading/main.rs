@@ -6,4 +6,5 @@ mod common;
 mod gltf;
 mod gltf_coverage;
 mod hostile;
+mod hostile_round3;
 mod scene_file;

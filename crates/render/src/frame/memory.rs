@@ -1,0 +1,73 @@
+//! The frame's memory, charged before any of it is allocated
+//! ([`gnomon_scene::memory`] declares the costs and the budget): the scene as the
+//! renderer holds it, every light's maps, and the image's targets. An upload checks
+//! the scene's part; every frame checks the whole against the renderer's budget.
+
+use gnomon_scene::{
+    Scene,
+    lights::ShadowView,
+    memory::{self, Charge},
+    settings::{Partition, Settings},
+};
+
+use super::Renderer;
+use crate::RenderError;
+
+impl Renderer {
+    /// The bytes the renderer may hold for a frame, and where that limit came from.
+    pub fn memory_budget(&self) -> (u64, &str) {
+        (self.memory_budget.0, &self.memory_budget.1)
+    }
+
+    /// Sets the bytes the renderer may hold for a frame (a host that knows what its
+    /// own device and application can spare); the default is
+    /// [`memory::frame_budget`].
+    pub fn set_memory_budget(&mut self, bytes: u64) {
+        self.memory_budget = (bytes, "set by the host".into());
+    }
+
+    /// Refuses `scene` if holding it would pass the budget.
+    pub(super) fn check_scene_memory(&self, scene: &Scene) -> Result<(), RenderError> {
+        let (budget, source) = self.memory_budget();
+        memory::refuse_over(&memory::scene_charges(scene), budget, source)
+            .map_err(|e| RenderError::OverBudget { scene: scene.name.clone(), over: e })
+    }
+
+    /// Refuses a frame of `scene` with `settings` if it would pass the budget: the
+    /// scene, each light's maps and the image's targets.
+    pub(super) fn check_frame_memory(&self, scene: &Scene, settings: &Settings) -> Result<(), RenderError> {
+        let mut charges = memory::scene_charges(scene);
+        let (width, height) = (settings.image.width, settings.image.height);
+        charges.push(Charge {
+            what: format!("the image's targets, {width}×{height}"),
+            bytes: u64::from(width) * u64::from(height) * memory::BYTES_PER_PIXEL,
+        });
+        for light in settings.resolve_lights(scene)? {
+            let shadow = &light.shadow;
+            let side = u64::from(shadow.map.resolution);
+            let cascades = match shadow.partition {
+                Partition::Cascades => u64::from(shadow.cascades.count),
+                Partition::Single | Partition::Virtual => 1,
+            };
+            let layers = match light.light.shadow_view() {
+                ShadowView::Parallel { .. } => cascades,
+                ShadowView::Frustum { .. } => 1,
+                // A cube's six faces (two paraboloids take fewer: charged as a cube).
+                ShadowView::Omni { .. } => 6,
+            };
+            // The light's own technique check first: a technique that cannot shadow it
+            // is that error, not a budget's.
+            let technique = self.techniques.check_light(shadow, &light.light, &light.name)?;
+            let filterable = technique.filterable_map(&shadow.filter).is_some();
+            let per_texel =
+                memory::BYTES_PER_MAP_TEXEL + if filterable { memory::BYTES_PER_MOMENT_TEXEL } else { 0 };
+            charges.push(Charge {
+                what: format!("light `{}`'s map, {layers} × {side}²", light.name),
+                bytes: side * side * layers * per_texel,
+            });
+        }
+        let (budget, source) = self.memory_budget();
+        memory::refuse_over(&charges, budget, source)
+            .map_err(|e| RenderError::OverBudget { scene: scene.name.clone(), over: e })
+    }
+}
