@@ -26,8 +26,14 @@ pub struct PyRenderer {
     upload: Option<Upload>,
 }
 
+/// A frame over the memory budget is a `MemoryError` (refused before anything was
+/// allocated); every other renderer error a `GpuError`.
 fn gpu_error(e: RenderError) -> PyErr {
-    GpuError::new_err(e.to_string())
+    if matches!(e, RenderError::OverBudget { .. }) {
+        pyo3::exceptions::PyMemoryError::new_err(e.to_string())
+    } else {
+        GpuError::new_err(e.to_string())
+    }
 }
 
 /// `scene` as a render draws it: with a ground plane under it where asked.

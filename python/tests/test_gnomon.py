@@ -107,7 +107,7 @@ def test_bad_scenes_and_files_raise_scene_errors(tmp_path):
         gnomon.Scene.builtin("nowhere")
     broken = tmp_path / "broken.glb"
     broken.write_bytes(b"glTF" + bytes([2, 0, 0, 0, 64, 0, 0, 0]) + b"z" * 52)
-    with pytest.raises(gnomon.SceneError, match=r"broken\.glb: unknown chunk type"):
+    with pytest.raises(gnomon.SceneError, match=r"broken\.glb: is a binary glTF \(GLB\) with a chunk of \d+ bytes that runs past the file's end"):
         gnomon.Scene.load(broken)
     with pytest.raises(gnomon.SceneError, match=r"missing\.glb"):
         gnomon.Scene.load(tmp_path / "missing.glb")
@@ -120,6 +120,16 @@ def test_a_reference_of_another_view_is_refused(renderer):
         gnomon.compare(frame, gnomon.reference(scene, gnomon.Settings(width=48, height=27)))
     with pytest.raises(ValueError, match=r"different views or lights"):
         gnomon.compare(frame, gnomon.reference(scene, gnomon.Settings(sun_elevation=20, **SIZE)))
+
+
+def test_a_frame_or_reference_over_the_memory_budget_is_refused_up_front(renderer):
+    scene = gnomon.Scene.builtin("spheres")
+    huge = gnomon.Settings(width=8000, height=8000)
+    with pytest.raises(MemoryError, match=r"the image's targets, 8000×8000 .* GiB"):
+        renderer.render(scene, huge)
+    with pytest.raises(MemoryError, match=r"the reference's pixels, 8000×8000"):
+        gnomon.reference(scene, huge)
+    renderer.render(scene, gnomon.Settings(**SIZE))  # and the renderer still renders
 
 
 def resident_bytes():

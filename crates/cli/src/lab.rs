@@ -143,6 +143,7 @@ pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow:
         height: settings.image.height,
         samples: settings.reference.samples,
     };
+    gnomon_reference::check_memory(scene, &options).map_err(anyhow::Error::msg)?;
     let key = cache::key(scene, &camera, &light, &options);
     let cached = if use_cache { cache::path_for(&key) } else { None };
     if let Some(path) = &cached

@@ -104,6 +104,25 @@ pub fn build(boxes: &[Aabb], leaf: usize) -> MedianTree {
     MedianTree { nodes, order }
 }
 
+/// The median tree over `boxes` as obvhs' binary BVH (leaves of at most `leaf`
+/// primitives) where PLOC cannot take them (more than [`MAX_COINCIDENT`] share a
+/// box); `None` where it can. The GPU tracer's and the reference's builders both ask.
+#[cfg(feature = "obvhs")]
+pub fn obvhs_fallback(boxes: &[obvhs::aabb::Aabb], leaf: usize) -> Option<obvhs::bvh2::Bvh2> {
+    use obvhs::{aabb::Aabb as ObvhsAabb, bvh2::node::Bvh2Node};
+    let plain: Vec<Aabb> = boxes.iter().map(|b| Aabb { min: b.min.into(), max: b.max.into() }).collect();
+    if largest_coincident_group(&plain) <= MAX_COINCIDENT {
+        return None;
+    }
+    let tree = build(&plain, leaf);
+    let nodes = tree
+        .nodes
+        .iter()
+        .map(|n| Bvh2Node::new(ObvhsAabb::new(n.bounds.min.into(), n.bounds.max.into()), n.count, n.first))
+        .collect();
+    Some(obvhs::bvh2::Bvh2 { nodes, primitive_indices: tree.order, ..Default::default() })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,4 +20,4 @@ mod tracer;
 mod visibility;
 
 pub use tracer::{Hit, TracedScene, offset_ray_origin};
-pub use visibility::{ReferenceImage, ReferenceOptions, reference_visibility};
+pub use visibility::{ReferenceImage, ReferenceOptions, check_memory, reference_visibility};

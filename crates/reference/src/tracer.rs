@@ -180,26 +180,10 @@ impl TracedScene {
 /// boxes coincide (a mesh instanced many times in one place), from the median-split
 /// tree, whose depth stays logarithmic (`gnomon_math::median_bvh` says why).
 fn cwbvh_over(boxes: &[Aabb]) -> CwBvh {
-    use gnomon_math::median_bvh;
-    let plain: Vec<gnomon_math::Aabb> =
-        boxes.iter().map(|b| gnomon_math::Aabb { min: b.min.into(), max: b.max.into() }).collect();
-    if median_bvh::largest_coincident_group(&plain) <= median_bvh::MAX_COINCIDENT {
-        return build_cwbvh(boxes, BvhBuildParams::medium_build(), &mut Default::default());
+    match gnomon_math::median_bvh::obvhs_fallback(boxes, 1) {
+        Some(bvh2) => obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh2, 3, true, false),
+        None => build_cwbvh(boxes, BvhBuildParams::medium_build(), &mut Default::default()),
     }
-    let tree = median_bvh::build(&plain, 1);
-    let mut bvh2 = obvhs::bvh2::Bvh2 { primitive_indices: tree.order, ..Default::default() };
-    bvh2.nodes = tree
-        .nodes
-        .iter()
-        .map(|n| {
-            obvhs::bvh2::node::Bvh2Node::new(
-                Aabb::new(n.bounds.min.into(), n.bounds.max.into()),
-                n.count,
-                n.first,
-            )
-        })
-        .collect();
-    obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh2, 3, true, false)
 }
 
 /// The ray obvhs traverses with. Its octant and slab tests read the sign bit of each

@@ -3,7 +3,10 @@
 //! directional light, or N stratified samples of an area light.
 
 use glam::{DVec2, DVec4, Vec3};
-use gnomon_scene::{Camera, Light};
+use gnomon_scene::{
+    Camera, Light, Scene,
+    memory::{self, Charge},
+};
 use rayon::prelude::*;
 
 use crate::{
@@ -60,6 +63,21 @@ impl ReferenceImage {
     pub fn pixel_count(&self) -> usize {
         (self.width * self.height) as usize
     }
+}
+
+/// Refuses a reference of `scene` with `options` that would take more memory than
+/// the budget ([`memory::frame_budget`]): the scene as the tracer holds it and every
+/// pixel's result, before any of it is allocated. The error says what it would take.
+pub fn check_memory(scene: &Scene, options: &ReferenceOptions) -> Result<(), String> {
+    let (budget, source) = memory::frame_budget()?;
+    let (width, height) = (options.width, options.height);
+    let mut charges = memory::scene_charges(scene);
+    charges.push(Charge {
+        what: format!("the reference's pixels, {width}×{height}"),
+        bytes: u64::from(width) * u64::from(height) * memory::BYTES_PER_REFERENCE_PIXEL,
+    });
+    memory::refuse_over(&charges, budget, &source)
+        .map_err(|e| format!("the reference of scene `{}`: {e}", scene.name))
 }
 
 /// Computes the reference visibility of `light` for `camera`, in parallel over rows.
@@ -177,6 +195,16 @@ struct PixelResult {
     triangle: u32,
     depth: f32,
     position: Vec3,
+}
+
+#[cfg(test)]
+#[test]
+fn the_declared_cost_of_a_pixel_covers_what_a_reference_holds() {
+    use std::mem::size_of;
+    let image = size_of::<f32>() * 3 + size_of::<bool>() + size_of::<u32>() * 2 + size_of::<Vec3>();
+    let held = (image + size_of::<PixelResult>()) as u64;
+    assert!(memory::BYTES_PER_REFERENCE_PIXEL >= held, "a pixel holds {held} bytes");
+    assert!(memory::BYTES_PER_REFERENCE_PIXEL < 2 * held, "a pixel holds only {held} bytes");
 }
 
 impl PixelResult {

@@ -43,6 +43,10 @@ pub const BYTES_PER_TEXEL: u64 = 10;
 /// lighting, masks, penumbra history) and their readbacks (measured: 227 B at the
 /// defaults, 240 B with a sized sun's beams, 1000² to 2000²).
 pub const BYTES_PER_PIXEL: u64 = 256;
+/// A pixel of a ray-traced reference (`gnomon_reference::ReferenceImage`): its
+/// per-pixel vectors (33 B) and, while the rows are gathered, each pixel's result
+/// beside them (48 B); rounded up. A test there holds it above the layout.
+pub const BYTES_PER_REFERENCE_PIXEL: u64 = 96;
 /// A texel of a shadow map (32-bit depth; measured: 3.9 B from 2048² to 8192²).
 pub const BYTES_PER_MAP_TEXEL: u64 = 4;
 /// What a texel of a filterable map adds (four 32-bit moments, and the blur's copy).
@@ -77,6 +81,26 @@ pub struct OverBudget {
 /// The budget in force: [`BUDGET_ENV`] if set, else [`DEFAULT_FRAME_BUDGET`], and at
 /// most the memory this machine has available; with where it came from, in words.
 pub fn frame_budget() -> Result<(u64, String), String> {
+    frame_budget_beside(None)
+}
+
+/// A window the user sized: its pixels are the user's choice, not a file's, so the
+/// default budget grows by their targets ([`frame_budget_beside`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    /// The largest the window can grow to (its monitor), in physical pixels.
+    pub width: u32,
+    /// The largest the window can grow to, in physical pixels.
+    pub height: u32,
+}
+
+/// [`frame_budget`] for a front end that draws into `window` (the viewer): the
+/// default then leaves [`DEFAULT_FRAME_BUDGET`] for the scene and its maps beside
+/// the targets of a frame as large as the window, so that a maximised window on a
+/// 4K monitor is not refused while a scene file's 8000×8000 image still is. A budget
+/// the user set ([`BUDGET_ENV`]) is kept as it is; either is capped by the memory
+/// this machine has available.
+pub fn frame_budget_beside(window: Option<Window>) -> Result<(u64, String), String> {
     let (asked, mut source) = match std::env::var(BUDGET_ENV) {
         Ok(text) => {
             let mib = text.trim().parse::<u64>().ok().filter(|m| (1..=MAX_BUDGET_MIB).contains(m));
@@ -85,7 +109,13 @@ pub fn frame_budget() -> Result<(u64, String), String> {
             })?;
             (mib << 20, format!("{BUDGET_ENV} = {mib}"))
         }
-        Err(_) => (DEFAULT_FRAME_BUDGET, format!("the default; set {BUDGET_ENV} to raise it")),
+        Err(_) => match window {
+            None => (DEFAULT_FRAME_BUDGET, format!("the default; set {BUDGET_ENV} to raise it")),
+            Some(Window { width, height }) => (
+                DEFAULT_FRAME_BUDGET + u64::from(width) * u64::from(height) * BYTES_PER_PIXEL,
+                format!("the default, with room for a {width}×{height} window; set {BUDGET_ENV} to raise it"),
+            ),
+        },
     };
     let available = available_memory();
     let budget = match available {
@@ -176,6 +206,26 @@ mod tests {
         let e = refuse_over(&charges, 768 << 20, "the default").unwrap_err().to_string();
         assert!(e.contains("b 900.0 MiB, a 10.0 MiB, d 5.0 MiB") && e.contains("at most 768.0 MiB"), "{e}");
         assert!(!e.contains("c 1.0"), "only the three largest: {e}");
+    }
+
+    #[test]
+    fn a_window_makes_room_for_its_own_targets_and_no_more() {
+        if std::env::var(BUDGET_ENV).is_ok() {
+            return; // the user's budget is kept as it is, window or not
+        }
+        let (plain, _) = frame_budget().unwrap();
+        let uhd = Window { width: 3840, height: 2160 };
+        let (beside, source) = frame_budget_beside(Some(uhd)).unwrap();
+        let targets = 3840 * 2160 * BYTES_PER_PIXEL;
+        if available_memory().is_none_or(|free| free >= DEFAULT_FRAME_BUDGET + targets) {
+            assert_eq!(plain, DEFAULT_FRAME_BUDGET);
+            assert_eq!(beside, DEFAULT_FRAME_BUDGET + targets, "{source}");
+            assert!(source.contains("3840×2160"), "{source}");
+        }
+        // A frame as large as the window then fits beside the default's scene.
+        let frame = [Charge { what: "the image's targets".into(), bytes: targets }];
+        assert!(refuse_over(&frame, plain, "").is_err() || targets <= DEFAULT_FRAME_BUDGET);
+        assert!(refuse_over(&frame, beside, "").is_ok() || beside < DEFAULT_FRAME_BUDGET + targets);
     }
 
     #[test]

@@ -127,6 +127,38 @@ fn outputs_that_would_write_one_file_are_refused_before_rendering() {
     assert!(files_in(&dir.join("D")).is_empty());
 }
 
+/// An image whose frame, or whose reference, would pass the memory budget is refused
+/// before any of it is allocated, naming what it would take, and writes nothing.
+#[test]
+fn an_image_over_the_memory_budget_is_refused_up_front() {
+    let temp = temp_dir("budget");
+    let huge = ["--width", "8000", "--height", "8000"];
+    for (command, item) in
+        [("render", "the image's targets, 8000×8000"), ("reference", "the reference's pixels, 8000×8000")]
+    {
+        let mut args = vec![command];
+        args.extend(huge);
+        args.extend(["--out", "x.png"]);
+        let out = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+            .current_dir(temp.path())
+            .env_remove("GNOMON_MEMORY_MIB")
+            .env("GNOMON_CACHE_DIR", temp.path().join("cache"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let e = stderr(&out);
+        assert!(
+            !out.status.success() && e.contains(item) && e.contains("GNOMON_MEMORY_MIB"),
+            "{command}: {e}"
+        );
+        assert!(
+            files_in(temp.path()).iter().all(|f| f == "cache"),
+            "{command} wrote {:?}",
+            files_in(temp.path())
+        );
+    }
+}
+
 #[test]
 fn instances_beyond_the_limit_are_out_of_range_not_unknown() {
     let temp = temp_dir("instances");

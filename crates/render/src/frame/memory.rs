@@ -26,6 +26,13 @@ impl Renderer {
         self.memory_budget = (bytes, "set by the host".into());
     }
 
+    /// Makes the budget [`memory::frame_budget_beside`] `window`: for a front end
+    /// whose image is as large as a window the user sized (the viewer).
+    pub fn make_room_for_window(&mut self, window: memory::Window) -> Result<(), RenderError> {
+        self.memory_budget = memory::frame_budget_beside(Some(window)).map_err(RenderError::MemoryBudget)?;
+        Ok(())
+    }
+
     /// Refuses `scene` if holding it would pass the budget.
     pub(super) fn check_scene_memory(&self, scene: &Scene) -> Result<(), RenderError> {
         let (budget, source) = self.memory_budget();

@@ -526,15 +526,10 @@ fn tree_links(nodes: &[NodeGpu], triangles: usize) -> (Vec<u32>, Vec<u32>, Vec<u
 /// place) take the median-split builder instead (`gnomon_math::median_bvh`), whose
 /// depth stays logarithmic where PLOC's would grow with the group.
 fn build_tree<T: Boundable>(primitives: &[T], config: BvhBuildParams) -> Bvh2 {
-    let boxes: Vec<gnomon_math::Aabb> = primitives
-        .iter()
-        .map(|p| {
-            let b = p.aabb();
-            gnomon_math::Aabb { min: b.min.into(), max: b.max.into() }
-        })
-        .collect();
-    if gnomon_math::median_bvh::largest_coincident_group(&boxes) > gnomon_math::median_bvh::MAX_COINCIDENT {
-        return median_bvh2(&boxes, config.max_prims_per_leaf.clamp(1, 255) as usize);
+    let boxes: Vec<Aabb> = primitives.iter().map(Boundable::aabb).collect();
+    let leaf = config.max_prims_per_leaf.clamp(1, 255) as usize;
+    if let Some(bvh) = gnomon_math::median_bvh::obvhs_fallback(&boxes, leaf) {
+        return bvh;
     }
     let mut bvh = PlocBuilder::with_capacity(primitives.len()).build(
         config.ploc_search_distance,
@@ -552,23 +547,6 @@ fn build_tree<T: Boundable>(primitives: &[T], config: BvhBuildParams) -> Bvh2 {
         None,
     );
     bvh
-}
-
-/// `gnomon_math`'s median-split tree as obvhs' binary BVH.
-pub(crate) fn median_bvh2(boxes: &[gnomon_math::Aabb], leaf: usize) -> Bvh2 {
-    let tree = gnomon_math::median_bvh::build(boxes, leaf);
-    let nodes = tree
-        .nodes
-        .iter()
-        .map(|n| {
-            obvhs::bvh2::node::Bvh2Node::new(
-                Aabb::new(n.bounds.min.into(), n.bounds.max.into()),
-                n.count,
-                n.first,
-            )
-        })
-        .collect();
-    Bvh2 { nodes, primitive_indices: tree.order, ..Default::default() }
 }
 
 #[cfg(test)]

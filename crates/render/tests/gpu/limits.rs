@@ -129,3 +129,26 @@ fn an_image_larger_than_the_devices_largest_buffer_is_refused_by_name() {
     (s.image.width, s.image.height) = (256, 256);
     renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).expect("2¹⁶ pixels of 16 bytes fit");
 }
+
+/// The frame's memory is charged before any of it is allocated: past the budget the
+/// renderer refuses, naming the largest item, and the same renderer then renders a
+/// frame within it.
+#[test]
+fn a_frame_over_the_memory_budget_is_refused_before_anything_is_allocated() {
+    let gpu = crate::support::gpu();
+    let mut renderer = Renderer::new(gpu).unwrap();
+    let mut s = Settings::default();
+    (s.image.width, s.image.height) = (640, 360);
+    // 640×360 takes 56 MiB of targets at 256 B a pixel: over a 32 MiB budget.
+    renderer.set_memory_budget(32 << 20);
+    assert_eq!(renderer.memory_budget(), (32 << 20, "set by the host"));
+    let err = renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap_err();
+    assert!(matches!(err, RenderError::OverBudget { .. }), "{err:?}");
+    let message = err.to_string();
+    assert!(
+        message.contains("the image's targets, 640×360") && message.contains("at most 32.0 MiB"),
+        "{message}"
+    );
+    renderer.set_memory_budget(96 << 20);
+    renderer.render(&builtin::spheres(), &s, &OutputRequest::default()).unwrap();
+}

@@ -138,6 +138,10 @@ fn meshes(
             match primitives::read(&prim, buffers, materials.texcoord_sets[material], label)? {
                 Some(mut m) => {
                     out.modes.triangles += 1;
+                    let lie = primitives::lying_bounds(&prim, &m.positions);
+                    if let Some(lie) = lie.filter(|a| !out.modes.lying_bounds.contains(a)) {
+                        out.modes.lying_bounds.push(lie);
+                    }
                     out.modes.degenerate_triangles += primitives::drop_degenerate(&mut m);
                     if !m.indices.is_empty() {
                         out.list.push(m);
@@ -282,6 +286,14 @@ fn drawn(meshes: &Meshes, placed: &mut Placed) -> Result<(), String> {
         placed.extras.warnings.push(format!(
             "{} triangle(s) of zero area dropped: they cover no pixel and cast no shadow",
             meshes.modes.degenerate_triangles
+        ));
+    }
+    if !meshes.modes.lying_bounds.is_empty() {
+        let list: Vec<String> = meshes.modes.lying_bounds.iter().map(usize::to_string).collect();
+        placed.extras.warnings.push(format!(
+            "the min/max of POSITION accessor(s) {} do not bound their data (glTF 2.0, §3.6.2.5): \
+             Gnomon takes its bounds from the data, but other viewers may cull what lies outside",
+            list.join(", ")
         ));
     }
     if placed.singular_nodes > 0 {

@@ -20,6 +20,9 @@ pub struct ModeCounts {
     /// Triangles of zero area, dropped: they cover no pixel and block no ray, and a
     /// file of thousands at one point made the BVH and meshlet builds degenerate.
     pub degenerate_triangles: usize,
+    /// The POSITION accessors whose declared `min`/`max` do not bound their data
+    /// (each once, in order): Gnomon takes its bounds from the data, and says so.
+    pub lying_bounds: Vec<usize>,
 }
 
 impl ModeCounts {
@@ -166,6 +169,23 @@ pub fn read(
         return Err(format!("{label}: {} texture coordinates for {} positions", uvs.len(), positions.len()));
     }
     Ok(Some(Mesh { name: label, positions, normals, uvs, indices }))
+}
+
+/// The index of `prim`'s POSITION accessor if its declared `min` and `max` do not
+/// bound `positions` (the data it was read into), beyond the rounding of a decimal
+/// in JSON. glTF 2.0 (§3.6.2.5, accessor bounds) requires them to; a viewer that culls by them would
+/// lose the vertices outside.
+pub fn lying_bounds(prim: &gltf::Primitive, positions: &[Vec3]) -> Option<usize> {
+    let accessor = prim.get(&gltf::Semantic::Positions)?;
+    let declared = |value: Option<gltf::json::Value>| -> Option<Vec3> {
+        let numbers: Vec<f32> =
+            value?.as_array()?.iter().map(|n| n.as_f64().map(|n| n as f32)).collect::<Option<_>>()?;
+        <[f32; 3]>::try_from(numbers).ok().map(Vec3::from_array)
+    };
+    let (min, max) = (declared(accessor.min())?, declared(accessor.max())?);
+    let slack = (min.abs().max(max.abs()) + Vec3::ONE) * 1e-5;
+    let outside = |p: &Vec3| p.cmplt(min - slack).any() || p.cmpgt(max + slack).any();
+    positions.iter().any(outside).then(|| accessor.index())
 }
 
 /// Removes `mesh`'s triangles of zero area (their edges' cross product is exactly 0,

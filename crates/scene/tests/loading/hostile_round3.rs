@@ -228,6 +228,27 @@ fn a_normalized_float_accessor_is_refused() {
 }
 
 #[test]
+fn min_and_max_that_do_not_bound_the_positions_are_warned_of() {
+    let lies =
+        |json: &str| load(json).unwrap().1.iter().any(|w| w.contains("min/max of POSITION accessor(s) 0"));
+    assert!(!lies(&with("{}", NODE)), "exact bounds");
+    // A bound off by a rounding of its decimal is no lie.
+    assert!(!lies(&with("{}", NODE).replace(r#""max": [1, 0, 0]"#, r#""max": [0.9999999, 0, 0]"#)));
+    for (from, to) in
+        [(r#""max": [1, 0, 0]"#, r#""max": [0.5, 0, 0]"#), (r#""min": [0, 0, -1]"#, r#""min": [0, 0, 0]"#)]
+    {
+        let json = with("{}", NODE).replace(from, to);
+        assert!(lies(&json), "{to}");
+        assert!(load(&json).unwrap().0.instances.len() == 1, "still drawn, from its data");
+    }
+    // An accessor shared by fifty primitives is named once.
+    let shared = sparse_model(3, 50, 1).replace(r#""max": [1, 0, 0]"#, r#""max": [0, 0, 0]"#);
+    let warnings = load(&shared).unwrap().1;
+    let named: Vec<&String> = warnings.iter().filter(|w| w.contains("min/max")).collect();
+    assert!(named.len() == 1 && named[0].contains("accessor(s) 0 do not"), "{named:?}");
+}
+
+#[test]
 fn skins_morph_targets_and_orthographic_cameras_are_warned_of() {
     let extra = r#""nodes": [{"mesh": 0}, {"camera": 0}], "cameras": [{"type": "orthographic",
         "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],"#;

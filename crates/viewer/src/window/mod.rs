@@ -379,7 +379,14 @@ async fn connect(window: Arc<Window>, scene: Arc<Scene>) -> anyhow::Result<Box<L
         config.view_formats = vec![config.format.add_srgb_suffix()];
     }
     surface.configure(&gpu.device, &config);
-    let renderer = Renderer::new(&gpu)?;
+    let mut renderer = Renderer::new(&gpu)?;
+    // The image is as large as the window: leave the budget room for the largest
+    // the user can make it (its monitor), not only a file's default.
+    let largest = window.current_monitor().map_or(size, |monitor| monitor.size());
+    renderer.make_room_for_window(gnomon_scene::memory::Window {
+        width: largest.width.max(size.width),
+        height: largest.height.max(size.height),
+    })?;
     let uploaded = renderer.upload(&scene)?;
     let egui_ctx = egui::Context::default();
     let egui = egui_winit::State::new(
