@@ -27,12 +27,16 @@ pub struct PyRenderer {
 }
 
 /// A frame over the memory budget is a `MemoryError` (refused before anything was
-/// allocated); every other renderer error a `GpuError`.
+/// allocated), a bad `GNOMON_MEMORY_MIB` a `SettingsError`; every other renderer
+/// error a `GpuError`.
 fn gpu_error(e: RenderError) -> PyErr {
+    let message = e.to_string();
     if matches!(e, RenderError::OverBudget { .. }) {
-        pyo3::exceptions::PyMemoryError::new_err(e.to_string())
+        pyo3::exceptions::PyMemoryError::new_err(message)
+    } else if matches!(e, RenderError::MemoryBudget(_)) {
+        crate::SettingsError::new_err(message)
     } else {
-        GpuError::new_err(e.to_string())
+        GpuError::new_err(message)
     }
 }
 

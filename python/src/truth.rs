@@ -103,7 +103,10 @@ pub fn reference(
         return Err(SettingsError::new_err("samples = 0 is invalid: give at least 1"));
     }
     let options = ReferenceOptions { width: settings.image.width, height: settings.image.height, samples };
-    gnomon_reference::check_memory(&drawn, &options).map_err(pyo3::exceptions::PyMemoryError::new_err)?;
+    let budget = gnomon_scene::memory::frame_budget().map_err(SettingsError::new_err)?;
+    gnomon_reference::check_memory(&drawn, &options, &budget).map_err(|e| {
+        pyo3::exceptions::PyMemoryError::new_err(format!("the reference of scene `{}`: {e}", drawn.name))
+    })?;
     let lift = 1e-5 * drawn.bounds().extent().length();
     let (image, traced) = interruptible(py, move || {
         let traced = TracedScene::build(&drawn);

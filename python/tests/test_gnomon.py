@@ -122,14 +122,22 @@ def test_a_reference_of_another_view_is_refused(renderer):
         gnomon.compare(frame, gnomon.reference(scene, gnomon.Settings(sun_elevation=20, **SIZE)))
 
 
-def test_a_frame_or_reference_over_the_memory_budget_is_refused_up_front(renderer):
+def test_a_frame_or_reference_over_the_memory_budget_is_refused_up_front(monkeypatch):
+    # The default budget (768 MiB): a renderer reads it when it is made.
+    monkeypatch.delenv("GNOMON_MEMORY_MIB", raising=False)
+    renderer = gnomon.Renderer()
     scene = gnomon.Scene.builtin("spheres")
-    huge = gnomon.Settings(width=8000, height=8000)
-    with pytest.raises(MemoryError, match=r"the image's targets, 8000×8000 .* GiB"):
+    # 4000²: 3.8 GiB of targets and 1.4 GiB of reference, each refused before it is
+    # allocated; its largest target (244 MiB) fits any device's largest buffer.
+    huge = gnomon.Settings(width=4000, height=4000)
+    with pytest.raises(MemoryError, match=r"the image's targets, 4000×4000 .* GiB"):
         renderer.render(scene, huge)
-    with pytest.raises(MemoryError, match=r"the reference's pixels, 8000×8000"):
+    with pytest.raises(MemoryError, match=r"the reference's pixels, 4000×4000"):
         gnomon.reference(scene, huge)
     renderer.render(scene, gnomon.Settings(**SIZE))  # and the renderer still renders
+    monkeypatch.setenv("GNOMON_MEMORY_MIB", "lots")
+    with pytest.raises(gnomon.SettingsError, match=r"GNOMON_MEMORY_MIB = `lots` is invalid"):
+        gnomon.reference(scene, gnomon.Settings(**SIZE))
 
 
 def resident_bytes():

@@ -143,7 +143,9 @@ pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow:
         height: settings.image.height,
         samples: settings.reference.samples,
     };
-    gnomon_reference::check_memory(scene, &options).map_err(anyhow::Error::msg)?;
+    let budget = gnomon_scene::memory::frame_budget().map_err(anyhow::Error::msg)?;
+    gnomon_reference::check_memory(scene, &options, &budget)
+        .map_err(|e| anyhow::anyhow!("the reference of scene `{}`: {e}", scene.name))?;
     let key = cache::key(scene, &camera, &light, &options);
     let cached = if use_cache { cache::path_for(&key) } else { None };
     if let Some(path) = &cached

@@ -66,18 +66,20 @@ impl ReferenceImage {
 }
 
 /// Refuses a reference of `scene` with `options` that would take more memory than
-/// the budget ([`memory::frame_budget`]): the scene as the tracer holds it and every
-/// pixel's result, before any of it is allocated. The error says what it would take.
-pub fn check_memory(scene: &Scene, options: &ReferenceOptions) -> Result<(), String> {
-    let (budget, source) = memory::frame_budget()?;
+/// `budget` ([`memory::frame_budget`] for a command): the scene as the tracer holds
+/// it and every pixel's result, before any of it is allocated.
+pub fn check_memory(
+    scene: &Scene,
+    options: &ReferenceOptions,
+    budget: &memory::FrameBudget,
+) -> Result<(), memory::OverBudget> {
     let (width, height) = (options.width, options.height);
     let mut charges = memory::scene_charges(scene);
     charges.push(Charge {
         what: format!("the reference's pixels, {width}×{height}"),
-        bytes: u64::from(width) * u64::from(height) * memory::BYTES_PER_REFERENCE_PIXEL,
+        bytes: memory::pixels(width, height).saturating_mul(memory::BYTES_PER_REFERENCE_PIXEL),
     });
-    memory::refuse_over(&charges, budget, &source)
-        .map_err(|e| format!("the reference of scene `{}`: {e}", scene.name))
+    memory::refuse_over(&charges, budget)
 }
 
 /// Computes the reference visibility of `light` for `camera`, in parallel over rows.
@@ -201,6 +203,7 @@ struct PixelResult {
 #[test]
 fn the_declared_cost_of_a_pixel_covers_what_a_reference_holds() {
     use std::mem::size_of;
+    // `ReferenceImage`'s per-pixel vectors, field by field (a new one belongs here).
     let image = size_of::<f32>() * 3 + size_of::<bool>() + size_of::<u32>() * 2 + size_of::<Vec3>();
     let held = (image + size_of::<PixelResult>()) as u64;
     assert!(memory::BYTES_PER_REFERENCE_PIXEL >= held, "a pixel holds {held} bytes");

@@ -78,9 +78,19 @@ pub struct OverBudget {
     pub largest: String,
 }
 
+/// A budget: the bytes a frame may take, and where that limit came from, in words
+/// (the default, the environment, the machine, a host).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameBudget {
+    /// The bytes.
+    pub bytes: u64,
+    /// Where the limit came from (`the default; set GNOMON_MEMORY_MIB to raise it`).
+    pub source: String,
+}
+
 /// The budget in force: [`BUDGET_ENV`] if set, else [`DEFAULT_FRAME_BUDGET`], and at
-/// most the memory this machine has available; with where it came from, in words.
-pub fn frame_budget() -> Result<(u64, String), String> {
+/// most the memory this machine has available.
+pub fn frame_budget() -> Result<FrameBudget, String> {
     frame_budget_beside(None)
 }
 
@@ -88,44 +98,55 @@ pub fn frame_budget() -> Result<(u64, String), String> {
 /// default budget grows by their targets ([`frame_budget_beside`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Window {
-    /// The largest the window can grow to (its monitor), in physical pixels.
+    /// The widest image the window can show (its largest monitor), in physical pixels.
     pub width: u32,
-    /// The largest the window can grow to, in physical pixels.
+    /// The tallest image the window can show, in physical pixels.
     pub height: u32,
 }
 
 /// [`frame_budget`] for a front end that draws into `window` (the viewer): the
 /// default then leaves [`DEFAULT_FRAME_BUDGET`] for the scene and its maps beside
-/// the targets of a frame as large as the window, so that a maximised window on a
-/// 4K monitor is not refused while a scene file's 8000×8000 image still is. A budget
+/// the targets of a frame as large as the window, so that a window maximised on a
+/// 4K monitor fits while a scene file's 8000×8000 image is still refused. A budget
 /// the user set ([`BUDGET_ENV`]) is kept as it is; either is capped by the memory
 /// this machine has available.
-pub fn frame_budget_beside(window: Option<Window>) -> Result<(u64, String), String> {
-    let (asked, mut source) = match std::env::var(BUDGET_ENV) {
-        Ok(text) => {
-            let mib = text.trim().parse::<u64>().ok().filter(|m| (1..=MAX_BUDGET_MIB).contains(m));
-            let mib = mib.ok_or_else(|| {
-                format!("{BUDGET_ENV} = `{text}` is invalid: a whole number of MiB, 1 to {MAX_BUDGET_MIB}")
-            })?;
-            (mib << 20, format!("{BUDGET_ENV} = {mib}"))
-        }
-        Err(_) => match window {
-            None => (DEFAULT_FRAME_BUDGET, format!("the default; set {BUDGET_ENV} to raise it")),
-            Some(Window { width, height }) => (
-                DEFAULT_FRAME_BUDGET + u64::from(width) * u64::from(height) * BYTES_PER_PIXEL,
-                format!("the default, with room for a {width}×{height} window; set {BUDGET_ENV} to raise it"),
-            ),
-        },
-    };
-    let available = available_memory();
-    let budget = match available {
-        Some(free) if free < asked => {
-            source = format!("what this machine has available; {source}");
-            free
+pub fn frame_budget_beside(window: Option<Window>) -> Result<FrameBudget, String> {
+    let asked = asked_budget(std::env::var(BUDGET_ENV).ok().as_deref(), window)?;
+    Ok(match available_memory() {
+        Some(free) if free < asked.bytes => {
+            FrameBudget { bytes: free, source: format!("what this machine has available; {}", asked.source) }
         }
         _ => asked,
-    };
-    Ok((budget, source))
+    })
+}
+
+/// The budget asked for, before the machine's memory caps it: `env` (the value of
+/// [`BUDGET_ENV`], if set) as it is, else the default with room for `window`.
+fn asked_budget(env: Option<&str>, window: Option<Window>) -> Result<FrameBudget, String> {
+    if let Some(text) = env {
+        let mib = text.trim().parse::<u64>().ok().filter(|m| (1..=MAX_BUDGET_MIB).contains(m));
+        let mib = mib.ok_or_else(|| {
+            format!("{BUDGET_ENV} = `{text}` is invalid: a whole number of MiB, 1 to {MAX_BUDGET_MIB}")
+        })?;
+        return Ok(FrameBudget { bytes: mib << 20, source: format!("{BUDGET_ENV} = {mib}") });
+    }
+    Ok(match window {
+        None => FrameBudget {
+            bytes: DEFAULT_FRAME_BUDGET,
+            source: format!("the default; set {BUDGET_ENV} to raise it"),
+        },
+        Some(Window { width, height }) => FrameBudget {
+            bytes: DEFAULT_FRAME_BUDGET.saturating_add(pixels(width, height).saturating_mul(BYTES_PER_PIXEL)),
+            source: format!(
+                "the default, with room for a {width}×{height} window; set {BUDGET_ENV} to raise it"
+            ),
+        },
+    })
+}
+
+/// `width × height`, widened before multiplying.
+pub fn pixels(width: u32, height: u32) -> u64 {
+    u64::from(width) * u64::from(height)
 }
 
 /// The memory this machine has available now (Linux: `MemAvailable`), or `None`
@@ -138,16 +159,16 @@ fn available_memory() -> Option<u64> {
 }
 
 /// Refuses `charges` if together they pass `budget`, naming the three largest.
-pub fn refuse_over(charges: &[Charge], budget: u64, source_of_budget: &str) -> Result<(), OverBudget> {
+pub fn refuse_over(charges: &[Charge], budget: &FrameBudget) -> Result<(), OverBudget> {
     let total = charges.iter().map(|c| c.bytes).fold(0u64, u64::saturating_add);
-    if total <= budget {
+    if total <= budget.bytes {
         return Ok(());
     }
     let mut sorted: Vec<&Charge> = charges.iter().collect();
     sorted.sort_by_key(|c| std::cmp::Reverse(c.bytes));
     let largest =
         sorted.iter().take(3).map(|c| format!("{} {}", c.what, size(c.bytes))).collect::<Vec<_>>().join(", ");
-    Err(OverBudget { total, budget, source_of_budget: source_of_budget.into(), largest })
+    Err(OverBudget { total, budget: budget.bytes, source_of_budget: budget.source.clone(), largest })
 }
 
 /// What `scene` takes as Gnomon holds it: its meshes, its instances and their
@@ -194,6 +215,10 @@ pub fn size(bytes: u64) -> String {
 mod tests {
     use super::*;
 
+    fn budget(bytes: u64) -> FrameBudget {
+        FrameBudget { bytes, source: "x".into() }
+    }
+
     #[test]
     fn a_refusal_names_the_largest_items_and_the_budget() {
         let charges = [
@@ -202,30 +227,36 @@ mod tests {
             Charge { what: "c".into(), bytes: 1 << 20 },
             Charge { what: "d".into(), bytes: 5 << 20 },
         ];
-        assert!(refuse_over(&charges, 1 << 30, "x").is_ok());
-        let e = refuse_over(&charges, 768 << 20, "the default").unwrap_err().to_string();
+        assert!(refuse_over(&charges, &budget(1 << 30)).is_ok());
+        let e = refuse_over(&charges, &budget(768 << 20)).unwrap_err().to_string();
         assert!(e.contains("b 900.0 MiB, a 10.0 MiB, d 5.0 MiB") && e.contains("at most 768.0 MiB"), "{e}");
         assert!(!e.contains("c 1.0"), "only the three largest: {e}");
     }
 
     #[test]
     fn a_window_makes_room_for_its_own_targets_and_no_more() {
-        if std::env::var(BUDGET_ENV).is_ok() {
-            return; // the user's budget is kept as it is, window or not
-        }
-        let (plain, _) = frame_budget().unwrap();
-        let uhd = Window { width: 3840, height: 2160 };
-        let (beside, source) = frame_budget_beside(Some(uhd)).unwrap();
+        let plain = asked_budget(None, None).unwrap();
+        assert_eq!(plain.bytes, DEFAULT_FRAME_BUDGET);
+        let uhd = asked_budget(None, Some(Window { width: 3840, height: 2160 })).unwrap();
         let targets = 3840 * 2160 * BYTES_PER_PIXEL;
-        if available_memory().is_none_or(|free| free >= DEFAULT_FRAME_BUDGET + targets) {
-            assert_eq!(plain, DEFAULT_FRAME_BUDGET);
-            assert_eq!(beside, DEFAULT_FRAME_BUDGET + targets, "{source}");
-            assert!(source.contains("3840×2160"), "{source}");
+        assert_eq!(uhd.bytes, DEFAULT_FRAME_BUDGET + targets);
+        assert!(uhd.source.contains("3840×2160"), "{}", uhd.source);
+        // A frame as large as the window fits beside a default scene; one a pixel
+        // taller does not, and the default alone refuses it.
+        let frame = |height: u64| Charge { what: "targets".into(), bytes: 3840 * height * BYTES_PER_PIXEL };
+        let scene = Charge { what: "scene".into(), bytes: DEFAULT_FRAME_BUDGET };
+        assert!(refuse_over(&[frame(2160), scene.clone()], &uhd).is_ok());
+        assert!(refuse_over(&[frame(2161), scene], &uhd).is_err());
+        assert!(refuse_over(&[frame(2160)], &plain).is_err());
+        // The user's budget is kept as it is, window or not; a bad one is refused.
+        let set = asked_budget(Some("100"), Some(Window { width: 3840, height: 2160 })).unwrap();
+        assert_eq!((set.bytes, set.source.as_str()), (100 << 20, "GNOMON_MEMORY_MIB = 100"));
+        for bad in ["0", "lots", "-5", "1048577"] {
+            assert!(asked_budget(Some(bad), None).unwrap_err().contains("1 to 1048576"), "{bad}");
         }
-        // A frame as large as the window then fits beside the default's scene.
-        let frame = [Charge { what: "the image's targets".into(), bytes: targets }];
-        assert!(refuse_over(&frame, plain, "").is_err() || targets <= DEFAULT_FRAME_BUDGET);
-        assert!(refuse_over(&frame, beside, "").is_ok() || beside < DEFAULT_FRAME_BUDGET + targets);
+        // No overflow for the largest window that can be named.
+        let huge = asked_budget(None, Some(Window { width: u32::MAX, height: u32::MAX })).unwrap();
+        assert_eq!(huge.bytes, u64::MAX);
     }
 
     #[test]

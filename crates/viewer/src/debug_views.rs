@@ -147,13 +147,23 @@ mod cpu {
     use gnomon_reference::{
         ReferenceOptions, TracedScene, metrics, metrics::RasterView, reference_visibility,
     };
-    use gnomon_scene::Scene;
+    use gnomon_scene::{Scene, memory};
 
     use super::*;
 
     impl ErrorJob {
-        /// Starts tracing the reference for the view of `frame` (rendered with `settings`).
-        pub fn start(scene: &Scene, frame: Frame, settings: Settings) -> Self {
+        /// Starts tracing the reference for the view of `frame` (rendered with `settings`),
+        /// or says why it would pass the memory budget (with room for the window's size).
+        pub fn start(scene: &Scene, frame: Frame, settings: Settings) -> Result<Self, String> {
+            let options = ReferenceOptions {
+                width: frame.width,
+                height: frame.height,
+                samples: settings.reference.samples,
+            };
+            let window = memory::Window { width: frame.width, height: frame.height };
+            let budget = memory::frame_budget_beside(Some(window))?;
+            gnomon_reference::check_memory(scene, &options, &budget)
+                .map_err(|e| format!("the error view's reference: {e}"))?;
             let rows_done = Arc::new(AtomicU64::new(0));
             let (sender, result) = mpsc::channel();
             let rows = frame.height as u64;
@@ -161,11 +171,6 @@ mod cpu {
             let counter = rows_done.clone();
             std::thread::spawn(move || {
                 let traced = TracedScene::build(&scene);
-                let options = ReferenceOptions {
-                    width: frame.width,
-                    height: frame.height,
-                    samples: settings.reference.samples,
-                };
                 let reference =
                     reference_visibility(&traced, &frame.camera, &frame.light, &options, &|done| {
                         counter.store(done, Ordering::Relaxed)
@@ -204,7 +209,7 @@ mod cpu {
                 };
                 let _ = sender.send(Picture::new(frame.width, frame.height, rgba, summary, settings));
             });
-            Self { rows_done, rows, result }
+            Ok(Self { rows_done, rows, result })
         }
     }
 }
@@ -278,14 +283,14 @@ mod tests {
         (settings.image.width, settings.image.height) = (128, 72);
         let frame = renderer.render(&scene, &settings, &OutputRequest::default()).unwrap();
         let surface = frame.object_id.iter().filter(|&&id| id != 0).count();
-        let good = finish(ErrorJob::start(&scene, frame.clone(), settings.clone()));
+        let good = finish(ErrorJob::start(&scene, frame.clone(), settings.clone()).unwrap());
         assert_eq!(good.rgba.len(), 128 * 72 * 4);
         assert!(good.summary.contains("% wrong"), "{}", good.summary);
         let mut inverted = frame;
         for v in inverted.visibility.iter_mut().filter(|v| !v.is_nan()) {
             *v = 1.0 - *v;
         }
-        let bad = finish(ErrorJob::start(&scene, inverted, settings));
+        let bad = finish(ErrorJob::start(&scene, inverted, settings).unwrap());
         let (good, bad) = (wrong(&good), wrong(&bad));
         assert!(good * 50 < surface, "{good} of {surface} surface pixels marked wrong on a good render");
         assert!(

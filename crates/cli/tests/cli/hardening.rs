@@ -132,9 +132,11 @@ fn outputs_that_would_write_one_file_are_refused_before_rendering() {
 #[test]
 fn an_image_over_the_memory_budget_is_refused_up_front() {
     let temp = temp_dir("budget");
-    let huge = ["--width", "8000", "--height", "8000"];
+    // 4000²: over the budget (3.8 GiB of targets, 1.4 GiB of reference), while its
+    // largest target (244 MiB) fits any device's largest buffer (WebGPU's default 256).
+    let huge = ["--width", "4000", "--height", "4000"];
     for (command, item) in
-        [("render", "the image's targets, 8000×8000"), ("reference", "the reference's pixels, 8000×8000")]
+        [("render", "the image's targets, 4000×4000"), ("reference", "the reference's pixels, 4000×4000")]
     {
         let mut args = vec![command];
         args.extend(huge);

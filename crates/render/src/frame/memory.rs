@@ -6,7 +6,7 @@
 use gnomon_scene::{
     Scene,
     lights::ShadowView,
-    memory::{self, Charge},
+    memory::{self, Charge, FrameBudget},
     settings::{Partition, Settings},
 };
 
@@ -15,15 +15,15 @@ use crate::RenderError;
 
 impl Renderer {
     /// The bytes the renderer may hold for a frame, and where that limit came from.
-    pub fn memory_budget(&self) -> (u64, &str) {
-        (self.memory_budget.0, &self.memory_budget.1)
+    pub fn memory_budget(&self) -> &FrameBudget {
+        &self.memory_budget
     }
 
     /// Sets the bytes the renderer may hold for a frame (a host that knows what its
     /// own device and application can spare); the default is
     /// [`memory::frame_budget`].
     pub fn set_memory_budget(&mut self, bytes: u64) {
-        self.memory_budget = (bytes, "set by the host".into());
+        self.memory_budget = FrameBudget { bytes, source: "set by the host".into() };
     }
 
     /// Makes the budget [`memory::frame_budget_beside`] `window`: for a front end
@@ -35,8 +35,7 @@ impl Renderer {
 
     /// Refuses `scene` if holding it would pass the budget.
     pub(super) fn check_scene_memory(&self, scene: &Scene) -> Result<(), RenderError> {
-        let (budget, source) = self.memory_budget();
-        memory::refuse_over(&memory::scene_charges(scene), budget, source)
+        memory::refuse_over(&memory::scene_charges(scene), self.memory_budget())
             .map_err(|e| RenderError::OverBudget { scene: scene.name.clone(), over: e })
     }
 
@@ -47,7 +46,7 @@ impl Renderer {
         let (width, height) = (settings.image.width, settings.image.height);
         charges.push(Charge {
             what: format!("the image's targets, {width}×{height}"),
-            bytes: u64::from(width) * u64::from(height) * memory::BYTES_PER_PIXEL,
+            bytes: memory::pixels(width, height).saturating_mul(memory::BYTES_PER_PIXEL),
         });
         for light in settings.resolve_lights(scene)? {
             let shadow = &light.shadow;
@@ -70,11 +69,10 @@ impl Renderer {
                 memory::BYTES_PER_MAP_TEXEL + if filterable { memory::BYTES_PER_MOMENT_TEXEL } else { 0 };
             charges.push(Charge {
                 what: format!("light `{}`'s map, {layers} × {side}²", light.name),
-                bytes: side * side * layers * per_texel,
+                bytes: (side * side * layers).saturating_mul(per_texel),
             });
         }
-        let (budget, source) = self.memory_budget();
-        memory::refuse_over(&charges, budget, source)
+        memory::refuse_over(&charges, self.memory_budget())
             .map_err(|e| RenderError::OverBudget { scene: scene.name.clone(), over: e })
     }
 }

@@ -98,7 +98,7 @@ pub struct Renderer {
     virtual_lights: virtual_pages::VirtualLights,
     /// The bytes a frame may hold, and where that limit came from
     /// ([`gnomon_scene::memory::frame_budget`]).
-    memory_budget: (u64, String),
+    memory_budget: gnomon_scene::memory::FrameBudget,
 }
 
 impl Renderer {

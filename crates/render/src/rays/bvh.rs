@@ -531,6 +531,7 @@ fn build_tree<T: Boundable>(primitives: &[T], config: BvhBuildParams) -> Bvh2 {
     if let Some(bvh) = gnomon_math::median_bvh::obvhs_fallback(&boxes, leaf) {
         return bvh;
     }
+    drop(boxes); // PLOC reads the primitives' own boxes
     let mut bvh = PlocBuilder::with_capacity(primitives.len()).build(
         config.ploc_search_distance,
         primitives,
@@ -540,7 +541,7 @@ fn build_tree<T: Boundable>(primitives: &[T], config: BvhBuildParams) -> Bvh2 {
     );
     let mut reinsertion = ReinsertionOptimizer::default();
     reinsertion.run(&mut bvh, config.reinsertion_batch_ratio, None);
-    collapse(&mut bvh, config.max_prims_per_leaf.clamp(1, 255), config.collapse_traversal_cost);
+    collapse(&mut bvh, leaf as u32, config.collapse_traversal_cost);
     reinsertion.run(
         &mut bvh,
         config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier,

@@ -138,10 +138,7 @@ fn meshes(
             match primitives::read(&prim, buffers, materials.texcoord_sets[material], label)? {
                 Some(mut m) => {
                     out.modes.triangles += 1;
-                    let lie = primitives::lying_bounds(&prim, &m.positions);
-                    if let Some(lie) = lie.filter(|a| !out.modes.lying_bounds.contains(a)) {
-                        out.modes.lying_bounds.push(lie);
-                    }
+                    out.modes.lying_bounds.extend(primitives::lying_bounds(&prim, &m.positions));
                     out.modes.degenerate_triangles += primitives::drop_degenerate(&mut m);
                     if !m.indices.is_empty() {
                         out.list.push(m);
@@ -288,8 +285,14 @@ fn drawn(meshes: &Meshes, placed: &mut Placed) -> Result<(), String> {
             meshes.modes.degenerate_triangles
         ));
     }
-    if !meshes.modes.lying_bounds.is_empty() {
-        let list: Vec<String> = meshes.modes.lying_bounds.iter().map(usize::to_string).collect();
+    let lying = &meshes.modes.lying_bounds;
+    if !lying.is_empty() {
+        // The first few by index: a hostile file may have millions.
+        const NAMED: usize = 10;
+        let mut list: Vec<String> = lying.iter().take(NAMED).map(usize::to_string).collect();
+        if lying.len() > NAMED {
+            list.push(format!("and {} more", lying.len() - NAMED));
+        }
         placed.extras.warnings.push(format!(
             "the min/max of POSITION accessor(s) {} do not bound their data (glTF 2.0, §3.6.2.5): \
              Gnomon takes its bounds from the data, but other viewers may cull what lies outside",

@@ -20,9 +20,9 @@ pub struct ModeCounts {
     /// Triangles of zero area, dropped: they cover no pixel and block no ray, and a
     /// file of thousands at one point made the BVH and meshlet builds degenerate.
     pub degenerate_triangles: usize,
-    /// The POSITION accessors whose declared `min`/`max` do not bound their data
-    /// (each once, in order): Gnomon takes its bounds from the data, and says so.
-    pub lying_bounds: Vec<usize>,
+    /// The POSITION accessors whose declared `min`/`max` do not bound their data:
+    /// Gnomon takes its bounds from the data, and says so.
+    pub lying_bounds: std::collections::BTreeSet<usize>,
 }
 
 impl ModeCounts {
@@ -183,6 +183,7 @@ pub fn lying_bounds(prim: &gltf::Primitive, positions: &[Vec3]) -> Option<usize>
         <[f32; 3]>::try_from(numbers).ok().map(Vec3::from_array)
     };
     let (min, max) = (declared(accessor.min())?, declared(accessor.max())?);
+    // 1e-5 of the bound's magnitude, and at least 1e-5: a decimal's rounding.
     let slack = (min.abs().max(max.abs()) + Vec3::ONE) * 1e-5;
     let outside = |p: &Vec3| p.cmplt(min - slack).any() || p.cmpgt(max + slack).any();
     positions.iter().any(outside).then(|| accessor.index())

@@ -43,9 +43,11 @@ pub struct Budget {
 
 impl Default for Budget {
     fn default() -> Self {
-        let (limit, source) = crate::memory::frame_budget()
-            .unwrap_or((crate::memory::DEFAULT_FRAME_BUDGET, "the default".into()));
-        Budget { left: limit, limit, source }
+        let budget = crate::memory::frame_budget().unwrap_or(crate::memory::FrameBudget {
+            bytes: crate::memory::DEFAULT_FRAME_BUDGET,
+            source: "the default".into(),
+        });
+        Budget { left: budget.bytes, limit: budget.bytes, source: budget.source }
     }
 }
 

@@ -61,7 +61,7 @@ impl Model<'_> {
 
 /// The budget in the words of a refusal: `at most 768.0 MiB`.
 fn at_most() -> String {
-    format!("at most {}", gnomon_scene::memory::size(gnomon_scene::memory::frame_budget().unwrap().0))
+    format!("at most {}", gnomon_scene::memory::size(gnomon_scene::memory::frame_budget().unwrap().bytes))
 }
 
 #[test]

@@ -7,12 +7,35 @@
 use std::sync::Arc;
 
 use gnomon_render::{Frame, GpuScene, LiveFrame, OutputRequest, RenderError, Renderer};
-use gnomon_scene::{Scene, Settings, settings::Technique};
+use gnomon_scene::{Scene, Settings, memory::Window, settings::Technique};
 
 /// The renderer and the scene it holds on the GPU: what a frame's work takes away.
 pub(crate) struct Workshop {
     pub renderer: Renderer,
     pub uploaded: GpuScene,
+    /// The largest image the renderer's memory budget has room for: the image is as
+    /// large as the window, a size the user chose, not a file.
+    pub room: Window,
+}
+
+impl Workshop {
+    /// A workshop whose budget has room for images up to `room`.
+    pub fn new(mut renderer: Renderer, uploaded: GpuScene, room: Window) -> Result<Self, RenderError> {
+        renderer.make_room_for_window(room)?;
+        Ok(Self { renderer, uploaded, room })
+    }
+
+    /// Grows the budget's room to an image of `width` × `height` where it has none
+    /// yet (a window dragged onto a larger monitor, or wider than any one).
+    pub fn make_room(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        if width <= self.room.width && height <= self.room.height {
+            return Ok(());
+        }
+        let room = Window { width: width.max(self.room.width), height: height.max(self.room.height) };
+        self.renderer.make_room_for_window(room)?;
+        self.room = room;
+        Ok(())
+    }
 }
 
 /// What a frame reads back besides its live image.
@@ -60,7 +83,7 @@ impl FrameJob {
     /// frame).
     pub async fn run(self) -> FrameDone {
         let FrameJob { mut workshop, scene, settings, read_back } = self;
-        let Workshop { renderer, uploaded } = &mut workshop;
+        let Workshop { renderer, uploaded, .. } = &mut workshop;
         let live = renderer.render_live_async(uploaded, &scene, &settings).await;
         let request = OutputRequest::default();
         let mut frame = None;

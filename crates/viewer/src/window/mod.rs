@@ -211,6 +211,7 @@ impl App {
         let settings = self.model.frame_settings();
         let Some(live) = self.live.as_mut() else { return Ok(()) };
         if let Some(mut workshop) = live.workshop.take() {
+            workshop.make_room(settings.image.width, settings.image.height)?;
             if let Some(new) = self.next_scene.take() {
                 self.switch_scene(&mut workshop, new);
             }
@@ -353,6 +354,15 @@ enum Carried {
     Wait(Action),
 }
 
+/// The largest image `window` can show, in physical pixels: the widest and the
+/// tallest of the monitors (winit lists them on Wayland too, where the window's own
+/// monitor is unknown until it is shown; none in a browser), and the window itself.
+fn largest_monitor(window: &Window) -> gnomon_scene::memory::Window {
+    let sizes = window.available_monitors().map(|m| m.size()).chain([window.inner_size()]);
+    let (width, height) = sizes.fold((0, 0), |(w, h), s| (w.max(s.width), h.max(s.height)));
+    gnomon_scene::memory::Window { width, height }
+}
+
 /// Opens the GPU for `window`: the device, the surface, the renderer with `scene`
 /// uploaded, and egui's painter.
 async fn connect(window: Arc<Window>, scene: Arc<Scene>) -> anyhow::Result<Box<Live>> {
@@ -379,15 +389,9 @@ async fn connect(window: Arc<Window>, scene: Arc<Scene>) -> anyhow::Result<Box<L
         config.view_formats = vec![config.format.add_srgb_suffix()];
     }
     surface.configure(&gpu.device, &config);
-    let mut renderer = Renderer::new(&gpu)?;
-    // The image is as large as the window: leave the budget room for the largest
-    // the user can make it (its monitor), not only a file's default.
-    let largest = window.current_monitor().map_or(size, |monitor| monitor.size());
-    renderer.make_room_for_window(gnomon_scene::memory::Window {
-        width: largest.width.max(size.width),
-        height: largest.height.max(size.height),
-    })?;
+    let renderer = Renderer::new(&gpu)?;
     let uploaded = renderer.upload(&scene)?;
+    let workshop = Workshop::new(renderer, uploaded, largest_monitor(&window))?;
     let egui_ctx = egui::Context::default();
     let egui = egui_winit::State::new(
         egui_ctx,
@@ -404,7 +408,7 @@ async fn connect(window: Arc<Window>, scene: Arc<Scene>) -> anyhow::Result<Box<L
         gpu,
         surface,
         config,
-        workshop: Some(Workshop { renderer, uploaded }),
+        workshop: Some(workshop),
         egui,
         painter,
         view_texture: None,
@@ -495,7 +499,7 @@ impl Panels<'_> {
             Action::Set { id, value } => self.model.set(&id, value.as_deref()),
             Action::Show(view) => self.model.view = view,
             Action::Grab(_) | Action::DragTo(_) | Action::MoveHeldBy(_) | Action::Release => {
-                let Some(Workshop { renderer, uploaded }) = live.workshop.as_mut() else {
+                let Some(Workshop { renderer, uploaded, .. }) = live.workshop.as_mut() else {
                     return Carried::Wait(action);
                 };
                 let reach = Reach { model: self.model, renderer, uploaded };

@@ -45,7 +45,7 @@ mod desktop {
         _traced: Option<gnomon_render::Frame>,
         settings: gnomon_scene::Settings,
     ) -> Result<ErrorJob, String> {
-        Ok(ErrorJob::start(scene, frame, settings))
+        ErrorJob::start(scene, frame, settings)
     }
 
     pub(super) fn spawn_on(app: &mut App, event_loop: &ActiveEventLoop, work: impl Future<Output = Arrived>) {
