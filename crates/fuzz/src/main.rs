@@ -3,7 +3,7 @@
 //! (each saved under `--crashes`).
 //!
 //! ```sh
-//! cargo run --release -p gnomon-fuzz -- --seconds 60            # every target, 60 s each (CI)
+//! cargo run --release -p gnomon-fuzz -- --seconds 60            # every target at once, 60 s each (CI)
 //! cargo run --release -p gnomon-fuzz -- gltf --seconds 3600     # one target for an hour
 //! ```
 //!
@@ -73,6 +73,11 @@ struct Args {
     /// Seconds to run each target.
     #[arg(long, default_value_t = 60)]
     seconds: u64,
+    /// How many targets run at once, each in its own worker process [default: all
+    /// of them]. Three targets for 60 s take 60 s of wall time, not 180; on fewer
+    /// cores than jobs, each worker gets its share of them.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    jobs: Option<u64>,
     /// The mutator's seed: a run repeats from it.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -148,9 +153,9 @@ fn main() -> ExitCode {
         "| target | seconds | executions | per second | distinct outcomes | corpus | slowest input | crashes (of them out of memory, timed out) | caught panics |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
+    let jobs = args.jobs.map_or(targets.len(), |j| usize::try_from(j).unwrap_or(usize::MAX));
     let mut crashed = false;
-    for target in targets {
-        let run = supervise(&args, target);
+    for (target, run) in supervise_all(&args, &targets, jobs) {
         println!(
             "| {} | {} | {} | {:.0} | {} | {} | {:.0} ms | {} ({}, {}) | {} |",
             target.name(),
@@ -216,6 +221,24 @@ fn watch(mut child: std::process::Child, current: &Path, limit: Duration) -> End
         }
         std::thread::sleep(Duration::from_millis(100));
     }
+}
+
+/// Runs `targets`, `jobs` of them at a time (each supervisor waits on its own worker
+/// process), and returns each target's run in the order given.
+fn supervise_all(args: &Args, targets: &[Target], jobs: usize) -> Vec<(Target, Supervised)> {
+    let mut runs = Vec::with_capacity(targets.len());
+    for batch in targets.chunks(jobs.max(1)) {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> =
+                batch.iter().map(|&target| (target, scope.spawn(move || supervise(args, target)))).collect();
+            for (target, handle) in handles {
+                // A supervisor that panicked (no temporary folder, no worker started)
+                // has already said why on stderr; its panic goes on.
+                runs.push((target, handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))));
+            }
+        });
+    }
+    runs
 }
 
 /// Runs `target` in workers for `--seconds` in all, starting a new one (with the next
