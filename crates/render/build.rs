@@ -24,7 +24,11 @@ fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 fn main() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    // Read when the script runs, not when it was compiled: cargo reuses a compiled
+    // build script across checkouts that share a target folder.
+    let manifest =
+        std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR for build scripts");
+    let src = Path::new(&manifest).join("src");
     println!("cargo::rerun-if-changed={}", src.display());
     let mut files = Vec::new();
     wgsl_files(&src, &mut files);
