@@ -8,6 +8,7 @@ use std::{sync::Arc, time::Duration};
 
 use gnomon_reference::{
     ReferenceImage, ReferenceOptions, TracedScene,
+    cross_check::shadow_segments,
     drawn::{DrawnOptions, DrawnSurfaces, drawn_truth, measure_drawn},
     metrics::{self, RasterView},
     reference_visibility,
@@ -46,6 +47,55 @@ impl PyReference {
     #[getter]
     fn width(&self) -> u32 {
         self.image.width
+    }
+
+    /// N×3×3 float32: the world-space triangles that cast shadows, each as its three
+    /// vertices, as the reference traces them: for tracing the same scene with
+    /// another tracer. Raises ValueError where an alpha test cuts any of them.
+    fn caster_triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let casters = self.traced.caster_triangles();
+        if casters.alpha_tested > 0 {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "{} of the scene's {} casting triangles are alpha-tested: another tracer would need their alpha test",
+                casters.alpha_tested,
+                casters.vertices.len()
+            )));
+        }
+        let n = casters.vertices.len();
+        let flat: Vec<f32> =
+            casters.vertices.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())).collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([n, 3, 3])?.into_any())
+    }
+
+    /// The shadow rays the truth traces from the surfaces `frame` drew, under a light
+    /// of size 0: one per light-facing pixel whose light lies above its surface, as a
+    /// dict of arrays: `pixel` (M uint32, row-major), `origin` and `direction` (M×3
+    /// float32, the origin already moved off the surface), `length` (M float32,
+    /// infinite under a sun) and `occluded` (M bool, the reference's answer). Raises
+    /// ValueError under a light with an area.
+    fn shadow_segments<'py>(&self, py: Python<'py>, frame: &PyFrame) -> PyResult<Bound<'py, PyDict>> {
+        if frame.kept.camera != self.camera || frame.kept.light != self.light {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "the frame and the reference see different views or lights: trace the reference with the frame's scene and settings",
+            ));
+        }
+        let (traced, light) = (self.traced.clone(), self.light);
+        let (position, normal) = (frame.kept.position.clone(), frame.kept.geometric_normal.clone());
+        let width = frame.width_px();
+        let segments = interruptible(py, move || {
+            let surfaces = DrawnSurfaces { width, position: &position, geometric_normal: &normal };
+            shadow_segments(&traced, &light, surfaces)
+        })?
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+        let m = segments.pixel.len();
+        let xyz = |v: &[glam::Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.to_array()).collect() };
+        let dict = PyDict::new(py);
+        dict.set_item("pixel", PyArray1::from_vec(py, segments.pixel.clone()))?;
+        dict.set_item("origin", PyArray1::from_vec(py, xyz(&segments.origin)).reshape([m, 3])?)?;
+        dict.set_item("direction", PyArray1::from_vec(py, xyz(&segments.direction)).reshape([m, 3])?)?;
+        dict.set_item("length", PyArray1::from_vec(py, segments.length.clone()))?;
+        dict.set_item("occluded", PyArray1::from_vec(py, segments.occluded.clone()))?;
+        Ok(dict)
     }
 
     #[getter]

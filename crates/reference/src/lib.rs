@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod aliasing;
+pub mod cross_check;
 pub mod drawn;
 mod emitter;
 pub mod flicker;
@@ -19,5 +20,5 @@ pub mod texture;
 mod tracer;
 mod visibility;
 
-pub use tracer::{Hit, TracedScene, offset_ray_origin};
+pub use tracer::{CasterTriangles, Hit, TracedScene, offset_ray_origin};
 pub use visibility::{ReferenceImage, ReferenceOptions, check_memory, reference_visibility};

@@ -40,6 +40,15 @@ struct AlphaTriangle {
     cutoff: f32,
 }
 
+/// The triangles that cast shadows ([`TracedScene::caster_triangles`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CasterTriangles {
+    /// Each triangle's three world-space vertices, in the BVH's order.
+    pub vertices: Vec<[Vec3; 3]>,
+    /// How many of them an alpha test cuts.
+    pub alpha_tested: usize,
+}
+
 /// A scene's triangles in a BVH, ready for parallel queries.
 pub struct TracedScene {
     bvh: CwBvh,
@@ -126,6 +135,20 @@ impl TracedScene {
             }
         }
         t
+    }
+
+    /// The world-space triangles of the instances that cast shadows, each as its
+    /// three vertices, and how many of them an alpha test cuts (which another tracer
+    /// would need the test for): what [`TracedScene::occluded`] traces against.
+    pub fn caster_triangles(&self) -> CasterTriangles {
+        let mut casters = CasterTriangles::default();
+        for ((triangle, owner), alpha) in self.triangles.iter().zip(&self.owners).zip(&self.alpha) {
+            if self.casts_shadow[owner.0 as usize] {
+                casters.vertices.push([triangle.v0, triangle.v1, triangle.v2].map(Vec3::from));
+                casters.alpha_tested += usize::from(alpha.is_some());
+            }
+        }
+        casters
     }
 
     /// Number of triangles traced: every instance's, casters or not.
