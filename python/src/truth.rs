@@ -8,7 +8,7 @@ use std::{sync::Arc, time::Duration};
 
 use gnomon_reference::{
     ReferenceImage, ReferenceOptions, TracedScene,
-    cross_check::shadow_segments,
+    cross_check::{ShadowSegments, shadow_segments},
     drawn::{DrawnOptions, DrawnSurfaces, drawn_truth, measure_drawn},
     metrics::{self, RasterView},
     reference_visibility,
@@ -74,11 +74,7 @@ impl PyReference {
     /// infinite under a sun) and `occluded` (M bool, the reference's answer). Raises
     /// ValueError under a light with an area.
     fn shadow_segments<'py>(&self, py: Python<'py>, frame: &PyFrame) -> PyResult<Bound<'py, PyDict>> {
-        if frame.kept.camera != self.camera || frame.kept.light != self.light {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "the frame and the reference see different views or lights: trace the reference with the frame's scene and settings",
-            ));
-        }
+        same_view(frame, self)?;
         let (traced, light) = (self.traced.clone(), self.light);
         let (position, normal) = (frame.kept.position.clone(), frame.kept.geometric_normal.clone());
         let width = frame.width_px();
@@ -87,14 +83,15 @@ impl PyReference {
             shadow_segments(&traced, &light, surfaces)
         })?
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-        let m = segments.pixel.len();
+        let ShadowSegments { pixel, origin, direction, length, occluded } = segments;
+        let m = pixel.len();
         let xyz = |v: &[glam::Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.to_array()).collect() };
         let dict = PyDict::new(py);
-        dict.set_item("pixel", PyArray1::from_vec(py, segments.pixel.clone()))?;
-        dict.set_item("origin", PyArray1::from_vec(py, xyz(&segments.origin)).reshape([m, 3])?)?;
-        dict.set_item("direction", PyArray1::from_vec(py, xyz(&segments.direction)).reshape([m, 3])?)?;
-        dict.set_item("length", PyArray1::from_vec(py, segments.length.clone()))?;
-        dict.set_item("occluded", PyArray1::from_vec(py, segments.occluded.clone()))?;
+        dict.set_item("pixel", PyArray1::from_vec(py, pixel))?;
+        dict.set_item("origin", PyArray1::from_vec(py, xyz(&origin)).reshape([m, 3])?)?;
+        dict.set_item("direction", PyArray1::from_vec(py, xyz(&direction)).reshape([m, 3])?)?;
+        dict.set_item("length", PyArray1::from_vec(py, length))?;
+        dict.set_item("occluded", PyArray1::from_vec(py, occluded))?;
         Ok(dict)
     }
 
@@ -187,11 +184,7 @@ pub fn compare<'py>(py: Python<'py>, frame: &PyFrame, truth: &PyReference) -> Py
             truth.image.width, truth.image.height
         )));
     }
-    if frame.kept.camera != truth.camera || frame.kept.light != truth.light {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "the frame and the reference see different views or lights: trace the reference with the frame's scene and settings",
-        ));
-    }
+    same_view(frame, truth)?;
     let visibility = read_f32(frame.visibility_array().bind(py))?;
     let depth = read_f32(frame.depth_array().bind(py))?;
     if visibility.len() != (w * h) as usize || depth.len() != (w * h) as usize {
@@ -216,6 +209,16 @@ pub fn compare<'py>(py: Python<'py>, frame: &PyFrame, truth: &PyReference) -> Py
     row.set_item("technique", frame.technique_name())?;
     row.set_item("drawn", to_python(py, &drawn)?)?;
     Ok(row)
+}
+
+/// Refuses a frame drawn from another view or light than the reference traced.
+fn same_view(frame: &PyFrame, truth: &PyReference) -> PyResult<()> {
+    if frame.kept.camera != truth.camera || frame.kept.light != truth.light {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "the frame and the reference see different views or lights: trace the reference with the frame's scene and settings",
+        ));
+    }
+    Ok(())
 }
 
 fn read_f32(array: &Bound<'_, PyAny>) -> PyResult<Vec<f32>> {
