@@ -134,6 +134,10 @@ pub struct PyFrame {
     /// Draw calls, state changes, instances and triangles.
     #[pyo3(get)]
     stats: Py<PyDict>,
+    /// One dict a light ([`LightReport`]): how its shadow was refined by rays, how
+    /// many pixels were traced, and the frames its penumbra history holds.
+    #[pyo3(get)]
+    lights: Py<PyAny>,
     /// The shadow technique it was drawn with.
     #[pyo3(get)]
     technique: String,
@@ -143,6 +147,42 @@ pub struct PyFrame {
     height: u32,
     /// What a comparison needs that the arrays do not hold.
     pub kept: Kept,
+}
+
+/// What `Frame.lights` says of one light: the fields of `gnomon_render::LightStats`
+/// that tell how its shadow was answered (`gnomon render --verbose` prints them).
+#[derive(serde::Serialize)]
+struct LightReport<'a> {
+    name: &'a str,
+    /// "sun", "spot" or "point".
+    kind: &'a str,
+    technique: &'a str,
+    /// The refinement it got: `auto` resolved ("rays", "every-pixel"), or "off".
+    refine: gnomon_scene::settings::Refine,
+    /// Shadow rays a refined pixel asks for: 1 under a hard light, a penumbra
+    /// beam's samples under a light with an area.
+    rays_per_pixel: u32,
+    /// Pixels refined this frame, on the mask path.
+    traced_pixels: Option<u32>,
+    /// Pixels whose rays decide, this frame or before.
+    unsure_pixels: Option<u32>,
+    /// Frames its penumbra history holds, this one counted.
+    penumbra_frames: Option<u32>,
+}
+
+impl<'a> LightReport<'a> {
+    fn of(light: &'a gnomon_render::LightStats) -> Self {
+        Self {
+            name: &light.name,
+            kind: light.kind,
+            technique: light.technique.name(),
+            refine: light.refine,
+            rays_per_pixel: light.rays_per_pixel,
+            traced_pixels: light.traced_pixels,
+            unsure_pixels: light.unsure_pixels,
+            penumbra_frames: light.penumbra_frames,
+        }
+    }
 }
 
 /// The frame's surfaces and view, for a comparison with the reference.
@@ -198,6 +238,8 @@ impl PyFrame {
         stats.set_item("shadow_instances", s.shadow_instances)?;
         stats.set_item("shadow_triangles", s.shadow_triangles)?;
         stats.set_item("lighting_instances", s.lighting_instances)?;
+        let reports: Vec<LightReport> = frame.lights.iter().map(LightReport::of).collect();
+        let lights = crate::to_python(py, &reports)?.unbind();
         let position_xyz = xyz(&frame.position);
         let normal = xyz(&frame.normal);
         let Frame { color, visibility, depth, object_id, position, geometric_normal, camera, light, .. } =
@@ -212,6 +254,7 @@ impl PyFrame {
             object_id: PyArray1::from_vec(py, object_id.clone()).reshape([h, w])?.into_any().unbind(),
             times: times.unbind(),
             stats: stats.unbind(),
+            lights,
             technique,
             width: w as u32,
             height: h as u32,

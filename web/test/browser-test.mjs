@@ -2,8 +2,9 @@
 // 127.0.0.1, opens it in headless Chromium (WebGPU on SwiftShader), and for each
 // case renders the same scene and settings natively (`gnomon render
 // --visibility-out`): the two visibility images must agree on at least 99.9 % of
-// pixels, lit or shadowed. Then drops a broken .glb on the page: the page must show
-// the command line's error, naming the file, and render on.
+// pixels, lit or shadowed. Under a light with a size at the defaults, both are also
+// measured against the truth over its penumbra. Then drops a broken .glb on the
+// page: the page must show the command line's error, naming the file, and render on.
 //
 // Then opens the viewer page (the desktop viewer on a canvas), which must measure
 // its view against `raytraced`, answer the keyboard and refuse a wrong flag.
@@ -50,8 +51,27 @@ const CASES = [
   { name: 'PCSS, sun of 3°', flags: { technique: 'pcss', 'sun-angular-diameter': '3' } },
   { name: 'cascaded sun, pcf', flags: { technique: 'pcf', partition: 'cascades' } },
   { name: 'point light, pcf2x2', flags: { technique: 'pcf2x2', light: 'point' } },
+  // Issue 74's defaults: only the light's size given. Each is also measured against
+  // the truth (a 1024-ray `gnomon reference`) over its penumbra, at a smaller size
+  // that keeps the reference's tracing to seconds.
+  // `knownGap`: the browser's penumbra is known to miss the bounds below (issue 74:
+  // its values scatter about the native ones as if it gathered fewer beams, cause
+  // not yet found). Such a case must still miss them, so the mark goes when it is
+  // fixed (a strict expected failure); the native frame must meet the bound anyway.
+  { name: 'the defaults, sun of 5°', flags: { 'sun-angular-diameter': '5' }, soft: true, knownGap: true },
+  { name: 'the defaults, spot of radius 0.3', flags: { light: 'spot', 'spot-radius': '0.3' }, soft: true, knownGap: true },
+  { name: 'the defaults, point light of radius 0.3', flags: { light: 'point', 'point-radius': '0.3' }, soft: true },
 ];
 const SIZE = { width: '640', height: '360' };
+const SOFT_SIZE = { width: '320', height: '180' };
+const SOFT_REFERENCE_SAMPLES = '1024';
+// Issue 74's bound on a still view's penumbra MAE at the defaults, which the native
+// renderer meets (refine_soft.rs): the browser must meet it too.
+const DEFAULT_PENUMBRA_MAE = 0.01;
+// The most the browser's penumbra may differ from the native one, on average over
+// the truth's penumbra: both beam the same samples, and differ only where rounding
+// tips a pixel's classification or a beam's triangle test.
+const PENUMBRA_DIFFERENCE = 0.002;
 
 function fail(message) {
   console.error(`browser test: FAILED: ${message}`);
@@ -86,13 +106,42 @@ function readNpy(file) {
   return new Float32Array(data.buffer.slice(data.byteOffset, data.byteOffset + data.length));
 }
 
-function native(flags, dir) {
+function native(flags, size, dir) {
   const npy = path.join(dir, 'visibility.npy');
   const argv = ['render', 'spheres', '-o', path.join(dir, 'native.png'), '--visibility-out', npy];
-  for (const [key, value] of Object.entries({ ...SIZE, ...flags })) argv.push(`--${key}`, value);
+  for (const [key, value] of Object.entries({ ...size, ...flags })) argv.push(`--${key}`, value);
   const run = spawnSync(gnomon, argv, { encoding: 'utf8' });
   check(run.status === 0, `gnomon ${argv.join(' ')}: ${run.stderr}`);
   return readNpy(npy);
+}
+
+// The truth for a case: `gnomon reference`'s visibility and its standard error.
+function reference(flags, size, dir) {
+  const [visibility, stdError] = [path.join(dir, 'reference.npy'), path.join(dir, 'reference-se.npy')];
+  const argv = ['reference', 'spheres', '--out', visibility, '--std-error-out', stdError, '--no-cache',
+    '--samples', SOFT_REFERENCE_SAMPLES];
+  for (const [key, value] of Object.entries({ ...size, ...flags })) argv.push(`--${key}`, value);
+  const run = spawnSync(gnomon, argv, { encoding: 'utf8' });
+  check(run.status === 0, `gnomon ${argv.join(' ')}: ${run.stderr}`);
+  return { visibility: readNpy(visibility), stdError: readNpy(stdError) };
+}
+
+// Over the truth's penumbra (strictly between 0 and 1 by more than its standard
+// error, as `gnomon compare` counts it, at pixels both frames drew): each frame's
+// MAE against the truth, and their mean difference.
+function penumbra(browser, nativeVisibility, truth) {
+  let pixels = 0;
+  let [browserError, nativeError, difference] = [0, 0, 0];
+  for (let i = 0; i < browser.length; i++) {
+    const [r, se, a, b] = [truth.visibility[i], truth.stdError[i], browser[i], nativeVisibility[i]];
+    if (![r, a, b].every(Number.isFinite) || !(r - se > 0 && r + se < 1)) continue;
+    pixels++;
+    browserError += Math.abs(a - r);
+    nativeError += Math.abs(b - r);
+    difference += Math.abs(a - b);
+  }
+  const n = Math.max(pixels, 1);
+  return { pixels, browser_mae: browserError / n, native_mae: nativeError / n, mean_difference: difference / n };
 }
 
 // The viewer page: the desktop viewer (winit and egui) on a canvas. It must draw,
@@ -345,7 +394,8 @@ async function main() {
       }
     }
     for (const c of CASES) {
-      const query = new URLSearchParams({ scene: 'spheres', ...c.flags, ...SIZE, status: '1' });
+      const size = c.soft ? SOFT_SIZE : SIZE;
+      const query = new URLSearchParams({ scene: 'spheres', ...c.flags, ...size, status: '1' });
       const started = Date.now();
       await page.goto(`http://127.0.0.1:${port}/?${query}`);
       const status = await waitForRender(page);
@@ -353,15 +403,18 @@ async function main() {
       for (const key of ['scene', 'technique', 'width', 'height', 'lit', 'shadowed', 'mismatch_vs_raytraced', 'adapter']) {
         check(key in status, `${c.name}: the status has no "${key}": ${JSON.stringify(status)}`);
       }
-      check(status.scene === 'spheres' && status.technique === c.flags.technique, `${c.name}: ${JSON.stringify(status)}`);
-      check(status.width === 640 && status.height === 360, `${c.name}: size ${status.width}x${status.height}`);
+      const technique = c.flags.technique ?? status.technique;
+      check(status.scene === 'spheres' && status.technique === technique, `${c.name}: ${JSON.stringify(status)}`);
+      check(`${status.width}` === size.width && `${status.height}` === size.height, `${c.name}: size ${status.width}x${status.height}`);
       // SwiftShader has timestamp queries: every frame is timed, pass by pass.
       check(status.frame_ms > 0 && status.passes.length > 0, `${c.name}: no pass times: ${JSON.stringify(status)}`);
       const m = status.mismatch_vs_raytraced;
       check(typeof m === 'number' && m >= 0 && m <= 1, `${c.name}: mismatch_vs_raytraced ${m}`);
       const visibility = await page.evaluate(() => Array.from(window.gnomon.lab.visibility(), (v) => (Number.isNaN(v) ? null : v)));
       const fromBrowser = Float32Array.from(visibility, (v) => (v === null ? NaN : v));
-      const compared = compare(fromBrowser, native(c.flags, dir));
+      const fromNative = native(c.flags, size, dir);
+      const compared = compare(fromBrowser, fromNative);
+      const soft = c.soft ? penumbra(fromBrowser, fromNative, reference(c.flags, size, dir)) : undefined;
       const countsOff = Math.abs(status.lit - compared.lit) + Math.abs(status.shadowed - compared.shadowed);
       const warm = await warmTimes(page);
       const line = {
@@ -371,6 +424,7 @@ async function main() {
         browser: { lit: status.lit, shadowed: status.shadowed },
         native: { lit: compared.lit, shadowed: compared.shadowed },
         mismatch_vs_raytraced: m,
+        penumbra: soft,
         first_frame_ms: status.frame_ms,
         warm_frame_ms: warm.frame_ms,
         warm_passes: warm.passes,
@@ -381,6 +435,20 @@ async function main() {
       console.log(JSON.stringify(line));
       check(compared.agreement >= AGREEMENT, `${c.name}: the visibility agrees on ${(100 * compared.agreement).toFixed(3)} % of pixels, below ${100 * AGREEMENT} %`);
       check(countsOff <= (1 - AGREEMENT) * fromBrowser.length, `${c.name}: lit/shadowed ${status.lit}/${status.shadowed} against native ${compared.lit}/${compared.shadowed}`);
+      if (soft) {
+        const said = `${c.name}: over ${soft.pixels} penumbra pixels`;
+        check(soft.pixels > 500, `${said}: too few to measure`);
+        check(soft.native_mae <= DEFAULT_PENUMBRA_MAE, `${said}, the native MAE ${soft.native_mae.toFixed(4)} is over ${DEFAULT_PENUMBRA_MAE}`);
+        const figures = `the browser's MAE ${soft.browser_mae.toFixed(4)} (at most ${DEFAULT_PENUMBRA_MAE}), `
+          + `${soft.mean_difference.toFixed(4)} from native (at most ${PENUMBRA_DIFFERENCE})`;
+        const met = soft.browser_mae <= DEFAULT_PENUMBRA_MAE && soft.mean_difference <= PENUMBRA_DIFFERENCE;
+        if (c.knownGap) {
+          check(!met, `${said}, ${figures}: the known gap is closed; remove its knownGap mark`);
+          console.error(`browser test: ${said}, known gap (issue 74): ${figures}`);
+        } else {
+          check(met, `${said}, ${figures}`);
+        }
+      }
     }
     if (screenshot) {
       await page.goto(`http://127.0.0.1:${port}/?${screenshotView}`);

@@ -11,8 +11,9 @@ use crate::{lab, output};
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: crate::lab::SceneArgs,
-    /// Output: `.exr` (float visibility, channel `Y`, NaN background) or `.png` (8-bit
-    /// gray visibility, background dark blue-grey).
+    /// Output: `.exr` (float visibility, channel `Y`, NaN background), `.npy` (the
+    /// same floats, height × width) or `.png` (8-bit gray visibility, background dark
+    /// blue-grey).
     #[arg(long, short, default_value = "reference.png", help_heading = "Outputs")]
     pub out: PathBuf,
     /// Also write the per-pixel standard error of the estimate (`.exr` or `.npy`).
@@ -28,7 +29,7 @@ pub struct ReferenceArgs {
 pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     args.settings.validate()?;
     let (scene, settings) = lab::load(&args.scene, &args.settings)?;
-    output::check_file(&args.out, &["exr", "png"], "--out")?;
+    output::check_file(&args.out, &["exr", "npy", "png"], "--out")?;
     if let Some(p) = &args.std_error_out {
         output::check_file(p, &["exr", "npy"], "--std-error-out")?;
         output::refuse_shared_destinations(&[
@@ -40,7 +41,9 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     let image = &reference.image;
     let (w, h) = (image.width, image.height);
     let mut staged = output::Staged::default();
-    if args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+    let float =
+        args.out.extension().is_some_and(|e| ["exr", "npy"].iter().any(|f| e.eq_ignore_ascii_case(f)));
+    if float {
         staged.float_image(&args.out, w, h, &image.visibility)?;
     } else {
         staged.png_rgba(&args.out, w, h, &output::visibility_rgba(&image.visibility))?;

@@ -307,6 +307,18 @@ fn reference_writes_visibility_and_standard_error() {
     assert!(stderr(&out).contains("Mrays/s") && stderr(&out).contains("standard error"), "{}", stderr(&out));
     let names = files_in(dir);
     assert!(names.contains(&"r.exr".to_string()) && names.contains(&"se.npy".to_string()), "{names:?}");
+    // The same visibility as a .npy (from the cache): a header, then 96 × 54 floats.
+    let npy = Command::new(env!("CARGO_BIN_EXE_gnomon"))
+        .current_dir(dir)
+        .env("GNOMON_CACHE_DIR", dir.join("cache"))
+        .args(["reference", "spheres", "--light", "spot", "--spot-radius", "0.4", "--samples", "16"])
+        .args(["--width", "96", "--height", "54", "--out", "r.npy"])
+        .output()
+        .unwrap();
+    assert!(npy.status.success(), "{}", stderr(&npy));
+    let bytes = std::fs::read(dir.join("r.npy")).unwrap();
+    let se = std::fs::read(dir.join("se.npy")).unwrap();
+    assert!(bytes.starts_with(b"\x93NUMPY") && bytes.len() == se.len(), "{} bytes", bytes.len());
     let bad = gnomon(dir, &["reference", "--samples", "4"]);
     assert!(!bad.status.success() && stderr(&bad).contains("--samples"), "{}", stderr(&bad));
 }
