@@ -55,8 +55,9 @@ const CASES = [
   // the truth (a 1024-ray `gnomon reference`) over its penumbra, at a smaller size
   // that keeps the reference's tracing to seconds.
   // `knownGap`: the browser's penumbra is known to miss the bounds below (issue 74:
-  // its values scatter about the native ones as if it gathered fewer beams, cause
-  // not yet found). Such a case must still miss them, so the mark goes when it is
+  // its beams answer differently from native ones, at the first frame and with
+  // `refine=every-pixel` too, so not through the history or the classification;
+  // cause not yet found). Such a case must still miss them, so the mark goes when it is
   // fixed (a strict expected failure); the native frame must meet the bound anyway.
   { name: 'the defaults, sun of 5°', flags: { 'sun-angular-diameter': '5' }, soft: true, knownGap: true },
   { name: 'the defaults, spot of radius 0.3', flags: { light: 'spot', 'spot-radius': '0.3' }, soft: true, knownGap: true },
