@@ -41,12 +41,11 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
     let image = &reference.image;
     let (w, h) = (image.width, image.height);
     let mut staged = output::Staged::default();
-    let float =
-        args.out.extension().is_some_and(|e| ["exr", "npy"].iter().any(|f| e.eq_ignore_ascii_case(f)));
-    if float {
-        staged.float_image(&args.out, w, h, &image.visibility)?;
-    } else {
+    // `float_image` writes .exr or .npy by the extension; a .png is 8-bit gray.
+    if args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         staged.png_rgba(&args.out, w, h, &output::visibility_rgba(&image.visibility))?;
+    } else {
+        staged.float_image(&args.out, w, h, &image.visibility)?;
     }
     if let Some(p) = &args.std_error_out {
         staged.float_image(p, w, h, &image.std_error)?;
