@@ -51,16 +51,12 @@ const CASES = [
   { name: 'PCSS, sun of 3°', flags: { technique: 'pcss', 'sun-angular-diameter': '3' } },
   { name: 'cascaded sun, pcf', flags: { technique: 'pcf', partition: 'cascades' } },
   { name: 'point light, pcf2x2', flags: { technique: 'pcf2x2', light: 'point' } },
-  // Issue 74's defaults: only the light's size given. Each is also measured against
-  // the truth (a 1024-ray `gnomon reference`) over its penumbra, at a smaller size
-  // that keeps the reference's tracing to seconds.
-  // `knownGap`: the browser's penumbra is known to miss the bounds below (issue 74:
-  // its beams answer differently from native ones, at the first frame and with
-  // `refine=every-pixel` too, so not through the history or the classification;
-  // cause not yet found). Such a case must still miss them, so the mark goes when it is
-  // fixed (a strict expected failure); the native frame must meet the bound anyway.
-  { name: 'the defaults, sun of 5°', flags: { 'sun-angular-diameter': '5' }, soft: true, knownGap: true },
-  { name: 'the defaults, spot of radius 0.3', flags: { light: 'spot', 'spot-radius': '0.3' }, soft: true, knownGap: true },
+  // Issue 74's defaults: only the light's size given. Each frame, the page's and the
+  // native one, is also measured against the truth (a 1024-ray `gnomon reference`)
+  // traced from the surfaces that frame drew, over its penumbra, at a smaller size
+  // that keeps the tracing to seconds.
+  { name: 'the defaults, sun of 5°', flags: { 'sun-angular-diameter': '5' }, soft: true },
+  { name: 'the defaults, spot of radius 0.3', flags: { light: 'spot', 'spot-radius': '0.3' }, soft: true },
   { name: 'the defaults, point light of radius 0.3', flags: { light: 'point', 'point-radius': '0.3' }, soft: true },
 ];
 const SIZE = { width: '640', height: '360' };
@@ -69,9 +65,11 @@ const SOFT_REFERENCE_SAMPLES = '1024';
 // Issue 74's bound on a still view's penumbra MAE at the defaults, which the native
 // renderer meets (refine_soft.rs): the browser must meet it too.
 const DEFAULT_PENUMBRA_MAE = 0.01;
-// The most the browser's penumbra may differ from the native one, on average over
-// the truth's penumbra: both beam the same samples, and differ only where rounding
-// tips a pixel's classification or a beam's triangle test.
+// The most the browser's penumbra MAE may exceed the native one's, each against the
+// truth at its own surfaces. Not a pixel-by-pixel difference: SwiftShader places the
+// surface points it rasterizes about 1 mm (a 25th of a pixel here) from lavapipe's,
+// the coarser sub-pixel grid of a GPU, and under a 5° sun that alone moves a pixel's
+// penumbra by 0.008 on average (docs/web.md); both frames beam the same samples.
 const PENUMBRA_DIFFERENCE = 0.002;
 
 function fail(message) {
@@ -107,19 +105,32 @@ function readNpy(file) {
   return new Float32Array(data.buffer.slice(data.byteOffset, data.byteOffset + data.length));
 }
 
-function native(flags, size, dir) {
+// A float32 .npy of `shape` (what `gnomon reference --surfaces` reads).
+function writeNpy(file, shape, values) {
+  let header = `{'descr': '<f4', 'fortran_order': False, 'shape': (${shape.join(', ')}), }`;
+  header += ' '.repeat(63 - ((10 + header.length) % 64)) + '\n';
+  const head = Buffer.alloc(10);
+  Buffer.from('\x93NUMPY\x01\x00', 'latin1').copy(head);
+  head.writeUInt16LE(header.length, 8);
+  fs.writeFileSync(file, Buffer.concat([head, Buffer.from(header, 'latin1'), Buffer.from(Float32Array.from(values).buffer)]));
+}
+
+// The native frame's visibility; with `surfaces`, also its --aov-out (npy) there.
+function native(flags, size, dir, surfaces) {
   const npy = path.join(dir, 'visibility.npy');
   const argv = ['render', 'spheres', '-o', path.join(dir, 'native.png'), '--visibility-out', npy];
+  if (surfaces) argv.push('--aov-out', surfaces, '--aov-format', 'npy');
   for (const [key, value] of Object.entries({ ...size, ...flags })) argv.push(`--${key}`, value);
   const run = spawnSync(gnomon, argv, { encoding: 'utf8' });
   check(run.status === 0, `gnomon ${argv.join(' ')}: ${run.stderr}`);
   return readNpy(npy);
 }
 
-// The truth for a case: `gnomon reference`'s visibility and its standard error.
-function reference(flags, size, dir) {
+// The truth for a case at the surfaces in the folder `surfaces` (`gnomon reference
+// --surfaces`): its visibility and its standard error.
+function reference(flags, size, dir, surfaces) {
   const [visibility, stdError] = [path.join(dir, 'reference.npy'), path.join(dir, 'reference-se.npy')];
-  const argv = ['reference', 'spheres', '--out', visibility, '--std-error-out', stdError, '--no-cache',
+  const argv = ['reference', 'spheres', '--surfaces', surfaces, '--out', visibility, '--std-error-out', stdError,
     '--samples', SOFT_REFERENCE_SAMPLES];
   for (const [key, value] of Object.entries({ ...size, ...flags })) argv.push(`--${key}`, value);
   const run = spawnSync(gnomon, argv, { encoding: 'utf8' });
@@ -127,22 +138,29 @@ function reference(flags, size, dir) {
   return { visibility: readNpy(visibility), stdError: readNpy(stdError) };
 }
 
-// Over the truth's penumbra (strictly between 0 and 1 by more than its standard
-// error, as `gnomon compare` counts it, at pixels both frames drew): each frame's
-// MAE against the truth, and their mean difference.
-function penumbra(browser, nativeVisibility, truth) {
-  let pixels = 0;
-  let [browserError, nativeError, difference] = [0, 0, 0];
-  for (let i = 0; i < browser.length; i++) {
-    const [r, se, a, b] = [truth.visibility[i], truth.stdError[i], browser[i], nativeVisibility[i]];
-    if (![r, a, b].every(Number.isFinite) || !(r - se > 0 && r + se < 1)) continue;
+// A frame's MAE against the truth at its own surfaces, over the truth's penumbra
+// (strictly between 0 and 1 by more than its standard error, as `gnomon compare`
+// counts it).
+function penumbra(visibility, truth) {
+  let [pixels, error] = [0, 0];
+  for (let i = 0; i < visibility.length; i++) {
+    const [r, se, v] = [truth.visibility[i], truth.stdError[i], visibility[i]];
+    if (![r, v].every(Number.isFinite) || !(r - se > 0 && r + se < 1)) continue;
     pixels++;
-    browserError += Math.abs(a - r);
-    nativeError += Math.abs(b - r);
-    difference += Math.abs(a - b);
+    error += Math.abs(v - r);
   }
-  const n = Math.max(pixels, 1);
-  return { pixels, browser_mae: browserError / n, native_mae: nativeError / n, mean_difference: difference / n };
+  return { pixels, mae: error / Math.max(pixels, 1) };
+}
+
+// The page's last frame's surfaces, written as `gnomon render --aov-out` writes them
+// (npy), into the folder `surfaces`.
+async function pageSurfaces(page, size, surfaces) {
+  fs.mkdirSync(surfaces, { recursive: true });
+  const shape = [Number(size.height), Number(size.width), 3];
+  for (const [name, method] of [['position', 'position'], ['geometric_normal', 'geometricNormal']]) {
+    const values = await page.evaluate((m) => Array.from(window.gnomon.lab[m](), (v) => (Number.isNaN(v) ? null : v)), method);
+    writeNpy(path.join(surfaces, `${name}.npy`), shape, values.map((v) => (v === null ? NaN : v)));
+  }
 }
 
 // The viewer page: the desktop viewer (winit and egui) on a canvas. It must draw,
@@ -413,9 +431,17 @@ async function main() {
       check(typeof m === 'number' && m >= 0 && m <= 1, `${c.name}: mismatch_vs_raytraced ${m}`);
       const visibility = await page.evaluate(() => Array.from(window.gnomon.lab.visibility(), (v) => (Number.isNaN(v) ? null : v)));
       const fromBrowser = Float32Array.from(visibility, (v) => (v === null ? NaN : v));
-      const fromNative = native(c.flags, size, dir);
+      const [pageAt, nativeAt] = [path.join(dir, 'page-surfaces'), path.join(dir, 'native-surfaces')];
+      const fromNative = native(c.flags, size, dir, c.soft ? nativeAt : undefined);
       const compared = compare(fromBrowser, fromNative);
-      const soft = c.soft ? penumbra(fromBrowser, fromNative, reference(c.flags, size, dir)) : undefined;
+      let soft;
+      if (c.soft) {
+        await pageSurfaces(page, size, pageAt);
+        soft = {
+          browser: penumbra(fromBrowser, reference(c.flags, size, dir, pageAt)),
+          native: penumbra(fromNative, reference(c.flags, size, dir, nativeAt)),
+        };
+      }
       const countsOff = Math.abs(status.lit - compared.lit) + Math.abs(status.shadowed - compared.shadowed);
       const warm = await warmTimes(page);
       const line = {
@@ -437,18 +463,13 @@ async function main() {
       check(compared.agreement >= AGREEMENT, `${c.name}: the visibility agrees on ${(100 * compared.agreement).toFixed(3)} % of pixels, below ${100 * AGREEMENT} %`);
       check(countsOff <= (1 - AGREEMENT) * fromBrowser.length, `${c.name}: lit/shadowed ${status.lit}/${status.shadowed} against native ${compared.lit}/${compared.shadowed}`);
       if (soft) {
-        const said = `${c.name}: over ${soft.pixels} penumbra pixels`;
-        check(soft.pixels > 500, `${said}: too few to measure`);
-        check(soft.native_mae <= DEFAULT_PENUMBRA_MAE, `${said}, the native MAE ${soft.native_mae.toFixed(4)} is over ${DEFAULT_PENUMBRA_MAE}`);
-        const figures = `the browser's MAE ${soft.browser_mae.toFixed(4)} (at most ${DEFAULT_PENUMBRA_MAE}), `
-          + `${soft.mean_difference.toFixed(4)} from native (at most ${PENUMBRA_DIFFERENCE})`;
-        const met = soft.browser_mae <= DEFAULT_PENUMBRA_MAE && soft.mean_difference <= PENUMBRA_DIFFERENCE;
-        if (c.knownGap) {
-          check(!met, `${said}, ${figures}: the known gap is closed; remove its knownGap mark`);
-          console.error(`browser test: ${said}, known gap (issue 74): ${figures}`);
-        } else {
-          check(met, `${said}, ${figures}`);
-        }
+        const { browser: b, native: n } = soft;
+        const said = `${c.name}: over ${b.pixels} penumbra pixels (native ${n.pixels})`;
+        check(b.pixels > 500 && n.pixels > 500, `${said}: too few to measure`);
+        check(n.mae <= DEFAULT_PENUMBRA_MAE, `${said}, the native MAE ${n.mae.toFixed(4)} is over ${DEFAULT_PENUMBRA_MAE}`);
+        check(b.mae <= DEFAULT_PENUMBRA_MAE && b.mae - n.mae <= PENUMBRA_DIFFERENCE,
+          `${said}, the browser's MAE ${b.mae.toFixed(4)}: at most ${DEFAULT_PENUMBRA_MAE}, `
+          + `and at most ${PENUMBRA_DIFFERENCE} over native's ${n.mae.toFixed(4)}`);
       }
     }
     if (screenshot) {

@@ -173,6 +173,36 @@ pub fn reference(scene: &Scene, settings: &Settings, use_cache: bool) -> anyhow:
     Ok(Reference { image, timing: Some(ReferenceTiming { build_seconds, trace_seconds }) })
 }
 
+/// The truth at `surfaces` (another frame's, read back by `--surfaces`): traced as
+/// [`drawn_metrics`] traces it, with the reference's samples and lift.
+pub fn drawn_truth_at(
+    scene: &Scene,
+    settings: &Settings,
+    surfaces: &crate::surfaces_in::ReadSurfaces,
+) -> anyhow::Result<DrawnTruth> {
+    let light: Light = settings.resolve_light(scene)?;
+    let traced = TracedScene::build(scene);
+    let options = drawn_options(scene, settings);
+    let bar = ProgressBar::new(surfaces.height as u64).with_style(
+        ProgressStyle::with_template("truth at the given surfaces {bar:40} {pos}/{len} rows, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let drawn = DrawnSurfaces {
+        width: surfaces.width,
+        position: &surfaces.position,
+        geometric_normal: &surfaces.geometric_normal,
+    };
+    let truth = drawn_truth(&traced, &light, drawn, &options, &|rows| bar.set_position(rows));
+    bar.finish_and_clear();
+    Ok(truth)
+}
+
+/// How the truth at drawn surfaces is traced: the reference's samples, and the lift
+/// that tells an ambiguous pixel, 10⁻⁵ of the scene's extent.
+fn drawn_options(scene: &Scene, settings: &Settings) -> DrawnOptions {
+    DrawnOptions { samples: settings.reference.samples, lift: 1e-5 * scene.bounds().extent().length() }
+}
+
 /// Each frame's metrics against the truth at the surfaces it drew
 /// (`gnomon_reference::drawn`): every light-facing pixel counted, traced from the
 /// frame's own points and normals. The truth is traced once per distinct set of
@@ -184,9 +214,7 @@ pub fn drawn_metrics(
 ) -> anyhow::Result<Vec<DrawnMetrics>> {
     let light: Light = settings.resolve_light(scene)?;
     let traced = TracedScene::build(scene);
-    // The lift that tells an ambiguous pixel: 10⁻⁵ of the scene's extent.
-    let lift = 1e-5 * scene.bounds().extent().length();
-    let options = DrawnOptions { samples: settings.reference.samples, lift };
+    let options = drawn_options(scene, settings);
     let bits =
         |v: &[glam::Vec3]| -> Vec<u32> { v.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect() };
     let mut truths: Vec<(Vec<u32>, DrawnTruth)> = Vec::new();

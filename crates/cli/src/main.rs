@@ -16,6 +16,7 @@ mod lab;
 mod output;
 mod reference_cmd;
 mod render_cmd;
+mod surfaces_in;
 mod view_cmd;
 
 use std::process::ExitCode;

@@ -1,11 +1,13 @@
-//! `gnomon reference`: the ray-traced visibility of the light, as an image.
+//! `gnomon reference`: the ray-traced visibility of the light, as an image: through
+//! the camera's pixel centres, or from the surfaces a frame drew (`--surfaces`, an
+//! `--aov-out` folder of any renderer's frame).
 
 use std::path::PathBuf;
 
 use clap::Args;
 use gnomon_scene::Settings;
 
-use crate::{lab, output};
+use crate::{lab, output, surfaces_in};
 
 #[derive(Args, Debug)]
 pub struct ReferenceArgs {
@@ -19,6 +21,14 @@ pub struct ReferenceArgs {
     /// Also write the per-pixel standard error of the estimate (`.exr` or `.npy`).
     #[arg(long, value_name = "FILE.exr|FILE.npy", help_heading = "Outputs")]
     pub std_error_out: Option<PathBuf>,
+    /// Trace from the surfaces a frame drew instead of through the camera's pixel
+    /// centres: the `position.npy` and `geometric_normal.npy` of this folder (as
+    /// `gnomon render --aov-out DIR --aov-format npy` writes them, or any renderer's
+    /// frame in that form). The image is theirs: its size and camera flags are not
+    /// used; the truth at each pixel is the light's visibility from the very point
+    /// the frame shows (0 where its surface faces away, NaN where it shows none).
+    #[arg(long, value_name = "DIR", help_heading = "Scene")]
+    pub surfaces: Option<PathBuf>,
     /// Trace again even when a cached reference exists.
     #[arg(long)]
     pub no_cache: bool,
@@ -37,22 +47,27 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
             output::Planned { flag: "--std-error-out".into(), path: p },
         ])?;
     }
+    if let Some(dir) = &args.surfaces {
+        let surfaces = surfaces_in::read_surfaces(dir)?;
+        let truth = lab::drawn_truth_at(&scene, &settings, &surfaces)?;
+        let written =
+            Written { width: surfaces.width, height: surfaces.height, visibility: &truth.visibility };
+        write_outputs(args, written, &truth.std_error)?;
+        eprintln!(
+            "gnomon: {} triangles, truth at the {}×{} surfaces of {}: {} samples per pixel, {} rays",
+            scene.triangle_count(),
+            surfaces.width,
+            surfaces.height,
+            dir.display(),
+            truth.samples,
+            truth.rays
+        );
+        return Ok(());
+    }
     let reference = lab::reference(&scene, &settings, !args.no_cache)?;
     let image = &reference.image;
     let (w, h) = (image.width, image.height);
-    let mut staged = output::Staged::default();
-    // `float_image` writes .exr or .npy by the extension; a .png is 8-bit gray.
-    if args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-        staged.png_rgba(&args.out, w, h, &output::visibility_rgba(&image.visibility))?;
-    } else {
-        staged.float_image(&args.out, w, h, &image.visibility)?;
-    }
-    if let Some(p) = &args.std_error_out {
-        staged.float_image(p, w, h, &image.std_error)?;
-    }
-    for path in staged.commit()? {
-        println!("{}", path.display());
-    }
+    write_outputs(args, Written { width: w, height: h, visibility: &image.visibility }, &image.std_error)?;
     let surface: Vec<usize> = (0..image.pixel_count()).filter(|&i| image.object_id[i] != 0).collect();
     let mean_se =
         surface.iter().map(|&i| image.std_error[i] as f64).sum::<f64>() / surface.len().max(1) as f64;
@@ -70,6 +85,32 @@ pub fn run(args: &ReferenceArgs) -> anyhow::Result<()> {
             image.rays as f64 / t.trace_seconds / 1e6
         ),
         None => eprintln!(" (cached)"),
+    }
+    Ok(())
+}
+
+/// A visibility image to write.
+struct Written<'a> {
+    width: u32,
+    height: u32,
+    visibility: &'a [f32],
+}
+
+/// `--out` (PNG, or `float_image`'s .exr or .npy by the extension) and
+/// `--std-error-out`, moved into place together.
+fn write_outputs(args: &ReferenceArgs, image: Written, std_error: &[f32]) -> anyhow::Result<()> {
+    let Written { width: w, height: h, visibility } = image;
+    let mut staged = output::Staged::default();
+    if args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+        staged.png_rgba(&args.out, w, h, &output::visibility_rgba(visibility))?;
+    } else {
+        staged.float_image(&args.out, w, h, visibility)?;
+    }
+    if let Some(p) = &args.std_error_out {
+        staged.float_image(p, w, h, std_error)?;
+    }
+    for path in staged.commit()? {
+        println!("{}", path.display());
     }
     Ok(())
 }

@@ -32,13 +32,15 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.exr|FILE.npy", help_heading = "Outputs")]
     pub visibility_out: Option<PathBuf>,
     /// Also write per-pixel float images to this directory (created if missing):
-    /// position.exr (world XYZ), normal.exr (world XYZ), depth.exr (view depth, Y),
-    /// object_id.exr (instance index + 1, Y; 0 is background) and visibility.exr.
-    /// Background pixels are NaN in the first three.
+    /// position.exr (world XYZ), normal.exr (the shading normal, world XYZ),
+    /// geometric_normal.exr (the triangle's plane, facing the camera: what shadow rays
+    /// leave along), depth.exr (view depth, Y), object_id.exr (instance index + 1, Y;
+    /// 0 is background) and visibility.exr. Background pixels are NaN in the first
+    /// four. `gnomon reference --surfaces` traces the truth from such a folder.
     #[arg(long, value_name = "DIR", help_heading = "Outputs")]
     pub aov_out: Option<PathBuf>,
     /// The format of `--aov-out`'s images: OpenEXR, or NumPy `.npy` (float32; position
-    /// and normal height × width × 3, the others height × width).
+    /// and normals height × width × 3, the others height × width).
     #[arg(long, value_enum, default_value = "exr", help_heading = "Outputs")]
     pub aov_format: AovFormat,
     /// Print the adapter, driver and backend used, and timings.
@@ -60,7 +62,7 @@ impl RenderArgs {
 
 /// The images `--aov-out` writes into its directory, by name (the format's
 /// extension follows).
-const AOV_NAMES: [&str; 5] = ["position", "normal", "depth", "object_id", "visibility"];
+const AOV_NAMES: [&str; 6] = ["position", "normal", "geometric_normal", "depth", "object_id", "visibility"];
 
 /// The file format of `--aov-out`'s images.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -81,7 +83,7 @@ impl AovFormat {
 }
 
 /// The files `--aov-out` writes, in the order of [`AOV_NAMES`].
-fn aov_files(dir: &std::path::Path, format: AovFormat) -> [PathBuf; 5] {
+fn aov_files(dir: &std::path::Path, format: AovFormat) -> [PathBuf; 6] {
     AOV_NAMES.map(|name| dir.join(format!("{name}.{}", format.extension())))
 }
 
@@ -233,9 +235,11 @@ fn stage_outputs(args: &RenderArgs, frame: &Frame) -> anyhow::Result<Staged> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--aov-out: cannot create directory {}", dir.display()))?;
         let (w, h) = (frame.width, frame.height);
-        let [position, normal, depth, object_id, visibility] = aov_files(dir, args.aov_format);
+        let [position, normal, geometric_normal, depth, object_id, visibility] =
+            aov_files(dir, args.aov_format);
         staged.vec3_image(&position, w, h, &frame.position)?;
         staged.vec3_image(&normal, w, h, &frame.normal)?;
+        staged.vec3_image(&geometric_normal, w, h, &frame.geometric_normal)?;
         staged.float_image(&depth, w, h, &frame.depth)?;
         let ids: Vec<f32> = frame.object_id.iter().map(|&i| i as f32).collect();
         staged.float_image(&object_id, w, h, &ids)?;

@@ -52,6 +52,10 @@ pub struct DrawnTruth {
     /// Fraction of the light visible from the pixel's point, in [0, 1]; NaN where
     /// the frame shows no surface, 0 where the surface does not face the light.
     pub visibility: Vec<f32>,
+    /// The standard error of each pixel's visibility (the spread of its stratified
+    /// batches, as the reference's): 0 under a point-like light, where one ray
+    /// decides, and where the whole light is provably in sight.
+    pub std_error: Vec<f32>,
     /// The surface faces the light (geometric N·L > 0) inside its cone and range.
     pub faces_light: Vec<bool>,
     /// The answer changes when the ray starts [`DrawnOptions::lift`] higher (hard
@@ -106,6 +110,7 @@ pub fn drawn_truth(
     let pixels: Vec<DrawnPixel> = rows.into_iter().flatten().collect();
     DrawnTruth {
         visibility: pixels.iter().map(|p| p.visibility).collect(),
+        std_error: pixels.iter().map(|p| p.std_error).collect(),
         faces_light: pixels.iter().map(|p| p.faces_light).collect(),
         ambiguous: pixels.iter().map(|p| p.ambiguous).collect(),
         samples,
@@ -141,6 +146,7 @@ impl DrawnTruth {
         let pixels = traced_visibility.len();
         DrawnTruth {
             visibility: traced_visibility,
+            std_error: vec![0.0; pixels],
             faces_light: faces_light(light, surfaces),
             ambiguous: vec![false; pixels],
             samples: 1,
@@ -151,6 +157,7 @@ impl DrawnTruth {
 
 struct DrawnPixel {
     visibility: f32,
+    std_error: f32,
     faces_light: bool,
     ambiguous: bool,
     rays: u64,
@@ -166,21 +173,33 @@ fn drawn_pixel(
     lift: f32,
 ) -> DrawnPixel {
     if !hit.position.is_finite() || !hit.normal.is_finite() {
-        return DrawnPixel { visibility: f32::NAN, faces_light: false, ambiguous: false, rays: 0 };
+        return DrawnPixel {
+            visibility: f32::NAN,
+            std_error: f32::NAN,
+            faces_light: false,
+            ambiguous: false,
+            rays: 0,
+        };
     }
     if !emitter.faces(&hit) {
-        return DrawnPixel { visibility: 0.0, faces_light: false, ambiguous: false, rays: 0 };
+        return DrawnPixel { visibility: 0.0, std_error: 0.0, faces_light: false, ambiguous: false, rays: 0 };
     }
     let sampling = LightSampling::SkipWhollyInSight;
-    let (visibility, _, rays) = shade(traced, emitter, &hit, samples, seed, sampling);
+    let (visibility, std_error, rays) = shade(traced, emitter, &hit, samples, seed, sampling);
     if samples > 1 {
-        return DrawnPixel { visibility, faces_light: true, ambiguous: false, rays };
+        return DrawnPixel { visibility, std_error, faces_light: true, ambiguous: false, rays };
     }
     // The same ray from a hair higher: where its answer differs, the truth depends
     // on where exactly the point lies, closer than it can be known.
     let lifted = Hit { position: hit.position + hit.normal * lift, ..hit };
     let (again, _, more) = shade(traced, emitter, &lifted, samples, seed, sampling);
-    DrawnPixel { visibility, faces_light: true, ambiguous: again != visibility, rays: rays + more }
+    DrawnPixel {
+        visibility,
+        std_error: 0.0,
+        faces_light: true,
+        ambiguous: again != visibility,
+        rays: rays + more,
+    }
 }
 
 /// A frame's visibility against the truth at its own surfaces, over every
@@ -250,6 +269,7 @@ mod tests {
         let n = visibility.len();
         DrawnTruth {
             faces_light: visibility.iter().map(|v| v.is_finite()).collect(),
+            std_error: vec![0.0; n],
             visibility,
             ambiguous,
             samples: 1,

@@ -110,6 +110,7 @@ mod tests {
     fn drawn_paints_each_class_its_colour() {
         let truth = crate::drawn::DrawnTruth {
             visibility: vec![1.0, 0.0, 1.0, 0.0, 0.0, 1.0, f32::NAN],
+            std_error: vec![0.0; 7],
             faces_light: vec![true, true, true, true, false, true, false],
             ambiguous: vec![false, false, false, false, false, true, false],
             samples: 1,

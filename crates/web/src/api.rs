@@ -129,6 +129,21 @@ impl JsLab {
         Ok(self.lab()?.visibility().map(<[f32]>::to_vec))
     }
 
+    /// The last frame's surfaces: each pixel's world-space point, XYZ, row-major from
+    /// the top, NaN where it shows none (what `gnomon render --aov-out` writes as
+    /// `position`). With [`Self::geometric_normal`], what `gnomon reference
+    /// --surfaces` traces the truth from.
+    pub fn position(&self) -> Result<Option<Vec<f32>>, JsError> {
+        Ok(self.lab()?.surfaces().map(|(position, _)| flatten(position)))
+    }
+
+    /// The last frame's geometric normals (each pixel's triangle's plane, facing the
+    /// camera), XYZ as [`Self::position`]: `--aov-out`'s `geometric_normal`.
+    #[wasm_bindgen(js_name = geometricNormal)]
+    pub fn geometric_normal(&self) -> Result<Option<Vec<f32>>, JsError> {
+        Ok(self.lab()?.surfaces().map(|(_, normal)| flatten(normal)))
+    }
+
     /// The last frame's image: RGBA8, sRGB, top row first (an `ImageData`'s bytes).
     pub fn color(&self) -> Result<Option<Vec<u8>>, JsError> {
         Ok(self.lab()?.color().map(<[u8]>::to_vec))
@@ -211,4 +226,9 @@ pub(crate) fn flags_of(object: &JsValue) -> Result<Vec<Flag>, JsError> {
 /// "unreachable executed".
 pub(crate) fn report_panics_to_the_console() {
     std::panic::set_hook(Box::new(|info| web_sys::console::error_1(&info.to_string().into())));
+}
+
+/// Vectors as their components, one after another.
+fn flatten(vectors: &[glam::Vec3]) -> Vec<f32> {
+    vectors.iter().flat_map(|v| v.to_array()).collect()
 }

@@ -215,6 +215,12 @@ impl Lab {
         self.shown.as_ref().map(|s| s.frame.color.as_slice())
     }
 
+    /// The last frame's surfaces: each pixel's world-space point and geometric normal,
+    /// row-major, NaN where it shows none.
+    pub fn surfaces(&self) -> Option<(&[glam::Vec3], &[glam::Vec3])> {
+        self.shown.as_ref().map(|s| (s.frame.position.as_slice(), s.frame.geometric_normal.as_slice()))
+    }
+
     /// The last frame's visibility: 1 lit, 0 shadowed, NaN background; row-major.
     pub fn visibility(&self) -> Option<&[f32]> {
         self.shown.as_ref().map(|s| s.frame.visibility.as_slice())

@@ -70,7 +70,14 @@ fn float_outputs_are_written_with_their_documented_layout() {
     assert!(matches!(map, image::DynamicImage::ImageLuma16(_)));
     assert_eq!(
         files_in(&dir.join("aov")),
-        ["depth.exr", "normal.exr", "object_id.exr", "position.exr", "visibility.exr"]
+        [
+            "depth.exr",
+            "geometric_normal.exr",
+            "normal.exr",
+            "object_id.exr",
+            "position.exr",
+            "visibility.exr"
+        ]
     );
 }
 
@@ -87,7 +94,14 @@ fn aovs_as_npy_have_their_documented_shapes() {
     let aov = dir.join("aov");
     assert_eq!(
         files_in(&aov),
-        ["depth.npy", "normal.npy", "object_id.npy", "position.npy", "visibility.npy"]
+        [
+            "depth.npy",
+            "geometric_normal.npy",
+            "normal.npy",
+            "object_id.npy",
+            "position.npy",
+            "visibility.npy"
+        ]
     );
     let header = |path: &std::path::Path| {
         let bytes = std::fs::read(path).unwrap();

@@ -8,3 +8,4 @@ mod calibrate;
 mod commands;
 mod hardening;
 mod rays;
+mod surfaces;
