@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes round three's hostile inputs (docs/hardening.md, "Round three") into a
+"""Writes round three's hostile inputs (docs/hardening-memory.md, "Round three") into a
 folder: small glTF and scene files that declare far more than they hold. Each is
 under 64 KB. `sh scripts/hostile-memory.sh` renders every one and reports its peak
 memory and time.

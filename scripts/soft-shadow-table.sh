@@ -1,7 +1,7 @@
 #!/bin/sh
 # Issue 24's soft-shadow table: every technique against the Monte Carlo area-light
 # reference (256 rays per pixel) in the three area-light configurations of
-# docs/measured.md, with the MAE over all compared pixels beside the MAE over the
+# docs/measured-soft.md, with the MAE over all compared pixels beside the MAE over the
 # reference's penumbra and the penumbra width error. Prints the README's combined
 # markdown table; each run's metrics.md (the full tables) and grid stay under OUT.
 #
@@ -44,7 +44,7 @@ for k, row in enumerate(rows):
             cells.append(f"{w['error_px']:.1f} ({w['bias_px']:+.1f}{extra})")
     print("| " + " | ".join(cells) + " |")
 print()
-# docs/measured.md's per-configuration tables, with the costs.
+# docs/measured-soft.md's per-configuration tables, with the costs.
 ms = lambda v: "–" if v is None else f"{v:.2f}"
 with open(f"{out}/measured.md", "w") as md:
     for name, label in configs:

@@ -10,7 +10,7 @@
 //!
 //! Each cost was measured as the peak resident memory of `gnomon render` on lavapipe
 //! as one quantity grows with the rest fixed (`sh scripts/hostile-memory.sh` reports
-//! the peaks of the hostile cases; docs/hardening.md, "Round three"), then rounded up.
+//! the peaks of the hostile cases; docs/hardening-memory.md, "Round three"), then rounded up.
 
 use crate::Scene;
 

@@ -114,7 +114,7 @@ fn sponzas_first_cascade_draws_a_small_share_of_its_one_mesh_and_the_same_map() 
     let Some(path) = common::shared_scene("sponza/sponza_geometry.glb") else { return };
     let (scene, _) = gnomon_scene::gltf_loader::load(&path).unwrap();
     assert_eq!(scene.meshes.len(), 1, "Sponza is one mesh");
-    // The view of the comparison with Bevy (docs/clusters.md): sun along (0.3, −1, −0.2).
+    // The view of the comparison with Bevy (docs/submission.md, "Clusters"): sun along (0.3, −1, −0.2).
     let mut s = settings(LightKind::Sun, CullMode::Auto);
     s.camera.eye = Some(glam::Vec3::new(-85.0, 12.0, -4.0));
     s.camera.target = Some(glam::Vec3::new(60.0, 30.0, -4.0));

@@ -113,7 +113,7 @@ fn raytraced_estimates_the_reference_penumbra_under_a_sun_disk() {
 /// (`facing_error`), and the two agree within issue 25's 0.01 %. Wherever they still
 /// disagree, the reference's own shadow ray (from its hit point, offset as it offsets
 /// it) is traced on the GPU too: the two tracers must answer it alike, so what
-/// differs is the surface each image shades there (docs/rays.md#measured), not the
+/// differs is the surface each image shades there (docs/rays-measured.md#measured), not the
 /// tracing.
 #[test]
 fn where_raytraced_and_the_reference_disagree_on_sponza_the_tracers_agree() {

@@ -54,7 +54,7 @@ fn a_point_lights_virtual_map_is_wrong_only_along_edges_and_exact_refined() {
 /// (`gnomon compare contact --light point --partition single --shadow-res N
 /// --techniques pcf2x2 --refine off --width 480 --height 270`). Kept, not loosened:
 /// the levels match a pixel's footprint across the light's rays, not on a receiver
-/// the light grazes (docs/virtual-maps.md, "A point light").
+/// the light grazes (docs/virtual-local-lights.md, "A point light").
 #[test]
 #[ignore = "fails at 0.541 % against 0.5 %: see the comment"]
 fn a_point_lights_virtual_map_on_contact_is_wrong_only_along_edges_and_exact_refined() {

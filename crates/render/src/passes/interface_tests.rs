@@ -2,8 +2,9 @@
 //! build (technique × light lookup × forward or mask path × role × refinement, the moment passes
 //! per format, and every fixed pass) links and validates with naga, as wgpu would
 //! compile it, and links again with each declaration named by its module, so that a
-//! module that reads a name without importing it fails; and every uniform struct's WGSL size and field offsets equal the Rust
-//! type's (`struct_layouts`).
+//! module that reads a name without importing it fails; every buffer struct's WGSL size
+//! and field offsets equal its Rust twin's, and no struct a variant binds lacks one
+//! (gpu_mirrors.rs).
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -11,116 +12,17 @@ use gnomon_scene::settings::Refine;
 use wgpu::naga;
 
 use super::{
-    blit, depth_reduce, gpu_cull, light_list, lighting,
+    blit, depth_reduce, gpu_cull,
+    gpu_mirrors::{GPU_ONLY, StructLayout, registered_names, struct_layouts, unregistered_bound_structs},
+    light_list, lighting,
     lighting::{LightingKey, LightingRole, Lookup, MapLookup},
     map_preview, map_scroll, moments, receiver, screen_space, shadow,
 };
 use crate::{
     rays::{LightSize, Traversal},
-    techniques,
     techniques::{TechniqueRef, TechniqueRegistry},
-    uniforms::{
-        BiasGpu, CameraGpu, CascadeChoiceGpu, CascadeGpu, ContactGpu, EmitterGpu, FalloffGpu, LightGpu,
-        LightKindGpu, MapGpu, PcfGpu, PcssGpu, RaysGpu,
-    },
+    uniforms::{FalloffGpu, LightKindGpu},
 };
-
-/// A GPU struct's fields as Rust lays them out, for the layout test to compare with
-/// the WGSL struct of the same name.
-struct StructLayout {
-    pub wgsl_name: &'static str,
-    pub size: usize,
-    pub fields: Vec<(&'static str, usize)>,
-}
-
-/// `StructLayout` of a `repr(C)` struct, listing its fields by name.
-macro_rules! struct_layout {
-    ($ty:ty as $wgsl:literal { $($field:ident),* $(,)? }) => {
-        StructLayout {
-            wgsl_name: $wgsl,
-            size: std::mem::size_of::<$ty>(),
-            fields: vec![$((stringify!($field), std::mem::offset_of!($ty, $field))),*],
-        }
-    };
-}
-
-/// Every uniform struct shared with WGSL.
-fn struct_layouts() -> Vec<StructLayout> {
-    vec![
-        struct_layout!(LightGpu as "Light" {
-            clip_from_world, light_from_world, emitter, ambient, _pad0, map, cascade_choice, bias, pcf, pcss,
-            contact, rays, technique, cascade_clip_from_world, cascades,
-        }),
-        struct_layout!(EmitterGpu as "Emitter" {
-            radiance, kind, direction, range, position, cos_inner, cos_outer, falloff, falloff_window, size,
-        }),
-        struct_layout!(MapGpu as "ShadowMap" {
-            layer_count, moment_layers, resolution, near, far, texel_ortho, texel_per_distance, _pad0,
-        }),
-        struct_layout!(CascadeChoiceGpu as "CascadeChoice" { by_projection, blend, _pad0, _pad1 }),
-        struct_layout!(BiasGpu as "Bias" { normal_offset, depth, slope, receiver_plane }),
-        struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
-        struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, max_search_texels, _pad1 }),
-        struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
-        struct_layout!(RaysGpu as "Rays" { penumbra_rays, history, frame, _pad0 }),
-        struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),
-        struct_layout!(techniques::variance::VarianceParams as "VarianceParams" {
-            positive_exponent, negative_exponent, min_variance, bleeding_reduction, variant, _pad0, _pad1, _pad2,
-        }),
-        struct_layout!(techniques::esm::EsmParams as "EsmParams" { exponent, _pad0, _pad1, _pad2, _pad3 }),
-        struct_layout!(techniques::msm::MsmParams as "MsmParams" { moment_bias, hausdorff, quantised, _pad0, _pad1 }),
-        struct_layout!(techniques::convolution::ConvolutionParams as "ConvolutionParams" {
-            terms, attenuation, scale, offset, _pad0,
-        }),
-        struct_layout!(light_list::LightListGpu as "LightList" {
-            ambient, shown, tiles_x, _pad0, _pad1, _pad2,
-        }),
-        struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
-            world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,
-            _pad2,
-        }),
-        struct_layout!(CascadeGpu as "Cascade" {
-            texel_world, warp_step, split_start, split_end, warped, _pad0, _pad1, _pad2,
-        }),
-        struct_layout!(CameraGpu as "Camera" {
-            clip_from_world, view_from_world, world_from_view, eye, debug_view, scale_x, scale_y, near,
-            far, width, height, inv_width, inv_height,
-        }),
-        struct_layout!(depth_reduce::BoundsParams as "BoundsParams" {
-            world_from_clip, light_from_world, splits, near, far, cascade_count, blend,
-        }),
-        struct_layout!(depth_reduce::Planes as "Planes" { near, far, _pad0, _pad1 }),
-        struct_layout!(crate::virtual_map::MapSpaceGpu as "MapSpace" {
-            light_from_world, near, far, tan_half_fov, kind,
-        }),
-        struct_layout!(crate::virtual_map::PageRequestParams as "PageRequestParams" {
-            map, origins, finest_texel, footprint_per_depth, reach_texels, levels, pages_per_side,
-            page_texels, width, height, edge_levels, area_light_size, area_cap_texels, cone_light_size,
-            cone_level_cap_texels, cone_reach_cap_texels, _pad0, _pad1,
-        }),
-        struct_layout!(crate::virtual_map::VirtualMapGpu as "VirtualMap" {
-            map, origins, finest_texel, levels, pages_per_side, page_texels,
-            pool_pages_per_side, footprint_per_depth, pool_rows_per_layer, edge_levels,
-        }),
-        struct_layout!(crate::virtual_map::SurfaceParams as "SurfaceParams" {
-            world_from_clip, view_z_from_world, width, height, _pad0, _pad1,
-        }),
-        struct_layout!(map_preview::PreviewParams as "Preview" { tile, layer_count, resolution, _pad, layers }),
-        struct_layout!(map_preview::PreviewLayer as "PreviewLayer" { perspective, near, far, _pad }),
-        struct_layout!(crate::gpu_scene::shadow_items::ItemGpu as "ShadowItem" {
-            min, bucket, max, has_cone, axis, sin_half_angle, index_count, first_index, base_vertex,
-            first_instance,
-        }),
-        struct_layout!(gpu_cull::CullViewGpu as "CullView" { planes, centre, item_count, near, _pad0, _pad1 }),
-        struct_layout!(gpu_cull::BucketGpu as "CullBucket" { first_slot, culled }),
-        struct_layout!(crate::gpu_scene::DrawArgs as "DrawArgs" {
-            index_count, instance_count, first_index, base_vertex, first_instance,
-        }),
-        struct_layout!(moments::FilterParamsGpu as "FilterParams" {
-            direction, radius, log_c, sigma, _pad0, _pad1, _pad2,
-        }),
-    ]
-}
 
 /// The lookups a technique's map can be read through, from its stated facts.
 fn lookups(technique: TechniqueRef) -> Vec<Lookup> {
@@ -267,7 +169,9 @@ fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
     let techniques = TechniqueRegistry::builtin().iter().count();
     assert!(variants.len() > 3 * 2 * techniques, "{} variants", variants.len());
     let layouts = struct_layouts();
-    let mut found: BTreeMap<&str, usize> = layouts.iter().map(|l| (l.wgsl_name, 0)).collect();
+    let registered = registered_names();
+    let mut found: BTreeMap<&str, usize> = registered.iter().map(|&name| (name, 0)).collect();
+    let mut unregistered: BTreeMap<String, String> = BTreeMap::new();
     for (name, source) in &variants {
         let module = parse(name, source);
         for layout in &layouts {
@@ -275,10 +179,38 @@ fn every_shader_variant_validates_and_every_uniform_matches_its_rust_type() {
                 *found.get_mut(layout.wgsl_name).expect("listed") += 1;
             }
         }
+        for (gpu_only, _) in GPU_ONLY {
+            if module.types.iter().any(|(_, t)| t.name.as_deref() == Some(gpu_only)) {
+                *found.get_mut(gpu_only).expect("listed") += 1;
+            }
+        }
+        for stray in unregistered_bound_structs(&module, &registered) {
+            unregistered.entry(stray).or_insert_with(|| name.clone());
+        }
     }
+    assert!(
+        unregistered.is_empty(),
+        "bound with no Rust twin in gpu_mirrors.rs (`struct_layouts`, or `GPU_ONLY` with why), each with a variant that binds it: {unregistered:#?}"
+    );
     for (name, count) in found {
-        assert!(count > 0, "no shader declares `{name}`: the layout check never ran for it");
+        assert!(count > 0, "no shader declares `{name}`: its registration in gpu_mirrors.rs checks nothing");
     }
+}
+
+/// The completeness check finds a bound struct nobody registered, held directly,
+/// in an array and inside another struct, and passes it once registered.
+#[test]
+fn a_bound_struct_without_a_rust_twin_is_found() {
+    let source = "struct Stray { a: u32 }\nstruct Inner { b: f32 }\nstruct Outer { inner: Inner }\n\
+        @group(0) @binding(0) var<uniform> stray: Stray;\n\
+        @group(0) @binding(1) var<storage, read> outers: array<Outer>;\n\
+        var<private> unbound: Stray;\n\
+        @compute @workgroup_size(1) fn main() { unbound = stray; _ = outers[0].inner.b; }";
+    let module = parse("stray", source);
+    let found: Vec<String> = unregistered_bound_structs(&module, &registered_names()).into_iter().collect();
+    assert_eq!(found, ["Inner", "Outer", "Stray"]);
+    let known = BTreeSet::from(["Stray", "Inner", "Outer"]);
+    assert!(unregistered_bound_structs(&module, &known).is_empty());
 }
 
 #[test]

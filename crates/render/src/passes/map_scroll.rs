@@ -10,11 +10,11 @@ use crate::pool::{Binding, Pool};
 /// The scroll's uniform (`Scroll` in `map_scroll.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct ScrollParams {
+pub(crate) struct ScrollParams {
     /// Where a target texel's depth comes from, relative to it, in texels.
-    offset: [i32; 2],
+    pub(crate) offset: [i32; 2],
     /// The layer's texels per side.
-    size: [i32; 2],
+    pub(crate) size: [i32; 2],
 }
 
 pub(crate) struct MapScrollPass {

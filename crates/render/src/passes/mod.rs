@@ -20,6 +20,8 @@ pub(crate) mod wgsl_interfaces;
 pub(crate) use binding_place::BindingPlace;
 
 #[cfg(test)]
+mod gpu_mirrors;
+#[cfg(test)]
 mod interface_tests;
 
 /// The shadow map's texel format.

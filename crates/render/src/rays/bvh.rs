@@ -92,7 +92,8 @@ pub(crate) struct AlphaTextureGpu {
     pub wrap_v: u32,
     /// 1 for nearest-texel lookups, 0 for bilinear.
     pub nearest: u32,
-    pub _pad: [u32; 2],
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
 /// How `trace.wgsl` names a wrap mode.
@@ -484,7 +485,8 @@ fn alpha_textures(scene: &Scene) -> (Vec<AlphaTextureGpu>, Vec<u32>, Vec<Option<
             wrap_u: wrap_code(texture.wrap_u),
             wrap_v: wrap_code(texture.wrap_v),
             nearest: texture.nearest as u32,
-            _pad: [0; 2],
+            _pad0: 0,
+            _pad1: 0,
         });
         texels.extend(pack_alpha(texture));
     }

@@ -7,7 +7,7 @@
 //! pass (`refine.rs`) binds the same resources where it refines a shadow.
 
 mod accel;
-mod bvh;
+pub(crate) mod bvh;
 mod forward;
 pub(crate) mod pyramid;
 pub(crate) mod query;

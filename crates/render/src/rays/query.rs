@@ -23,11 +23,11 @@ pub struct ShadowRay {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct RayGpu {
-    origin: [f32; 3],
-    length: f32,
-    direction: [f32; 3],
-    _pad: f32,
+pub(crate) struct RayGpu {
+    pub(crate) origin: [f32; 3],
+    pub(crate) length: f32,
+    pub(crate) direction: [f32; 3],
+    pub(crate) _pad: f32,
 }
 
 /// Threads per workgroup of the query shader (`QUERY_WORKGROUP` there).

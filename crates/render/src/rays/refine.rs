@@ -12,6 +12,8 @@ use gnomon_scene::settings::Refine;
 
 use std::collections::HashMap;
 
+use bytemuck::{Pod, Zeroable};
+
 use super::Traversal;
 use crate::{
     passes::{self, Layouts, compose_wgsl, lighting::MapLookup},
@@ -28,20 +30,51 @@ pub(crate) const MAX_GROUPS: u32 = 65_535;
 /// `min_storage_buffer_offset_alignment` WebGPU allows, so every device accepts the
 /// dynamic offset.
 pub(crate) const COUNTER_STRIDE: u64 = 256;
-/// Bytes of one light's counters (`RefineCounters` in refine_append.wgsl): the three
+/// One light's counters, as the mask pass counts them (`RefineCounters` in
+/// refine_append.wgsl, atomics) and the trace, fill and edge passes read them
+/// (`ListedPixels` in refine_list.wgsl, its dispatch counts as `vec3<u32>`): the three
 /// workgroup counts of the trace pass's indirect dispatch, then the pixels listed;
-/// then the same for the pixels listed to be filled; then the unsure pixels their
-/// penumbra history answered: 36 bytes, which the trace pass reads as a struct of
-/// two `vec3<u32>` (`ListedPixels`, 16-byte aligned) of 48.
-const COUNTER_BYTES: u64 = 48;
-/// Bytes from a light's counters to those of its fill pass.
-const FILL_COUNTERS: u64 = 16;
+/// the same for the pixels listed to be filled; then the unsure pixels their penumbra
+/// history answered. 48 bytes, as `ListedPixels`' 16-byte alignment rounds it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub(crate) struct RefineCountersGpu {
+    pub groups_x: u32,
+    pub groups_y: u32,
+    pub groups_z: u32,
+    pub count: u32,
+    pub fill_groups_x: u32,
+    pub fill_groups_y: u32,
+    pub fill_groups_z: u32,
+    pub fill_count: u32,
+    pub kept_count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// Bytes of one light's counters ([`RefineCountersGpu`]).
+const COUNTER_BYTES: u64 = std::mem::size_of::<RefineCountersGpu>() as u64;
+/// Bytes from a light's counters to those of its fill pass (its indirect dispatch).
+const FILL_COUNTERS: u64 = std::mem::offset_of!(RefineCountersGpu, fill_groups_x) as u64;
 /// Texels of the ring around a lookup's bilinear 2×2 that the footprint test reads
 /// (`refine_footprint.wgsl`): a virtual map's pixels ask for the pages it reaches.
 pub(crate) const UNSURE_RING_TEXELS: i32 = 2;
-/// Bytes of one listed pixel (`UnsurePixel`): its position, its map layer, and the
-/// mean and count of the beams its penumbra history holds.
-pub(crate) const PIXEL_BYTES: u64 = 16;
+/// One listed pixel (`UnsurePixel` in refine_list.wgsl), which only the GPU writes
+/// and reads: its position, its map layer (and penumbra width), and the mean and
+/// count of the beams its penumbra history holds. Rust sizes the list by it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct UnsurePixelGpu {
+    /// x | y << 16.
+    pub pixel: u32,
+    pub layer: u32,
+    pub mean: f32,
+    pub beams: f32,
+}
+
+/// Bytes of one listed pixel ([`UnsurePixelGpu`]).
+pub(crate) const PIXEL_BYTES: u64 = std::mem::size_of::<UnsurePixelGpu>() as u64;
 
 /// The constants the list (`refine_list.wgsl` and the passes that import it) shares
 /// with Rust.
@@ -533,12 +566,18 @@ impl RefineLists {
     /// traced) this frame, and unsure in all (beamed, filled, or answered by their
     /// penumbra history).
     pub fn listed(counters: &[u32], lights: usize) -> Vec<Listed> {
-        let stride = (COUNTER_STRIDE / 4) as usize;
-        let word = |light: usize, k: usize| counters.get(light * stride + k).copied().unwrap_or(0);
+        let bytes: &[u8] = bytemuck::cast_slice(counters);
+        let light_counters = |light: usize| {
+            let start = light * COUNTER_STRIDE as usize;
+            bytes
+                .get(start..start + COUNTER_BYTES as usize)
+                .map(bytemuck::pod_read_unaligned::<RefineCountersGpu>)
+                .unwrap_or_default()
+        };
         (0..lights)
-            .map(|light| Listed {
-                traced: word(light, 3),
-                unsure: word(light, 3) + word(light, 7) + word(light, 8),
+            .map(|light| {
+                let c = light_counters(light);
+                Listed { traced: c.count, unsure: c.count + c.fill_count + c.kept_count }
             })
             .collect()
     }

@@ -20,6 +20,10 @@ struct RefineCounters {
     // Unsure pixels answered by the beams their history holds, neither beamed nor
     // filled this frame (penumbra_mask.wgsl).
     kept_count: atomic<u32>,
+    // To `ListedPixels`' 48 bytes, the size of Rust's `RefineCountersGpu`.
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(1) @binding(4) var<storage, read_write> refine_counters: RefineCounters;

@@ -16,7 +16,7 @@ const UNSURE_DEPTH_TEXELS: f32 = 2.0;
 // depth per texel, so the default slope bias (1.5) stores it 15 texels or more
 // behind its plane along the ray, a surface curving away from the light around it
 // is biased as much or more, and the normal offset's push toward the light moves
-// the lookup's plane in front of it by the push over N·L (docs/rays.md, "A steep
+// the lookup's plane in front of it by the push over N·L (docs/rays-measured.md, "A steep
 // caster's bias").
 const UNSURE_GRAZING_COS: f32 = 0.1;
 

@@ -17,5 +17,16 @@ struct UnsurePixel {
     beams: f32,
 };
 
+// A light's counters (`RefineCounters` in refine_append.wgsl) as the passes
+// dispatched by them read them, each at binding 4 of its own group 1: the trace and
+// fill passes' workgroups and pixels, then the unsure pixels the history answered.
+struct ListedPixels {
+    groups: vec3<u32>,
+    count: u32,
+    fill_groups: vec3<u32>,
+    fill_count: u32,
+    kept_count: u32,
+};
+
 // Written by the mask pass (refine_append.wgsl), completed by the trace pass.
 @group(1) @binding(3) var<storage, read_write> unsure_pixels: array<UnsurePixel>;

@@ -23,23 +23,13 @@ import package::passes::octahedron::octahedron_decode;
 import package::passes::screen_common::{prepass_normals, prepass_surface};
 import package::passes::shading::light_geometry;
 import package::rays::light_sample::lowbias32;
-import package::rays::refine_list::unsure_pixels;
+import package::rays::refine_list::{ListedPixels, unsure_pixels};
 import package::rays::surface_rays::{centre_ray_blocked, surface_ray_origin};
 import package::variant::{REFINE_GROUP_SIZE, REFINE_PENUMBRAE, area_visibility};
 
-// The light's counters, read only: they are also the passes' indirect dispatches,
-// which no pass may write while it reads them so (`RefineCounters` in
-// refine_append.wgsl).
-struct ListedPixels {
-    groups: vec3<u32>,
-    count: u32,
-    fill_groups: vec3<u32>,
-    fill_count: u32,
-    kept_count: u32,
-};
-
-// The list itself is `unsure_pixels` (refine_list.wgsl); its counters are read-only
-// here.
+// The list itself is `unsure_pixels` (refine_list.wgsl); the light's counters are
+// read only here: they are also the passes' indirect dispatches, which no pass may
+// write while it reads them so (`RefineCounters` in refine_append.wgsl).
 @group(1) @binding(4) var<storage, read> listed: ListedPixels;
 
 @group(2) @binding(0) var refined_mask: texture_storage_2d<r32float, write>;

@@ -26,7 +26,7 @@ impl Traversal {
     /// device has them, or by `auto` on a GPU that has them; the shader otherwise,
     /// with why it was not ray queries where they were asked for by name. (On
     /// lavapipe, which runs ray queries in software, the shader's BVH traced
-    /// Florence's unsure pixels 5–6× faster: docs/rays.md.)
+    /// Florence's unsure pixels 5–6× faster: docs/rays-tracers.md.)
     pub(crate) fn resolve(tracer: Tracer, gpu: &Gpu) -> (Self, Option<RayQueriesUnavailable>) {
         match tracer {
             Tracer::Shader => (Traversal::Shader, None),

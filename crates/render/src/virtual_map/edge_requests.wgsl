@@ -7,20 +7,14 @@
 // so the band where the map is unsure, as wide as the footprint test's block of
 // texels, narrows by half with each level; a pixel asks for nothing finer than
 // `edge_levels` below its footprint's level.
-import package::rays::refine_list::unsure_pixels;
+import package::rays::refine_list::{ListedPixels, unsure_pixels};
 import package::constants::TRACED_LAYER_FLAG;
 import package::passes::screen_common::prepass_surface;
 import package::variant::REFINE_GROUP_SIZE;
 import package::virtual_map::page_requests::{footprint_level, request_area_search, request_level_pages, request_params, window_level};
 
-// The light's refinement counters (`RefineCounters` in refine_append.wgsl), read
-// only: the pass is dispatched by them.
-struct EdgeListed {
-    groups: vec3<u32>,
-    count: u32,
-};
-
-@group(1) @binding(4) var<storage, read> edge_listed: EdgeListed;
+// The light's refinement counters, read only: the pass is dispatched by them.
+@group(1) @binding(4) var<storage, read> edge_listed: ListedPixels;
 
 @compute @workgroup_size(REFINE_GROUP_SIZE)
 fn request_edge_pages(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {

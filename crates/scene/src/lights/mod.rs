@@ -6,7 +6,7 @@
 //! reference and the front ends ask these facts instead of matching on the kind, so
 //! a new kind is its file, a variant and a line of [`Light::kind`] here, and its
 //! branch in the shaders' `light_kinds.wgsl`
-//! (docs/architecture.md, "Walk-through: add a light kind").
+//! (docs/extending.md, "Walk-through: add a light kind").
 
 /// A kind's struct as its variant of [`Light`]: `From<$kind> for Light` and
 /// [`KindType`], written once for every kind (`kind_type!(SpotLight, Spot, "spot")`).

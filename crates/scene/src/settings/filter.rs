@@ -302,7 +302,7 @@ pub struct PcssSettings {
     /// separate cap from the search's: a fine map under a low, wide sun (a single
     /// map fitted to the receivers) has penumbrae wider than 32 texels, and clipping
     /// them there doubled PCSS's penumbra error on `grazing` under a 2° sun
-    /// (docs/measured.md, "Soft shadows"). A point light's 2048² cube faces under
+    /// (docs/measured-soft.md, "Soft shadows"). A point light's 2048² cube faces under
     /// a wide sphere want more (up to 256); a virtual map asks for the pages as far
     /// as it reaches, so on one it costs pages.
     #[cfg_attr(feature = "cli", arg(long, value_name = "TEXELS", default_value_t = PcssSettings::default().max_penumbra, help_heading = "PCSS"))]

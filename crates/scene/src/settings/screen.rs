@@ -82,7 +82,7 @@ pub enum Refine {
 
 /// Which tracer answers the shadow rays that `refine` and the `raytraced` technique
 /// cast. Both trace the same casters and give the CPU reference's answers
-/// (docs/rays.md, "Two tracers").
+/// (docs/rays-tracers.md, "Two tracers").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
