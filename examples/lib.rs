@@ -25,12 +25,12 @@ pub mod guide {
     pub struct Readme;
     #[doc = include_str!("../docs/library.md")]
     pub struct Library;
-    #[doc = include_str!("../docs/rays.md")]
-    pub struct Rays;
+    #[doc = include_str!("../docs/rays-tracers.md")]
+    pub struct RaysTracers;
 }
 
 /// The pages `guide` compiles, as paths from the repository's root.
-pub const COMPILED_PAGES: &[&str] = &["README.md", "docs/library.md", "docs/rays.md"];
+pub const COMPILED_PAGES: &[&str] = &["README.md", "docs/library.md", "docs/rays-tracers.md"];
 
 #[cfg(test)]
 mod tests {
