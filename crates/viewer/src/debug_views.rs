@@ -263,6 +263,43 @@ mod tests {
         );
     }
 
+    /// The viewer's settings with only a light's size given (through its form, as a
+    /// user sets them), in the frame its error view measures (`render_uploaded`, as
+    /// the window's comparison draws it): the defaults beam the penumbrae to within
+    /// issue 74's 0.01 of the truth, as on the command line, in Python and in the
+    /// browser (docs/soft-shadows.md).
+    #[test]
+    fn the_viewers_error_view_finds_the_soft_defaults_within_a_hundredth() {
+        let gpu = Gpu::new_headless().unwrap();
+        let mut renderer = Renderer::new(&gpu).unwrap();
+        let scene = builtin::spheres();
+        let form = crate::settings_form::SettingsForm::new();
+        let sized = form.set(&Settings::default(), "sun_angular_diameter", Some("5")).unwrap();
+        // The truth's own noise, under 0.01 over a penumbra, needs more rays than the
+        // default 256 (python/tests/test_soft_defaults.py says why).
+        let mut settings = form.set(&sized, "samples", Some("1024")).unwrap();
+        (settings.image.width, settings.image.height) = (320, 180);
+        let uploaded = renderer.upload(&scene).unwrap();
+        let frame =
+            renderer.render_uploaded(&uploaded, &scene, &settings, &OutputRequest::default()).unwrap();
+        let [light] = &frame.lights[..] else { panic!("one light: {:?}", frame.lights) };
+        assert_eq!(light.refine, gnomon_scene::settings::Refine::Rays, "{light:?}");
+        assert!(light.penumbra_frames.is_some_and(|f| f > 1), "a still view gathers frames: {light:?}");
+        let picture = finish(ErrorJob::start(&scene, frame, settings).unwrap());
+        // "…, 0.0038 over the 573 penumbra pixels, …": the figure the viewer shows.
+        let mae: f64 = picture
+            .summary
+            .split(", ")
+            .find(|part| part.ends_with("penumbra pixels"))
+            .and_then(|part| part.split(' ').next()?.parse().ok())
+            .unwrap_or_else(|| panic!("no penumbra MAE in: {}", picture.summary));
+        println!(
+            "figure: the viewer's error view, spheres 320×180, sun 5°, the defaults: {}",
+            picture.summary
+        );
+        assert!(mae <= 0.01, "{}", picture.summary);
+    }
+
     /// Pixels painted as wrongly shadowed or wrongly lit.
     fn wrong(picture: &Picture) -> usize {
         picture

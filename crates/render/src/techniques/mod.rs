@@ -22,7 +22,6 @@
 
 pub(crate) mod convolution;
 pub(crate) mod esm;
-mod hard;
 pub(crate) mod msm;
 mod params;
 mod pcf;
@@ -42,11 +41,11 @@ use crate::passes::wgsl_interfaces::TECHNIQUE_CONTRACT;
 /// Every built-in technique, in the order the command line lists them. Adding one
 /// is its module, its WGSL and one line here.
 pub static BUILTIN: &[&dyn ShadowTechnique] = &[
-    &hard::Hard,
-    &pcf::Pcf2x2,
-    &pcf::PcfBox,
-    &pcf::PcfTent,
-    &pcf::PcfPoisson,
+    &pcf::HARD,
+    &pcf::PCF2X2,
+    &pcf::PCF_BOX,
+    &pcf::PCF_TENT,
+    &pcf::PCF_POISSON,
     &pcss::Pcss,
     &variance::VSM,
     &esm::Esm,
