@@ -4,7 +4,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::UVec4;
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+use super::{
+    contract::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables},
+    params::{GpuParams, TechniqueParams},
+};
 
 /// ESM's parameters (`EsmParams` in esm.wgsl).
 #[repr(C)]

@@ -11,7 +11,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique, Tunables};
+use super::contract::{MapSupport, ShadowTechnique, Tunables};
 
 /// What a row's lookup filters over.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

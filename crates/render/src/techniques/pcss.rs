@@ -4,7 +4,7 @@
 
 use gnomon_scene::settings::{FilterSettings, Technique};
 
-use super::{MapSupport, ShadowTechnique, Tunables, VirtualReach};
+use super::contract::{MapSupport, ShadowTechnique, Tunables, VirtualReach};
 
 pub struct Pcss;
 

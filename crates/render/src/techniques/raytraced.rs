@@ -8,7 +8,7 @@
 
 use gnomon_scene::settings::{FilterSettings, RayUse, Technique};
 
-use super::{MapSupport, ShadowTechnique, Tunables};
+use super::contract::{MapSupport, ShadowTechnique, Tunables};
 
 pub struct Raytraced;
 

@@ -11,11 +11,30 @@ use gnomon_scene::{
     settings::{ResolvedLight, SettingsError, ShadowSettings, Technique, WarpKind, value_name},
 };
 
-use super::{BUILTIN, ShadowTechnique};
+use super::{contract::ShadowTechnique, convolution, esm, msm, pcf, pcss, raytraced, variance};
 use crate::{
     light_map::MapLookup,
     passes::wgsl_interfaces::{ENCODE_MOMENTS, SAMPLE_SHADOW, SAMPLE_SHADOW_CUBE, SAMPLE_SHADOW_VIRTUAL},
 };
+
+/// Every built-in technique, in the order the command line lists them. Adding one
+/// is its module, its WGSL and one line here.
+pub static BUILTIN: &[&dyn ShadowTechnique] = &[
+    &pcf::HARD,
+    &pcf::PCF2X2,
+    &pcf::PCF_BOX,
+    &pcf::PCF_TENT,
+    &pcf::PCF_POISSON,
+    &pcss::Pcss,
+    &variance::VSM,
+    &esm::Esm,
+    &variance::EVSM2,
+    &variance::EVSM4,
+    &msm::HAMBURGER,
+    &msm::HAUSDORFF,
+    &convolution::Convolution,
+    &raytraced::Raytraced,
+];
 
 /// A registered technique: a cheap handle that compares and hashes by name (names
 /// are unique within a registry), for the pipeline caches' keys.

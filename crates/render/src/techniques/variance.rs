@@ -5,7 +5,10 @@
 use bytemuck::{Pod, Zeroable};
 use gnomon_scene::settings::{FilterSettings, MomentFormat, SettingsError, Technique};
 
-use super::{FilterableMap, GpuParams, MapPrecision, MapSupport, ShadowTechnique, TechniqueParams, Tunables};
+use super::{
+    contract::{FilterableMap, MapPrecision, MapSupport, ShadowTechnique, Tunables},
+    params::{GpuParams, TechniqueParams},
+};
 
 /// The Chebyshev family's parameters (`VarianceParams` in variance.wgsl).
 #[repr(C)]
