@@ -180,27 +180,47 @@ pub fn drawn_truth_at(
     settings: &Settings,
     surfaces: &crate::surfaces_in::ReadSurfaces,
 ) -> anyhow::Result<DrawnTruth> {
-    let light: Light = settings.resolve_light(scene)?;
-    let traced = TracedScene::build(scene);
-    let options = drawn_options(scene, settings);
-    let bar = ProgressBar::new(surfaces.height as u64).with_style(
-        ProgressStyle::with_template("truth at the given surfaces {bar:40} {pos}/{len} rows, {eta} left")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
     let drawn = DrawnSurfaces {
         width: surfaces.width,
         position: &surfaces.position,
         geometric_normal: &surfaces.geometric_normal,
     };
-    let truth = drawn_truth(&traced, &light, drawn, &options, &|rows| bar.set_position(rows));
-    bar.finish_and_clear();
-    Ok(truth)
+    Ok(DrawnTracer::new(scene, settings)?.trace(drawn, surfaces.height, "the given surfaces"))
 }
 
-/// How the truth at drawn surfaces is traced: the reference's samples, and the lift
-/// that tells an ambiguous pixel, 10⁻⁵ of the scene's extent.
-fn drawn_options(scene: &Scene, settings: &Settings) -> DrawnOptions {
-    DrawnOptions { samples: settings.reference.samples, lift: 1e-5 * scene.bounds().extent().length() }
+/// The truth at drawn surfaces for one scene and light: the reference's samples,
+/// and the lift that tells an ambiguous pixel, 10⁻⁵ of the scene's extent.
+struct DrawnTracer {
+    light: Light,
+    traced: TracedScene,
+    options: DrawnOptions,
+}
+
+impl DrawnTracer {
+    fn new(scene: &Scene, settings: &Settings) -> anyhow::Result<Self> {
+        Ok(Self {
+            light: settings.resolve_light(scene)?,
+            traced: TracedScene::build(scene),
+            options: DrawnOptions {
+                samples: settings.reference.samples,
+                lift: 1e-5 * scene.bounds().extent().length(),
+            },
+        })
+    }
+
+    /// The truth at `surfaces` (`height` rows), with a progress bar naming `what`.
+    fn trace(&self, surfaces: DrawnSurfaces, height: u32, what: &str) -> DrawnTruth {
+        let bar = ProgressBar::new(u64::from(height)).with_style(
+            ProgressStyle::with_template(&format!(
+                "truth at {what} {{bar:40}} {{pos}}/{{len}} rows, {{eta}} left"
+            ))
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let truth =
+            drawn_truth(&self.traced, &self.light, surfaces, &self.options, &|rows| bar.set_position(rows));
+        bar.finish_and_clear();
+        truth
+    }
 }
 
 /// Each frame's metrics against the truth at the surfaces it drew
@@ -212,9 +232,7 @@ pub fn drawn_metrics(
     settings: &Settings,
     frames: &[&Frame],
 ) -> anyhow::Result<Vec<DrawnMetrics>> {
-    let light: Light = settings.resolve_light(scene)?;
-    let traced = TracedScene::build(scene);
-    let options = drawn_options(scene, settings);
+    let tracer = DrawnTracer::new(scene, settings)?;
     let bits =
         |v: &[glam::Vec3]| -> Vec<u32> { v.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect() };
     let mut truths: Vec<(Vec<u32>, DrawnTruth)> = Vec::new();
@@ -225,20 +243,12 @@ pub fn drawn_metrics(
         let index = match known {
             Some(index) => index,
             None => {
-                let bar = ProgressBar::new(frame.height as u64).with_style(
-                    ProgressStyle::with_template(
-                        "truth at the drawn surfaces {bar:40} {pos}/{len} rows, {eta} left",
-                    )
-                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
-                );
                 let surfaces = DrawnSurfaces {
                     width: frame.width,
                     position: &frame.position,
                     geometric_normal: &frame.geometric_normal,
                 };
-                let truth = drawn_truth(&traced, &light, surfaces, &options, &|rows| bar.set_position(rows));
-                bar.finish_and_clear();
-                truths.push((key, truth));
+                truths.push((key, tracer.trace(surfaces, frame.height, "the drawn surfaces")));
                 truths.len() - 1
             }
         };

@@ -5,7 +5,7 @@ use std::process::Command;
 
 use crate::support;
 
-use support::{files_in, gnomon, stderr, temp_dir};
+use support::{files_in, gnomon, read_npy, stderr, temp_dir};
 
 #[test]
 fn no_arguments_renders_spheres_to_gnomon_png() {
@@ -54,12 +54,8 @@ fn float_outputs_are_written_with_their_documented_layout() {
         "--verbose names the adapter: {}",
         stderr(&out)
     );
-    let bytes = std::fs::read(dir.join("v.npy")).unwrap();
-    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    let (header, values) = read_npy(&dir.join("v.npy"));
     assert!(header.contains("'shape': (90, 160)"), "{header}");
-    let values: Vec<f32> =
-        bytes[10 + header_len..].chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
     assert_eq!(values.len(), 160 * 90);
     assert!(values.iter().all(|v| v.is_nan() || (0.0..=1.0).contains(v)));
     let lit = values.iter().filter(|v| **v > 0.5).count();

@@ -3,13 +3,11 @@
 
 use std::path::Path;
 
-use super::support::{files_in, gnomon, stderr, temp_dir};
+use super::support::{files_in, gnomon, read_npy, stderr, temp_dir};
 
 /// A float32 `.npy`'s values (as `--aov-out` and `reference --out` write them).
 fn npy_values(path: &Path) -> Vec<f32> {
-    let bytes = std::fs::read(path).unwrap();
-    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    bytes[10 + len..].chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+    read_npy(path).1
 }
 
 const SIZE: [&str; 4] = ["--width", "96", "--height", "54"];
