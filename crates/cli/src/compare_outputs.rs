@@ -63,7 +63,7 @@ pub(crate) fn stage(staged: &mut output::Staged, out: &Path, measured: Measured)
         if let Some(t) = timing {
             caption.push(format!("shadow pass {:.2} ms", t.shadow_ms));
             if let Some(f) = t.filter_ms {
-                caption.push(format!("moment pass {f:.2} ms"));
+                caption.push(format!("derived maps {f:.2} ms"));
             }
             caption.push(format!("lighting pass {:.2} ms", t.lighting_ms));
         }

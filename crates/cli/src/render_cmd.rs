@@ -192,7 +192,7 @@ fn report_frame(gpu: &Gpu, scene: &Scene, frame: &Frame, render_time: std::time:
         eprintln!("gnomon: moment map {format:?}{why}");
     }
     if let Some(t) = frame.timings {
-        let filter = t.filter_ms.map(|f| format!(", moment pass {f:.2} ms")).unwrap_or_default();
+        let filter = t.filter_ms.map(|f| format!(", derived maps {f:.2} ms")).unwrap_or_default();
         let prepass = t.prepass_ms.map(|p| format!(", prepass {p:.2} ms")).unwrap_or_default();
         let mask = t.mask_ms.map(|m| format!(", shadow mask {m:.2} ms")).unwrap_or_default();
         let trace = t.trace_ms.map(|m| format!(", ray trace {m:.2} ms")).unwrap_or_default();
@@ -338,7 +338,7 @@ fn light_line(index: usize, light: &gnomon_render::LightStats) -> String {
         light.layer_triangles.iter().sum::<u64>(),
         triangles.join(" "),
         ms("shadow", light.shadow_ms),
-        ms("moments", light.filter_ms),
+        ms("derived maps", light.filter_ms),
         ms("mask", light.mask_ms),
         ms("trace", light.trace_ms),
         ms("lighting", light.lighting_ms),

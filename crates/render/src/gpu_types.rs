@@ -23,9 +23,58 @@ pub struct InstanceGpu {
     pub alpha_cutoff: f32,
     /// 1 when the base colour is multiplied by the bound texture.
     pub textured: u32,
-    pub _pad0: u32,
+    /// Which of its faces the camera's passes draw: a [`SeenFaces`].
+    pub seen_faces: u32,
     pub _pad1: u32,
     pub _pad2: u32,
+}
+
+/// Which faces of an instance the camera's passes draw (`InstanceGpu::seen_faces`;
+/// `hidden_face` in scene_common.wgsl).
+///
+/// A closed mesh's inside is never seen from outside it, so the camera draws only
+/// its outer faces, by the winding they have on screen, as glTF asks of a
+/// single-sided material (glTF 2.0, "Double Sided"). Where snapping the vertices of
+/// a sliver a fraction of a pixel wide (a 4 mm wire across 300 pixels) opens gaps
+/// in its near faces, the rasterizer showed its far faces through them, from
+/// inside, where every shadow ray is blocked: the truth there is shadow and the
+/// map's answer light. An open mesh's faces are both drawn, as before: a wall or a
+/// card seen from behind shows its back.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SeenFaces {
+    /// A double-sided material, or an open mesh (or a closed one of no volume).
+    Both = 0,
+    /// A closed mesh whose outer faces wind counter-clockwise on screen.
+    CounterClockwise = 1,
+    /// A closed mesh whose outer faces wind clockwise: one wound inside out, or
+    /// placed by a mirroring transform.
+    Clockwise = 2,
+}
+
+impl SeenFaces {
+    pub const ALL: [SeenFaces; 3] = [SeenFaces::Both, SeenFaces::CounterClockwise, SeenFaces::Clockwise];
+
+    /// The WGSL constant's name (`package::constants`).
+    pub fn wgsl_name(self) -> &'static str {
+        match self {
+            SeenFaces::Both => "SEEN_BOTH",
+            SeenFaces::CounterClockwise => "SEEN_CCW",
+            SeenFaces::Clockwise => "SEEN_CW",
+        }
+    }
+
+    /// The faces seen of a mesh placed by `world_from_object`, whose winding
+    /// `outward` says (None: open, or double-sided; Some(true): its outer faces wind
+    /// counter-clockwise seen from outside, a positive signed volume).
+    pub fn of(outward: Option<bool>, world_from_object: Mat4) -> SeenFaces {
+        match outward {
+            None => SeenFaces::Both,
+            // A transform of negative determinant mirrors the mesh and its winding.
+            Some(ccw) if ccw == (world_from_object.determinant() > 0.0) => SeenFaces::CounterClockwise,
+            Some(_) => SeenFaces::Clockwise,
+        }
+    }
 }
 
 /// The vertex-buffer slot of the instance transforms, after the vertices (slot 0).

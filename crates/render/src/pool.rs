@@ -409,10 +409,11 @@ mod tests {
             "virtual_map/draw.rs",
             // Its tests' full-resolution reference maps.
             "virtual_map/draw/tests.rs",
-            // A map's depth pyramid, kept with the map it was built from
-            // (`frame/pyramid_cache.rs`), and each light's penumbra history, kept
-            // across frames: both counted in `Renderer::creations`.
+            // A map's depth pyramid and touched layer, kept with the map they were
+            // derived from (`frame/derived_cache.rs`), and each light's penumbra
+            // history, kept across frames: all counted in `Renderer::creations`.
             "rays/pyramid.rs",
+            "rays/touched.rs",
             "frame/penumbra_history.rs",
         ];
         let creations =

@@ -14,7 +14,9 @@ pub enum PassKind {
     Prepass,
     /// One layer (cascade, cube face, hemisphere or the single map) of a light's map.
     Shadow,
-    /// A filterable technique's moment pass: encoding, blur and mipmaps.
+    /// What a light derives from its map: a filterable technique's moment pass
+    /// (encoding, blur and mipmaps), the depth pyramid of a light with an area, the
+    /// touched layer of a map its rays refine (`rays/touched.rs`).
     Filter,
     /// A light's screen-space shadow-mask pass (with refinement by rays, the
     /// classification of its pixels).

@@ -51,6 +51,9 @@ pub const BYTES_PER_REFERENCE_PIXEL: u64 = 96;
 pub const BYTES_PER_MAP_TEXEL: u64 = 4;
 /// What a texel of a filterable map adds (four 32-bit moments, and the blur's copy).
 pub const BYTES_PER_MOMENT_TEXEL: u64 = 32;
+/// What a texel of a 2D map its rays refine adds: the touched layer of casters
+/// thinner than a texel beside it (32-bit depth; `gnomon-render`'s `rays/touched.rs`).
+pub const BYTES_PER_TOUCHED_TEXEL: u64 = 4;
 
 /// One item of a frame's memory: what it is, and its bytes.
 #[derive(Clone, Debug, PartialEq, Eq)]

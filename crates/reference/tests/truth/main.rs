@@ -23,5 +23,6 @@ mod refine_forward;
 mod refine_soft;
 mod screen_space;
 mod soft_shadows;
+mod thin_casters;
 mod virtual_local_lights;
 mod virtual_maps;

@@ -27,6 +27,9 @@ pub(crate) struct FixedBindings {
     /// Bound in place of a depth pyramid's planes and ranges where the mask pass
     /// reads none.
     placeholder_pyramid: [wgpu::TextureView; 2],
+    /// Bound in place of a touched layer where a light has none: its zeros say that
+    /// nothing touches a texel (`rays/touched.rs`).
+    placeholder_touched: wgpu::TextureView,
 }
 
 /// A virtual map's uniform and page table, as a light's shadow group binds them.
@@ -50,6 +53,9 @@ pub(crate) struct ShadowViews<'a> {
     /// The depth map's pyramid, for the mask pass of a light whose penumbrae it
     /// classifies.
     pub pyramid: Option<&'a super::recording::PyramidViews>,
+    /// The depth map's touched layer, where its rays refine it under the footprint
+    /// test.
+    pub touched: Option<&'a wgpu::TextureView>,
 }
 
 fn placeholder(
@@ -139,6 +145,10 @@ impl FixedBindings {
                     wgpu::TextureViewDimension::D2Array,
                 )
             }),
+            placeholder_touched: view_as(
+                placeholder(device, "no touched layer", SHADOW_FORMAT, 1),
+                wgpu::TextureViewDimension::D2Array,
+            ),
             placeholder_virtual: VirtualBuffers {
                 uniform: placeholder_buffer(
                     device,
@@ -159,8 +169,10 @@ impl FixedBindings {
             None => [&self.placeholder_pyramid[0], &self.placeholder_pyramid[1]],
         }
         .map(|view| Binding::View(view.clone()));
-        // The mask and the pyramid after the shadow resources (`passes::Layouts::shadow`).
-        let bindings = [self.map_bindings(&views), vec![mask, planes, ranges]].concat();
+        let touched = Binding::View(views.touched.unwrap_or(&self.placeholder_touched).clone());
+        // The mask, the pyramid and the touched layer after the shadow resources
+        // (`passes::Layouts::shadow`).
+        let bindings = [self.map_bindings(&views), vec![mask, planes, ranges, touched]].concat();
         pool.bind_group("shadow map", &layouts.shadow, &bindings)
     }
 

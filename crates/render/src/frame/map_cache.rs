@@ -16,8 +16,9 @@
 
 use gnomon_scene::settings::BiasSettings;
 
-use super::{moment_cache::MomentCache, plan::LightPlan, pyramid_cache::PyramidCache};
+use super::{derived_cache::DerivedCache, moment_cache::MomentCache, plan::LightPlan};
 use crate::passes::SHADOW_FORMAT;
+use crate::rays::{Pyramid, Touched};
 
 /// Everything a layer's still casters' depth depends on: its projection, and the
 /// rest as bytes compared whole.
@@ -146,7 +147,9 @@ pub(super) struct MapCache {
     /// The moment maps filtered from the kept maps.
     pub moments: MomentCache,
     /// The depth pyramids built from them.
-    pub pyramids: PyramidCache,
+    pub pyramids: DerivedCache<Pyramid>,
+    /// The touched layers drawn with them (`rays/touched.rs`).
+    pub touched: DerivedCache<Touched>,
 }
 
 impl MapCache {
@@ -216,9 +219,10 @@ impl MapCache {
         &self.uses
     }
 
-    /// How many cache textures it has created, moment maps and pyramids included.
+    /// How many cache textures it has created, moment maps, pyramids and touched
+    /// layers included.
     pub fn created(&self) -> u64 {
-        self.created + self.moments.created() + self.pyramids.created()
+        self.created + self.moments.created() + self.pyramids.created() + self.touched.created()
     }
 }
 

@@ -7,7 +7,7 @@ use gnomon_scene::{
     Scene,
     lights::ShadowView,
     memory::{self, Charge, FrameBudget},
-    settings::{Partition, Settings},
+    settings::{Partition, Refine, Settings},
 };
 
 use super::Renderer;
@@ -65,8 +65,24 @@ impl Renderer {
             // is that error, not a budget's.
             let technique = self.techniques.check_light(shadow, &light.light, &light.name)?;
             let filterable = technique.filterable_map(&shadow.filter).is_some();
-            let per_texel =
-                memory::BYTES_PER_MAP_TEXEL + if filterable { memory::BYTES_PER_MOMENT_TEXEL } else { 0 };
+            // A 2D map that rays may refine has a touched layer beside it (charged
+            // whether or not the frame's plan then draws one).
+            let refined = match settings.screen.refine {
+                Refine::Auto | Refine::Rays => true,
+                Refine::Off | Refine::EveryPixel => false,
+            };
+            let two_d = match light.light.shadow_view() {
+                ShadowView::Parallel { .. } | ShadowView::Frustum { .. } => true,
+                ShadowView::Omni { .. } => false,
+            };
+            let paged = match shadow.partition {
+                Partition::Virtual => true,
+                Partition::Single | Partition::Cascades => false,
+            };
+            let touched = if refined && two_d && !paged { memory::BYTES_PER_TOUCHED_TEXEL } else { 0 };
+            let per_texel = memory::BYTES_PER_MAP_TEXEL
+                + touched
+                + if filterable { memory::BYTES_PER_MOMENT_TEXEL } else { 0 };
             charges.push(Charge {
                 what: format!("light `{}`'s map, {layers} × {side}²", light.name),
                 bytes: (side * side * layers).saturating_mul(per_texel),

@@ -8,6 +8,7 @@ mod baseline;
 mod bindings;
 mod cull;
 mod depth_pass;
+mod derived_cache;
 mod host_target;
 mod late;
 mod light_passes;
@@ -19,7 +20,6 @@ mod penumbra_history;
 #[cfg(test)]
 mod penumbra_tests;
 mod plan;
-mod pyramid_cache;
 mod receiver;
 mod record;
 mod recording;
@@ -27,6 +27,8 @@ mod refine;
 mod screen;
 mod shadow_maps;
 mod tile_pass;
+#[cfg(test)]
+mod touched_tests;
 #[cfg(test)]
 mod virtual_depth_tests;
 mod virtual_pages;
@@ -52,7 +54,7 @@ use crate::{
         screen_space::ScreenSpacePass, shadow::ShadowPass,
     },
     pool::Pool,
-    rays::{PyramidPass, TracePasses},
+    rays::{PyramidPass, TouchedPass, TracePasses},
     techniques::TechniqueRegistry,
     timing::ClockChoice,
 };
@@ -69,6 +71,7 @@ struct Passes {
     trace: TracePasses,
     moments: MomentPass,
     pyramid: PyramidPass,
+    touched: TouchedPass,
     depth_reduce: DepthReducePass,
     map_preview: MapPreviewPass,
     map_scroll: MapScrollPass,
@@ -123,6 +126,7 @@ impl Renderer {
                 trace: TracePasses::default(),
                 moments: MomentPass::new(device, &gpu.queue),
                 pyramid: PyramidPass::new(device),
+                touched: TouchedPass::new(device),
                 depth_reduce: DepthReducePass::new(device),
                 map_preview: MapPreviewPass::new(device),
                 map_scroll: MapScrollPass::new(device),

@@ -180,7 +180,9 @@ pub struct LightStats {
     /// Time of its shadow passes (every layer), moment pass and lighting pass, where
     /// the frame was timed.
     pub shadow_ms: Option<f64>,
-    /// GPU time of its moment pass (filterable techniques only), where the frame was timed.
+    /// GPU time of what it derives from its map, where the frame was timed: the
+    /// moment pass of a filterable technique, the depth pyramid of a light with an
+    /// area, the touched layer of a 2D map its rays refine (`rays/touched.rs`).
     pub filter_ms: Option<f64>,
     /// GPU time of its lighting pass, where the frame was timed.
     pub lighting_ms: Option<f64>,
@@ -277,7 +279,9 @@ pub struct FrameCost {
 pub struct PassTimings {
     /// The shadow passes: every layer of every light's map.
     pub shadow_ms: f64,
-    /// The moment pass (encoding, blur, mipmaps) of the filterable techniques.
+    /// What the lights derive from their maps: the moment pass (encoding, blur,
+    /// mipmaps) of the filterable techniques, the depth pyramids of lights with an
+    /// area, the touched layers of 2D maps that rays refine.
     pub filter_ms: Option<f64>,
     /// The lighting passes, every light's.
     pub lighting_ms: f64,

@@ -145,7 +145,8 @@ impl Renderer {
             for (index, light) in plan.lights.iter().enumerate() {
                 let map =
                     self.record_shadow_maps(&mut rec, uploaded, light, &culled.layers[index], index as u32);
-                let maps = self.light_maps(&mut rec, light, index as u32, &map, None);
+                let derived = super::record::DerivedInputs { history: None, bvh: None };
+                let maps = self.light_maps(&mut rec, light, index as u32, &map, derived);
                 let uniforms = ReceiverUniforms { light: &maps.light_buffer, camera: &camera };
                 let bind_group =
                     self.fixed.receiver_group(&mut self.pool, &self.layouts, uniforms, maps.views(None));

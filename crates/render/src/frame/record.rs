@@ -15,12 +15,12 @@ use super::{
     Renderer,
     bindings::{CameraDraws, camera_arguments, scene_group},
     cull::Culled,
+    derived_cache::DerivedPlan,
     light_passes::{MaskInputs, SharedLighting},
     moment_cache::{MomentKey, MomentPlan},
     outputs::{Submitted, TimedLights},
     penumbra_history::{HistoryFrame, HistoryKey},
     plan::{FramePlan, LightPlan},
-    pyramid_cache::PyramidPlan,
     recording::{
         DrawStats, FrameReadbacks, LayerCommands, LightBindings, LightMaps, PyramidViews, Recorded, Recording,
     },
@@ -30,11 +30,15 @@ use crate::{
     GpuScene, RenderError,
     layout::ShadowLayout,
     passes::{
+        SHADOW_FORMAT,
         lighting::MapLookup,
         moments::{MomentInput, MomentLayout, MomentTarget},
     },
     pool::{Binding, ViewKey},
-    rays::{self, PyramidInput, PyramidLayout, PyramidParams, RefineLists},
+    rays::{
+        self, GpuBvh, PyramidInput, PyramidLayout, PyramidParams, RefineLists, Touched, TouchedInput,
+        TouchedLayout, touched::Timed,
+    },
     readback,
     timing::{ClockChoice, PassClock, PassKind, PendingTimes},
     uniforms::CameraGpu,
@@ -314,15 +318,18 @@ impl Renderer {
     }
 
     /// A light's uniform and its maps as the passes from the camera read them: the
-    /// depth map (drawn already), its moment map (recorded here) and its cube view.
+    /// depth map (drawn already), its moment map (recorded here) and its cube view,
+    /// its pyramid where its penumbra `history` classifies, and its touched layer
+    /// where its rays refine a 2D map, drawn from the casters' `bvh`.
     pub(super) fn light_maps(
         &mut self,
         rec: &mut Recording,
         light: &LightPlan,
         index: u32,
         map: &wgpu::Texture,
-        history: Option<&HistoryFrame>,
+        derived: DerivedInputs,
     ) -> LightMaps {
+        let DerivedInputs { history, bvh } = derived;
         let gpu = self.gpu.clone();
         // The history's state this frame, which the penumbra passes read.
         let mut uniform = light.light_gpu;
@@ -382,7 +389,59 @@ impl Renderer {
                 None
             }
         };
-        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, pyramid, lookup }
+        let touched = match bvh {
+            Some(bvh) if history.is_none() && rays::reads_touched(light.refine, lookup) => Some(
+                self.touched_layer(rec, light, index, &light_buffer, TouchedFrom { map: &map_view, bvh }),
+            ),
+            Some(_) | None => {
+                self.map_cache.touched.forget(index as usize);
+                None
+            }
+        };
+        LightMaps { light_buffer, map: map_view, moments, cube, virtual_map, pyramid, touched, lookup }
+    }
+
+    /// Light `index`'s touched layer (`rays/touched.rs`), drawn beside its map from
+    /// the casters of `drawn` with its uniform `light_buffer`, or kept where its
+    /// depth map was kept whole and still casters keep maps (the same casters, seen
+    /// the same way).
+    fn touched_layer(
+        &mut self,
+        rec: &mut Recording,
+        light: &LightPlan,
+        index: u32,
+        light_buffer: &wgpu::Buffer,
+        drawn: TouchedFrom,
+    ) -> wgpu::TextureView {
+        let gpu = self.gpu.clone();
+        let layout = TouchedLayout { resolution: light.map_resolution(), layers: light.layers() };
+        // Kept with a kept map; without kept maps, a pooled texture drawn every frame,
+        // found again whatever the map's size was last frame.
+        let (touched, draw) = match light.settings.shadow.map.cache {
+            MapCacheSetting::StillCasters => {
+                let kept = self.map_cache.kept_whole(index as usize);
+                match self.map_cache.touched.plan(&gpu.device, index as usize, layout, kept) {
+                    DerivedPlan::Keep(touched) => (touched, false),
+                    DerivedPlan::Build(touched) => (touched, true),
+                }
+            }
+            MapCacheSetting::Off => {
+                self.map_cache.touched.forget(index as usize);
+                let texture =
+                    self.pool.texture("touched layer", layout.size(), SHADOW_FORMAT, TouchedLayout::USAGE);
+                (Touched { texture }, true)
+            }
+        };
+        if draw {
+            let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
+            let (triangles, count, queue) =
+                (drawn.bvh.triangle_buffer(), drawn.bvh.triangles as u32, &gpu.queue);
+            let input = TouchedInput { light: light_buffer, triangles, count, map: drawn.map, layout, queue };
+            let timed = Some(Timed { clock: &rec.clock, slot });
+            self.passes.touched.record(&mut self.pool, rec.encoder, input, &touched, timed);
+            rec.clock.end(&gpu, rec.encoder, slot);
+        }
+        self.pool.view(&touched.texture, ViewKey::whole(wgpu::TextureViewDimension::D2Array))
     }
 
     /// Light `index`'s depth pyramid, built from `map` (`rays/pyramid.rs`), or kept
@@ -399,8 +458,8 @@ impl Renderer {
         let kept = light.settings.shadow.map.cache == MapCacheSetting::StillCasters
             && self.map_cache.kept_whole(index as usize);
         let pyramid = match self.map_cache.pyramids.plan(&gpu.device, index as usize, layout, kept) {
-            PyramidPlan::Keep(pyramid) => pyramid,
-            PyramidPlan::Build(pyramid) => {
+            DerivedPlan::Keep(pyramid) => pyramid,
+            DerivedPlan::Build(pyramid) => {
                 let slot = rec.clock.begin(&gpu, rec.encoder, PassKind::Filter, Some(index), None);
                 let mut pass = rec.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("depth pyramid"),
@@ -437,7 +496,7 @@ impl Renderer {
         drawn: DrawnLight,
     ) -> LightBindings {
         let DrawnLight { index, map, mask_layer, history } = drawn;
-        let maps = self.light_maps(rec, light, index, map, history);
+        let maps = self.light_maps(rec, light, index, map, DerivedInputs { history, bvh: uploaded.rays() });
         let scene = scene_group(&mut self.pool, &self.layouts, uploaded, &maps.light_buffer);
         // The mask pass writes the layer its light's lighting pass reads.
         let lighting = self.fixed.shadow_group(&mut self.pool, &self.layouts, maps.views(mask_layer));
@@ -454,6 +513,21 @@ struct DrawnLight<'a> {
     map: &'a wgpu::Texture,
     mask_layer: Option<&'a wgpu::TextureView>,
     history: Option<&'a HistoryFrame>,
+}
+
+/// What a light's derived textures are made from: its penumbra history, where its
+/// mask pass classifies penumbrae (then its map's pyramid is built), and the
+/// casters' BVH, where rays refine the frame (its triangles draw the touched layer).
+pub(super) struct DerivedInputs<'a> {
+    pub history: Option<&'a HistoryFrame>,
+    pub bvh: Option<&'a GpuBvh>,
+}
+
+/// What a light's touched layer is drawn from: its map (every layer), whose tiny
+/// triangles it holds itself, and the casters' BVH.
+struct TouchedFrom<'a> {
+    map: &'a wgpu::TextureView,
+    bvh: &'a GpuBvh,
 }
 
 /// What the first passes read besides the plan: the culled layers, the mask's layers,

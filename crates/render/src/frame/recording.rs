@@ -124,6 +124,9 @@ pub(super) struct LightMaps {
     /// The depth map's pyramid, for a light whose penumbrae the mask pass
     /// classifies (`rays/pyramid.rs`).
     pub pyramid: Option<PyramidViews>,
+    /// The depth map's touched layer, where its rays refine a 2D map under the
+    /// footprint test (`rays/touched.rs`).
+    pub touched: Option<wgpu::TextureView>,
     pub lookup: MapLookup,
 }
 
@@ -137,6 +140,7 @@ impl LightMaps {
             mask,
             virtual_map: self.virtual_map.as_ref(),
             pyramid: self.pyramid.as_ref(),
+            touched: self.touched.as_ref(),
         }
     }
 }

@@ -22,7 +22,7 @@ use shadow_items::ShadowItems;
 use crate::{
     Gpu, RenderError,
     clusters::{MeshClusters, cluster_mesh, place_clusters},
-    gpu_types::{INSTANCE_SLOT, InstanceGpu, VertexGpu, VertexStream},
+    gpu_types::{INSTANCE_SLOT, InstanceGpu, SeenFaces, VertexGpu, VertexStream},
     passes::Layouts,
 };
 
@@ -66,6 +66,9 @@ pub struct GpuScene {
     slots: Vec<Option<u32>>,
     /// Each mesh's bounds in its own space, for a moved instance's new box.
     mesh_bounds: Vec<Aabb>,
+    /// Each mesh's winding where the camera draws only its outer faces: a closed
+    /// mesh's, true where they wind counter-clockwise ([`SeenFaces::of`]).
+    mesh_windings: Vec<Option<bool>>,
     /// Each mesh's clusters, where a batch of one instance draws a large mesh.
     mesh_clusters: Vec<Option<MeshClusters>>,
     /// Names what the still casters (`Motion::Static`) look like: unique to this upload,
@@ -140,6 +143,7 @@ impl GpuScene {
         let mesh_bounds: Vec<Aabb> = scene.meshes.iter().map(|m| m.bounds()).collect();
 
         let closed = scene.closed_meshes();
+        let mesh_windings = mesh_windings(scene, &closed);
         let (mut batches, order) = batch_instances(scene, &ranges, &mesh_bounds, &closed);
         let mesh_clusters = cluster_meshes(scene, &batches);
         let mut shadow_indices = indices.clone();
@@ -171,7 +175,8 @@ impl GpuScene {
         for (slot, &index) in order.iter().enumerate() {
             slots[index] = Some(slot as u32);
         }
-        let instance_data: Vec<InstanceGpu> = order.iter().map(|&i| instance_gpu(scene, i)).collect();
+        let instance_data: Vec<InstanceGpu> =
+            order.iter().map(|&i| instance_gpu(scene, i, &mesh_windings)).collect();
         check_instance_bytes(gpu, scene, &instance_data)?;
         let device = &gpu.device;
         let buffer = |label: &str, contents: &[u8], usage| {
@@ -210,6 +215,7 @@ impl GpuScene {
             bounds,
             slots,
             mesh_bounds,
+            mesh_windings,
             mesh_clusters,
             still_generation: next_generation(),
             caster_generation: next_generation(),
@@ -237,7 +243,7 @@ impl GpuScene {
                 gpu.queue.write_buffer(
                     &self.instances,
                     slot as u64 * size,
-                    bytemuck::bytes_of(&instance_gpu(scene, index)),
+                    bytemuck::bytes_of(&instance_gpu(scene, index, &self.mesh_windings)),
                 );
                 // The batches hold consecutive slots, in order.
                 let batch = self.batches.partition_point(|b| b.first_instance <= slot) - 1;
@@ -494,10 +500,28 @@ fn cluster_meshes(scene: &Scene, batches: &[Batch]) -> Vec<Option<MeshClusters>>
         .collect()
 }
 
-/// The GPU record of the scene's instance `i`.
-fn instance_gpu(scene: &Scene, i: usize) -> InstanceGpu {
+/// Each mesh's winding, given which are `closed`: for a closed mesh that encloses a
+/// volume, whether its outer faces wind counter-clockwise seen from outside
+/// ([`gnomon_scene::Mesh::signed_volume`]); None for the others, of which the camera
+/// draws both faces.
+fn mesh_windings(scene: &Scene, closed: &[bool]) -> Vec<Option<bool>> {
+    scene
+        .meshes
+        .iter()
+        .zip(closed)
+        .map(|(mesh, &closed)| {
+            let volume = if closed { mesh.signed_volume() } else { 0.0 };
+            (volume != 0.0).then_some(volume > 0.0)
+        })
+        .collect()
+}
+
+/// The GPU record of the scene's instance `i`, whose mesh's winding `windings` holds
+/// ([`mesh_windings`]).
+fn instance_gpu(scene: &Scene, i: usize, windings: &[Option<bool>]) -> InstanceGpu {
     let inst = &scene.instances[i];
     let material = &scene.materials[inst.material];
+    let outward = windings[inst.mesh].filter(|_| !material.double_sided);
     let cutoff = match material.alpha_mode {
         AlphaMode::Mask { cutoff } => cutoff,
         AlphaMode::Opaque | AlphaMode::Blend => -1.0,
@@ -511,7 +535,7 @@ fn instance_gpu(scene: &Scene, i: usize) -> InstanceGpu {
         object_id: (i + 1) as u32,
         alpha_cutoff: cutoff,
         textured: material.base_color_texture.is_some().into(),
-        _pad0: 0,
+        seen_faces: SeenFaces::of(outward, inst.world_from_object) as u32,
         _pad1: 0,
         _pad2: 0,
     }

@@ -51,6 +51,9 @@ pub fn wgsl_constants() -> String {
     for falloff in FalloffGpu::ALL {
         s += &format!("const {}: u32 = {}u;\n", falloff.wgsl_name(), falloff as u32);
     }
+    for faces in crate::gpu_types::SeenFaces::ALL {
+        s += &format!("const {}: u32 = {}u;\n", faces.wgsl_name(), faces as u32);
+    }
     s += &format!("const CULL_WORKGROUP: u32 = {}u;\n", gpu_cull::CULL_WORKGROUP);
     for code in gpu_cull::WindingCode::ALL {
         s += &format!("const {}: u32 = {}u;\n", code.wgsl_name(), code as u32);

@@ -74,7 +74,7 @@ pub(super) fn struct_layouts() -> Vec<StructLayout> {
             ambient, shown, tiles_x, _pad0, _pad1, _pad2,
         }),
         struct_layout!(crate::gpu_types::InstanceGpu as "Instance" {
-            world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, _pad0, _pad1,
+            world_from_object, base_color, specular, shininess, object_id, alpha_cutoff, textured, seen_faces, _pad1,
             _pad2,
         }),
         struct_layout!(CascadeGpu as "Cascade" {
@@ -127,6 +127,9 @@ pub(super) fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(map_scroll::ScrollParams as "Scroll" { offset, size }),
         struct_layout!(crate::virtual_map::VirtualProbe as "Probe" { world, level }),
         struct_layout!(rays::PyramidParams as "PyramidParams" { cube, range, near, _pad }),
+        struct_layout!(rays::touched::TouchedDrawGpu as "TouchedDraw" {
+            vertex_count, instance_count, first_vertex, first_instance,
+        }),
         struct_layout!(rays::refine::UnsurePixelGpu as "UnsurePixel" { pixel, layer, mean, beams }),
         struct_layout!(rays::refine::RefineCountersGpu as "RefineCounters" {
             groups_x, groups_y, groups_z, count, fill_groups_x, fill_groups_y, fill_groups_z, fill_count,

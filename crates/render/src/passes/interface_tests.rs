@@ -124,6 +124,8 @@ fn every_variant() -> Vec<(String, String)> {
     out.push(("surface from depth".into(), crate::virtual_map::surface_from_depth_wgsl()));
     out.push(("virtual lookup probe".into(), crate::virtual_map::lookup_probe_wgsl()));
     out.push(("depth pyramid".into(), crate::rays::pyramid::depth_pyramid_wgsl()));
+    out.push(("touched layer, list".into(), crate::rays::touched::touched_list_wgsl()));
+    out.push(("touched layer, draw".into(), crate::rays::touched::touched_draw_wgsl()));
     for traversal in [Traversal::Shader, Traversal::RayQuery] {
         for size in [LightSize::Hard, LightSize::Area] {
             let source = crate::rays::trace_pass_wgsl(traversal, size);

@@ -12,7 +12,7 @@ import package::passes::camera_binding::camera;
 import package::passes::light::Emitter;
 import package::passes::light_kinds::emitter_geometry;
 import package::passes::lighting_common::{FragmentOut, layer_tint, pages_tint};
-import package::passes::scene_common::{alpha_cut, base_color_of, instances};
+import package::passes::scene_common::{alpha_cut, base_color_of, hidden_face, instances};
 import package::passes::shading::blinn_phong;
 import package::passes::surface::SurfaceVertex;
 import package::variant::{is_seen_surface, seen_surface};
@@ -44,9 +44,9 @@ fn listed_visibility(texel: vec2<u32>, i: u32) -> vec3<f32> {
 }
 
 @fragment
-fn fs_light_list(in: SurfaceVertex) -> FragmentOut {
+fn fs_light_list(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
-    if alpha_cut(inst, in.uv) {
+    if alpha_cut(inst, in.uv) || hidden_face(inst, front) {
         discard;
     }
     // The prepass's surface at this pixel, which every light's mask was resolved

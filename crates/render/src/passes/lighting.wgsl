@@ -13,13 +13,13 @@ import package::constants::{DEBUG_VIEW_CASCADES, DEBUG_VIEW_PAGES, DEBUG_VIEW_TR
 import package::passes::camera_binding::camera;
 import package::passes::light_binding::light;
 import package::passes::lighting_common::{FragmentOut, layer_tint, pages_tint};
-import package::passes::scene_common::{alpha_cut, base_color_of, instances};
+import package::passes::scene_common::{alpha_cut, base_color_of, hidden_face, instances};
 import package::passes::shading::{blinn_phong, facing_error, light_geometry};
 import package::passes::surface::SurfaceVertex;
 import package::variant::{is_seen_surface, pixel_visibility, refine_forward, seen_surface};
 
 @fragment
-fn fs_lighting(in: SurfaceVertex) -> FragmentOut {
+fn fs_lighting(in: SurfaceVertex, @builtin(front_facing) front: bool) -> FragmentOut {
     let inst = instances[in.instance];
     // The surface this pixel shows: the fragment's own, or on the mask path the
     // prepass's (seen_own.wgsl, seen_prepass.wgsl).
@@ -46,7 +46,7 @@ fn fs_lighting(in: SurfaceVertex) -> FragmentOut {
     let traced = u32(shadow.y) >= TRACED_LAYER_FLAG;
     let layer = u32(shadow.y) % TRACED_LAYER_FLAG;
 
-    if alpha_cut(inst, in.uv) || !is_seen_surface(in) {
+    if alpha_cut(inst, in.uv) || hidden_face(inst, front) || !is_seen_surface(in) {
         discard;
     }
     let albedo = base_color_of(inst, in.uv).rgb;

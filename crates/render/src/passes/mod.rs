@@ -162,6 +162,10 @@ pub(crate) mod receiver;
 /// What the lighting and shadow-mask passes share about a point and its light.
 pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 
+/// The binding of the shadow group that holds a 2D map's touched layer
+/// (`rays/touched.rs`; `touched_map` in refine_map.wgsl).
+pub(crate) const TOUCHED_BINDING: u32 = 12;
+
 /// Bind group layouts shared by the passes.
 pub(crate) struct Layouts {
     /// Group 0: instances (storage) and the light (uniform); the trace pass's
@@ -179,7 +183,9 @@ pub(crate) struct Layouts {
     /// filterable techniques' moment map and its sampler, a point light's cube with
     /// its nearest comparison and gathering samplers, on the mask path the light's
     /// layer of the shadow mask, and in the mask pass of a light whose penumbrae it
-    /// classifies the map's min-max pyramid (`rays/pyramid.rs`).
+    /// classifies the map's min-max pyramid (`rays/pyramid.rs`), then where its
+    /// rays refine a 2D map under the footprint test the map's touched layer
+    /// ([`TOUCHED_BINDING`]).
     pub shadow: wgpu::BindGroupLayout,
     /// The shadow receiver's one group, in the host's shader: the light's and the
     /// camera's uniforms, then the shadow resources in the order of `shadow`.
@@ -239,6 +245,10 @@ impl Layouts {
                             fragment_entry(binding, texture(unfiltered, wgpu::TextureViewDimension::D2Array))
                         })
                         .collect(),
+                    vec![fragment_entry(
+                        TOUCHED_BINDING,
+                        texture(wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                    )],
                 ]
                 .concat(),
             ),

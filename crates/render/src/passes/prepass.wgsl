@@ -13,7 +13,7 @@
 // unsnapped triangle).
 import package::passes::camera_binding::camera;
 import package::passes::octahedron::octahedron_encode;
-import package::passes::scene_common::{alpha_cut, instances};
+import package::passes::scene_common::{alpha_cut, hidden_face, instances};
 import package::passes::surface::{SurfaceVertex, surface_normals};
 
 struct PrepassTargets {
@@ -28,9 +28,9 @@ struct PrepassTargets {
 
 // The vertex stage is surface.wgsl's vs_surface, the lighting pass's own.
 @fragment
-fn fs_prepass(in: SurfaceVertex) -> PrepassTargets {
+fn fs_prepass(in: SurfaceVertex, @builtin(front_facing) front: bool) -> PrepassTargets {
     let normals = surface_normals(in);
-    if alpha_cut(instances[in.instance], in.uv) {
+    if alpha_cut(instances[in.instance], in.uv) || hidden_face(instances[in.instance], front) {
         discard;
     }
     var out: PrepassTargets;

@@ -1,6 +1,7 @@
 // Declarations shared by every pass that draws scene geometry: the per-instance
 // data, the vertex layout, and the light uniform's binding (its struct is in
 // light.wgsl), imported by the passes that draw geometry.
+import package::constants::{SEEN_CCW, SEEN_CW};
 import package::passes::material_bindings::{base_color_sampler, base_color_texture};
 
 struct Instance {
@@ -11,7 +12,7 @@ struct Instance {
     object_id: u32,         // the scene's instance index + 1
     alpha_cutoff: f32,      // of a MASK material; −1 for none
     textured: u32,          // 1 when the base colour is multiplied by the bound texture
-    _pad0: u32,
+    seen_faces: u32,        // the faces the camera draws: SEEN_BOTH, SEEN_CCW or SEEN_CW
     _pad1: u32,
     _pad2: u32,
 };
@@ -66,6 +67,14 @@ fn base_color_of(inst: Instance, uv: vec2<f32>) -> vec4<f32> {
 }
 
 // Whether an instance's surface is cut away at this point (alpha-masked materials).
+// Whether the camera's passes drop a fragment of `inst` whose face is `front` (its
+// winding on screen counter-clockwise): a face inside a closed mesh, which from
+// outside it shows only through the gaps that snapping a sliver's vertices opens
+// (gpu_types.rs's `SeenFaces`).
+fn hidden_face(inst: Instance, front: bool) -> bool {
+    return (inst.seen_faces == SEEN_CCW && !front) || (inst.seen_faces == SEEN_CW && front);
+}
+
 fn alpha_cut(inst: Instance, uv: vec2<f32>) -> bool {
     return inst.alpha_cutoff >= 0.0 && base_color_of(inst, uv).a < inst.alpha_cutoff;
 }

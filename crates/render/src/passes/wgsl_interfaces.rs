@@ -184,6 +184,18 @@ pub(crate) const FOOTPRINT_RECEIVER: WgslInterface = WgslInterface {
     returns: Some("vec4<f32>"),
 };
 
+/// What touches a 2 × 2 block of texels, for the shared footprint test
+/// (refine_footprint.wgsl): each texel's nearness (1 − depth) of the nearest caster
+/// touching its square, in gather's order, from the block's shared corner `corner`
+/// (in [0, 1]) of layer `layer`. `projected_footprint_touched` (refine_map.wgsl: a 2D
+/// map's touched layer, `rays/touched.rs`) or `untouched_footprint` (0: a map with
+/// no touched layer, a cube's or a virtual map's, says nothing), by `MapLookup`.
+pub(crate) const FOOTPRINT_TOUCHED: WgslInterface = WgslInterface {
+    name: "footprint_touched",
+    params: &[("corner", "vec2<f32>"), ("layer", "u32")],
+    returns: Some("vec4<f32>"),
+};
+
 /// The technique contract: a technique's lit fraction at a receiver of its 2D map
 /// (`pcf_box_sample_shadow` in `techniques/pcf_box.wgsl`, …), bound by
 /// `techniques::technique_wgsl` for the technique the registry picks.

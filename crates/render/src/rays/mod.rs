@@ -12,6 +12,7 @@ mod forward;
 pub(crate) mod pyramid;
 pub(crate) mod query;
 pub(crate) mod refine;
+pub(crate) mod touched;
 mod traversal;
 
 pub(crate) use forward::{forward_group, forward_layouts, forward_refine_wgsl};
@@ -26,6 +27,7 @@ pub(crate) use refine::{
     classifies_penumbrae, history_layout, mask_refine_wgsl, refined_mask_layout,
     screen_layout as refine_screen_layout,
 };
+pub(crate) use touched::{Touched, TouchedInput, TouchedLayout, TouchedPass, reads_touched};
 pub use traversal::{RayQueriesUnavailable, Traversal};
 pub(crate) use traversal::{TracerLayouts, trace_wgsl};
 
@@ -240,6 +242,12 @@ const TRIANGLE_BUFFER: usize = 1;
 const ALPHA_BUFFERS: std::ops::Range<usize> = 2..5;
 
 impl GpuBvh {
+    /// The casters' triangles in world space, [`bvh::TriangleGpu`] each, kept
+    /// current by every refit: what the touched layer draws ([`touched`]).
+    pub(crate) fn triangle_buffer(&self) -> &wgpu::Buffer {
+        &self.buffers[TRIANGLE_BUFFER]
+    }
+
     /// Builds the casters' BVH of `scene` and uploads it. The scene must be valid.
     /// Refuses a tree deeper than the shader's stack, or a buffer larger than the
     /// device binds.

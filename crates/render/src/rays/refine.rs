@@ -6,7 +6,7 @@
 //! pass holds listed pixels only, so no lane waits on a neighbour's ray.
 
 use crate::passes::wgsl_interfaces::{
-    AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, MAP_UNSURE, RAY_DECIDES,
+    AREA_VISIBILITY, DEFER_TO_RAY, FOOTPRINT_RECEIVER, FOOTPRINT_TOUCHED, MAP_UNSURE, RAY_DECIDES,
 };
 use gnomon_scene::settings::Refine;
 
@@ -159,12 +159,14 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
             include_str!("refine_footprint.wgsl").to_owned(),
             include_str!("refine_map.wgsl").to_owned(),
             FOOTPRINT_RECEIVER.bind("projected_footprint_receiver"),
+            FOOTPRINT_TOUCHED.bind("projected_footprint_touched"),
             MAP_UNSURE.bind("projected_map_unsure"),
         ],
         MapLookup::Cube => vec![
             include_str!("refine_footprint.wgsl").to_owned(),
             include_str!("refine_cube.wgsl").to_owned(),
             FOOTPRINT_RECEIVER.bind("cube_footprint_receiver"),
+            FOOTPRINT_TOUCHED.bind("untouched_footprint"),
             MAP_UNSURE.bind("cube_map_unsure"),
         ],
         MapLookup::Paraboloid => {
@@ -177,6 +179,7 @@ pub(crate) fn classify_wgsl(refine: Refine, lookup: MapLookup, size: LightSize) 
             // a 2D map's plane.
             include_str!("refine_map.wgsl").to_owned(),
             FOOTPRINT_RECEIVER.bind("projected_footprint_receiver"),
+            FOOTPRINT_TOUCHED.bind("untouched_footprint"),
             MAP_UNSURE.bind("virtual_map_unsure"),
         ],
     };

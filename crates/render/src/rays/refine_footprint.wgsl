@@ -3,7 +3,7 @@
 // plane. Each caller works out the plane's depth and slope in its own map's terms.
 import package::passes::light_binding::light;
 import package::techniques::bindings::{shadow_gather, shadow_map};
-import package::variant::footprint_receiver;
+import package::variant::{footprint_receiver, footprint_touched};
 
 import package::constants::UNSURE_RING_TEXELS;
 // The depth band, in texel world sizes along the light's ray, inside which a stored
@@ -70,8 +70,11 @@ const FOOTPRINT_EDGE_UNSURE: bool = true;
 // `footprint_receiver(x, y)` gives for a 2×2 block of texels (in gather's order). A
 // texel within `bounds.tolerance` behind or in front of the plane, or farther
 // behind, is evidence of light; one more than `bounds.margin` in front, of a caster;
-// one in between, or both kinds together, make the pixel unsure. A footprint that
-// leaves the layer is `FOOTPRINT_EDGE_UNSURE`.
+// one in between, or both kinds together, make the pixel unsure. A caster that
+// touches a texel (`footprint_touched`, a 2D map's touched layer: rays/touched.rs)
+// more than `bounds.margin` in front is one too, though the map stored none there:
+// one thinner than a texel. A footprint that leaves the layer is
+// `FOOTPRINT_EDGE_UNSURE`.
 //
 // In the bilinear 2×2, the texels the lookup reads, a texel is evidence of light
 // only once the receiver's own bias is taken off it as well. The receiver is stored
@@ -112,6 +115,11 @@ fn leaves_unsure(e: Evidence) -> bool {
     return e.unsure || (e.light && e.casters);
 }
 
+// A map without a touched layer (`footprint_touched`): nothing touches its texels.
+fn untouched_footprint(corner: vec2<f32>, layer: u32) -> vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
 // The evidence of `footprint_unsure`'s texels, which a light with an area weighs
 // against its search over the light's cone (refine_map.wgsl's `area_unsure`).
 fn footprint_evidence(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> Evidence {
@@ -137,8 +145,11 @@ fn footprint_evidence(uv: vec2<f32>, bounds: FootprintBounds, layer: u32) -> Evi
             if evidence.x {
                 return Evidence(true, false, false);
             }
+            // A caster the map stored no depth of (thinner than a texel, or between
+            // the texels' centres) that touches a texel in front of the receiver.
+            let touched = vec4<f32>(1.0) - footprint_touched(corner, layer);
             lit = lit || evidence.y;
-            shadowed = shadowed || evidence.z;
+            shadowed = shadowed || evidence.z || any(touched <= receiver - vec4<f32>(bounds.margin));
         }
     }
     return Evidence(false, lit, shadowed);

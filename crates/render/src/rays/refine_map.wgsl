@@ -20,15 +20,26 @@
 // where the light's own footprint in the map (`area_unsure`) holds casters over part
 // of it: the penumbra as the geometry bounds it, not as the technique estimated it.
 //
-// What this cannot see: a caster thinner than a texel that the map's rasterization
-// missed altogether leaves no depth to disagree with.
+// A caster thinner than a texel, which the map's rasterization missed altogether,
+// leaves no depth to disagree with; the map's touched layer (rays/touched.rs), drawn
+// conservatively, holds it (`projected_footprint_touched`).
 import package::passes::light_binding::{light, light_distance_from_depth, texel_shape, texel_world_size_at};
 import package::passes::light_kinds::emitter_cone_radius;
 import package::passes::map_visibility::{local_texel_world_size, shadow_coords};
 import package::rays::refine_footprint::{Evidence, FootprintBounds, UNSURE_DEPTH_TEXELS, UNSURE_GRAZING_COS, footprint_evidence, leaves_unsure, receiver_bias};
 import package::rays::map_step::map_step;
-import package::techniques::bindings::shadow_map;
+import package::techniques::bindings::{shadow_gather, shadow_map};
 import package::variant::REFINE_PENUMBRAE;
+
+// The map's touched layer (rays/touched.rs): per texel, the nearness (1 − depth) of
+// the nearest opaque caster touching its square. Binding 12 of the shadow group
+// (`passes::TOUCHED_BINDING`).
+@group(2) @binding(12) var touched_map: texture_depth_2d_array;
+
+// What touches the 2 × 2 texels round `corner` of layer `layer`, in gather's order.
+fn projected_footprint_touched(corner: vec2<f32>, layer: u32) -> vec4<f32> {
+    return textureGather(touched_map, shadow_gather, corner, layer);
+}
 
 // The receiver's plane in the map, for `footprint_receiver`: depth `depth` at texel
 // position `p` (texel centres at whole numbers), changing by `gradient` per texel. A

@@ -5,6 +5,7 @@
 // the error of t, and cut-out casters alpha-tested (trace_common.wgsl).
 //
 // Bindings 2 and 3 of group TRACE_GROUP: the nodes and the triangles.
+import package::rays::bvh_triangle::BvhTriangle;
 import package::rays::trace_common::alpha_blocks;
 import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
@@ -15,17 +16,6 @@ struct BvhNode {
     max: vec3<f32>,
     // The first child (the second follows it), or the leaf's first triangle.
     first: u32,
-};
-
-struct BvhTriangle {
-    v0: vec3<f32>,
-    // Index into bvh_alpha, or NO_ALPHA.
-    alpha: u32,
-    v1: vec3<f32>,
-    // 1 for a triangle of a closed, opaque mesh (bvh.rs's `TriangleGpu::closed`).
-    closed: u32,
-    v2: vec3<f32>,
-    _pad2: u32,
 };
 
 @group(TRACE_GROUP) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;

@@ -235,7 +235,12 @@ fn a_changed_setting_creates_only_what_depends_on_it() {
     let warm = renderer.creations();
     renderer.render_live(&uploaded, &scene, &large_map).unwrap();
     let changed = renderer.creations();
-    assert_eq!(changed.textures - warm.textures, 1, "one new shadow map: {warm:?} → {changed:?}");
+    // The map and the touched layer beside it that rays read (`rays/touched.rs`).
+    assert_eq!(
+        changed.textures - warm.textures,
+        2,
+        "a new shadow map and touched layer: {warm:?} → {changed:?}"
+    );
     assert_eq!(changed.buffers, warm.buffers, "no buffer depends on the map's size");
     assert!(changed.bind_groups > warm.bind_groups, "the groups binding the map are new");
     renderer.render_live(&uploaded, &scene, &small_map).unwrap();

@@ -4,8 +4,10 @@
 use glam::{Mat4, Vec3};
 
 mod lamps;
+mod wires;
 
 pub use lamps::{MAX_LAMPS, lamp_grid, lamps};
+pub use wires::{WIRE_THICKNESS, wires};
 
 use crate::{
     Camera, DirectionalLight, Falloff, Instance, Material, Mesh, PointLight, Scene, SceneLight, SpotLight,
@@ -43,6 +45,11 @@ pub const BUILTINS: &[Builtin] = &[
         name: "columns",
         description: "a long ground with rows of columns far from the camera: a large depth range",
         build: columns,
+    },
+    Builtin {
+        name: "wires",
+        description: "wires, a railing and poles 4 mm thick over a ground: casters thinner than a map's texel",
+        build: wires,
     },
     Builtin {
         name: "lamps",
