@@ -174,8 +174,6 @@ fn the_defaults_beam_a_lights_penumbrae_to_the_truth() {
             Some(s.screen.penumbra_frames),
             "{name}: the frames a still view gathers"
         );
-        let traced = light.traced_pixels.expect("a refined frame reports its pixels");
-        assert!(traced > 0 && (traced as usize) < frame.pixel_count() / 4, "{name}: {traced} pixels traced");
         // Over the pixels compared: where both see the same surface, facing the light.
         let raster =
             RasterView { visibility: &frame.visibility, object_id: &frame.object_id, depth: &frame.depth };
@@ -193,7 +191,12 @@ fn the_defaults_beam_a_lights_penumbrae_to_the_truth() {
             .collect();
         s.screen.penumbra_frames = 1;
         renderer.forget_penumbra_history();
-        let first = compare(&render(&mut renderer, &scene, &s), &truth);
+        let first_frame = render(&mut renderer, &scene, &s);
+        // The first frame beams (a still view's last may not: its unsure pixels may
+        // all hold their beams by then), and at most a quarter of the screen.
+        let traced = first_frame.lights[0].traced_pixels.expect("a refined frame reports its pixels");
+        assert!(traced > 0 && (traced as usize) < frame.pixel_count() / 4, "{name}: {traced} pixels traced");
+        let first = compare(&first_frame, &truth);
         let mut alone = s.clone();
         alone.screen.refine = Refine::Off;
         alone.shadow.filter.technique = Technique::PCSS;

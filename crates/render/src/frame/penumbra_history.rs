@@ -25,6 +25,9 @@ impl HistoryKey {
         let mut uniform = light.light_gpu;
         uniform.rays.history = 0;
         uniform.rays.frame = 0;
+        // How many frames a still view gathers says when to stop beaming, not what
+        // the beams gathered so far answered: asking for more goes on from them.
+        uniform.rays.penumbra_frames = 0;
         let mut bytes = bytemuck::bytes_of(&uniform).to_vec();
         bytes.extend_from_slice(bytemuck::bytes_of(camera));
         bytes.extend_from_slice(&caster_generation.to_le_bytes());

@@ -340,3 +340,43 @@ fn the_penumbra_history_follows_on_only_where_nothing_it_depends_on_moved() {
     still.screen.penumbra_frames = 6;
     assert_eq!(held(&render(&mut renderer, &uploaded, &scene, &still)), Some(6));
 }
+
+/// A still view stops beaming once its unsure pixels hold the beams
+/// `screen.penumbra_frames` gives them: the next frame traces nothing and shows the
+/// same image; asking for more frames goes on beaming from what it holds.
+#[test]
+fn a_settled_still_view_beams_no_more_until_asked_for_more() {
+    let gpu = gpu();
+    let (scene, mut settings) = spot_on_contact();
+    settings.screen.penumbra_frames = 4;
+    let mut renderer = Renderer::new(&gpu).unwrap();
+    let uploaded = renderer.upload(&scene).unwrap();
+    let mut render =
+        |s: &Settings| renderer.render_uploaded(&uploaded, &scene, s, &OutputRequest::default()).unwrap();
+    let gathered = render(&settings);
+    assert_eq!(held(&gathered), Some(4));
+    let traced =
+        |frame: &crate::Frame| frame.lights[0].traced_pixels.expect("a waited frame counts its beams");
+    assert!(traced(&gathered) > 0, "the fourth frame beamed nothing");
+
+    let settled = render(&settings);
+    assert_eq!(held(&settled), Some(5), "the history outlived a still view");
+    assert_eq!(traced(&settled), 0, "a settled still view went on beaming");
+    assert_eq!(
+        settled.lights[0].unsure_pixels, gathered.lights[0].unsure_pixels,
+        "its history forgot pixels"
+    );
+    let differ = settled
+        .visibility
+        .iter()
+        .zip(&gathered.visibility)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(differ, 0, "{differ} pixels of a settled view changed with no beam");
+
+    // Eight frames' worth: the phase the eighth frame beams gets its second beam.
+    settings.screen.penumbra_frames = 8;
+    let more = render(&settings);
+    assert_eq!(held(&more), Some(8), "asking for more frames threw the history away");
+    assert!(traced(&more) > 0, "asking for more frames beamed nothing more");
+}

@@ -60,7 +60,7 @@ pub(super) fn struct_layouts() -> Vec<StructLayout> {
         struct_layout!(PcfGpu as "Pcf" { kernel_width, kernel_in_world, poisson_taps, _pad0 }),
         struct_layout!(PcssGpu as "Pcss" { blocker_taps, max_penumbra_texels, max_search_texels, _pad1 }),
         struct_layout!(ContactGpu as "Contact" { steps, length, thickness, bias, distance, _pad0, _pad1, _pad2 }),
-        struct_layout!(RaysGpu as "Rays" { penumbra_rays, history, frame, _pad0 }),
+        struct_layout!(RaysGpu as "Rays" { penumbra_rays, history, frame, penumbra_frames }),
         struct_layout!(techniques::NoParams as "NoParams" { _pad0, _pad1 }),
         struct_layout!(techniques::variance::VarianceParams as "VarianceParams" {
             positive_exponent, negative_exponent, min_variance, bleeding_reduction, variant, _pad0, _pad1, _pad2,

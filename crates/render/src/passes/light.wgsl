@@ -101,7 +101,7 @@ struct Rays {
     penumbra_rays: u32,  // rays per pixel over the light's area (0: hard, one ray)
     history: u32,        // 1 where the penumbra history holds last frame's answers
     frame: u32,          // frames the history holds, this one counted
-    _pad0: u32,
+    penumbra_frames: u32, // frames a still view's penumbrae gather, then beam no more
 };
 
 // One layer (cascade) of the map.

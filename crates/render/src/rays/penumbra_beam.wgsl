@@ -35,6 +35,9 @@ import package::variant::{NO_ALPHA, TRACE_GROUP, TRACE_STACK_SIZE};
 
 const ALL_SAMPLES: vec4<u32> = vec4<u32>(0xffffffffu);
 
+// `beam_entry`'s answer for a box the cone cannot meet: below every entry (t ≥ 0).
+const BEAM_MISSES: f32 = -1.0;
+
 // The light's sample k, in the unit disk.
 fn light_mask_sample(k: u32) -> vec2<f32> {
     let pair = bitcast<vec4<f32>>(textureLoad(light_masks, vec2<u32>(k / 2u, 0u), 0));
@@ -53,7 +56,7 @@ struct Beam {
 };
 
 // The walk's axis ray, and the reciprocals of its direction plus and minus the
-// cone's widening, for `beam_enters`.
+// cone's widening, for `beam_entry`.
 struct BeamAxis {
     origin: vec3<f32>,
     direction: vec3<f32>,
@@ -93,12 +96,14 @@ fn beam_axis(beam: Beam) -> BeamAxis {
 // that half-size about the axis's point: the cone may meet the box only at a t where
 // that cube does, which along each of the box's axes is a pair of linear bounds on t,
 // o + t a ≥ lo − k t and o + t a ≤ hi + k t: a slab test whose two sides have their
-// own slopes, a ± k, exact for the growing cube.
-fn beam_enters(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+// own slopes, a ± k, exact for the growing cube. Returns the least such t, by which
+// the walk visits the nearer child first, or `BEAM_MISSES` where the cone cannot
+// meet the box.
+fn beam_entry(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
     // The box's corner farthest along the normal, over the receiver's plane.
     let above = select(lo, hi, axis.normal > vec3<f32>(0.0)) - axis.origin;
     if dot(above, axis.normal) <= 0.0 {
-        return false;
+        return BEAM_MISSES;
     }
     // t (a + k) ≥ lo − o: a lower bound on t where a + k > 0, an upper one where not.
     let low = (lo - axis.origin) * axis.inv_plus;
@@ -116,7 +121,7 @@ fn beam_enters(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let near = max(t_min.x, max(t_min.y, t_min.z));
     let far = min(t_max.x, min(t_max.y, t_max.z));
     if near > far * 1.000001 + 1e-30 {
-        return false;
+        return BEAM_MISSES;
     }
     // And the box's bounding sphere against the cone itself: its centre no farther
     // outside the cone's surface than its radius (the cube bound above is √3 loose
@@ -125,7 +130,7 @@ fn beam_enters(axis: BeamAxis, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let radius = 0.5 * length(hi - lo);
     let along = dot(centre, axis.direction);
     let across = length(centre - along * axis.direction);
-    return across * axis.cos_half - along * axis.sin_half <= radius * 1.000001;
+    return select(BEAM_MISSES, near, across * axis.cos_half - along * axis.sin_half <= radius * 1.000001);
 }
 
 // The samples on the inner side of the plane through the origin with normal `m`:
@@ -289,7 +294,7 @@ fn walk_beam(beam: Beam) -> BeamHits {
     var stack: array<u32, TRACE_STACK_SIZE>;
     var top = 0u;
     var node = bvh_nodes[0];
-    if !beam_enters(axis, node.min, node.max) {
+    if beam_entry(axis, node.min, node.max) == BEAM_MISSES {
         return hits;
     }
     let max_steps = arrayLength(&bvh_nodes);
@@ -299,12 +304,21 @@ fn walk_beam(beam: Beam) -> BeamHits {
             steps++;
             let left = bvh_nodes[node.first];
             let right = bvh_nodes[node.first + 1u];
-            let in_left = beam_enters(axis, left.min, left.max);
-            let in_right = beam_enters(axis, right.min, right.max);
+            let left_at = beam_entry(axis, left.min, left.max);
+            let right_at = beam_entry(axis, right.min, right.max);
+            let in_left = left_at != BEAM_MISSES;
+            let in_right = right_at != BEAM_MISSES;
             if in_left && in_right {
-                stack[top] = node.first + 1u;
+                // Nearer the receiver first: a near caster hides the most of the
+                // light, and a walk ends once every sample is hidden.
+                if left_at <= right_at {
+                    stack[top] = node.first + 1u;
+                    node = left;
+                } else {
+                    stack[top] = node.first;
+                    node = right;
+                }
                 top++;
-                node = left;
             } else if in_left {
                 node = left;
             } else if in_right {

@@ -5,7 +5,8 @@
 // the unsure pixels, one of each 2 × 2 block in turn (`PENUMBRA_PHASES`), and keeps
 // what its beams found in the light's penumbra history, which the next frame starts
 // from where nothing changed: a still view's unsure pixels gather a beam every fourth
-// frame, and the map's classification is read back rather than made again. Where the
+// frame until they hold `beams_gathered`, and the map's classification is read back
+// rather than made again. Where the
 // history does not hold (the first frame, or a camera, light or caster that moved:
 // `light.rays.history` 0), an unsure pixel that this frame does not beam is filled
 // from its neighbours' answers (`cs_fill_penumbra`, refine_trace.wgsl).
@@ -32,6 +33,15 @@ import package::variant::{penumbra_layer, pixel_visibility, ray_decides};
 
 // The blocks a frame beams one pixel of: 2 × 2, so four frames beam them all.
 const PENUMBRA_PHASES: u32 = 4u;
+
+// The beams an unsure pixel of a still view gathers before it is beamed no more: those
+// `light.rays.penumbra_frames` frames give it, one every PENUMBRA_PHASES-th. Past
+// them the history answers it alone, so a settled still view (a viewer's, a lab's)
+// costs its mask pass and no beam, and its image stays the one the last beam left;
+// anything the history depends on moving starts the gathering again.
+fn beams_gathered() -> f32 {
+    return f32(max((light.rays.penumbra_frames + PENUMBRA_PHASES - 1u) / PENUMBRA_PHASES, 1u));
+}
 
 // What the mask holds, until the trace or fill pass writes it, for an unsure pixel:
 // below every packed visibility, so that the fill pass takes no neighbour's answer
@@ -98,7 +108,8 @@ fn fs_penumbra_mask(@builtin(position) frag: vec4<f32>) -> @location(0) f32 {
     // edge-on, which the map called lit or dark) is beamed whenever its history has
     // no answer: its neighbours' would not say.
     let own = shadow.x != CLASSIFIED_UNSURE && beams == 0.0;
-    if beamed_this_frame(texel_u) || own {
+    let gathering = beams < beams_gathered();
+    if gathering && (beamed_this_frame(texel_u) || own) {
         listed_defer_beam(texel_u, u32(layer), vec2<f32>(select(0.0, past.x, beams > 0.0), beams));
         return PENUMBRA_PENDING;
     }

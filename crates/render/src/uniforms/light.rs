@@ -204,8 +204,12 @@ pub struct RaysGpu {
     /// The frames the history holds, counting this one: which quarter of the unsure
     /// pixels this frame beams, and how their samples turn.
     pub frame: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// The frames a still view's penumbrae gather (`screen.penumbra_frames`): once an
+    /// unsure pixel holds the beams that many frames give it (one every
+    /// `PENUMBRA_PHASES`th frame, rays/penumbra_mask.wgsl), it is beamed no more
+    /// until something it depends on moves, so that a settled view costs its mask
+    /// pass alone.
+    pub penumbra_frames: u32,
 }
 
 /// The light uniform (`Light` in `light.wgsl`): the light, its map's layers and the
@@ -325,6 +329,7 @@ impl LightGpu {
             },
             rays: RaysGpu {
                 penumbra_rays: if light.is_hard() { 0 } else { settings.screen.penumbra_rays },
+                penumbra_frames: settings.screen.penumbra_frames,
                 ..Default::default()
             },
             technique: params.block(),

@@ -163,9 +163,10 @@ pub struct ScreenSpaceSettings {
     /// Frames a still image's penumbrae gather under a light with an area whose
     /// unsure pixels are beamed (`render`, `compare`, Python's `render`): each frame
     /// beams a quarter of them and keeps what the frames before found where nothing
-    /// moved, so 4 frames beam every one once and 16 four times (512 samples each). A
-    /// live view (the viewer, the lab) gathers them as it goes; 1 returns the first
-    /// frame, a quarter beamed and the rest filled from their neighbours.
+    /// moved, so 4 frames beam every one once and 16 four times (512 samples each),
+    /// and then beams them no more until something moves. A live view (the viewer,
+    /// the lab) gathers them as it goes; 1 returns the first frame, a quarter beamed
+    /// and the rest filled from their neighbours.
     #[cfg_attr(
         feature = "cli",
         arg(long, value_name = "N", default_value_t = ScreenSpaceSettings::default().penumbra_frames, help_heading = "Screen-space shadows")
