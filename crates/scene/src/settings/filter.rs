@@ -199,7 +199,7 @@ pub struct FilterSettings {
 pub const POISSON_TAPS: std::ops::RangeInclusive<u32> = 8..=64;
 
 /// The widest blur of a moment map, in texels on each side (`moments.blur_radius`):
-/// the filter pass's arrays hold `2 × MAX_BLUR_RADIUS + 1` taps (`MAX_BLUR_TAPS` in WGSL).
+/// each texel of each of the blur's two passes reads `2 × MAX_BLUR_RADIUS + 1` taps.
 pub const MAX_BLUR_RADIUS: u32 = 16;
 
 /// `shadow.filter.pcf_kernel`'s range when in texels (in world units it is any
