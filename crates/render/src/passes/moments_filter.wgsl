@@ -1,6 +1,6 @@
 // Filtering of moment maps: a separable Gaussian blur and a 2×2 mip reduction, both
-// linear, or in log space for ESM (log Σ wᵢ exp(c·dᵢ), computed relative to the
-// largest dᵢ so that it cannot overflow).
+// linear, or in log space for ESM (log Σ wᵢ exp(c·dᵢ), taken relative to the
+// largest dᵢ so far so that it cannot overflow: `LogAverage`).
 import package::variant::MomentTarget;
 
 struct FilterParams {
@@ -20,9 +20,10 @@ struct FilterParams {
 // A weighted average of values in log space (channel x only), log Σ wᵢ exp(c·dᵢ) / c
 // over Σ wᵢ, taken one value at a time about the largest seen so far, so that no
 // exp overflows (the streaming log-sum-exp): no array of the taps is kept. WGSL
-// zeroes a function's array where it is declared, and two arrays of MAX_BLUR_TAPS
-// zeroed at every texel of every blur and reduction made a moving light's filter
-// pass cost 510–700 ms on lavapipe (`contact`, 2048² map).
+// zeroes a function's array where it is declared, and two arrays of the widest
+// blur's taps were zeroed at every texel of every blur and reduction, whatever the
+// technique: under a moving sun on `contact` (lavapipe) the filter pass took
+// 510–700 ms with them and 440–560 ms without, most of it the blur's reads.
 struct LogAverage {
     // The largest value added, and Σ wᵢ exp(c·(dᵢ − top)).
     top: f32,
