@@ -15,10 +15,11 @@
 // plane and a least depth above every depth, a greatest below. Map texels no caster
 // covers (`MAP_CLEARED`) are left out of the planes, not the ranges.
 //
-// Level 0 reads 4 × 4 map texels (`cs_pyramid_first`); each level after it the 2 × 2
-// texels of the one before (`cs_pyramid_next`), whose planes bound the new one's
-// residuals: within a child square, its plane differs from the parent's by a linear
-// function whose least and greatest lie at the square's corners.
+// Level 0 reads 4 × 4 map texels, in four gathers (`cs_pyramid_first`); each level
+// after it the 2 × 2 texels of the one before (`cs_pyramid_next`), whose planes bound
+// the new one's residuals: within a child square, its plane differs from the
+// parent's by a linear function whose least and greatest lie at the square's
+// corners.
 
 import package::constants::MAP_CLEARED;
 
@@ -42,6 +43,9 @@ struct PyramidParams {
     _pad: u32,
 };
 @group(0) @binding(5) var<uniform> pyramid_params: PyramidParams;
+// Nearest, clamped: level 0 reads the map 2 × 2 texels at a time, by
+// `textureGather`, a quarter of the calls 16 loads would make.
+@group(0) @binding(6) var map_gather: sampler;
 
 // The depth the pyramid holds of map texel `texel` storing `stored`.
 fn pyramid_depth(texel: vec2<u32>, stored: f32, resolution: f32) -> f32 {
@@ -61,30 +65,101 @@ const PYRAMID_EMPTY_RANGE: vec2<f32> = vec2<f32>(2.0, -1.0);
 const FIRST_SIDE: u32 = 4u;
 
 
-// The least-squares plane (depth at the square's centre, per texel along x and y)
-// through the depths `depths` at the texels `present` (bit k: texel k of the 4 × 4,
-// at offsets ±0.5, ±1.5 from the centre), from the normal equations by Cramer's rule,
-// about the first present depth `reference` so that their sums keep the depths'
-// precision. Flat through the mean where the texels lie on a line or fewer.
-fn first_level_plane(depths: array<f32, 16>, present: u32, reference: f32) -> vec3<f32> {
-    var n = 0.0;
-    var su = vec2<f32>(0.0);
-    var suu = vec3<f32>(0.0); // Σu², Σuv, Σv²
-    var sd = 0.0;
-    var sud = vec2<f32>(0.0);
-    for (var k = 0u; k < 16u; k++) {
-        if (present & (1u << k)) == 0u {
-            continue;
-        }
-        let o = vec2<f32>(f32(k % 4u), f32(k / 4u)) - vec2<f32>(1.5);
-        let d = depths[k] - reference;
-        n += 1.0;
-        su += o;
-        suu += vec3<f32>(o.x * o.x, o.x * o.y, o.y * o.y);
-        sd += d;
-        sud += o * d;
-    }
-    return solved_plane(n, su, suu, sd, sud, reference, vec3<f32>(reference + sd / n, 0.0, 0.0));
+// A first-level square's 2 × 2 quarter `q` (0 to 3: x + 2y), read by one gather:
+// its texels' depths as the pyramid holds them, in the order (0, 0), (1, 0), (0, 1),
+// (1, 1), their offsets from the square's centre, and which of them lie inside the
+// map and which a caster covers (bits 0 to 3 in that order). Held in vectors, not an
+// array a loop indexes: on lavapipe such an array lives in memory, each access a
+// gather and a scatter, and level 0 cost 75-90 ms of a moving spot's frame so.
+struct Quarter {
+    depths: vec4<f32>,
+    x: vec4<f32>,
+    y: vec4<f32>,
+    inside: u32,
+    present: u32,
+};
+
+fn read_quarter(id: vec3<u32>, q: u32, map: vec2<u32>) -> Quarter {
+    let corner = id.xy * FIRST_SIDE + 2u * vec2<u32>(q & 1u, q >> 1u);
+    // Nearest texels round the point between the four centres; past the map's edge
+    // the sampler clamps, and those texels are left out.
+    let g = textureGather(map_depths, map_gather, (vec2<f32>(corner) + vec2<f32>(1.0)) / vec2<f32>(map), id.z);
+    // The gather orders them (0, 1), (1, 1), (1, 0), (0, 0).
+    let stored = vec4<f32>(g.w, g.z, g.x, g.y);
+    let resolution = f32(map.x);
+    let depths = vec4<f32>(
+        pyramid_depth(corner, stored.x, resolution),
+        pyramid_depth(corner + vec2<u32>(1u, 0u), stored.y, resolution),
+        pyramid_depth(corner + vec2<u32>(0u, 1u), stored.z, resolution),
+        pyramid_depth(corner + vec2<u32>(1u, 1u), stored.w, resolution),
+    );
+    let inside_x = vec4<bool>(corner.x < map.x, corner.x + 1u < map.x, corner.x < map.x, corner.x + 1u < map.x);
+    let inside_y = vec4<bool>(corner.y < map.y, corner.y < map.y, corner.y + 1u < map.y, corner.y + 1u < map.y);
+    let inside = inside_x & inside_y;
+    let present = inside & (stored < vec4<f32>(MAP_CLEARED));
+    let base = vec2<f32>(2.0 * f32(q & 1u), 2.0 * f32(q >> 1u)) - vec2<f32>(1.5);
+    return Quarter(
+        depths,
+        vec4<f32>(0.0, 1.0, 0.0, 1.0) + base.x,
+        vec4<f32>(0.0, 0.0, 1.0, 1.0) + base.y,
+        mask_bits(inside),
+        mask_bits(present),
+    );
+}
+
+fn mask_bits(b: vec4<bool>) -> u32 {
+    return dot(select(vec4<u32>(0u), vec4<u32>(1u, 2u, 4u, 8u), b), vec4<u32>(1u));
+}
+
+fn bits_mask(bits: u32) -> vec4<f32> {
+    return select(vec4<f32>(0.0), vec4<f32>(1.0), (vec4<u32>(bits) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u));
+}
+
+// The least-squares normal equations' sums over the covered texels: their count,
+// offsets `su`, products `suu` (Σu², Σuv, Σv²), depths less a reference `sd`, and
+// offsets times those depths `sud` (`solved_plane`).
+struct PlaneSums {
+    n: f32,
+    su: vec2<f32>,
+    suu: vec3<f32>,
+    sd: f32,
+    sud: vec2<f32>,
+};
+
+fn add_quarter(sums: PlaneSums, q: Quarter, reference: f32) -> PlaneSums {
+    let m = bits_mask(q.present);
+    let d = (q.depths - vec4<f32>(reference)) * m;
+    let one = vec4<f32>(1.0);
+    return PlaneSums(
+        sums.n + dot(m, one),
+        sums.su + vec2<f32>(dot(q.x, m), dot(q.y, m)),
+        sums.suu + vec3<f32>(dot(q.x * q.x, m), dot(q.x * q.y, m), dot(q.y * q.y, m)),
+        sums.sd + dot(d, one),
+        sums.sud + vec2<f32>(dot(q.x, d), dot(q.y, d)),
+    );
+}
+
+// The least residual below `plane` of a quarter's covered texels (3.0e38 where none).
+fn quarter_lowest(q: Quarter, plane: vec3<f32>) -> f32 {
+    let residual = q.depths - (vec4<f32>(plane.x) + plane.y * q.x + plane.z * q.y);
+    let r = select(vec4<f32>(3.0e38), residual, (vec4<u32>(q.present) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u));
+    return min(min(r.x, r.y), min(r.z, r.w));
+}
+
+// A quarter's first covered texel's depth (any, where none is).
+fn quarter_first(q: Quarter) -> f32 {
+    return q.depths[firstTrailingBit(q.present) & 3u];
+}
+
+// A quarter's least and greatest depth over its texels inside the map, with `range`.
+fn quarter_range(q: Quarter, range: vec2<f32>) -> vec2<f32> {
+    let inside = (vec4<u32>(q.inside) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u);
+    let low = select(vec4<f32>(range.x), q.depths, inside);
+    let high = select(vec4<f32>(range.y), q.depths, inside);
+    return vec2<f32>(
+        min(range.x, min(min(low.x, low.y), min(low.z, low.w))),
+        max(range.y, max(max(high.x, high.y), max(high.z, high.w))),
+    );
 }
 
 // The plane (depth at the offsets' origin, per texel along x and y) solving the
@@ -148,28 +223,13 @@ fn cs_pyramid_first(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let map = textureDimensions(map_depths);
-    var depths: array<f32, 16>;
-    // Texels inside the map, and of those the ones a caster covers.
-    var inside = 0u;
-    var present = 0u;
-    var reference = 0.0;
-    var range = PYRAMID_EMPTY_RANGE;
-    for (var k = 0u; k < 16u; k++) {
-        let texel = id.xy * FIRST_SIDE + vec2<u32>(k % 4u, k / 4u);
-        if all(texel < map) {
-            let stored = textureLoad(map_depths, texel, id.z, 0);
-            let d = pyramid_depth(texel, stored, f32(map.x));
-            depths[k] = d;
-            inside |= 1u << k;
-            range = vec2<f32>(min(range.x, d), max(range.y, d));
-            if stored < MAP_CLEARED {
-                if present == 0u {
-                    reference = d;
-                }
-                present |= 1u << k;
-            }
-        }
-    }
+    let q0 = read_quarter(id, 0u, map);
+    let q1 = read_quarter(id, 1u, map);
+    let q2 = read_quarter(id, 2u, map);
+    let q3 = read_quarter(id, 3u, map);
+    let inside = q0.inside | q1.inside | q2.inside | q3.inside;
+    let present = q0.present | (q1.present << 4u) | (q2.present << 8u) | (q3.present << 12u);
+    let range = quarter_range(q3, quarter_range(q2, quarter_range(q1, quarter_range(q0, PYRAMID_EMPTY_RANGE))));
     if inside == 0u {
         textureStore(pyramid_planes, id.xy, id.z, PYRAMID_EMPTY_PLANE);
         textureStore(pyramid_ranges, id.xy, id.z, vec4<f32>(PYRAMID_EMPTY_RANGE, 0.0, 0.0));
@@ -180,17 +240,22 @@ fn cs_pyramid_first(@builtin(global_invocation_id) id: vec3<u32>) {
         textureStore(pyramid_ranges, id.xy, id.z, vec4<f32>(range, 0.0, 0.0));
         return;
     }
-    var plane = first_level_plane(depths, present, reference);
+    // The sums are taken about a covered texel's depth, so that they keep the
+    // depths' precision.
+    let reference = select(
+        select(select(quarter_first(q3), quarter_first(q2), q2.present != 0u), quarter_first(q1), q1.present != 0u),
+        quarter_first(q0),
+        q0.present != 0u,
+    );
+    var sums = PlaneSums(0.0, vec2<f32>(0.0), vec3<f32>(0.0), 0.0, vec2<f32>(0.0));
+    sums = add_quarter(add_quarter(add_quarter(add_quarter(sums, q0, reference), q1, reference), q2, reference), q3, reference);
+    // Flat through the mean where the covered texels lie on a line or fewer.
+    let flat = vec3<f32>(reference + sums.sd / sums.n, 0.0, 0.0);
+    var plane = solved_plane(sums.n, sums.su, sums.suu, sums.sd, sums.sud, reference, flat);
     if countOneBits(present) < 16u && !(abs(plane.y) > 0.0 || abs(plane.z) > 0.0) {
         plane = widened_plane(id, plane, reference);
     }
-    var lowest = 3.0e38;
-    for (var k = 0u; k < 16u; k++) {
-        if (present & (1u << k)) != 0u {
-            let offset = vec2<f32>(f32(k % 4u), f32(k / 4u)) - vec2<f32>(1.5);
-            lowest = min(lowest, depths[k] - (plane.x + dot(plane.yz, offset)));
-        }
-    }
+    let lowest = min(min(quarter_lowest(q0, plane), quarter_lowest(q1, plane)), min(quarter_lowest(q2, plane), quarter_lowest(q3, plane)));
     textureStore(pyramid_planes, id.xy, id.z, vec4<f32>(plane, lowest));
     textureStore(pyramid_ranges, id.xy, id.z, vec4<f32>(range, 0.0, 0.0));
 }

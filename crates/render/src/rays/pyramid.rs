@@ -100,6 +100,8 @@ pub(crate) struct PyramidInput<'a> {
 /// The pyramid's two pipelines: the first level from the map, each next from the
 /// one before.
 pub(crate) struct PyramidPass {
+    /// Nearest and clamped, for level 0's gathers of the map.
+    gather: wgpu::Sampler,
     first_layout: wgpu::BindGroupLayout,
     next_layout: wgpu::BindGroupLayout,
     first: wgpu::ComputePipeline,
@@ -143,9 +145,10 @@ impl PyramidPass {
                 min_binding_size: None,
             },
         );
+        let sampler = entry(6, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering));
         let first_layout = layout(
             "depth pyramid, first level",
-            &[vec![read(0, wgpu::TextureSampleType::Depth), params], outputs.to_vec()].concat(),
+            &[vec![read(0, wgpu::TextureSampleType::Depth), params, sampler], outputs.to_vec()].concat(),
         );
         let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
         let next_layout = layout(
@@ -173,7 +176,11 @@ impl PyramidPass {
         };
         let first = pipeline(&first_layout, "cs_pyramid_first");
         let next = pipeline(&next_layout, "cs_pyramid_next");
-        Self { first_layout, next_layout, first, next }
+        let gather = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("depth pyramid, gather"),
+            ..Default::default()
+        });
+        Self { gather, first_layout, next_layout, first, next }
     }
 
     /// Records every level of `pyramid` (of `layout`) from the depth map `map` (all
@@ -207,6 +214,7 @@ impl PyramidPass {
                 pass.set_pipeline(&self.first);
                 bindings.push((0, Binding::View(map.clone())));
                 bindings.push((5, Binding::Buffer(params.clone())));
+                bindings.push((6, Binding::Sampler(self.gather.clone())));
                 pool.bind_group_numbered("depth pyramid, first level", &self.first_layout, bindings)
             } else {
                 pass.set_pipeline(&self.next);
