@@ -107,12 +107,13 @@ fn read_quarter(id: vec3<u32>, q: u32, map: vec2<u32>) -> Quarter {
     );
 }
 
+// A quarter's four flags as its bits 0 to 3, and back.
 fn mask_bits(b: vec4<bool>) -> u32 {
     return dot(select(vec4<u32>(0u), vec4<u32>(1u, 2u, 4u, 8u), b), vec4<u32>(1u));
 }
 
-fn bits_mask(bits: u32) -> vec4<f32> {
-    return select(vec4<f32>(0.0), vec4<f32>(1.0), (vec4<u32>(bits) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u));
+fn bits_set(bits: u32) -> vec4<bool> {
+    return (vec4<u32>(bits) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u);
 }
 
 // The least-squares normal equations' sums over the covered texels: their count,
@@ -126,8 +127,11 @@ struct PlaneSums {
     sud: vec2<f32>,
 };
 
+const NO_SUMS: PlaneSums = PlaneSums(0.0, vec2<f32>(0.0), vec3<f32>(0.0), 0.0, vec2<f32>(0.0));
+
+// `sums` with a quarter's covered texels added.
 fn add_quarter(sums: PlaneSums, q: Quarter, reference: f32) -> PlaneSums {
-    let m = bits_mask(q.present);
+    let m = select(vec4<f32>(0.0), vec4<f32>(1.0), bits_set(q.present));
     let d = (q.depths - vec4<f32>(reference)) * m;
     let one = vec4<f32>(1.0);
     return PlaneSums(
@@ -142,7 +146,7 @@ fn add_quarter(sums: PlaneSums, q: Quarter, reference: f32) -> PlaneSums {
 // The least residual below `plane` of a quarter's covered texels (3.0e38 where none).
 fn quarter_lowest(q: Quarter, plane: vec3<f32>) -> f32 {
     let residual = q.depths - (vec4<f32>(plane.x) + plane.y * q.x + plane.z * q.y);
-    let r = select(vec4<f32>(3.0e38), residual, (vec4<u32>(q.present) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u));
+    let r = select(vec4<f32>(3.0e38), residual, bits_set(q.present));
     return min(min(r.x, r.y), min(r.z, r.w));
 }
 
@@ -153,7 +157,7 @@ fn quarter_first(q: Quarter) -> f32 {
 
 // A quarter's least and greatest depth over its texels inside the map, with `range`.
 fn quarter_range(q: Quarter, range: vec2<f32>) -> vec2<f32> {
-    let inside = (vec4<u32>(q.inside) & vec4<u32>(1u, 2u, 4u, 8u)) != vec4<u32>(0u);
+    let inside = bits_set(q.inside);
     let low = select(vec4<f32>(range.x), q.depths, inside);
     let high = select(vec4<f32>(range.y), q.depths, inside);
     return vec2<f32>(
@@ -163,10 +167,14 @@ fn quarter_range(q: Quarter, range: vec2<f32>) -> vec2<f32> {
 }
 
 // The plane (depth at the offsets' origin, per texel along x and y) solving the
-// least-squares normal equations of `n` depths about `reference`, from their sums
-// (offsets `su`, their products `suu` = Σu², Σuv, Σv², depths `sd`, offsets times
-// depths `sud`) by Cramer's rule; `degenerate` where the offsets lie on a line.
-fn solved_plane(n: f32, su: vec2<f32>, suu: vec3<f32>, sd: f32, sud: vec2<f32>, reference: f32, degenerate: vec3<f32>) -> vec3<f32> {
+// least-squares normal equations of depths about `reference` from their sums, by
+// Cramer's rule; `degenerate` where the offsets lie on a line.
+fn solved_plane(sums: PlaneSums, reference: f32, degenerate: vec3<f32>) -> vec3<f32> {
+    let n = sums.n;
+    let su = sums.su;
+    let suu = sums.suu;
+    let sd = sums.sd;
+    let sud = sums.sud;
     let det = n * (suu.x * suu.z - suu.y * suu.y) - su.x * (su.x * suu.z - suu.y * su.y) + su.y * (su.x * suu.y - suu.x * su.y);
     if !(abs(det) > 1e-3) {
         return degenerate;
@@ -191,11 +199,7 @@ fn widened_plane(id: vec3<u32>, flat: vec3<f32>, reference: f32) -> vec3<f32> {
     let origin = vec2<i32>(id.xy * FIRST_SIDE) - vec2<i32>(i32(WIDE_SIDE - FIRST_SIDE) / 2);
     // Offsets from the square's centre.
     let centre = vec2<f32>(0.5 * f32(FIRST_SIDE) - 0.5);
-    var n = 0.0;
-    var su = vec2<f32>(0.0);
-    var suu = vec3<f32>(0.0);
-    var sd = 0.0;
-    var sud = vec2<f32>(0.0);
+    var sums = NO_SUMS;
     for (var k = 0u; k < WIDE_SIDE * WIDE_SIDE; k++) {
         let texel = origin + vec2<i32>(i32(k % WIDE_SIDE), i32(k / WIDE_SIDE));
         if any(texel < vec2<i32>(0)) || any(vec2<u32>(texel) >= map) {
@@ -207,13 +211,15 @@ fn widened_plane(id: vec3<u32>, flat: vec3<f32>, reference: f32) -> vec3<f32> {
         }
         let o = vec2<f32>(texel - vec2<i32>(id.xy * FIRST_SIDE)) - centre;
         let d = pyramid_depth(vec2<u32>(texel), stored, f32(map.x)) - reference;
-        n += 1.0;
-        su += o;
-        suu += vec3<f32>(o.x * o.x, o.x * o.y, o.y * o.y);
-        sd += d;
-        sud += o * d;
+        sums = PlaneSums(
+            sums.n + 1.0,
+            sums.su + o,
+            sums.suu + vec3<f32>(o.x * o.x, o.x * o.y, o.y * o.y),
+            sums.sd + d,
+            sums.sud + o * d,
+        );
     }
-    return solved_plane(n, su, suu, sd, sud, reference, flat);
+    return solved_plane(sums, reference, flat);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -247,11 +253,10 @@ fn cs_pyramid_first(@builtin(global_invocation_id) id: vec3<u32>) {
         quarter_first(q0),
         q0.present != 0u,
     );
-    var sums = PlaneSums(0.0, vec2<f32>(0.0), vec3<f32>(0.0), 0.0, vec2<f32>(0.0));
-    sums = add_quarter(add_quarter(add_quarter(add_quarter(sums, q0, reference), q1, reference), q2, reference), q3, reference);
+    let sums = add_quarter(add_quarter(add_quarter(add_quarter(NO_SUMS, q0, reference), q1, reference), q2, reference), q3, reference);
     // Flat through the mean where the covered texels lie on a line or fewer.
     let flat = vec3<f32>(reference + sums.sd / sums.n, 0.0, 0.0);
-    var plane = solved_plane(sums.n, sums.su, sums.suu, sums.sd, sums.sud, reference, flat);
+    var plane = solved_plane(sums, reference, flat);
     if countOneBits(present) < 16u && !(abs(plane.y) > 0.0 || abs(plane.z) > 0.0) {
         plane = widened_plane(id, plane, reference);
     }
