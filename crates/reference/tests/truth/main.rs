@@ -9,6 +9,7 @@ mod against_raster;
 mod aliasing;
 mod alpha;
 mod analytic;
+mod canyon;
 mod clusters;
 mod falloff;
 mod gpu_rays;

@@ -3,9 +3,11 @@
 
 use glam::{Mat4, Vec3};
 
+mod canyon;
 mod lamps;
 mod wires;
 
+pub use canyon::canyon;
 pub use lamps::{MAX_LAMPS, lamp_grid, lamps};
 pub use wires::{WIRE_THICKNESS, wires};
 
@@ -50,6 +52,12 @@ pub const BUILTINS: &[Builtin] = &[
         name: "wires",
         description: "wires, a railing and poles 4 mm thick over a ground: casters thinner than a map's texel",
         build: wires,
+    },
+    Builtin {
+        name: "canyon",
+        description: "a street canyon of tall buildings under a sun 15° up, seen from 2 m above the road: \
+                      long shadows across a street and wedges of light through its alleys",
+        build: canyon,
     },
     Builtin {
         name: "lamps",
