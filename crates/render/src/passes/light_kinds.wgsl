@@ -240,3 +240,9 @@ fn emitter_plane_weight(e: Emitter, plane: SamplePlane, d: vec3<f32>) -> f32 {
     let c = inverseSqrt(dot(d, d) / dot(plane.toward, plane.toward));
     return c * c * c;
 }
+
+// Whether `emitter_plane_weight` weighs all of `e`'s samples alike: a spot whose
+// light does not fall off with distance (its samples lie uniform in area).
+fn emitter_weighs_samples_alike(e: Emitter) -> bool {
+    return e.kind == LIGHT_SPOT && e.falloff != FALLOFF_INVERSE_SQUARE;
+}
