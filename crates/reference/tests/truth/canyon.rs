@@ -20,12 +20,12 @@ use gnomon_scene::{
 const DEFAULTS_MISMATCH: f64 = 0.0002;
 
 /// How much more of the view the virtual map alone may get wrong than the single
-/// map of its memory: a handful of pixels (0.01 % is 23 of 640×360). Its far levels
-/// hold coarser texels than a single map fitted to the view, so along the far
-/// buildings' edges each gets a few pixels the other gets right; over 33 suns 10–20°
-/// up, it measured at most 0.009 % more, and up to 0.23 % less
-/// (docs/virtual-measured.md, "A street canyon"). The leak the issue saw was 1.4 %
-/// more.
+/// map of its memory: a handful of pixels (0.01 % is 14 of the view's 144,000
+/// light-facing pixels at 640×360). Its far levels hold coarser texels than a single
+/// map fitted to the view, so along the far buildings' edges each gets a few pixels
+/// the other gets right; over 33 suns 10–20° up, it measured at most 0.009 % more,
+/// and up to 0.23 % less (docs/hard-cases.md, "A street canyon"). The leak the issue
+/// saw was 1.4 % more.
 const FEW_PIXELS: f64 = 0.0001;
 
 fn view(elevation: f32, azimuth: f32) -> Settings {
