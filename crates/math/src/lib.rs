@@ -7,7 +7,8 @@
 //! whether a mesh is closed, for face culling in the shadow pass ([`topology`]); and
 //! which way a projection winds a triangle or a cluster of them ([`facing`]); and the
 //! pixels a light's range can reach on screen ([`screen_bounds`]); and a virtual shadow
-//! map's clipmap, its page requests and its page pool ([`virtual_map`]).
+//! map's clipmap, its page requests and its page pool ([`virtual_map`]); and an
+//! integer hash for deterministic patterns ([`hash`]).
 //!
 //! Conventions, used everywhere in Gnomon:
 //! - World space is right-handed and y-up.
@@ -24,6 +25,7 @@ pub mod cascades;
 pub mod culling;
 pub mod facing;
 pub mod fitting;
+pub mod hash;
 pub mod kernels;
 mod light;
 pub mod light_masks;

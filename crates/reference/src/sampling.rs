@@ -76,15 +76,8 @@ pub fn cmj(s: u32, count: u32, pattern: u32) -> Vec2 {
     .clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON))
 }
 
-/// A 32-bit hash for seeding a pixel's patterns (a "lowbias32" integer hash).
-pub fn hash(mut x: u32) -> u32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846ca68b);
-    x ^= x >> 16;
-    x
-}
+/// A 32-bit hash for seeding a pixel's patterns: `gnomon_math::hash::lowbias32`.
+pub use gnomon_math::hash::lowbias32 as hash;
 
 /// The unit square to the unit disk, keeping strata compact: P. Shirley and K. Chiu,
 /// "A Low Distortion Map Between Disk and Square", JGT 1997.

@@ -8,6 +8,7 @@
 //! and where a map fitted to the whole street spreads its texels thin.
 
 use glam::Vec3;
+use gnomon_math::hash::unit_from_hash;
 
 use super::{GROUND, SceneBuilder, at, point, spot, sun};
 use crate::{Camera, Scene, geometry};
@@ -17,16 +18,10 @@ const STREET_HALF_WIDTH: f32 = 6.0;
 /// How far the street runs from the camera's end, in metres.
 const STREET_LENGTH: f32 = 300.0;
 
-/// A deterministic value in [0, 1) from `n` (a 32-bit integer hash), so that the
-/// buildings are the same in every build: the scene is a test fixture.
+/// A deterministic value in [0, 1) from `n`, so that the buildings are the same in
+/// every build: the scene is a test fixture.
 fn unit(n: u32) -> f32 {
-    let mut x = n.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b;
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    (x >> 8) as f32 / 16_777_216.0
+    unit_from_hash(n.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b)
 }
 
 /// Buildings along both sides of the street, each a closed box on the ground
